@@ -1,0 +1,129 @@
+!> The thin interface that f2py wraps: flat arrays in C kinds, sizes passed in, and an error
+!> code with a message (0 = ok; 1 bad case, 2 solver, 3 thermal interference). A case is given
+!> as the path of a namelist file. State vectors have nstate = 14 entries, written as a literal
+!> in the dummy arguments because f2py cannot see imported parameters.
+!> Nothing here computes physics: it reads the case and calls the modules.
+module spline_api
+  use, intrinsic :: iso_c_binding, only: c_double, c_int
+  use spline_kinds, only: wp
+  use spline_case_io, only: model_t, case_read_file, case_write_defaults, nstate, ndof
+  use spline_dynamics, only: accelerations, start_state
+  use spline_mesh, only: mesh_eval
+  use spline_run, only: run_case, ntooth_q, tooth_q_names, tooth_q_units
+  use spline_solver, only: nstats, stat_names
+  implicit none
+  private
+  public :: api_sizes, api_simulate, api_rhs, api_start_state, api_write_defaults, api_names
+
+contains
+
+  !> Number of teeth and of output times of a case (to size the arrays of api_simulate).
+  subroutine api_sizes(path, z, nt, nq, ns, ierr, errmsg)
+    character(len=*), intent(in) :: path
+    integer(c_int), intent(out) :: z, nt, nq, ns, ierr
+    character(len=512), intent(out) :: errmsg
+    type(model_t) :: m
+    integer :: ie
+    call case_read_file(path, m, ie, errmsg)
+    ierr = ie
+    z = m%z; nt = m%n_out; nq = ntooth_q; ns = nstats
+  end subroutine api_sizes
+
+  !> Simulate a case: output times t, SI states y (nt x 14), per-tooth quantities tooth
+  !> (nt x z x nq, order of api_names('tooth')), meshing torque tm and solver statistics.
+  subroutine api_simulate(path, z, nt, nq, ns, t, y, tooth, tm, stats, ierr, errmsg)
+    character(len=*), intent(in) :: path
+    integer(c_int), intent(in) :: z, nt, nq, ns
+    real(c_double), intent(out) :: t(nt), y(nt, 14), tooth(nt, z, nq), tm(nt), stats(ns)
+    integer(c_int), intent(out) :: ierr
+    character(len=512), intent(out) :: errmsg
+    type(model_t) :: m
+    real(wp), allocatable :: ycol(:, :)
+    integer :: ie
+    t = 0; y = 0; tooth = 0; tm = 0; stats = 0
+    call case_read_file(path, m, ie, errmsg)
+    if (ie == 0 .and. (m%z /= z .or. m%n_out /= nt .or. nq /= ntooth_q .or. ns /= nstats)) then
+      ie = 1
+      errmsg = 'api_simulate: array sizes do not match the case (call api_sizes first)'
+    end if
+    if (ie == 0) then
+      allocate(ycol(nstate, nt))
+      call run_case(m, t, ycol, tooth, tm, stats, ie, errmsg)
+      y = transpose(ycol)
+    end if
+    ierr = ie
+  end subroutine api_simulate
+
+  !> Right-hand side in SI units at (t, y) with the contact states decided by the state, plus
+  !> the mesh: per-tooth mesh(:, k) in the order of api_names('tooth') and the torque tm.
+  !> Exposed so that tests can hold it against the independent numpy oracle.
+  subroutine api_rhs(path, z, nq, t, y, ydot, mesh, tm, ierr, errmsg)
+    character(len=*), intent(in) :: path
+    integer(c_int), intent(in) :: z, nq
+    real(c_double), intent(in) :: t, y(14)
+    real(c_double), intent(out) :: ydot(14), mesh(z, nq), tm
+    integer(c_int), intent(out) :: ierr
+    character(len=512), intent(out) :: errmsg
+    type(model_t) :: m
+    real(wp) :: fx1, fy1, sp(z), cp(z)
+    integer :: ie
+    ydot = 0; mesh = 0; tm = 0
+    call case_read_file(path, m, ie, errmsg)
+    if (ie == 0 .and. (m%z /= z .or. nq /= ntooth_q)) then
+      ie = 1; errmsg = 'api_rhs: array sizes do not match the case'
+    end if
+    if (ie == 0) then
+      ydot(1:ndof) = y(ndof+1:)
+      call accelerations(m, t, y(1:ndof), y(ndof+1:), ydot(ndof+1:), ie, errmsg)
+    end if
+    if (ie == 0) then
+      call mesh_eval(m, t, y(1:ndof), y(ndof+1:), fx1, fy1, tm, ie, errmsg, flash=.true., &
+           f=mesh(:, 1), dn=mesh(:, 4), c=mesh(:, 5), tf=mesh(:, 6), rc1=mesh(:, 7), &
+           rc2=mesh(:, 8), sphi_out=sp, cphi_out=cp)
+      mesh(:, 2) = mesh(:, 1)*sp
+      mesh(:, 3) = mesh(:, 1)*cp
+    end if
+    ierr = ie
+  end subroutine api_rhs
+
+  !> The start state of a case (SI): static equilibrium or rest, plus dq0, dv0.
+  subroutine api_start_state(path, y, ierr, errmsg)
+    character(len=*), intent(in) :: path
+    real(c_double), intent(out) :: y(14)
+    integer(c_int), intent(out) :: ierr
+    character(len=512), intent(out) :: errmsg
+    type(model_t) :: m
+    integer :: ie
+    y = 0
+    call case_read_file(path, m, ie, errmsg)
+    if (ie == 0) call start_state(m, y, ie, errmsg)
+    ierr = ie
+  end subroutine api_start_state
+
+  !> Write the default case (every field) as a namelist file.
+  subroutine api_write_defaults(path, ierr, errmsg)
+    character(len=*), intent(in) :: path
+    integer(c_int), intent(out) :: ierr
+    character(len=512), intent(out) :: errmsg
+    integer :: ie
+    call case_write_defaults(path, ie, errmsg)
+    ierr = ie
+  end subroutine api_write_defaults
+
+  !> Name (and unit) number i of a list: kind 'tooth' (per-tooth quantities) or 'stats'.
+  subroutine api_names(kind, i, name, unit)
+    character(len=*), intent(in) :: kind
+    integer(c_int), intent(in) :: i
+    character(len=32), intent(out) :: name, unit
+    name = ''; unit = ''
+    select case (kind)
+    case ('tooth')
+      if (i >= 1 .and. i <= ntooth_q) then
+        name = tooth_q_names(i); unit = tooth_q_units(i)
+      end if
+    case ('stats')
+      if (i >= 1 .and. i <= nstats) name = stat_names(i)
+    end select
+  end subroutine api_names
+
+end module spline_api

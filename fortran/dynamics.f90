@@ -1,0 +1,181 @@
+!> Equations of motion: the 8-DOF system of Eq. 23 reduced exactly to 7 DOF in the relative
+!> coordinates of Eq. 24, its scaled first-order form (Eq. 25), and the static equilibrium.
+module spline_dynamics
+  use spline_kinds, only: wp
+  use spline_case_io, only: model_t, ndof, nstate
+  use spline_mesh, only: mesh_eval
+  implicit none
+  private
+  public :: accelerations, rhs_scaled, to_scaled, from_scaled, static_equilibrium, start_state
+
+contains
+
+  !> Eqs. 23-24: accelerations of q = (x1, y1, x2, y2, D1, D2, D3) in SI units.
+  !> With a1 = D1/r_b = th1 - thM, a3 = D3/r_b = th2 - thL and the shaft torques
+  !> S1 = k_T1 a1 + c_T1 a1', S3 = k_T2 a3 + c_T2 a3', the four torsional equations of Eq. 23 read
+  !>   J_M thM'' = T_d + S1,  J_1 th1'' = T_m - S1,  J_2 th2'' = -T_m - S3,  J_L thL'' = S3 - T_L,
+  !> so (derived here: the paper's Eq. 24 has a sign slip on T_L)
+  !>   D1'' = r_b ((T_m - S1)/J_1 - (T_d + S1)/J_M)
+  !>   D2'' = r_b ((-T_m - S3)/J_2 - (T_m - S1)/J_1)
+  !>   D3'' = r_b ((-T_m - S3)/J_2 - (S3 - T_L)/J_L)
+  subroutine accelerations(m, t, q, v, a, ierr, errmsg, mode)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t, q(ndof), v(ndof)
+    real(wp), intent(out) :: a(ndof)
+    integer, intent(out) :: ierr
+    character(len=*), intent(inout) :: errmsg
+    integer, intent(in), optional :: mode(m%z)
+    real(wp) :: fx1, fy1, tm, s1, s3, th1dd
+    call mesh_eval(m, t, q, v, fx1, fy1, tm, ierr, errmsg, mode=mode)
+    if (ierr /= 0) return
+    a(1) = (fx1 - m%c_p1*v(1) - m%k_p1*q(1))/m%m_1
+    a(2) = (fy1 - m%c_p1*v(2) - m%k_p1*q(2))/m%m_1 - m%grav
+    a(3) = (-fx1 - m%c_p2*v(3) - m%k_p2*q(3))/m%m_2
+    a(4) = (-fy1 - m%c_p2*v(4) - m%k_p2*q(4))/m%m_2 - m%grav
+    s1 = (m%k_t1*q(5) + m%c_t1*v(5))/m%r_b
+    s3 = (m%k_t2*q(7) + m%c_t2*v(7))/m%r_b
+    th1dd = (tm - s1)/m%j_1
+    a(5) = m%r_b*(th1dd - (m%t_d + s1)/m%j_m)
+    a(6) = m%r_b*((-tm - s3)/m%j_2 - th1dd)
+    a(7) = m%r_b*((-tm - s3)/m%j_2 - (s3 - m%t_l)/m%j_l)
+  end subroutine accelerations
+
+  !> Eq. 25: scaled state ys = (q / l, v / (l w)) in scaled time tau = w t.
+  pure subroutine to_scaled(m, y, ys)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: y(nstate)
+    real(wp), intent(out) :: ys(nstate)
+    ys(1:ndof) = y(1:ndof)/m%l_ref
+    ys(ndof+1:) = y(ndof+1:)/(m%l_ref*m%w_ref)
+  end subroutine to_scaled
+
+  pure subroutine from_scaled(m, ys, y)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: ys(nstate)
+    real(wp), intent(out) :: y(nstate)
+    y(1:ndof) = ys(1:ndof)*m%l_ref
+    y(ndof+1:) = ys(ndof+1:)*(m%l_ref*m%w_ref)
+  end subroutine from_scaled
+
+  !> Eq. 25: d(ys)/d(tau) for the scaled state, ys' = (vs, a / (l w^2)).
+  subroutine rhs_scaled(m, tau, ys, dys, ierr, errmsg, mode)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: tau, ys(nstate)
+    real(wp), intent(out) :: dys(nstate)
+    integer, intent(out) :: ierr
+    character(len=*), intent(inout) :: errmsg
+    integer, intent(in), optional :: mode(m%z)
+    real(wp) :: y(nstate), a(ndof)
+    call from_scaled(m, ys, y)
+    call accelerations(m, tau/m%w_ref, y(1:ndof), y(ndof+1:), a, ierr, errmsg, mode)
+    dys(1:ndof) = ys(ndof+1:)
+    dys(ndof+1:) = a/(m%l_ref*m%w_ref**2)
+  end subroutine rhs_scaled
+
+  !> Start state (SI): the static equilibrium at t0 or rest, plus the case's offsets dq0, dv0.
+  subroutine start_state(m, y, ierr, errmsg)
+    type(model_t), intent(in) :: m
+    real(wp), intent(out) :: y(nstate)
+    integer, intent(out) :: ierr
+    character(len=*), intent(inout) :: errmsg
+    y = 0.0_wp
+    ierr = 0
+    if (m%start_equilibrium) call static_equilibrium(m, m%t0, y(1:ndof), ierr, errmsg)
+    if (ierr /= 0) return
+    y(1:ndof) = y(1:ndof) + m%dq0
+    y(ndof+1:) = m%dv0
+  end subroutine start_state
+
+  !> Static equilibrium at time t: the displacements q with zero velocities for which all
+  !> accelerations of Eq. 23 vanish (under T_d, T_L, gravity and misalignment). Newton's method
+  !> on the piecewise-linear residual, Jacobian by forward differences, backtracking line search;
+  !> the closed-form guess: shafts twisted by the torques, every tooth loaded equally, supports
+  !> sagging under gravity. Converged when the scaled step is below 1e-12.
+  subroutine static_equilibrium(m, t, q, ierr, errmsg)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t
+    real(wp), intent(out) :: q(ndof)
+    integer, intent(out) :: ierr
+    character(len=*), intent(inout) :: errmsg
+    real(wp) :: r(ndof), rn(ndof), jac(ndof, ndof), dq(ndof), qn(ndof), h, lam
+    integer :: it, k, ls
+    q = 0.0_wp
+    q(2) = -m%m_1*m%grav/max(m%k_p1, tiny(1.0_wp))
+    q(4) = -m%m_2*m%grav/max(m%k_p2, tiny(1.0_wp))
+    if (m%k_p1 == 0.0_wp) q(2) = 0.0_wp
+    if (m%k_p2 == 0.0_wp) q(4) = 0.0_wp
+    q(5) = -m%r_b*m%t_d/max(m%k_t1, tiny(1.0_wp))
+    q(7) = m%r_b*m%t_l/max(m%k_t2, tiny(1.0_wp))
+    q(6) = -sign(m%c_bulk, m%t_d) - m%t_d/(m%z*m%k_m*m%r_b)
+    call residual(q, r)
+    if (ierr /= 0) return
+    do it = 1, 100
+      do k = 1, ndof
+        h = 1.0e-7_wp*max(abs(q(k)), m%l_ref)
+        qn = q
+        qn(k) = q(k) + h
+        call residual(qn, rn)
+        if (ierr /= 0) return
+        jac(:, k) = (rn - r)/h
+      end do
+      call solve_dense(jac, -r, dq, ierr)
+      if (ierr /= 0) then
+        ierr = 2
+        errmsg = 'case '//trim(m%name)//': no unique static equilibrium (a free body, e.g. '// &
+             'the mesh out of contact under zero torque): use start = ''rest'''
+        return
+      end if
+      lam = 1.0_wp
+      do ls = 1, 30
+        qn = q + lam*dq
+        call residual(qn, rn)
+        if (ierr /= 0) return
+        if (norm2(rn) < norm2(r) .or. norm2(r) == 0.0_wp) exit
+        lam = 0.5_wp*lam
+      end do
+      q = qn
+      r = rn
+      if (maxval(abs(lam*dq))/m%l_ref < 1.0e-12_wp) return
+    end do
+    ierr = 2
+    errmsg = 'case '//trim(m%name)//': static equilibrium did not converge in 100 Newton steps'
+  contains
+    subroutine residual(qq, rr)
+      real(wp), intent(in) :: qq(ndof)
+      real(wp), intent(out) :: rr(ndof)
+      real(wp), parameter :: zero(ndof) = 0.0_wp
+      call accelerations(m, t, qq, zero, rr, ierr, errmsg)
+      rr = rr/(m%l_ref*m%w_ref**2)
+    end subroutine residual
+  end subroutine static_equilibrium
+
+  !> Gaussian elimination with partial pivoting for the small Newton systems. ierr = 1: singular.
+  subroutine solve_dense(a_in, b, x, ierr)
+    real(wp), intent(in) :: a_in(:, :), b(:)
+    real(wp), intent(out) :: x(:)
+    integer, intent(out) :: ierr
+    real(wp) :: a(size(b), size(b)), rhs(size(b)), rowtmp(size(b)), tmp, scale
+    integer :: n, i, p
+    n = size(b)
+    a = a_in
+    rhs = b
+    ierr = 0
+    scale = maxval(abs(a))
+    do i = 1, n
+      p = maxloc(abs(a(i:, i)), dim=1) + i - 1
+      if (abs(a(p, i)) <= 1.0e-13_wp*scale) then
+        ierr = 1; return
+      end if
+      if (p /= i) then
+        rowtmp = a(i, :); a(i, :) = a(p, :); a(p, :) = rowtmp
+        tmp = rhs(i); rhs(i) = rhs(p); rhs(p) = tmp
+      end if
+      rhs(i+1:) = rhs(i+1:) - a(i+1:, i)/a(i, i)*rhs(i)
+      a(i+1:, i:) = a(i+1:, i:) - spread(a(i+1:, i)/a(i, i), 2, n - i + 1)*spread(a(i, i:), 1, n - i)
+    end do
+    do i = n, 1, -1
+      x(i) = (rhs(i) - dot_product(a(i, i+1:), x(i+1:)))/a(i, i)
+    end do
+  end subroutine solve_dense
+
+end module spline_dynamics

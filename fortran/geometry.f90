@@ -1,0 +1,46 @@
+!> Spline geometry: tooth angles (Eqs. 8-9) and the contact-point radius (Eqs. 12-14).
+module spline_geometry
+  use spline_kinds, only: wp, pi
+  implicit none
+  private
+  public :: tooth_angles, contact_radius, profile_shift
+
+contains
+
+  !> Eqs. 8-9: line-of-action angle of every tooth pair, phi_j = 2 pi j / Z + omega t + theta_0 - alpha,
+  !> returned as sin and cos (what the mesh needs).
+  pure subroutine tooth_angles(z, omega, t, theta0, alpha, sphi, cphi)
+    integer, intent(in) :: z
+    real(wp), intent(in) :: omega, t, theta0, alpha
+    real(wp), intent(out) :: sphi(z), cphi(z)
+    integer :: j
+    real(wp) :: phi
+    do j = 1, z
+      phi = 2.0_wp*pi*j/z + omega*t + theta0 - alpha
+      sphi(j) = sin(phi)
+      cphi(j) = cos(phi)
+    end do
+  end subroutine tooth_angles
+
+  !> Eq. 12 in its exact simplified form: displacement of spline i in the tooth-profile direction,
+  !> Delta = x cos(phi) + y sin(phi), and its total time derivative (phi' = omega).
+  pure subroutine profile_shift(x, y, vx, vy, omega, sphi, cphi, delta, ddelta)
+    real(wp), intent(in) :: x, y, vx, vy, omega, sphi, cphi
+    real(wp), intent(out) :: delta, ddelta
+    delta = x*cphi + y*sphi
+    ddelta = vx*cphi + vy*sphi + omega*(-x*sphi + y*cphi)
+  end subroutine profile_shift
+
+  !> Eqs. 13-14: radius of the contact point of a spline with pitch radius r (R = m Z / 2) whose
+  !> profile is shifted by delta. Moving towards the root (ddelta < 0): law of cosines (Eq. 13);
+  !> otherwise towards the tip: law of sines (Eq. 14).
+  pure real(wp) function contact_radius(delta, ddelta, r, alpha) result(rc)
+    real(wp), intent(in) :: delta, ddelta, r, alpha
+    if (ddelta < 0.0_wp) then
+      rc = sqrt(delta**2 + r**2 - 2.0_wp*r*delta*cos(alpha))
+    else
+      rc = r*sin(pi - alpha - asin(delta*sin(alpha)/r))/sin(alpha)
+    end if
+  end function contact_radius
+
+end module spline_geometry

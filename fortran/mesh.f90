@@ -1,0 +1,226 @@
+!> Tooth-pair contact and mesh forces: relative displacement along each line of action (Eq. 11),
+!> dead-zone contact with time-varying backlash (Eqs. 2, 15-17), flash-temperature coupling
+!> (Eqs. 1, 3-7, 12-14) and the energy-consistent mesh forces on the bodies (Eqs. 19-22, corrected).
+module spline_mesh
+  use spline_kinds, only: wp
+  use spline_case_io, only: model_t, thermal_oneway, thermal_coupled
+  use spline_geometry, only: tooth_angles, profile_shift, contact_radius
+  use spline_thermal, only: thermal_backlash, flash_temperature
+  implicit none
+  private
+  public :: mesh_eval, mesh_switch_functions, coupling_stats_reset, coupling_worst_residual, &
+       coupling_max_iterations
+
+  integer, parameter :: max_coupling_iter = 60
+  real(wp), parameter :: coupling_tol = 1.0e-14_wp   !< relative step tolerance on T_f
+  real(wp), save :: worst_residual = 0.0_wp          !< largest |T - T_f(F(T))| accepted [degC]
+  integer, save :: worst_iterations = 0
+
+contains
+
+  !> Evaluate the mesh at time t for displacements q and velocities v (SI, layout of Eq. 24).
+  !> Returns the generalised mesh forces on spline 1 (F_x1, F_y1) and the meshing torque T_m
+  !> (Eq. 22); spline 2 receives the opposites. Optional per-tooth outputs for reporting.
+  !> mode (optional): frozen contact state per tooth (+1 drive flank, 0 free, -1 back flank),
+  !> used between the located switches; without it the state decides (|dn_j| > c_j, Eq. 16).
+  !> flash (optional, default false): compute T_f and the contact radii even when the thermal
+  !> level does not feed them back (one-way post-processing and output).
+  subroutine mesh_eval(m, t, q, v, fx1, fy1, tm, ierr, errmsg, mode, flash, dn, c, f, tf, rc1, rc2, &
+       sphi_out, cphi_out)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t, q(7), v(7)
+    real(wp), intent(out) :: fx1, fy1, tm
+    integer, intent(out) :: ierr
+    character(len=*), intent(inout) :: errmsg
+    integer, intent(in), optional :: mode(m%z)
+    logical, intent(in), optional :: flash
+    real(wp), intent(out), optional, dimension(m%z) :: dn, c, f, tf, rc1, rc2, sphi_out, cphi_out
+    real(wp) :: sp(m%z), cp(m%z)
+    real(wp) :: ex, ey, evx, evy, dnj, ddnj, cj, fj, tfj, r1, r2, sumf
+    integer :: j, mj
+    logical :: want_flash, coupled
+
+    ierr = 0
+    call tooth_angles(m%z, m%omega, t, m%theta0, m%alpha, sp, cp)
+    ! relative centre offset of spline 1 (misaligned, Section 1) against spline 2
+    ex = q(1) + m%l_x - q(3)
+    ey = q(2) + m%l_y - q(4)
+    evx = v(1) - v(3)
+    evy = v(2) - v(4)
+    coupled = m%thermal == thermal_coupled
+    want_flash = coupled
+    if (present(flash)) want_flash = want_flash .or. (flash .and. m%thermal >= thermal_oneway)
+    fx1 = 0.0_wp; fy1 = 0.0_wp; sumf = 0.0_wp
+    do j = 1, m%z
+      ! Eq. 11 and its total time derivative (phi_j' = omega)
+      dnj = ex*sp(j) - ey*cp(j) + q(6)
+      ddnj = evx*sp(j) - evy*cp(j) + v(6) + m%omega*(ex*cp(j) + ey*sp(j))
+      if (present(mode)) then
+        mj = mode(j)
+      else
+        mj = contact_state(dnj, m%c_bulk)
+      end if
+      cj = m%c_bulk
+      tfj = 0.0_wp
+      r1 = m%r_pitch; r2 = m%r_pitch
+      if (want_flash) call contact_radii(m, q, v, sp(j), cp(j), r1, r2)
+      if (mj /= 0) then
+        if (coupled) then
+          call solve_coupled(m, dnj, ddnj, mj, r1, r2, fj, tfj, ierr)
+          if (ierr /= 0) then
+            write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': thermal interference: '// &
+                 'the flash temperature closes the backlash of tooth ', j, ' at t = ', t, &
+                 ' s (Eq. 2: c_j <= 0)'
+            if (ierr == 2) write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)// &
+                 ': flash-temperature coupling did not converge on tooth ', j, ' at t = ', t, ' s'
+            ierr = 3                                   ! a thermal failure, for the caller
+            return
+          end if
+          cj = thermal_backlash(m%c_bulk, m%kappa, tfj)
+        else
+          fj = contact_force(m, dnj, ddnj, mj, cj)     ! Eqs. 15-17
+          if (want_flash) tfj = flash_of(m, fj, r1, r2)
+        end if
+      else
+        fj = 0.0_wp
+      end if
+      ! Eqs. 19-22 with the tooth's own line-of-action angle (MODEL.md Section 4)
+      fx1 = fx1 - fj*sp(j)
+      fy1 = fy1 + fj*cp(j)
+      sumf = sumf + fj
+      if (present(dn)) dn(j) = dnj
+      if (present(c)) c(j) = cj
+      if (present(f)) f(j) = fj
+      if (present(tf)) tf(j) = tfj
+      if (present(rc1)) rc1(j) = r1
+      if (present(rc2)) rc2(j) = r2
+    end do
+    tm = m%r_b*sumf
+    if (present(sphi_out)) sphi_out = sp
+    if (present(cphi_out)) cphi_out = cp
+  end subroutine mesh_eval
+
+  !> Eq. 16: contact state of a tooth pair, +1 drive flank (dn > c), -1 back flank (dn < -c), 0 free.
+  pure integer function contact_state(dn, c)
+    real(wp), intent(in) :: dn, c
+    contact_state = 0
+    if (dn > c) contact_state = 1
+    if (dn < -c) contact_state = -1
+  end function contact_state
+
+  !> Eqs. 15-17: tooth force in contact state mode (+-1): k_m (dn -+ c) + c_m d(dn)/dt.
+  pure real(wp) function contact_force(m, dn, ddn, mode, c) result(f)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: dn, ddn, c
+    integer, intent(in) :: mode
+    f = m%k_m*(dn - mode*c) + m%c_m*ddn
+  end function contact_force
+
+  !> Eqs. 12-14: contact-point radii of tooth pair (sp, cp) on spline 1 (misaligned centre) and 2.
+  pure subroutine contact_radii(m, q, v, sp, cp, r1, r2)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: q(7), v(7), sp, cp
+    real(wp), intent(out) :: r1, r2
+    real(wp) :: d, dd
+    call profile_shift(q(1) + m%l_x, q(2) + m%l_y, v(1), v(2), m%omega, sp, cp, d, dd)
+    r1 = contact_radius(d, dd, m%r_pitch, m%alpha)
+    call profile_shift(q(3), q(4), v(3), v(4), m%omega, sp, cp, d, dd)
+    r2 = contact_radius(d, dd, m%r_pitch, m%alpha)
+  end subroutine contact_radii
+
+  !> Eqs. 3-7 for one tooth with the model's material data.
+  pure real(wp) function flash_of(m, f, r1, r2) result(tf)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: f, r1, r2
+    real(wp) :: bh
+    call flash_temperature(f, r1, r2, m%r_b, m%alpha, m%omega, m%b, m%e_mod, m%nu, m%eta_hertz, &
+         m%u_flash, m%f_m, m%k_cond, m%rho, m%c_heat, tf, bh)
+  end function flash_of
+
+  !> Eqs. 1, 2, 15-17 and 3-7 together: the tooth force F depends on itself through
+  !> T_f(F) -> c(T_f) -> F. Unknown: the flash temperature T; residual
+  !>   g(T) = T - T_f(F(T)),  F(T) = k_m (dn - mode (c_bulk - kappa T)) + c_m d(dn)/dt.
+  !> Secant iteration from T = 0 and T = T_f(F(0)); it stops when a step is below
+  !> 1e-14 (1 + T) degC. The map T -> T_f(F(T)) contracts by about k_m kappa dT_f/dF (~1e-3 for the
+  !> paper's k_m), so 3-5 iterations reach round-off. ierr = 1: backlash closed; 2: no convergence.
+  subroutine solve_coupled(m, dn, ddn, mode, r1, r2, f, t, ierr)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: dn, ddn, r1, r2
+    integer, intent(in) :: mode
+    real(wp), intent(out) :: f, t
+    integer, intent(out) :: ierr
+    real(wp) :: ta, ga, tb, gb, tn
+    integer :: k
+    ierr = 0
+    ta = 0.0_wp
+    ga = -tf_at(ta)
+    tb = -ga
+    t = ta
+    if (ga /= 0.0_wp) then
+      gb = tb - tf_at(tb)
+      if (ierr /= 0) return
+      do k = 1, max_coupling_iter
+        if (gb == 0.0_wp .or. gb == ga) exit
+        tn = tb - gb*(tb - ta)/(gb - ga)
+        ta = tb; ga = gb
+        tb = tn
+        gb = tb - tf_at(tb)
+        if (ierr /= 0) return
+        if (abs(tb - ta) <= coupling_tol*(1.0_wp + abs(tb))) exit
+      end do
+      if (k > max_coupling_iter) then
+        ierr = 2; return
+      end if
+      worst_iterations = max(worst_iterations, k)
+      worst_residual = max(worst_residual, abs(gb))
+      t = tb
+    end if
+    if (thermal_backlash(m%c_bulk, m%kappa, t) <= 0.0_wp) then
+      ierr = 1; return
+    end if
+    f = contact_force(m, dn, ddn, mode, thermal_backlash(m%c_bulk, m%kappa, t))
+  contains
+    real(wp) function tf_at(tt)
+      real(wp), intent(in) :: tt
+      real(wp) :: cc
+      cc = thermal_backlash(m%c_bulk, m%kappa, tt)
+      tf_at = 0.0_wp
+      if (cc <= 0.0_wp) then
+        ierr = 1; return
+      end if
+      tf_at = flash_of(m, contact_force(m, dn, ddn, mode, cc), r1, r2)
+    end function tf_at
+  end subroutine solve_coupled
+
+  !> Root functions for the contact switches of Eq. 16: g_{2j-1} = dn_j - c_j, g_{2j} = dn_j + c_j
+  !> (with the backlash at the bulk temperature, which decides the contact state).
+  subroutine mesh_switch_functions(m, t, q, g)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t, q(7)
+    real(wp), intent(out) :: g(2*m%z)
+    real(wp) :: sp(m%z), cp(m%z), ex, ey, dnj
+    integer :: j
+    call tooth_angles(m%z, m%omega, t, m%theta0, m%alpha, sp, cp)
+    ex = q(1) + m%l_x - q(3)
+    ey = q(2) + m%l_y - q(4)
+    do j = 1, m%z
+      dnj = ex*sp(j) - ey*cp(j) + q(6)
+      g(2*j - 1) = dnj - m%c_bulk
+      g(2*j) = dnj + m%c_bulk
+    end do
+  end subroutine mesh_switch_functions
+
+  subroutine coupling_stats_reset()
+    worst_residual = 0.0_wp
+    worst_iterations = 0
+  end subroutine coupling_stats_reset
+
+  real(wp) function coupling_worst_residual()
+    coupling_worst_residual = worst_residual
+  end function coupling_worst_residual
+
+  integer function coupling_max_iterations()
+    coupling_max_iterations = worst_iterations
+  end function coupling_max_iterations
+
+end module spline_mesh

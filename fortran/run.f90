@@ -1,0 +1,84 @@
+!> One simulation of a case, shared by the executable and the Python API: output times,
+!> start state (static equilibrium by default), integration, and the per-tooth quantities
+!> (Eqs. 11, 15-22 and, for the thermal levels that have it, Eqs. 1-7) at every output time.
+module spline_run
+  use spline_kinds, only: wp
+  use spline_case_io, only: model_t, nstate, ndof
+  use spline_dynamics, only: start_state
+  use spline_mesh, only: mesh_eval
+  use spline_solver, only: integrate, nstats
+  implicit none
+  private
+  public :: run_case, output_times, tooth_outputs, ntooth_q, tooth_q_names, tooth_q_units
+
+  integer, parameter :: ntooth_q = 8
+  character(len=4), parameter :: tooth_q_names(ntooth_q) = [character(len=4) :: &
+       'F', 'Fx', 'Fy', 'dn', 'c', 'Tf', 'rc1', 'rc2']
+  character(len=4), parameter :: tooth_q_units(ntooth_q) = [character(len=4) :: &
+       'N', 'N', 'N', 'm', 'm', 'degC', 'm', 'm']
+
+contains
+
+  !> Uniform output times on [t0 + t_transient, t_end] (one time: t_end).
+  pure subroutine output_times(m, t)
+    type(model_t), intent(in) :: m
+    real(wp), intent(out) :: t(m%n_out)
+    integer :: k
+    real(wp) :: ta
+    ta = m%t0 + m%t_transient
+    if (m%n_out == 1) then
+      t(1) = m%t_end
+    else
+      t = [(ta + (m%t_end - ta)*(k - 1)/real(m%n_out - 1, wp), k = 1, m%n_out)]
+      t(m%n_out) = m%t_end
+    end if
+  end subroutine output_times
+
+  !> Run a validated case: y(:, k) is the SI state at t(k), tooth(k, j, :) the quantities named
+  !> in tooth_q_names for tooth j, tm(k) the meshing torque (Eq. 22).
+  subroutine run_case(m, t, y, tooth, tm, stats, ierr, errmsg)
+    type(model_t), intent(in) :: m
+    real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
+    real(wp), intent(out) :: tm(m%n_out), stats(nstats)
+    integer, intent(out) :: ierr
+    character(len=*), intent(out) :: errmsg
+    real(wp) :: y0(nstate)
+    integer :: modes(m%z, m%n_out)
+    errmsg = ''
+    stats = 0.0_wp
+    call output_times(m, t)
+    call start_state(m, y0, ierr, errmsg)
+    if (ierr /= 0) return
+    call integrate(m, y0, m%n_out, t, y, modes, stats, ierr, errmsg)
+    if (ierr /= 0) return
+    call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg)
+  end subroutine run_case
+
+  !> Per-tooth quantities at the output times, with the contact states the integration used.
+  subroutine tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t(:), y(:, :)
+    integer, intent(in) :: modes(:, :)
+    real(wp), intent(out) :: tooth(:, :, :), tm(:)
+    integer, intent(out) :: ierr
+    character(len=*), intent(inout) :: errmsg
+    real(wp) :: fx1, fy1, sp(m%z), cp(m%z)
+    integer :: k
+    ierr = 0
+    do k = 1, size(t)
+      if (modes(1, k) == 2) then
+        call mesh_eval(m, t(k), y(1:ndof, k), y(ndof+1:, k), fx1, fy1, tm(k), ierr, errmsg, &
+             flash=.true., f=tooth(k, :, 1), dn=tooth(k, :, 4), c=tooth(k, :, 5), tf=tooth(k, :, 6), &
+             rc1=tooth(k, :, 7), rc2=tooth(k, :, 8), sphi_out=sp, cphi_out=cp)
+      else
+        call mesh_eval(m, t(k), y(1:ndof, k), y(ndof+1:, k), fx1, fy1, tm(k), ierr, errmsg, &
+             mode=modes(:, k), flash=.true., f=tooth(k, :, 1), dn=tooth(k, :, 4), c=tooth(k, :, 5), &
+             tf=tooth(k, :, 6), rc1=tooth(k, :, 7), rc2=tooth(k, :, 8), sphi_out=sp, cphi_out=cp)
+      end if
+      if (ierr /= 0) return
+      tooth(k, :, 2) = tooth(k, :, 1)*sp     ! F_jx (Eq. 19 with phi_j)
+      tooth(k, :, 3) = tooth(k, :, 1)*cp     ! F_jy
+    end do
+  end subroutine tooth_outputs
+
+end module spline_run

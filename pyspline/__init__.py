@@ -1,0 +1,10 @@
+"""pyspline: nonlinear dynamics of an involute spline coupling with parallel misalignment and
+flash temperature (Xue, Shen & Xue 2025). The physics lives in the Fortran core (fortran/);
+this package reads cases, runs them and plots them."""
+from .case import (Case, CaseError, SolverError, SplineError, ThermalInterferenceError,
+                   defaults, load_case)
+from .core import Result, rhs, simulate, start_state
+
+__all__ = ["Case", "CaseError", "Result", "SolverError", "SplineError",
+           "ThermalInterferenceError", "defaults", "load_case", "rhs", "simulate", "start_state"]
+__version__ = "0.1.0"

@@ -1,0 +1,108 @@
+"""Python face of the Fortran core: simulate a case, evaluate the right-hand side.
+
+Nothing here computes physics. Each call writes the case as a namelist file and hands its path
+to the f2py-wrapped API (fortran/api.f90), the same reader the executable uses.
+"""
+from __future__ import annotations
+
+import contextlib
+import functools
+import os
+import tempfile
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import _core
+from .case import Case, load_case, raise_for
+
+_api = _core.spline_api
+STATE_NAMES = ("x1", "y1", "x2", "y2", "D1", "D2", "D3")
+
+
+@functools.cache
+def _names(kind: str, n: int) -> tuple:
+    out = []
+    for i in range(1, n + 1):
+        name, unit = _api.api_names(kind, i)
+        out.append((name.decode().strip(), unit.decode().strip()))
+    return tuple(out)
+
+
+@contextlib.contextmanager
+def _case_file(case: Case):
+    with tempfile.TemporaryDirectory(prefix="pyspline-") as tmp:
+        path = os.path.join(tmp, f"{case.name or 'case'}.nml")
+        case.to_namelist(path)
+        yield path
+
+
+@dataclass
+class Result:
+    """A simulation in SI units. Per-tooth arrays have shape (nt, Z)."""
+    case: Case
+    t: np.ndarray            #: output times [s]
+    y: np.ndarray            #: states (nt, 14): x1, y1, x2, y2, D1, D2, D3 [m], then their velocities [m/s]
+    tooth: dict              #: per-tooth quantities by name: F, Fx, Fy [N], dn, c [m], Tf [degC], rc1, rc2 [m]
+    Tm: np.ndarray           #: meshing torque T_m (Eq. 22) [N m]
+    stats: dict = field(default_factory=dict)   #: CVODE statistics and run time
+
+    @property
+    def kv(self) -> np.ndarray:
+        """Dynamic load coefficient k_v = |T_m| / T_d."""
+        return np.abs(self.Tm) / self.case["t_d"]
+
+    def __getattr__(self, name):
+        tooth = self.__dict__.get("tooth", {})
+        if name in tooth:
+            return tooth[name]
+        if name in STATE_NAMES:
+            return self.y[:, STATE_NAMES.index(name)]
+        if name.startswith("v") and name[1:] in STATE_NAMES:
+            return self.y[:, 7 + STATE_NAMES.index(name[1:])]
+        raise AttributeError(name)
+
+
+def simulate(case) -> Result:
+    """Run one case (a Case, a dict of fields or a namelist path) and return a Result.
+    Raises CaseError, SolverError or ThermalInterferenceError with a message naming the case."""
+    case = load_case(case)
+    with _case_file(case) as path:
+        z, nt, nq, ns, ierr, msg = _api.api_sizes(path)
+        raise_for(ierr, msg)
+        t0 = time.perf_counter()
+        t, y, tooth, tm, stats, ierr, msg = _api.api_simulate(path, z, nt, nq, ns)
+        wall = time.perf_counter() - t0
+        raise_for(ierr, msg)
+    qnames = [n for n, _ in _names("tooth", nq)]
+    stats = {n: (float(v) if n.endswith(("_s", "_degC")) else int(v))
+             for (n, _), v in zip(_names("stats", ns), stats)}
+    stats["wall_s"] = wall
+    return Result(case=case, t=t, y=y, tooth={n: tooth[:, :, i] for i, n in enumerate(qnames)},
+                  Tm=tm, stats=stats)
+
+
+def rhs(case, t: float, y) -> tuple[np.ndarray, dict, float]:
+    """The Fortran right-hand side in SI units at (t, y), contact states from the state.
+    Returns (dy/dt, per-tooth dict as in Result.tooth but 1-D, T_m). For tests and peers."""
+    case = load_case(case)
+    with _case_file(case) as path:
+        return rhs_at_path(path, case["z"], t, y)
+
+
+def rhs_at_path(path: str, z: int, t: float, y):
+    """rhs() on a namelist file that already exists (no temporary file per call)."""
+    nq = len(_names("tooth", 8))
+    ydot, mesh, tm, ierr, msg = _api.api_rhs(path, z, nq, t, np.asarray(y, dtype=float))
+    raise_for(ierr, msg)
+    return ydot, {n: mesh[:, i] for i, (n, _) in enumerate(_names("tooth", nq))}, float(tm)
+
+
+def start_state(case) -> np.ndarray:
+    """The case's start state (SI): the static equilibrium (default) or rest, plus dq0, dv0."""
+    case = load_case(case)
+    with _case_file(case) as path:
+        y, ierr, msg = _api.api_start_state(path)
+    raise_for(ierr, msg)
+    return y

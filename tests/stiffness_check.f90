@@ -1,0 +1,217 @@
+!> Standalone check of module spline_stiffness (MODEL.md Section 7, Eq. 18). Build and run:
+!>   gfortran -O2 fortran/kinds.f90 fortran/stiffness.f90 tests/stiffness_check.f90 -o /tmp/stiff && /tmp/stiff
+!> Prints: the spline's terms (MODEL.md Section 8), a convergence table in nquad, the spur gear
+!> of Tian (2004) / Chen & Shao (2011) at its pitch point, two independent cross-checks
+!> (Tian's closed-form integrands in his angle variable, and the rack / trapezoid closed form
+!> that both tooth routines must approach for z -> infinity), and the error paths.
+!> Exit status 1 if a cross-check fails (tolerances printed with each check).
+program stiffness_check
+  use spline_kinds, only: wp, pi
+  use spline_stiffness, only: hertz_stiffness, external_tooth_stiffness, &
+       internal_tooth_stiffness, spline_mesh_stiffness
+  implicit none
+  real(wp), parameter :: deg = pi/180.0_wp
+  integer, parameter :: nref = 64
+  integer :: ierr, i, nfail
+  character(len=256) :: msg
+  real(wp) :: kh, kb1, ks1, ka1, kb2, ks2, ka2, km, ref(7), cur(7)
+  real(wp) :: z, m, alpha, b, e, nu
+  integer, parameter :: nq(5) = [8, 16, 32, 64, 128]
+
+  nfail = 0
+
+  ! ---------------- 1. the spline (MODEL.md Section 8) -----------------------------------------
+  z = 16; m = 2e-3_wp; alpha = 30*deg; b = 0.03_wp; e = 2.1e11_wp; nu = 0.3_wp
+  call spline_mesh_stiffness(z, m, alpha, b, e, nu, 14.5e-3_wp, 17.5e-3_wp, 15e-3_wp, nref, &
+       kh, kb1, ks1, ka1, kb2, ks2, ka2, km, ierr, msg)
+  call must(ierr == 0, 'spline_mesh_stiffness returned an error: '//trim(msg))
+  print '(a)', '== Spline, Z=16, m=2 mm, alpha=30 deg, b=30 mm, E=2.1e11, nu=0.3, pitch point =='
+  print '(a,f8.4,a,f8.4,a)', '   base radius ', 0.5_wp*m*z*cos(alpha)*1e3_wp, ' mm, pitch radius ', &
+       0.5_wp*m*z*1e3_wp, ' mm'
+  print '(a,es14.6,a)', '   k_h  (Hertz)              ', kh, ' N/m'
+  print '(a,es14.6,a)', '   k_b1 (external, bending)  ', kb1, ' N/m'
+  print '(a,es14.6,a)', '   k_s1 (external, shear)    ', ks1, ' N/m'
+  print '(a,es14.6,a)', '   k_a1 (external, axial)    ', ka1, ' N/m'
+  print '(a,es14.6,a)', '   k_b2 (internal, bending)  ', kb2, ' N/m'
+  print '(a,es14.6,a)', '   k_s2 (internal, shear)    ', ks2, ' N/m'
+  print '(a,es14.6,a)', '   k_a2 (internal, axial)    ', ka2, ' N/m'
+  print '(a,es14.6,a)', '   k_m  (Eq. 18)             ', km, ' N/m'
+  call must(km > 1e8_wp .and. km < 3e9_wp, 'k_m outside the expected 1e8 - 3e9 N/m')
+
+  ! ---------------- 2. convergence in nquad -----------------------------------------------------
+  ref = [kb1, ks1, ka1, kb2, ks2, ka2, km]
+  print '(/a)', '== Convergence (relative difference to nquad = 64) =='
+  print '(a)', '  nquad       k_b1       k_s1       k_a1       k_b2       k_s2       k_a2        k_m'
+  do i = 1, size(nq)
+    call spline_mesh_stiffness(z, m, alpha, b, e, nu, 14.5e-3_wp, 17.5e-3_wp, 15e-3_wp, nq(i), &
+         kh, cur(1), cur(2), cur(3), cur(4), cur(5), cur(6), cur(7), ierr, msg)
+    print '(i7,7es11.2)', nq(i), abs(cur/ref - 1.0_wp)
+    call must(all(abs(cur/ref - 1.0_wp) < merge(1e-8_wp, 1e-12_wp, nq(i) < 16)), &
+         'not converged (tolerance 1e-8 at nquad = 8, 1e-12 from nquad = 16)')
+  end do
+
+  ! ---------------- 3. spur gear of Tian (2004) / Chen & Shao (2011) ----------------------------
+  call spur_gear_case()
+
+  ! ---------------- 4. cross-check against Tian's closed-form integrands ------------------------
+  call tian_crosscheck(19.0_wp, 3.2e-3_wp, 20*deg, 16e-3_wp, 2.068e11_wp, 0.3_wp)   ! root < r_b
+  call tian_crosscheck(48.0_wp, 3.2e-3_wp, 20*deg, 16e-3_wp, 2.068e11_wp, 0.3_wp)   ! root > r_b
+  call tian_crosscheck(16.0_wp, 2e-3_wp, 30*deg, 0.03_wp, 2.1e11_wp, 0.3_wp, 14.5e-3_wp)  ! spline
+
+  ! ---------------- 5. rack limit (z -> infinity): trapezoidal cantilever closed form -----------
+  call rack_limit()
+
+  ! ---------------- 6. error paths --------------------------------------------------------------
+  print '(/a)', '== Error reporting =='
+  call external_tooth_stiffness(2.0_wp, m, alpha, b, 14.5e-3_wp, e, nu, 16e-3_wp, nref, kb1, ks1, ka1, ierr, msg)
+  call report_error(ierr, msg)
+  call external_tooth_stiffness(z, m, alpha, b, 14.5e-3_wp, e, 0.5_wp, 16e-3_wp, nref, kb1, ks1, ka1, ierr, msg)
+  call report_error(ierr, msg)
+  call external_tooth_stiffness(z, m, alpha, b, 16.5e-3_wp, e, nu, 16e-3_wp, nref, kb1, ks1, ka1, ierr, msg)
+  call report_error(ierr, msg)
+  call external_tooth_stiffness(z, m, alpha, b, 14.5e-3_wp, e, nu, 18.5e-3_wp, nref, kb1, ks1, ka1, ierr, msg)
+  call report_error(ierr, msg)
+  call internal_tooth_stiffness(z, m, alpha, b, 17.5e-3_wp, 13e-3_wp, e, nu, 16e-3_wp, nref, kb2, ks2, ka2, ierr, msg)
+  call report_error(ierr, msg)
+  call internal_tooth_stiffness(z, m, alpha, b, 17.5e-3_wp, 15e-3_wp, e, nu, 14.9e-3_wp, nref, kb2, ks2, ka2, ierr, msg)
+  call report_error(ierr, msg)
+  call spline_mesh_stiffness(z, m, 0.0_wp, b, e, nu, 14.5e-3_wp, 17.5e-3_wp, 15e-3_wp, nref, &
+       kh, kb1, ks1, ka1, kb2, ks2, ka2, km, ierr, msg)
+  call report_error(ierr, msg)
+
+  print '(/a,i0)', 'failed checks: ', nfail
+  if (nfail > 0) error stop 1
+
+contains
+
+  subroutine must(ok, what)
+    logical, intent(in) :: ok
+    character(len=*), intent(in) :: what
+    if (.not. ok) then
+      nfail = nfail + 1
+      print '(a)', '   FAIL: '//what
+    end if
+  end subroutine must
+
+  subroutine report_error(ierr, msg)
+    integer, intent(in) :: ierr
+    character(len=*), intent(in) :: msg
+    print '(a,i0,a)', '   ierr=', ierr, '  '//trim(msg)
+    call must(ierr /= 0 .and. len_trim(msg) > 0, 'bad input not reported')
+  end subroutine report_error
+
+  !> Tian (2004) / Chen & Shao (2011) spur gear pair, standard full-depth teeth (root radius
+  !> m (z/2 - 1.25)), both teeth loaded at the pitch point.
+  subroutine spur_gear_case()
+    real(wp) :: kbp, ksp, kap, kbg, ksg, kag, khh, kmm
+    real(wp), parameter :: mm = 3.2e-3_wp, aa = 20*deg, bb = 16e-3_wp, ee = 2.068e11_wp, vv = 0.3_wp
+    real(wp), parameter :: z1 = 19, z2 = 48
+    print '(/a)', '== Spur gear pair of Tian (2004) / Chen & Shao (2011): Z1=19, Z2=48, m=3.2 mm,'
+    print '(a)',  '   alpha=20 deg, b=16 mm, E=2.068e11 Pa, nu=0.3, root radius m(z/2-1.25), pitch point =='
+    call external_tooth_stiffness(z1, mm, aa, bb, mm*(z1/2 - 1.25_wp), ee, vv, mm*z1/2, nref, &
+         kbp, ksp, kap, ierr, msg)
+    call must(ierr == 0, trim(msg))
+    call external_tooth_stiffness(z2, mm, aa, bb, mm*(z2/2 - 1.25_wp), ee, vv, mm*z2/2, nref, &
+         kbg, ksg, kag, ierr, msg)
+    call must(ierr == 0, trim(msg))
+    khh = hertz_stiffness(ee, vv, bb)
+    kmm = 1.0_wp/(1.0_wp/khh + 1.0_wp/kbp + 1.0_wp/ksp + 1.0_wp/kap + 1.0_wp/kbg + 1.0_wp/ksg + 1.0_wp/kag)
+    print '(a,3(f8.3,a))', '   pinion: r_f, r_b, r_p = ', mm*(z1/2 - 1.25_wp)*1e3_wp, ', ', &
+         mm*z1/2*cos(aa)*1e3_wp, ', ', mm*z1/2*1e3_wp, ' mm (root inside base circle)'
+    print '(a,3(f8.3,a))', '   gear:   r_f, r_b, r_p = ', mm*(z2/2 - 1.25_wp)*1e3_wp, ', ', &
+         mm*z2/2*cos(aa)*1e3_wp, ', ', mm*z2/2*1e3_wp, ' mm (root outside base circle)'
+    print '(a,3es13.5)', '   pinion k_b, k_s, k_a [N/m]: ', kbp, ksp, kap
+    print '(a,3es13.5)', '   gear   k_b, k_s, k_a [N/m]: ', kbg, ksg, kag
+    print '(a,es13.5)',  '   k_h [N/m]:                   ', khh
+    print '(a,es13.5)',  '   single-pair k at pitch [N/m]:', kmm
+  end subroutine spur_gear_case
+
+  !> Independent evaluation of Tian's (2004) integrals in his angle variable a in [-a1, a_hi]
+  !> (a_hi = alpha_2 if the root is inside the base circle, else alpha_2 - t_root), composite
+  !> Simpson with 20000 panels, plus the Chen & Shao (2011) straight-segment closed forms.
+  subroutine tian_crosscheck(zz, mm, aa, bb, ee, vv, rf_in)
+    real(wp), intent(in) :: zz, mm, aa, bb, ee, vv
+    real(wp), intent(in), optional :: rf_in
+    integer, parameter :: np = 20000
+    real(wp) :: rb, rp, rf, a1, a2, ahi, hs, a, wgt, h, d, cb, cs, ca, kb, ks, ka, hb, xb, xr, tol
+    integer :: j
+    rp = mm*zz/2; rb = rp*cos(aa)
+    rf = mm*(zz/2 - 1.25_wp)
+    if (present(rf_in)) rf = rf_in
+    a2 = pi/(2*zz) + tan(aa) - aa
+    a1 = tan(aa) - a2                           ! load angle at the pitch point
+    ahi = a2
+    if (rf > rb) ahi = a2 - sqrt((rf/rb)**2 - 1)
+    hs = (ahi + a1)/np
+    cb = 0; cs = 0; ca = 0
+    do j = 0, np
+      a = -a1 + j*hs
+      wgt = merge(1.0_wp, merge(4.0_wp, 2.0_wp, mod(j, 2) == 1), j == 0 .or. j == np)*hs/3
+      h = sin(a) + (a2 - a)*cos(a)              ! half thickness / r_b
+      d = (a2 - a)*cos(a)                       ! |dx/da| / r_b
+      cb = cb + wgt*3*(1 + cos(a1)*((a2 - a)*sin(a) - cos(a)))**2*d/(2*ee*bb*h**3)
+      cs = cs + wgt*1.2_wp*(1 + vv)*d*cos(a1)**2/(ee*bb*h)
+      ca = ca + wgt*d*sin(a1)**2/(2*ee*bb*h)
+    end do
+    if (rf < rb) then                           ! Chen & Shao straight segment, closed form
+      hb = rb*sin(a2); xb = rb*cos(a2); xr = sqrt(rf**2 - hb**2)
+      cb = cb + ((rb - cos(a1)*xr)**3 - (rb - cos(a1)*xb)**3)/(2*ee*bb*cos(a1)*hb**3)
+      cs = cs + 1.2_wp*(1 + vv)*cos(a1)**2*(xb - xr)/(ee*bb*hb)
+      ca = ca + sin(a1)**2*(xb - xr)/(2*ee*bb*hb)
+    end if
+    call external_tooth_stiffness(zz, mm, aa, bb, rf, ee, vv, rp, nref, kb, ks, ka, ierr, msg)
+    tol = 1e-9_wp
+    print '(/a,f5.0,a,f6.2,a,f6.3,a,f6.3,a)', '== Cross-check vs Tian closed-form integrands: z=', zz, &
+         ', alpha=', aa/deg, ' deg, r_f=', rf*1e3_wp, ' mm, r_b=', rb*1e3_wp, ' mm =='
+    print '(a,3es13.5)', '   Tian/Chen-Shao k_b, k_s, k_a: ', 1/cb, 1/cs, 1/ca
+    print '(a,3es13.5)', '   module         k_b, k_s, k_a: ', kb, ks, ka
+    print '(a,3es10.2,a,es8.1,a)', '   relative differences: ', kb*cb - 1, ks*cs - 1, ka*ca - 1, &
+         '  (tolerance ', tol, ')'
+    call must(ierr == 0 .and. abs(kb*cb - 1) < tol .and. abs(ks*cs - 1) < tol .and. &
+         abs(ka*ca - 1) < tol, 'Tian cross-check')
+  end subroutine tian_crosscheck
+
+  !> z -> infinity: both the external and the internal tooth become the rack tooth, a trapezoid
+  !> of half thickness h(d) = pi m / 4 + d tan(alpha) at depth d below the pitch line, loaded at
+  !> the pitch line with load angle alpha. Closed form (dx = dh / tan(alpha)):
+  !>   1/k_b = 3/(2 E b tan a) [-A^2/(2h^2) - 2 A B/h + B^2 ln h]_{h_c}^{h_f},
+  !>           M/F = A + B h, B = cos(a)/tan(a), A = -h_c (cos(a)/tan(a) + sin(a))
+  !>   1/k_s = 1.2 cos(a)^2 ln(h_f/h_c) / (2 G b tan a),  1/k_a = sin(a)^2 ln(h_f/h_c) / (2 E b tan a)
+  subroutine rack_limit()
+    real(wp), parameter :: mm = 2e-3_wp, aa = 30*deg, bb = 0.03_wp, ee = 2.1e11_wp, vv = 0.3_wp
+    real(wp) :: hc, hf, ca, cb, cs, gg, aco, bco, ta, kb, ks, ka, zz, dev(3), dev_ext(3, 3), dev_int(3, 3)
+    integer :: k
+    gg = ee/(2*(1 + vv)); ta = tan(aa)
+    hc = pi*mm/4; hf = hc + 1.25_wp*mm*ta
+    bco = cos(aa)/ta; aco = -hc*(cos(aa)/ta + sin(aa))
+    cb = 3/(2*ee*bb*ta)*(-aco**2/(2*hf**2) - 2*aco*bco/hf + bco**2*log(hf) &
+                         + aco**2/(2*hc**2) + 2*aco*bco/hc - bco**2*log(hc))
+    cs = 1.2_wp*cos(aa)**2*log(hf/hc)/(2*gg*bb*ta)
+    ca = sin(aa)**2*log(hf/hc)/(2*ee*bb*ta)
+    print '(/a)', '== Rack limit: trapezoid tooth, m=2 mm, alpha=30 deg, dedendum 1.25 m, b=30 mm =='
+    print '(a,3es13.5)', '   closed form        k_b, k_s, k_a: ', 1/cb, 1/cs, 1/ca
+    do k = 3, 5
+      zz = 10.0_wp**k
+      call external_tooth_stiffness(zz, mm, aa, bb, mm*(zz/2 - 1.25_wp), ee, vv, mm*zz/2, nref, &
+           kb, ks, ka, ierr, msg)
+      dev = [kb*cb, ks*cs, ka*ca] - 1
+      print '(a,i1,a,3es13.5,a,3es9.1)', '   external z=1e', k, ' k_b, k_s, k_a: ', kb, ks, ka, '  rel.diff', dev
+      dev_ext(:, k - 2) = dev
+      call must(ierr == 0, 'external rack tooth: '//trim(msg))
+      call internal_tooth_stiffness(zz, mm, aa, bb, mm*(zz/2 + 1.25_wp), mm*(zz/2 - 1), ee, vv, &
+           mm*zz/2, nref, kb, ks, ka, ierr, msg)
+      dev = [kb*cb, ks*cs, ka*ca] - 1
+      print '(a,i1,a,3es13.5,a,3es9.1)', '   internal z=1e', k, ' k_b, k_s, k_a: ', kb, ks, ka, '  rel.diff', dev
+      dev_int(:, k - 2) = dev
+      call must(ierr == 0, 'internal rack tooth: '//trim(msg))
+    end do
+    ! the involute tooth differs from the trapezoid by O(m/R) = O(1/z): deviations must fall
+    ! tenfold per decade of z and be below 3e-4 at z = 1e5
+    print '(a)', '   (checks: |rel.diff| < 3e-4 at z=1e5 and ratio of z=1e4 to z=1e5 deviations in [8, 12])'
+    call must(all(abs(dev_ext(:, 3)) < 3e-4_wp) .and. all(abs(dev_int(:, 3)) < 3e-4_wp), &
+         'rack limit not reached at z = 1e5')
+    call must(all(abs(dev_ext(:, 2)/dev_ext(:, 3) - 10) < 2) .and. &
+         all(abs(dev_int(:, 2)/dev_int(:, 3) - 10) < 2), 'rack limit not approached as 1/z')
+  end subroutine rack_limit
+
+end program stiffness_check
