@@ -63,9 +63,8 @@ program spline_dyn
   end do
   write(u, '(a)') ''
   do k = 1, m%n_out
-    write(u, '(es24.16e3)', advance='no') t(k)
-    write(u, '(*(",",es24.16e3))', advance='no') y(:, k), tm(k), abs(tm(k))/m%t_d
-    write(u, '(*(",",es24.16e3))') ((tooth(k, j, q), j = 1, m%z), q = 1, ntooth_q)
+    write(u, '(es24.16e3,*(:,",",es24.16e3))') t(k), y(:, k), tm(k), abs(tm(k))/m%t_d, &
+         ((tooth(k, j, q), j = 1, m%z), q = 1, ntooth_q)
   end do
   close(u)
 
@@ -90,7 +89,7 @@ contains
   subroutine die(msg)
     character(len=*), intent(in) :: msg
     write(0, '(a)') 'spline-dyn: error: '//trim(msg)
-    error stop 1
+    stop 1, quiet=.true.
   end subroutine die
 
 end program spline_dyn

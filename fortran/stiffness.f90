@@ -105,10 +105,13 @@ contains
   !> Bending, shear and axial-compression stiffness [N/m] of ONE internal (ring) tooth loaded at
   !> radius r_contact. Formulation: slice-beam (variable-section cantilever) integration of the
   !> exact internal involute profile with the same energy expressions as the external tooth
-  !> (Yang & Lin 1987 / Tian 2004), as in the ring-tooth model of Chen & Shao (2013, Mech. Mach.
-  !> Theory 62: 63-74), here written out from first principles (not transcribed from their
-  !> printed integrals). Geometry: the SPACE of the ring is pi m / 2 at the pitch circle, so the
-  !> space half angle is pi/(2z) + inv(alpha) - inv(alpha_r) and the ring tooth half angle is
+  !> (Yang & Lin 1987 / Tian 2004). This is the approach of the ring-tooth model of Chen & Shao
+  !> (2013, Mech. Mach. Theory 69: 1-12), derived here from first principles; their printed
+  !> integrals were not available to compare term by term (the ring-rim deformation of that paper
+  !> is not included: the tooth is clamped at its root circle). Checked in tests/stiffness_check.f90
+  !> against the rack (z -> infinity) closed form.
+  !> Geometry: the SPACE of the ring is pi m / 2 at the pitch circle, so the space half angle is
+  !> pi/(2z) + inv(alpha) - inv(alpha_r) and the ring tooth half angle is
   !> psi(r) = pi/(2z) - inv(alpha) + inv(alpha_r): it thickens towards its root (larger r).
   !> The ring tooth is clamped at its root circle r_root (the LARGER radius) and free at its tip
   !> r_tip; the loaded part runs from r_contact out to r_root. The force on the ring tooth,

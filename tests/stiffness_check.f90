@@ -1,5 +1,6 @@
 !> Standalone check of module spline_stiffness (MODEL.md Section 7, Eq. 18). Build and run:
 !>   gfortran -O2 fortran/kinds.f90 fortran/stiffness.f90 tests/stiffness_check.f90 -o /tmp/stiff && /tmp/stiff
+!> (add -J /tmp to keep the .mod files out of the source tree)
 !> Prints: the spline's terms (MODEL.md Section 8), a convergence table in nquad, the spur gear
 !> of Tian (2004) / Chen & Shao (2011) at its pitch point, two independent cross-checks
 !> (Tian's closed-form integrands in his angle variable, and the rack / trapezoid closed form
@@ -37,15 +38,22 @@ program stiffness_check
   print '(a,es14.6,a)', '   k_a2 (internal, axial)    ', ka2, ' N/m'
   print '(a,es14.6,a)', '   k_m  (Eq. 18)             ', km, ' N/m'
   call must(km > 1e8_wp .and. km < 3e9_wp, 'k_m outside the expected 1e8 - 3e9 N/m')
+  ! context only (different method, includes gear-body compliance): ISO 6336-1 single stiffness
+  ! c' = c'_th C_M C_R C_B b, c'_th = 1/q', q' = 0.04723 + 0.15551/z1 + 0.25791/z2 (x = 0; z2 = inf
+  ! for an internal gear), C_M = 0.8, C_R = 1, C_B = (1 + 0.5 (1.2 - h_fP/m)) (1 - 0.02 (20 - alpha_deg));
+  ! spline: h_fP = 0.75 m, alpha = 30 deg (outside the range ISO 6336 was fitted on).
+  print '(a,es11.3,a)', '   ISO 6336-1 c''*b (indicative, h_fP=0.75m):', iso_cprime(16.0_wp, huge(1.0_wp), &
+       0.75_wp, 30.0_wp)*b*1e9_wp, ' N/m'
 
   ! ---------------- 2. convergence in nquad -----------------------------------------------------
   ref = [kb1, ks1, ka1, kb2, ks2, ka2, km]
   print '(/a)', '== Convergence (relative difference to nquad = 64) =='
-  print '(a)', '  nquad       k_b1       k_s1       k_a1       k_b2       k_s2       k_a2        k_m'
+  print '(a)', '  nquad       k_b1       k_s1       k_a1       k_b2       k_s2       k_a2        k_m' // &
+       '    k_m [N/m]'
   do i = 1, size(nq)
     call spline_mesh_stiffness(z, m, alpha, b, e, nu, 14.5e-3_wp, 17.5e-3_wp, 15e-3_wp, nq(i), &
          kh, cur(1), cur(2), cur(3), cur(4), cur(5), cur(6), cur(7), ierr, msg)
-    print '(i7,7es11.2)', nq(i), abs(cur/ref - 1.0_wp)
+    print '(i7,7es11.2,es18.10)', nq(i), abs(cur/ref - 1.0_wp), cur(7)
     call must(all(abs(cur/ref - 1.0_wp) < merge(1e-8_wp, 1e-12_wp, nq(i) < 16)), &
          'not converged (tolerance 1e-8 at nquad = 8, 1e-12 from nquad = 16)')
   end do
@@ -124,7 +132,17 @@ contains
     print '(a,3es13.5)', '   gear   k_b, k_s, k_a [N/m]: ', kbg, ksg, kag
     print '(a,es13.5)',  '   k_h [N/m]:                   ', khh
     print '(a,es13.5)',  '   single-pair k at pitch [N/m]:', kmm
+    print '(a,es13.5)',  '   ISO 6336-1 c''*b (context) :  ', iso_cprime(z1, z2, 1.25_wp, 20.0_wp)*bb*1e9_wp
   end subroutine spur_gear_case
+
+  !> ISO 6336-1:2006 single stiffness c' [N/(mm um)] for x1 = x2 = 0, beta = 0, solid blanks.
+  real(wp) function iso_cprime(z1, z2, hfp_over_m, alpha_deg) result(c)
+    real(wp), intent(in) :: z1, z2, hfp_over_m, alpha_deg
+    real(wp) :: q, cb
+    q = 0.04723_wp + 0.15551_wp/z1 + 0.25791_wp/z2
+    cb = (1 + 0.5_wp*(1.2_wp - hfp_over_m))*(1 - 0.02_wp*(20 - alpha_deg))
+    c = 0.8_wp*cb/q
+  end function iso_cprime
 
   !> Independent evaluation of Tian's (2004) integrals in his angle variable a in [-a1, a_hi]
   !> (a_hi = alpha_2 if the root is inside the base circle, else alpha_2 - t_root), composite

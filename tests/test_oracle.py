@@ -1,0 +1,62 @@
+"""The Fortran right-hand side against the independent numpy oracle (tests/oracle.py), written
+from MODEL.md by someone who did not read the Fortran."""
+import numpy as np
+import pytest
+
+import oracle
+import pyspline
+from conftest import PAPER
+
+
+def random_states(case, n, rng):
+    c0 = case["c0"]
+    ys = []
+    for _ in range(n):
+        q = np.r_[rng.uniform(-2, 2, 4) * c0,              # lateral: in and out of contact
+                  rng.uniform(-300, 300) * c0,             # D1 (shaft twist is large)
+                  rng.uniform(-6, 6) * c0,                 # D2 across the dead zone
+                  rng.uniform(-300, 300) * c0]
+        v = rng.uniform(-0.2, 0.2, 7)
+        ys.append(np.r_[q, v])
+    return ys
+
+
+CASES = {
+    "aligned": dict(PAPER),
+    "misaligned": dict(PAPER, l_x=1e-4, l_y=-3e-5),
+    "bulk": dict(PAPER, l_x=1e-4, thermal="bulk", t_bulk=100.0),
+    "oneway": dict(PAPER, l_x=1e-4, thermal="oneway", t_bulk=50.0),
+    "coupled": dict(PAPER, l_x=1e-4, thermal="coupled", t_bulk=100.0, f_m=0.3),
+    "slow_z7": dict(PAPER, z=7, speed_rpm=300.0, l_x=5e-5, l_y=5e-5, grav=0.0),
+}
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_rhs_matches_oracle(name, tmp_path):
+    case = pyspline.load_case(dict(CASES[name], name=name))
+    path = tmp_path / "c.nml"
+    case.to_namelist(path)
+    p = oracle.prepare(dict(case))
+    rng = np.random.default_rng(abs(hash(name)) % 2**32)
+    n_free = n_contact = 0
+    for y in random_states(case, 40, rng):
+        t = rng.uniform(0, 0.05)
+        f, mesh, tm = pyspline.core.rhs_at_path(str(path), case["z"], t, y)
+        o = oracle.mesh(t, y, p)
+        fo = oracle.rhs(t, y, p)
+        scale_f = case["k_m"] * case["c0"]
+        np.testing.assert_allclose(f, fo, rtol=1e-12, atol=1e-12 * np.abs(fo).max())
+        for q in ("F", "Fx", "Fy"):
+            np.testing.assert_allclose(mesh[q], o[q], rtol=1e-12, atol=1e-12 * scale_f)
+        for q in ("dn", "c"):
+            np.testing.assert_allclose(mesh[q], o[q], rtol=1e-12, atol=1e-12 * case["c0"])
+        np.testing.assert_allclose(tm, o["Tm"], rtol=1e-12, atol=1e-12 * scale_f * 0.02)
+        if case["thermal"] in ("oneway", "coupled"):
+            np.testing.assert_allclose(mesh["rc1"], o["rc1"], rtol=1e-12)
+            np.testing.assert_allclose(mesh["rc2"], o["rc2"], rtol=1e-12)
+            np.testing.assert_allclose(mesh["Tf"], o["Tf"], rtol=1e-10, atol=1e-12)
+        contact = np.abs(o["dn"]) > o["c"]
+        n_contact += contact.sum()
+        n_free += (~contact).sum()
+    # the random states exercised both sides of the dead zone
+    assert n_contact > 50 and n_free > 50

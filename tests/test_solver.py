@@ -1,0 +1,58 @@
+"""Convergence, root finding, methods, and the executable against Python."""
+import subprocess
+
+import numpy as np
+import pytest
+
+import pyspline
+from conftest import CASES, PAPER
+
+SHORT = dict(t_end=0.1, n_out=401)
+
+
+def run(**kw):
+    return pyspline.simulate(dict(PAPER, name="conv", l_x=1e-4, start="rest", **SHORT) | kw)
+
+
+def err(a, b):
+    return np.abs(a.Tm - b.Tm).max() / np.abs(b.Tm).max()
+
+
+def test_converges_as_rtol_tightens():
+    ref = run(rtol=1e-12, atol=1e-14, roots=True)
+    errs = [err(run(rtol=r, atol=r * 1e-2), ref) for r in (1e-5, 1e-7, 1e-9)]
+    assert errs[0] > errs[1] > errs[2]
+    assert errs[2] < 1e-6
+
+
+@pytest.mark.parametrize("method,roots", [("bdf", True), ("adams", False), ("adams", True)])
+def test_methods_agree(method, roots):
+    ref = run(rtol=1e-11, atol=1e-13)
+    res = run(rtol=1e-9, atol=1e-11, method=method, roots=roots)
+    assert err(res, ref) < 1e-5
+
+
+def test_root_finding_locates_switches():
+    """From rest the teeth engage: root finding sees the engagement and restarts there."""
+    res = run(rtol=1e-8, roots=True)
+    assert res.stats["roots_found"] >= res.case["z"]
+    assert res.stats["mode_resyncs"] == 0
+
+
+@pytest.mark.parametrize("name", ["paper_ideal", "paper_lx5e-5", "paper_lx1e-4"])
+def test_executable_matches_python(name, exe, tmp_path):
+    case = pyspline.load_case(CASES / f"{name}.nml", t_end=0.1, n_out=641)
+    nml = tmp_path / f"{name}.nml"
+    case.to_namelist(nml)
+    out = tmp_path / "out.csv"
+    subprocess.run([exe, str(nml), "-o", str(out)], check=True, capture_output=True)
+    header = [ln for ln in out.read_text().splitlines() if not ln.startswith("#")][0].split(",")
+    data = np.loadtxt(out, delimiter=",", comments="#", skiprows=4)
+    res = pyspline.simulate(case)
+    col = {h.split(" [")[0]: i for i, h in enumerate(header)}
+    assert header[0] == "t [s]" and "F_16 [N]" in header and "Tm [N m]" in header
+    np.testing.assert_array_equal(data[:, col["t"]], res.t)
+    np.testing.assert_array_equal(data[:, col["D2"]], res.D2)
+    np.testing.assert_array_equal(data[:, col["Tm"]], res.Tm)
+    np.testing.assert_array_equal(data[:, col["F_1"]:col["F_16"] + 1], res.tooth["F"])
+    np.testing.assert_array_equal(data[:, col["kv"]], res.kv)
