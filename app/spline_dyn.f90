@@ -4,7 +4,7 @@
 !>   usage: spline-dyn CASE.nml [-o OUT.csv]
 program spline_dyn
   use spline_kinds, only: wp
-  use spline_case_io, only: model_t, case_read_file, case_name_of, nstate
+  use spline_case_io, only: model_t, case_read_file, case_name_of, nstate, nkterms, kterm_names
   use spline_run, only: run_case, ntooth_q, tooth_q_names, tooth_q_units
   use spline_solver, only: nstats, stat_names
   implicit none
@@ -45,6 +45,8 @@ program spline_dyn
   if (ierr /= 0) call die('cannot write '//trim(out))
   write(u, '(a)') '# spline-dyn output (pyspline): SI units, per-tooth columns Q_j for teeth j = 1..Z'
   write(u, '(a)') '# case: '//trim(m%name)//' ('//trim(path)//')'
+  write(u, '(a,es24.16e3,a)') '# k_m: ', m%k_m, merge(' N/m (computed, Eq. 18)', ' N/m (case)            ', &
+       m%k_m_computed)
   write(u, '(a)', advance='no') '# stats:'
   do i = 1, nstats
     write(u, '(1x,a,"=",g0)', advance='no') trim(stat_names(i)), stats(i)
@@ -69,6 +71,13 @@ program spline_dyn
   close(u)
 
   write(*, '(a)') 'case '//trim(m%name)//': '//trim(out)
+  write(*, '(a)', advance='no') '  mesh stiffness, potential energy method (Eq. 18) [N/m]:'
+  do i = 1, nkterms
+    write(*, '(1x,a,"=",es11.4)', advance='no') trim(kterm_names(i)), m%k_terms(i)
+  end do
+  write(*, '(a)') ''
+  write(*, '(a,es11.4,a)') '  k_m used: ', m%k_m, merge(' N/m (computed)', ' N/m (case)    ', &
+       m%k_m_computed)
   write(*, '(a,i0,a,es10.3,a,es10.3,a)') '  outputs ', m%n_out, ' on [', t(1), ', ', t(m%n_out), '] s'
   write(*, '(a,2es12.4)') '  meshing torque T_m min/max [N m]: ', minval(tm), maxval(tm)
   write(*, '(a,2es12.4)') '  tooth force F_j min/max [N]:      ', minval(tooth(:, :, 1)), &

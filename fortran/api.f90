@@ -6,7 +6,8 @@
 module spline_api
   use, intrinsic :: iso_c_binding, only: c_double, c_int
   use spline_kinds, only: wp
-  use spline_case_io, only: model_t, case_read_file, case_write_defaults, nstate, ndof
+  use spline_case_io, only: model_t, case_read_file, case_write_defaults, nstate, ndof, nkterms
+  use spline_stiffness, only: external_tooth_stiffness, internal_tooth_stiffness
   use spline_dynamics, only: accelerations, start_state
   use spline_mesh, only: mesh_eval
   use spline_run, only: run_case, ntooth_q, tooth_q_names, tooth_q_units
@@ -14,6 +15,7 @@ module spline_api
   implicit none
   private
   public :: api_sizes, api_simulate, api_rhs, api_start_state, api_write_defaults, api_names
+  public :: api_mesh_stiffness, api_tooth_stiffness
 
 contains
 
@@ -99,6 +101,46 @@ contains
     if (ie == 0) call start_state(m, y, ie, errmsg)
     ierr = ie
   end subroutine api_start_state
+
+  !> Eq. 18 terms of a case (k_h, k_b1, k_s1, k_a1, k_b2, k_s2, k_a2, k_m of the geometry) and
+  !> the k_m the case uses (computed when the case leaves k_m = 0).
+  subroutine api_mesh_stiffness(path, terms, k_used, computed, ierr, errmsg)
+    character(len=*), intent(in) :: path
+    real(c_double), intent(out) :: terms(8), k_used
+    integer(c_int), intent(out) :: computed, ierr
+    character(len=512), intent(out) :: errmsg
+    type(model_t) :: m
+    integer :: ie
+    terms = 0; k_used = 0; computed = 0
+    call case_read_file(path, m, ie, errmsg)
+    if (ie == 0) then
+      terms = m%k_terms(1:nkterms)
+      k_used = m%k_m
+      computed = merge(1, 0, m%k_m_computed)
+    end if
+    ierr = ie
+  end subroutine api_mesh_stiffness
+
+  !> Bending, shear and axial stiffness of one involute tooth (potential energy method) for any
+  !> gear: external (internal = 0; r_tip unused) or internal (ring) tooth. Angles in radians.
+  subroutine api_tooth_stiffness(internal, z, m, alpha, b, r_root, r_tip, e, nu, r_contact, &
+       nquad, kb, ks, ka, ierr, errmsg)
+    integer(c_int), intent(in) :: internal, nquad
+    real(c_double), intent(in) :: z, m, alpha, b, r_root, r_tip, e, nu, r_contact
+    real(c_double), intent(out) :: kb, ks, ka
+    integer(c_int), intent(out) :: ierr
+    character(len=512), intent(out) :: errmsg
+    integer :: ie
+    if (internal /= 0) then
+      call internal_tooth_stiffness(z, m, alpha, b, r_root, r_tip, e, nu, r_contact, nquad, &
+           kb, ks, ka, ie, errmsg)
+    else
+      call external_tooth_stiffness(z, m, alpha, b, r_root, e, nu, r_contact, nquad, &
+           kb, ks, ka, ie, errmsg)
+    end if
+    ierr = ie
+    if (ie == 0) errmsg = ''
+  end subroutine api_tooth_stiffness
 
   !> Write the default case (every field) as a namelist file.
   subroutine api_write_defaults(path, ierr, errmsg)

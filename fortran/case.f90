@@ -6,17 +6,22 @@
 !> variables; `case_defaults` resets them before every read, so nothing leaks between cases.
 module spline_case_io
   use spline_kinds, only: wp, pi
+  use spline_stiffness, only: spline_mesh_stiffness
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
   public :: model_t, case_read_file, case_read_string, case_write_defaults, case_to_model
   public :: nstate, ndof, thermal_none, thermal_bulk, thermal_oneway, thermal_coupled
-  public :: case_name_of
+  public :: case_name_of, nkterms, kterm_names
 
   integer, parameter :: ndof = 7            !< x1, y1, x2, y2, D1, D2, D3 (Eq. 24)
   integer, parameter :: nstate = 2*ndof     !< displacements then velocities
   integer, parameter :: thermal_none = 0, thermal_bulk = 1, thermal_oneway = 2, thermal_coupled = 3
   integer, parameter :: namelen = 64
+  integer, parameter :: nkterms = 8         !< terms of Eq. 18 reported with every case
+  character(len=4), parameter :: kterm_names(nkterms) = [character(len=4) :: &
+       'k_h', 'k_b1', 'k_s1', 'k_a1', 'k_b2', 'k_s2', 'k_a2', 'k_m']
+  integer, parameter :: stiffness_nquad = 32   !< Gauss points: converged to 1e-15 from 16 on
 
   ! ---- namelist fields (declared here, given values in case_defaults only) ----
   character(len=namelen) :: name            ! case name, used in messages
@@ -83,7 +88,8 @@ module spline_case_io
     real(wp) :: theta0                      !< pi / (2 Z)  (Eq. 9)
     real(wp) :: kappa                       !< 2 lambda s cos(alpha): backlash loss per degC (Eq. 2)
     real(wp) :: c_bulk                      !< backlash with the bulk rise only [m]
-    logical  :: k_m_computed = .false.
+    logical  :: k_m_computed = .false.      !< k_m from Eq. 18 (the case left k_m = 0)
+    real(wp) :: k_terms(nkterms) = 0.0_wp   !< Eq. 18 terms k_h, k_b1, ..., k_m (0: not computable)
   end type model_t
 
 contains
@@ -233,10 +239,6 @@ contains
     if (.not. nonneg(c_t1, 'c_t1')) return
     if (.not. nonneg(c_t2, 'c_t2')) return
     if (.not. nonneg(k_m, 'k_m')) return
-    if (k_m == 0.0_wp) then
-      call fail('k_m', 'is 0 (= computed by the potential energy method, Eq. 18), which this '// &
-           'build does not provide yet: set k_m in N/m'); return
-    end if
     if (.not. nonneg(c_m, 'c_m')) return
     if (.not. in_range(speed_rpm, 0.0_wp, 1.0e6_wp, 'speed_rpm', 'r/min, not negative')) return
     if (max(abs(l_x), abs(l_y)) > 0.5_wp*module_m*z) then
@@ -265,6 +267,25 @@ contains
     m%k_p1 = k_p1; m%k_p2 = k_p2; m%c_p1 = c_p1; m%c_p2 = c_p2
     m%k_t1 = k_t1; m%k_t2 = k_t2; m%c_t1 = c_t1; m%c_t2 = c_t2
     m%k_m = k_m; m%c_m = c_m; m%t_d = t_d; m%t_l = t_l
+    ! Eq. 18 at the pitch point, ISO 4156 flat-root radii: external minor m (Z - 1.5) / 2,
+    ! internal major m (Z + 1.5) / 2 and minor m (Z - 1) / 2. Always reported; used if k_m = 0.
+    call spline_mesh_stiffness(real(z, wp), module_m, alpha_deg*pi/180.0_wp, b, e_mod, nu, &
+         0.5_wp*module_m*(z - 1.5_wp), 0.5_wp*module_m*(z + 1.5_wp), 0.5_wp*module_m*(z - 1.0_wp), &
+         stiffness_nquad, m%k_terms(1), m%k_terms(2), m%k_terms(3), m%k_terms(4), m%k_terms(5), &
+         m%k_terms(6), m%k_terms(7), m%k_terms(8), ierr, errmsg)
+    if (ierr /= 0) then
+      m%k_terms = 0.0_wp
+      if (k_m == 0.0_wp) then
+        ierr = 1
+        call fail('k_m', '= 0 asks for the potential-energy stiffness (Eq. 18), which fails for '// &
+             'this geometry: '//trim(errmsg)//'; set k_m in N/m'); return
+      end if
+    end if
+    ierr = 1
+    if (k_m == 0.0_wp) then
+      m%k_m = m%k_terms(8)
+      m%k_m_computed = .true.
+    end if
     m%omega = speed_rpm*2.0_wp*pi/60.0_wp; m%grav = grav; m%l_x = l_x; m%l_y = l_y
     m%t_bulk = t_bulk; m%f_m = f_m; m%u_flash = u_flash; m%eta_hertz = eta_hertz
     m%rtol = rtol; m%atol = atol; m%max_steps = max_steps; m%n_out = n_out
@@ -316,6 +337,7 @@ contains
     m%w_ref = w_ref
     if (m%w_ref == 0.0_wp) m%w_ref = m%omega
     if (m%w_ref == 0.0_wp) m%w_ref = sqrt(max(m%k_p1, m%k_m)/m%m_1)
+    errmsg = ''
     ierr = 0
 
   contains

@@ -18,15 +18,15 @@ contains
   !>   D1'' = r_b ((T_m - S1)/J_1 - (T_d + S1)/J_M)
   !>   D2'' = r_b ((-T_m - S3)/J_2 - (T_m - S1)/J_1)
   !>   D3'' = r_b ((-T_m - S3)/J_2 - (S3 - T_L)/J_L)
-  subroutine accelerations(m, t, q, v, a, ierr, errmsg, mode)
+  subroutine accelerations(m, t, q, v, a, ierr, errmsg, mode, branch)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(ndof), v(ndof)
     real(wp), intent(out) :: a(ndof)
     integer, intent(out) :: ierr
     character(len=*), intent(inout) :: errmsg
-    integer, intent(in), optional :: mode(m%z)
+    integer, intent(in), optional :: mode(m%z), branch(2, m%z)
     real(wp) :: fx1, fy1, tm, s1, s3, th1dd
-    call mesh_eval(m, t, q, v, fx1, fy1, tm, ierr, errmsg, mode=mode)
+    call mesh_eval(m, t, q, v, fx1, fy1, tm, ierr, errmsg, mode=mode, branch=branch)
     if (ierr /= 0) return
     a(1) = (fx1 - m%c_p1*v(1) - m%k_p1*q(1))/m%m_1
     a(2) = (fy1 - m%c_p1*v(2) - m%k_p1*q(2))/m%m_1 - m%grav
@@ -58,16 +58,16 @@ contains
   end subroutine from_scaled
 
   !> Eq. 25: d(ys)/d(tau) for the scaled state, ys' = (vs, a / (l w^2)).
-  subroutine rhs_scaled(m, tau, ys, dys, ierr, errmsg, mode)
+  subroutine rhs_scaled(m, tau, ys, dys, ierr, errmsg, mode, branch)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: tau, ys(nstate)
     real(wp), intent(out) :: dys(nstate)
     integer, intent(out) :: ierr
     character(len=*), intent(inout) :: errmsg
-    integer, intent(in), optional :: mode(m%z)
+    integer, intent(in), optional :: mode(m%z), branch(2, m%z)
     real(wp) :: y(nstate), a(ndof)
     call from_scaled(m, ys, y)
-    call accelerations(m, tau/m%w_ref, y(1:ndof), y(ndof+1:), a, ierr, errmsg, mode)
+    call accelerations(m, tau/m%w_ref, y(1:ndof), y(ndof+1:), a, ierr, errmsg, mode, branch)
     dys(1:ndof) = ys(ndof+1:)
     dys(ndof+1:) = a/(m%l_ref*m%w_ref**2)
   end subroutine rhs_scaled

@@ -25,8 +25,10 @@ contains
   !> used between the located switches; without it the state decides (|dn_j| > c_j, Eq. 16).
   !> flash (optional, default false): compute T_f and the contact radii even when the thermal
   !> level does not feed them back (one-way post-processing and output).
+  !> branch (optional): frozen root (-1) / tip (+1) branch of Eqs. 13-14 for spline 1 (row 1) and
+  !> 2 (row 2) of every tooth, used between located branch switches; else the sign of dDelta/dt.
   subroutine mesh_eval(m, t, q, v, fx1, fy1, tm, ierr, errmsg, mode, flash, dn, c, f, tf, rc1, rc2, &
-       sphi_out, cphi_out)
+       sphi_out, cphi_out, branch)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(7), v(7)
     real(wp), intent(out) :: fx1, fy1, tm
@@ -34,6 +36,7 @@ contains
     character(len=*), intent(inout) :: errmsg
     integer, intent(in), optional :: mode(m%z)
     logical, intent(in), optional :: flash
+    integer, intent(in), optional :: branch(2, m%z)
     real(wp), intent(out), optional, dimension(m%z) :: dn, c, f, tf, rc1, rc2, sphi_out, cphi_out
     real(wp) :: sp(m%z), cp(m%z)
     real(wp) :: ex, ey, evx, evy, dnj, ddnj, cj, fj, tfj, r1, r2, sumf
@@ -63,7 +66,13 @@ contains
       cj = m%c_bulk
       tfj = 0.0_wp
       r1 = m%r_pitch; r2 = m%r_pitch
-      if (want_flash) call contact_radii(m, q, v, sp(j), cp(j), r1, r2)
+      if (want_flash) then
+        if (present(branch)) then
+          call contact_radii(m, q, v, sp(j), cp(j), r1, r2, branch(:, j))
+        else
+          call contact_radii(m, q, v, sp(j), cp(j), r1, r2)
+        end if
+      end if
       if (mj /= 0) then
         if (coupled) then
           call solve_coupled(m, dnj, ddnj, mj, r1, r2, fj, tfj, ierr)
@@ -117,14 +126,18 @@ contains
   end function contact_force
 
   !> Eqs. 12-14: contact-point radii of tooth pair (sp, cp) on spline 1 (misaligned centre) and 2.
-  pure subroutine contact_radii(m, q, v, sp, cp, r1, r2)
+  !> The branch is the sign of dDelta/dt, or the frozen branch br (-1 root, +1 tip) if given.
+  pure subroutine contact_radii(m, q, v, sp, cp, r1, r2, br)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: q(7), v(7), sp, cp
     real(wp), intent(out) :: r1, r2
+    integer, intent(in), optional :: br(2)
     real(wp) :: d, dd
     call profile_shift(q(1) + m%l_x, q(2) + m%l_y, v(1), v(2), m%omega, sp, cp, d, dd)
+    if (present(br)) dd = br(1)
     r1 = contact_radius(d, dd, m%r_pitch, m%alpha)
     call profile_shift(q(3), q(4), v(3), v(4), m%omega, sp, cp, d, dd)
+    if (present(br)) dd = br(2)
     r2 = contact_radius(d, dd, m%r_pitch, m%alpha)
   end subroutine contact_radii
 
@@ -193,12 +206,16 @@ contains
   end subroutine solve_coupled
 
   !> Root functions for the contact switches of Eq. 16: g_{2j-1} = dn_j - c_j, g_{2j} = dn_j + c_j
-  !> (with the backlash at the bulk temperature, which decides the contact state).
-  subroutine mesh_switch_functions(m, t, q, g)
+  !> (with the backlash at the bulk temperature, which decides the contact state), and, if gb is
+  !> present, for the root/tip branch switches of Eqs. 13-14: gb_{2j-1} = dDelta_1j/dt,
+  !> gb_{2j} = dDelta_2j/dt (needs the velocities v).
+  subroutine mesh_switch_functions(m, t, q, g, v, gb)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(7)
     real(wp), intent(out) :: g(2*m%z)
-    real(wp) :: sp(m%z), cp(m%z), ex, ey, dnj
+    real(wp), intent(in), optional :: v(7)
+    real(wp), intent(out), optional :: gb(2*m%z)
+    real(wp) :: sp(m%z), cp(m%z), ex, ey, dnj, d
     integer :: j
     call tooth_angles(m%z, m%omega, t, m%theta0, m%alpha, sp, cp)
     ex = q(1) + m%l_x - q(3)
@@ -207,6 +224,11 @@ contains
       dnj = ex*sp(j) - ey*cp(j) + q(6)
       g(2*j - 1) = dnj - m%c_bulk
       g(2*j) = dnj + m%c_bulk
+      if (present(gb)) then
+        call profile_shift(q(1) + m%l_x, q(2) + m%l_y, v(1), v(2), m%omega, sp(j), cp(j), d, &
+             gb(2*j - 1))
+        call profile_shift(q(3), q(4), v(3), v(4), m%omega, sp(j), cp(j), d, gb(2*j))
+      end if
     end do
   end subroutine mesh_switch_functions
 

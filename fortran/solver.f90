@@ -12,7 +12,7 @@ module spline_solver
   use fsunmatrix_dense_mod
   use fsunlinsol_dense_mod
   use spline_kinds, only: wp
-  use spline_case_io, only: model_t, nstate, ndof
+  use spline_case_io, only: model_t, nstate, ndof, thermal_coupled
   use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled
   use spline_mesh, only: mesh_switch_functions, coupling_stats_reset, coupling_worst_residual, &
        coupling_max_iterations
@@ -27,9 +27,11 @@ module spline_solver
        'mode_resyncs', 'coupling_residual_degC', 'coupling_iterations']
 
   ! What the C callbacks see (CVODE calls them without our arguments): the model being
-  ! integrated, the frozen contact states between located switches, and the first error.
+  ! integrated, the frozen contact states between located switches (allocated only when
+  ! root finding is on: an unallocated array is an absent optional argument), the frozen
+  ! root/tip branches of Eqs. 13-14 (coupled flash temperature only), and the first error.
   type(model_t), save :: mdl
-  integer, allocatable, save :: modes(:)
+  integer, allocatable, save :: modes(:), branches(:, :)
   logical, save :: frozen = .false.
   integer, save :: cb_ierr = 0
   character(len=512), save :: cb_msg = ''
@@ -55,9 +57,10 @@ contains
     type(N_Vector), pointer :: sv
     type(SUNMatrix), pointer :: amat
     type(SUNLinearSolver), pointer :: ls
-    integer(c_int) :: flag, rootsfound(2*m%z)
+    integer(c_int) :: flag, nroot
+    integer(c_int), allocatable :: rootsfound(:)
     integer(c_long) :: cnt(1)
-    integer :: k, nroots, nresync
+    integer :: k, k0, nroots, nresync
 
     ierr = 0
     errmsg = ''
@@ -67,11 +70,22 @@ contains
     nroots = 0; nresync = 0
     call coupling_stats_reset()
     if (allocated(modes)) deallocate(modes)
-    allocate(modes(m%z))
+    if (allocated(branches)) deallocate(branches)
     frozen = m%roots
+    nroot = 0
+    if (frozen) then
+      allocate(modes(m%z))
+      nroot = 2*m%z
+      if (m%thermal == thermal_coupled) then
+        allocate(branches(2, m%z))
+        nroot = 4*m%z
+      end if
+    end if
+    allocate(rootsfound(nroot))
     call to_scaled(m, y0, ys)
     tau = m%t0*m%w_ref
-    if (frozen) call sync_modes(tau, ys, modes, k)
+    k = 0
+    if (frozen) call sync_modes(tau, ys, k)
 
     ctx = sundials_context_new()
     sv => FN_VMake_Serial(int(nstate, c_long), ys, ctx)
@@ -87,7 +101,7 @@ contains
     if (flag == 0) flag = FCVodeSStolerances(mem, real(m%rtol, c_double), real(m%atol, c_double))
     if (flag == 0) flag = FCVodeSetLinearSolver(mem, ls, amat)
     if (flag == 0) flag = FCVodeSetMaxNumSteps(mem, int(m%max_steps, c_long))
-    if (flag == 0 .and. frozen) flag = FCVodeRootInit(mem, int(2*m%z, c_int), c_funloc(roots_cb))
+    if (flag == 0 .and. frozen) flag = FCVodeRootInit(mem, nroot, c_funloc(roots_cb))
     if (flag == 0 .and. frozen) flag = FCVodeSetNoInactiveRootWarn(mem)
     if (flag /= 0) then
       call fail(flag, tau, 'setting up CVODE')
@@ -102,7 +116,7 @@ contains
           if (flag == CV_ROOT_RETURN) then
             ! Step onto the switch, flip the states of the teeth that crossed, restart.
             flag = FCVodeGetRootInfo(mem, rootsfound)
-            call apply_roots(rootsfound, modes, nroots)
+            call apply_roots(rootsfound, nroots)
             flag = FCVodeReInit(mem, tau, sv)
             if (flag < 0) exit
           end if
@@ -113,8 +127,9 @@ contains
         end if
         ! Safety net: a grazing contact can touch a switch without a sign change over a step.
         if (frozen) then
-          call sync_modes(tau, ys, modes, nresync)
-          if (nresync > 0 .and. k < nt) flag = FCVodeReInit(mem, tau, sv)
+          k0 = nresync
+          call sync_modes(tau, ys, nresync)
+          if (nresync > k0 .and. k < nt) flag = FCVodeReInit(mem, tau, sv)
         end if
         call from_scaled(m, ys, yout(:, k))
         if (frozen) then
@@ -174,40 +189,53 @@ contains
     flag = FSUNContext_Create(c_null_ptr, ctx)
   end function sundials_context_new
 
-  !> Contact states from the sign of the switch functions g = dn -+ c. Counts the teeth whose
-  !> stored state disagreed clearly (beyond round-off) with the state: that would be a missed switch.
-  subroutine sync_modes(tau, ys, md, nchanged)
+  !> Contact states (and branches) from the sign of the switch functions. Counts the switches
+  !> whose stored state disagreed clearly (beyond round-off) with the state: a missed switch.
+  subroutine sync_modes(tau, ys, nchanged)
     real(c_double), intent(in) :: tau, ys(nstate)
-    integer, intent(inout) :: md(:)
     integer, intent(inout) :: nchanged
-    real(wp) :: y(nstate), g(2*mdl%z), eps
-    integer :: j, want
+    real(wp) :: y(nstate), g(2*mdl%z), gb(2*mdl%z), eps, epsv
+    integer :: j, i, want
     call from_scaled(mdl, ys, y)
-    call mesh_switch_functions(mdl, tau/mdl%w_ref, y(1:ndof), g)
+    call mesh_switch_functions(mdl, tau/mdl%w_ref, y(1:ndof), g, y(ndof+1:), gb)
     eps = 1.0e-9_wp*mdl%c_bulk
+    epsv = eps*mdl%w_ref
     do j = 1, mdl%z
       want = 0
       if (g(2*j - 1) > 0.0_wp) want = 1
       if (g(2*j) < 0.0_wp) want = -1
-      if (want /= md(j)) then
+      if (want /= modes(j)) then
         if (abs(g(2*j - 1)) > eps .and. abs(g(2*j)) > eps) nchanged = nchanged + 1
-        md(j) = want
+        modes(j) = want
       end if
+      if (.not. allocated(branches)) cycle
+      do i = 1, 2
+        want = merge(-1, 1, gb(2*j - 2 + i) < 0.0_wp)
+        if (want /= branches(i, j)) then
+          if (abs(gb(2*j - 2 + i)) > epsv) nchanged = nchanged + 1
+          branches(i, j) = want
+        end if
+      end do
     end do
   end subroutine sync_modes
 
   !> A located root of g_{2j-1} = dn_j - c_j (rising: drive flank engages, falling: it opens)
-  !> or of g_{2j} = dn_j + c_j (falling: back flank engages, rising: it opens).
-  subroutine apply_roots(rootsfound, md, nroots)
+  !> or of g_{2j} = dn_j + c_j (falling: back flank engages, rising: it opens); then, in coupled
+  !> mode, of dDelta_ij/dt (rising: the contact point moves to the tip, falling: to the root).
+  subroutine apply_roots(rootsfound, nroots)
     integer(c_int), intent(in) :: rootsfound(:)
-    integer, intent(inout) :: md(:)
     integer, intent(inout) :: nroots
-    integer :: j
-    do j = 1, size(md)
-      if (rootsfound(2*j - 1) == 1) md(j) = 1
-      if (rootsfound(2*j - 1) == -1) md(j) = 0
-      if (rootsfound(2*j) == -1) md(j) = -1
-      if (rootsfound(2*j) == 1) md(j) = 0
+    integer :: j, i, z
+    z = size(modes)
+    do j = 1, z
+      if (rootsfound(2*j - 1) == 1) modes(j) = 1
+      if (rootsfound(2*j - 1) == -1) modes(j) = 0
+      if (rootsfound(2*j) == -1) modes(j) = -1
+      if (rootsfound(2*j) == 1) modes(j) = 0
+      if (.not. allocated(branches)) cycle
+      do i = 1, 2
+        if (rootsfound(2*z + 2*j - 2 + i) /= 0) branches(i, j) = rootsfound(2*z + 2*j - 2 + i)
+      end do
     end do
     nroots = nroots + count(rootsfound /= 0)
   end subroutine apply_roots
@@ -220,11 +248,7 @@ contains
     integer :: ierr
     ys => FN_VGetArrayPointer(sv_y)
     fs => FN_VGetArrayPointer(sv_f)
-    if (frozen) then
-      call rhs_scaled(mdl, tau, ys, fs, ierr, cb_msg, modes)
-    else
-      call rhs_scaled(mdl, tau, ys, fs, ierr, cb_msg)
-    end if
+    call rhs_scaled(mdl, tau, ys, fs, ierr, cb_msg, modes, branches)   ! absent if unallocated
     ret = 0
     if (ierr /= 0) then
       cb_ierr = ierr
@@ -239,9 +263,16 @@ contains
     type(c_ptr), value :: udata
     real(c_double), pointer :: ys(:)
     real(wp) :: y(nstate)
+    integer :: z
     ys => FN_VGetArrayPointer(sv_y)
     call from_scaled(mdl, ys, y)
-    call mesh_switch_functions(mdl, tau/mdl%w_ref, y(1:ndof), gout(1:2*mdl%z))
+    z = mdl%z
+    if (allocated(branches)) then
+      call mesh_switch_functions(mdl, tau/mdl%w_ref, y(1:ndof), gout(1:2*z), y(ndof+1:), &
+           gout(2*z+1:4*z))
+    else
+      call mesh_switch_functions(mdl, tau/mdl%w_ref, y(1:ndof), gout(1:2*z))
+    end if
     ret = 0
   end function roots_cb
 

@@ -3,8 +3,9 @@ flash temperature (Xue, Shen & Xue 2025). The physics lives in the Fortran core 
 this package reads cases, runs them and plots them."""
 from .case import (Case, CaseError, SolverError, SplineError, ThermalInterferenceError,
                    defaults, load_case)
-from .core import Result, rhs, simulate, start_state
+from .core import Result, mesh_stiffness, rhs, simulate, start_state, tooth_stiffness
 
 __all__ = ["Case", "CaseError", "Result", "SolverError", "SplineError",
-           "ThermalInterferenceError", "defaults", "load_case", "rhs", "simulate", "start_state"]
+           "ThermalInterferenceError", "defaults", "load_case", "mesh_stiffness", "rhs", "simulate",
+           "start_state", "tooth_stiffness"]
 __version__ = "0.1.0"

@@ -106,3 +106,28 @@ def start_state(case) -> np.ndarray:
         y, ierr, msg = _api.api_start_state(path)
     raise_for(ierr, msg)
     return y
+
+
+def mesh_stiffness(case) -> dict:
+    """Eq. 18 by the potential energy method at the pitch point: every term [N/m] (k_h; bending,
+    shear, axial of the external (1) and internal (2) tooth; k_m), the k_m the case uses
+    ('k_m_used') and whether it is the computed one ('computed')."""
+    case = load_case(case)
+    with _case_file(case) as path:
+        terms, k_used, computed, ierr, msg = _api.api_mesh_stiffness(path)
+    raise_for(ierr, msg)
+    names = ("k_h", "k_b1", "k_s1", "k_a1", "k_b2", "k_s2", "k_a2", "k_m")
+    out = dict(zip(names, map(float, terms)))
+    out.update(k_m_used=float(k_used), computed=bool(computed))
+    return out
+
+
+def tooth_stiffness(z, module, alpha_deg, b, r_root, r_contact, e_mod=2.1e11, nu=0.3,
+                    internal=False, r_tip=0.0, nquad=32) -> dict:
+    """Bending, shear and axial-compression stiffness [N/m] of one involute tooth of any gear
+    (potential energy method; fortran/stiffness.f90), loaded at radius r_contact."""
+    kb, ks, ka, ierr, msg = _api.api_tooth_stiffness(
+        int(internal), float(z), module, np.radians(alpha_deg), b, r_root, r_tip, e_mod, nu,
+        r_contact, nquad)
+    raise_for(ierr, msg)
+    return {"k_b": kb, "k_s": ks, "k_a": ka}
