@@ -59,7 +59,6 @@ contains
     type(SUNLinearSolver), pointer :: ls
     integer(c_int) :: flag, nroot
     integer(c_int), allocatable :: rootsfound(:)
-    integer(c_long) :: cnt(1)
     integer :: k, k0, nroots, nresync
 
     ierr = 0
@@ -117,6 +116,7 @@ contains
             ! Step onto the switch, flip the states of the teeth that crossed, restart.
             flag = FCVodeGetRootInfo(mem, rootsfound)
             call apply_roots(rootsfound, nroots)
+            call add_counters(mem, stats)           ! CVodeReInit zeroes CVODE's counters
             flag = FCVodeReInit(mem, tau, sv)
             if (flag < 0) exit
           end if
@@ -129,7 +129,10 @@ contains
         if (frozen) then
           k0 = nresync
           call sync_modes(tau, ys, nresync)
-          if (nresync > k0 .and. k < nt) flag = FCVodeReInit(mem, tau, sv)
+          if (nresync > k0 .and. k < nt) then
+            call add_counters(mem, stats)
+            flag = FCVodeReInit(mem, tau, sv)
+          end if
         end if
         call from_scaled(m, ys, yout(:, k))
         if (frozen) then
@@ -140,16 +143,8 @@ contains
       end do
     end if
 
-    flag = FCVodeGetNumSteps(mem, cnt);                stats(1) = cnt(1)
-    flag = FCVodeGetNumRhsEvals(mem, cnt);             stats(2) = cnt(1)
-    flag = FCVodeGetNumJacEvals(mem, cnt);             stats(3) = cnt(1)
-    flag = FCVodeGetNumLinRhsEvals(mem, cnt);          stats(4) = cnt(1)
-    flag = FCVodeGetNumErrTestFails(mem, cnt);         stats(5) = cnt(1)
-    flag = FCVodeGetNumNonlinSolvConvFails(mem, cnt);  stats(6) = cnt(1)
+    call add_counters(mem, stats)
     stats(7) = nroots
-    if (frozen) then
-      flag = FCVodeGetNumGEvals(mem, cnt);             stats(8) = cnt(1)
-    end if
     flag = FCVodeGetLastStep(mem, hlast);              stats(9) = hlast(1)/m%w_ref
     stats(10) = nresync
     stats(11) = coupling_worst_residual()
@@ -181,6 +176,23 @@ contains
     end subroutine fail
 
   end subroutine integrate
+
+  !> Add CVODE's counters since the last (re)initialisation to stats (order of stat_names).
+  subroutine add_counters(mem, stats)
+    type(c_ptr), intent(in) :: mem
+    real(wp), intent(inout) :: stats(nstats)
+    integer(c_long) :: cnt(1)
+    integer(c_int) :: flag
+    flag = FCVodeGetNumSteps(mem, cnt);                stats(1) = stats(1) + cnt(1)
+    flag = FCVodeGetNumRhsEvals(mem, cnt);             stats(2) = stats(2) + cnt(1)
+    flag = FCVodeGetNumJacEvals(mem, cnt);             stats(3) = stats(3) + cnt(1)
+    flag = FCVodeGetNumLinRhsEvals(mem, cnt);          stats(4) = stats(4) + cnt(1)
+    flag = FCVodeGetNumErrTestFails(mem, cnt);         stats(5) = stats(5) + cnt(1)
+    flag = FCVodeGetNumNonlinSolvConvFails(mem, cnt);  stats(6) = stats(6) + cnt(1)
+    if (frozen) then
+      flag = FCVodeGetNumGEvals(mem, cnt);             stats(8) = stats(8) + cnt(1)
+    end if
+  end subroutine add_counters
 
   !> SUNDIALS 6.x context (SUNDIALS 7 takes SUN_COMM_NULL here): the one version-specific call.
   function sundials_context_new() result(ctx)
