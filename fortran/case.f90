@@ -49,6 +49,7 @@ module spline_case_io
   real(wp) :: f_m, u_flash, eta_hertz       ! friction coefficient, Blok factor u, Hertz factor eta [-]
   character(len=16) :: method               ! bdf | adams
   character(len=16) :: jacobian             ! dq (difference quotients)
+  character(len=16) :: nonlinear            ! newton (dense direct) | fixedpoint (no Jacobian: non-stiff scenes)
   logical  :: roots                         ! locate contact switches |dn_j| = c_j by root finding
   real(wp) :: rtol, atol                    ! tolerances on the scaled states [-]
   integer  :: max_steps                     ! CVODE steps allowed between two output times
@@ -62,7 +63,7 @@ module spline_case_io
   namelist /spline_case/ name, z, module_m, alpha_deg, b, s, c0, e_mod, nu, lambda_th, &
        k_cond, rho, c_heat, j_m, j_l, j_1, j_2, m_1, m_2, k_p1, k_p2, c_p1, c_p2, &
        k_t1, k_t2, c_t1, c_t2, k_m, c_m, t_d, t_l, speed_rpm, grav, l_x, l_y, &
-       thermal, t_bulk, f_m, u_flash, eta_hertz, method, jacobian, roots, rtol, atol, &
+       thermal, t_bulk, f_m, u_flash, eta_hertz, method, jacobian, nonlinear, roots, rtol, atol, &
        max_steps, t0, t_end, t_transient, n_out, start, dq0, dv0, l_ref, w_ref
 
   !> Model parameters derived from a validated case (SI, radians, rad/s).
@@ -75,6 +76,7 @@ module spline_case_io
     integer  :: thermal = thermal_none
     real(wp) :: t_bulk, f_m, u_flash, eta_hertz
     integer  :: method_bdf = 1              !< 1 = BDF, 0 = Adams
+    logical  :: newton = .true.             !< Newton + dense solver, else fixed-point iteration
     logical  :: roots = .false.
     real(wp) :: rtol, atol
     integer  :: max_steps, n_out
@@ -108,7 +110,7 @@ contains
     t_d = 30.7_wp; t_l = 30.7_wp; speed_rpm = 6000.0_wp; grav = 9.81_wp
     l_x = 0.0_wp; l_y = 0.0_wp
     thermal = 'none'; t_bulk = 0.0_wp; f_m = 0.1_wp; u_flash = 0.83_wp; eta_hertz = 1.127_wp
-    method = 'bdf'; jacobian = 'dq'; roots = .false.
+    method = 'bdf'; jacobian = 'dq'; nonlinear = 'newton'; roots = .false.
     rtol = 1.0e-8_wp; atol = 1.0e-10_wp; max_steps = 100000
     t0 = 0.0_wp; t_end = 0.1_wp; t_transient = 0.0_wp; n_out = 1001
     start = 'equilibrium'; dq0 = 0.0_wp; dv0 = 0.0_wp
@@ -310,6 +312,12 @@ contains
     case ('dq')
     case default
       call fail('jacobian', 'is "'//trim(jacobian)//'": use dq'); return
+    end select
+    select case (trim(nonlinear))
+    case ('newton');     m%newton = .true.
+    case ('fixedpoint'); m%newton = .false.
+    case default
+      call fail('nonlinear', 'is "'//trim(nonlinear)//'": use newton or fixedpoint'); return
     end select
     select case (trim(start))
     case ('equilibrium'); m%start_equilibrium = .true.

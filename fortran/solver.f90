@@ -11,6 +11,8 @@ module spline_solver
   use fnvector_serial_mod
   use fsunmatrix_dense_mod
   use fsunlinsol_dense_mod
+  use fsundials_nonlinearsolver_mod
+  use fsunnonlinsol_fixedpoint_mod
   use spline_kinds, only: wp
   use spline_case_io, only: model_t, nstate, ndof, thermal_coupled
   use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled
@@ -57,6 +59,7 @@ contains
     type(N_Vector), pointer :: sv
     type(SUNMatrix), pointer :: amat
     type(SUNLinearSolver), pointer :: ls
+    type(SUNNonlinearSolver), pointer :: nls
     integer(c_int) :: flag, nroot
     integer(c_int), allocatable :: rootsfound(:)
     integer :: k, k0, nroots, nresync
@@ -88,6 +91,7 @@ contains
 
     ctx = sundials_context_new()
     sv => FN_VMake_Serial(int(nstate, c_long), ys, ctx)
+    flag = FN_VEnableFusedOps_Serial(sv, 1)   ! fused vector kernels: less overhead per step
     amat => FSUNDenseMatrix(int(nstate, c_long), int(nstate, c_long), ctx)
     ls => FSUNLinSol_Dense(sv, amat, ctx)
     if (m%method_bdf == 1) then
@@ -98,7 +102,12 @@ contains
     flag = FCVodeInit(mem, c_funloc(rhs_cb), tau, sv)
     if (flag == 0) flag = FCVodeSetErrHandlerFn(mem, c_funloc(err_cb), c_null_ptr)
     if (flag == 0) flag = FCVodeSStolerances(mem, real(m%rtol, c_double), real(m%atol, c_double))
-    if (flag == 0) flag = FCVodeSetLinearSolver(mem, ls, amat)
+    if (m%newton) then
+      if (flag == 0) flag = FCVodeSetLinearSolver(mem, ls, amat)
+    else
+      nls => FSUNNonlinSol_FixedPoint(sv, 0, ctx)   ! functional iteration, no Anderson acceleration
+      if (flag == 0) flag = FCVodeSetNonlinearSolver(mem, nls)
+    end if
     if (flag == 0) flag = FCVodeSetMaxNumSteps(mem, int(m%max_steps, c_long))
     if (flag == 0 .and. frozen) flag = FCVodeRootInit(mem, nroot, c_funloc(roots_cb))
     if (flag == 0 .and. frozen) flag = FCVodeSetNoInactiveRootWarn(mem)
@@ -152,6 +161,7 @@ contains
 
     call FCVodeFree(mem)
     flag = FSUNLinSolFree(ls)
+    if (.not. m%newton) flag = FSUNNonlinSolFree(nls)
     call FSUNMatDestroy(amat)
     call FN_VDestroy(sv)
     flag = FSUNContext_Free(ctx)
@@ -183,10 +193,13 @@ contains
     real(wp), intent(inout) :: stats(nstats)
     integer(c_long) :: cnt(1)
     integer(c_int) :: flag
+    cnt = 0
     flag = FCVodeGetNumSteps(mem, cnt);                stats(1) = stats(1) + cnt(1)
     flag = FCVodeGetNumRhsEvals(mem, cnt);             stats(2) = stats(2) + cnt(1)
-    flag = FCVodeGetNumJacEvals(mem, cnt);             stats(3) = stats(3) + cnt(1)
-    flag = FCVodeGetNumLinRhsEvals(mem, cnt);          stats(4) = stats(4) + cnt(1)
+    if (mdl%newton) then
+      flag = FCVodeGetNumJacEvals(mem, cnt);           stats(3) = stats(3) + cnt(1)
+      flag = FCVodeGetNumLinRhsEvals(mem, cnt);        stats(4) = stats(4) + cnt(1)
+    end if
     flag = FCVodeGetNumErrTestFails(mem, cnt);         stats(5) = stats(5) + cnt(1)
     flag = FCVodeGetNumNonlinSolvConvFails(mem, cnt);  stats(6) = stats(6) + cnt(1)
     if (frozen) then

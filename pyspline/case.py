@@ -15,7 +15,13 @@ from pathlib import Path
 
 import f90nml
 
-from . import _core
+try:
+    from . import _core
+except ImportError as exc:  # the source tree shadows the installed package
+    raise ImportError(
+        f"pyspline's compiled core (_core) is not next to {__file__}: this is the source tree, "
+        "not the installed package. Run `bash scripts/setup.sh` (pip install .) and import "
+        "pyspline from outside the repository root (or use the `pyspline` command).") from exc
 
 GROUP = "spline_case"
 
