@@ -131,3 +131,14 @@ def tooth_stiffness(z, module, alpha_deg, b, r_root, r_contact, e_mod=2.1e11, nu
         r_contact, nquad)
     raise_for(ierr, msg)
     return {"k_b": kb, "k_s": ks, "k_a": ka}
+
+
+def read_csv(path) -> tuple[list[str], np.ndarray]:
+    """Read a spline-dyn CSV: the column names (with units) and the data (nt x columns)."""
+    with open(path) as f:
+        for line in f:
+            if not line.startswith("#"):
+                header = line.strip().split(",")
+                break
+        data = np.loadtxt(f, delimiter=",", ndmin=2)
+    return header, data

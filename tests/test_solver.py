@@ -46,8 +46,7 @@ def test_executable_matches_python(name, exe, tmp_path):
     case.to_namelist(nml)
     out = tmp_path / "out.csv"
     subprocess.run([exe, str(nml), "-o", str(out)], check=True, capture_output=True)
-    header = [ln for ln in out.read_text().splitlines() if not ln.startswith("#")][0].split(",")
-    data = np.loadtxt(out, delimiter=",", comments="#", skiprows=5)
+    header, data = pyspline.core.read_csv(out)
     res = pyspline.simulate(case)
     col = {h.split(" [")[0]: i for i, h in enumerate(header)}
     assert header[0] == "t [s]" and "F_16 [N]" in header and "Tm [N m]" in header

@@ -1,0 +1,150 @@
+"""Figures like the paper's (matplotlib, PNG): one file per paper figure group."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from .paper import SETTLE, poincare, poincare_count  # noqa: E402
+
+
+def _time_panel(ax, res, y, label, unit):
+    ax.plot(res.t, y, lw=0.7)
+    ax.set_xlabel("time t [s]")
+    ax.set_ylabel(f"{label} [{unit}]")
+
+
+def _tooth_bars(ax_f, ax_fx, res):
+    """F_j and F_jx at the instant of largest load, with max/min envelopes over t > SETTLE."""
+    k = int(np.argmax(np.abs(res.Tm)))
+    j = np.arange(1, res.F.shape[1] + 1)
+    late = res.t > SETTLE
+    for ax, q, name in ((ax_f, res.F, "F_j"), (ax_fx, res.Fx, "F_jx")):
+        ax.bar(j, q[k], color="tab:blue", label=f"at t = {res.t[k]:.4f} s (largest load)")
+        if late.any():
+            ax.plot(j, q[late].max(axis=0), "v", color="tab:red", ms=4, label="max over time")
+            ax.plot(j, q[late].min(axis=0), "^", color="tab:green", ms=4, label="min over time")
+        ax.set_xlabel("tooth j")
+        ax.set_ylabel(f"{name} [N]")
+        ax.set_xticks(j)
+        ax.axhline(0, color="k", lw=0.5)
+    ax_f.legend(fontsize=7, loc="lower right")
+    ax_fx.set_title(f"sum of F_jx at that instant: {res.Fx[k].sum():.2e} N", fontsize=8)
+
+
+def dynamics_figure(res, path, title, extra_kv=False):
+    """Relative displacement, phase plane, Poincare map, per-tooth F_j and F_jx (+ k_v)."""
+    n = 6 if extra_kv else 5
+    fig, axs = plt.subplots(2, 3, figsize=(15, 8.5))
+    axs = axs.ravel()
+    _time_panel(axs[0], res, res.D2 * 1e3, "relative displacement D_2 (line of action)", "mm")
+    axs[1].plot(res.D2 * 1e3, res.vD2, lw=0.5)
+    axs[1].set_xlabel("D_2 [mm]")
+    axs[1].set_ylabel("dD_2/dt [m/s]")
+    axs[1].set_title("phase plane")
+    p = poincare(res)
+    nd = poincare_count(res)
+    axs[2].plot(p[:, 0] * 1e3, p[:, 1], "o", ms=3)
+    axs[2].set_xlabel("D_2 [mm]")
+    axs[2].set_ylabel("dD_2/dt [m/s]")
+    axs[2].set_title(f"Poincare map (once per revolution, t > {SETTLE} s); second half: {nd} "
+                     f"distinct point{'s' if nd != 1 else ''}", fontsize=9)
+    _tooth_bars(axs[3], axs[4], res)
+    if extra_kv:
+        _time_panel(axs[5], res, res.kv, "dynamic load coefficient k_v", "-")
+    else:
+        _time_panel(axs[5], res, res.Tm, "meshing torque T_m", "N m")
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def misalignment_figure(results, names, path):
+    fig, axs = plt.subplots(len(names), 4, figsize=(18, 4.2 * len(names)), squeeze=False)
+    for row, name in zip(axs, names):
+        res = results[name]
+        lx = res.case["l_x"]
+        _time_panel(row[0], res, res.D2 * 1e3, f"D_2, l_x = {lx:g} m", "mm")
+        p = poincare(res)
+        row[1].plot(res.D2 * 1e3, res.vD2, lw=0.4, color="0.6")
+        row[1].plot(p[:, 0] * 1e3, p[:, 1], "o", ms=3, color="tab:red",
+                    label=f"Poincare (second half): {poincare_count(res)} distinct")
+        row[1].set_xlabel("D_2 [mm]")
+        row[1].set_ylabel("dD_2/dt [m/s]")
+        row[1].legend(fontsize=7)
+        _tooth_bars(row[2], row[3], res)
+        ax = row[0].twinx()
+        ax.plot(res.t, res.kv, lw=0.5, color="tab:orange")
+        ax.set_ylabel("k_v [-] (orange)")
+    fig.suptitle("Parallel misalignment (paper Figs. 5-6)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
+
+
+def temperature_figure(results, names, path):
+    fig, axs = plt.subplots(len(names), 4, figsize=(18, 4.2 * len(names)), squeeze=False)
+    for row, name in zip(axs, names):
+        res = results[name]
+        _tooth_bars(row[0], row[1], res)
+        row[0].set_title(f"{name}: T_M = {res.case['t_bulk']:g} degC, l_x = {res.case['l_x']:g} m",
+                         fontsize=9)
+        _time_panel(row[2], res, res.Tm, "meshing torque T_m", "N m")
+        _time_panel(row[3], res, res.kv, "dynamic load coefficient k_v", "-")
+    fig.suptitle("Bulk temperature, contact temperature coupled into the backlash (paper Figs. 7-8)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
+
+
+def flash_figure(results, names, path):
+    fig, axs = plt.subplots(1, 3, figsize=(17, 4.8))
+    last = results[names[-1]]
+    for j in range(last.Tf.shape[1]):
+        axs[0].plot(last.t, last.Tf[:, j], lw=0.5)
+    axs[0].set_xlabel("time t [s]")
+    axs[0].set_ylabel("flash temperature T_fj [degC]")
+    axs[0].set_title(f"every tooth, l_x = {last.case['l_x']:g} m", fontsize=9)
+    for name in names:
+        res = results[name]
+        axs[1].plot(res.t, res.Tf.max(axis=1), lw=0.6, label=f"l_x = {res.case['l_x']:g} m")
+    axs[1].set_xlabel("time t [s]")
+    axs[1].set_ylabel("max over teeth of T_fj [degC]")
+    axs[1].set_yscale("symlog", linthresh=1e-6)
+    axs[1].legend(fontsize=7)
+    lx = [results[n].case["l_x"] for n in names]
+    tmax = [results[n].Tf.max() for n in names]
+    axs[2].plot(np.array(lx) * 1e3, tmax, "o-")
+    axs[2].set_xlabel("misalignment l_x [mm]")
+    axs[2].set_ylabel("largest flash temperature [degC]")
+    fig.suptitle(f"Flash temperature (paper Figs. 9-10), f_m = {last.case['f_m']:g}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
+
+
+def draw_all(results, out, groups):
+    out = Path(out)
+    drawn = [
+        dynamics_figure(results["paper_ideal"], out / "fig4_ideal.png",
+                        "Ideal spline pair: no misalignment, no thermal effects (paper Fig. 4)"),
+        misalignment_figure(results, groups["fig5_6_misalignment"], out / "fig5_6_misalignment.png"),
+        temperature_figure(results, groups["fig7_8_bulk_temperature"],
+                           out / "fig7_8_bulk_temperature.png"),
+        flash_figure(results, groups["fig9_10_flash_temperature"],
+                     out / "fig9_10_flash_temperature.png"),
+    ]
+    if "physical_lx1e-4" in results:
+        drawn.append(dynamics_figure(results["physical_lx1e-4"], out / "physical_lx1e-4.png",
+                                     "Physical k_m (potential energy method), l_x = 1e-4 m, "
+                                     "T_M = 100 degC, coupled flash", extra_kv=True))
+    return drawn

@@ -1,0 +1,86 @@
+"""The main job: reproduce (quick), Poincare point counting, calibration."""
+import json
+
+import numpy as np
+import pytest
+
+import pyspline
+from pyspline import paper
+from conftest import CASES
+
+
+def strobe(x, v):
+    return np.c_[x, v]
+
+
+def test_poincare_period_1_3_and_quasiperiodic():
+    n = np.arange(300)
+    # period-1: a fixed point (with round-off noise)
+    p1 = strobe(1.0 + 1e-12 * np.sin(n), 0.5 + 1e-12 * np.cos(n))
+    assert paper.count_distinct(p1, scale=[1.0, 1.0]) == 1
+    # period-3: x_n = cos(2 pi n / 3)
+    p3 = strobe(np.cos(2 * np.pi * n / 3), np.sin(2 * np.pi * n / 3))
+    assert paper.count_distinct(p3) == 3
+    # quasi-periodic: irrational rotation on a circle fills it
+    w = 2 * np.pi * (np.sqrt(5) - 1) / 2
+    pq = strobe(np.cos(w * n), np.sin(w * n))
+    assert paper.count_distinct(pq) > 250
+
+
+def test_poincare_of_a_simulated_periodic_orbit():
+    """Sampled once per revolution, a response at the shaft frequency is a single point."""
+    class R:  # a minimal Result stand-in
+        pass
+    r = R()
+    r.case = {"speed_rpm": 6000.0}
+    r.t = np.linspace(0, 1, 64001)
+    w = 2 * np.pi * 100
+    r.D2 = -8e-4 + 1e-5 * np.sin(w * r.t)
+    r.vD2 = 1e-5 * w * np.cos(w * r.t)
+    assert paper.poincare_count(r) == 1
+    r.D2 = -8e-4 + 1e-5 * np.sin(w * r.t / 3)       # subharmonic: period-3
+    r.vD2 = 1e-5 * w / 3 * np.cos(w * r.t / 3)
+    assert paper.poincare_count(r) == 3
+
+
+def test_reproduce_quick_writes_every_figure_and_row(tmp_path):
+    s = paper.reproduce(tmp_path, quick=True, directory=CASES, progress=False)
+    for name in ("fig4_ideal", "fig5_6_misalignment", "fig7_8_bulk_temperature",
+                 "fig9_10_flash_temperature", "physical_lx1e-4"):
+        png = tmp_path / f"{name}.png"
+        assert png.stat().st_size > 20_000, name
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    md = (tmp_path / "verification.md").read_text()
+    assert "QUICK RUN" in md
+    csv = (tmp_path / "verification.csv").read_text().splitlines()
+    assert len(csv) == 1 + len(paper.ROWS)                   # no row hidden
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert len(summary["rows"]) == len(paper.ROWS)
+    assert all(v == "identical" for v in summary["executable_check"].values())
+    assert summary["k_m"]["ratio"] > 1000
+    for row in summary["rows"]:
+        assert np.isfinite(row["ours"])
+        assert row["status"] == "ok" or row["why"], row     # every miss says why
+
+
+def test_calibration_recovers_known_parameters(tmp_path):
+    """Simulate with known k_m and f_m, then fit them back from the two calibration rows."""
+    truth = {"k_m": 3.1e5, "f_m": 0.37}
+    targets = {}
+    for row, key in ((paper.CAL_KM, "D2max"), (paper.CAL_FM, "Tfmax")):
+        case = paper.load_paper_case(row.case, CASES, quick=True).replace(**truth)
+        targets[key] = float(row.extract(pyspline.simulate(case)))
+    fit = paper.calibrate(CASES, quick=True, targets=targets, progress=False)
+    assert fit["k_m"] == pytest.approx(truth["k_m"], rel=1e-6)
+    assert fit["f_m"] == pytest.approx(truth["f_m"], rel=1e-6)
+
+
+def test_write_calibration_keeps_comments(tmp_path):
+    for name in ("paper_ideal", "paper_T100"):
+        (tmp_path / f"{name}.nml").write_text((CASES / f"{name}.nml").read_text())
+    changed = paper.write_calibration(tmp_path, {"k_m": 1.5e5, "f_m": 0.2})
+    assert sorted(changed) == ["paper_T100.nml", "paper_ideal.nml"]
+    ideal = pyspline.load_case(tmp_path / "paper_ideal.nml")
+    hot = pyspline.load_case(tmp_path / "paper_T100.nml")
+    assert ideal["k_m"] == 1.5e5 and hot["k_m"] == 1.5e5 and hot["f_m"] == 0.2
+    assert "fitted by 'pyspline calibrate'" in (tmp_path / "paper_T100.nml").read_text()
