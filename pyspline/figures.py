@@ -14,6 +14,7 @@ from .paper import SETTLE, poincare, poincare_count  # noqa: E402
 
 def _time_panel(ax, res, y, label, unit):
     ax.plot(res.t, y, lw=0.7)
+    ax.ticklabel_format(axis="y", useOffset=False)
     ax.set_xlabel("time t [s]")
     ax.set_ylabel(f"{label} [{unit}]")
 
@@ -36,9 +37,8 @@ def _tooth_bars(ax_f, ax_fx, res):
     ax_fx.set_title(f"sum of F_jx at that instant: {res.Fx[k].sum():.2e} N", fontsize=8)
 
 
-def dynamics_figure(res, path, title, extra_kv=False):
-    """Relative displacement, phase plane, Poincare map, per-tooth F_j and F_jx (+ k_v)."""
-    n = 6 if extra_kv else 5
+def dynamics_figure(res, path, title):
+    """Relative displacement, phase plane, Poincare map, per-tooth F_j and F_jx, T_m(t)."""
     fig, axs = plt.subplots(2, 3, figsize=(15, 8.5))
     axs = axs.ravel()
     _time_panel(axs[0], res, res.D2 * 1e3, "relative displacement D_2 (line of action)", "mm")
@@ -54,10 +54,7 @@ def dynamics_figure(res, path, title, extra_kv=False):
     axs[2].set_title(f"Poincare map (once per revolution, t > {SETTLE} s); second half: {nd} "
                      f"distinct point{'s' if nd != 1 else ''}", fontsize=9)
     _tooth_bars(axs[3], axs[4], res)
-    if extra_kv:
-        _time_panel(axs[5], res, res.kv, "dynamic load coefficient k_v", "-")
-    else:
-        _time_panel(axs[5], res, res.Tm, "meshing torque T_m", "N m")
+    _time_panel(axs[5], res, res.Tm, "meshing torque T_m", "N m")
     fig.suptitle(title)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
@@ -89,7 +86,7 @@ def misalignment_figure(results, names, path):
     return path
 
 
-def temperature_figure(results, names, path):
+def temperature_figure(results, names, path, title=None):
     fig, axs = plt.subplots(len(names), 4, figsize=(18, 4.2 * len(names)), squeeze=False)
     for row, name in zip(axs, names):
         res = results[name]
@@ -98,7 +95,8 @@ def temperature_figure(results, names, path):
                          fontsize=9)
         _time_panel(row[2], res, res.Tm, "meshing torque T_m", "N m")
         _time_panel(row[3], res, res.kv, "dynamic load coefficient k_v", "-")
-    fig.suptitle("Bulk temperature, contact temperature coupled into the backlash (paper Figs. 7-8)")
+    fig.suptitle(title or "Bulk temperature, contact temperature coupled into the backlash "
+                 "(paper Figs. 7-8)")
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)
@@ -144,7 +142,7 @@ def draw_all(results, out, groups):
                      out / "fig9_10_flash_temperature.png"),
     ]
     if "physical_lx1e-4" in results:
-        drawn.append(dynamics_figure(results["physical_lx1e-4"], out / "physical_lx1e-4.png",
-                                     "Physical k_m (potential energy method), l_x = 1e-4 m, "
-                                     "T_M = 100 degC, coupled flash", extra_kv=True))
+        drawn.append(temperature_figure(results, ["physical_lx1e-4"], out / "physical_lx1e-4.png",
+                                        "Physical k_m = 1.92e9 N/m (potential energy method), "
+                                        "started at its static equilibrium: steady"))
     return drawn

@@ -63,7 +63,9 @@ def count_distinct(points, scale=None, tol: float = 1e-3) -> int:
         return 0
     if scale is None:
         scale = np.ptp(p, axis=0)
-    scale = np.where(np.asarray(scale) > 0, scale, np.maximum(np.abs(p).max(axis=0), 1e-300))
+    # motion below 1e-9 of the magnitude is round-off and integration noise, not dynamics
+    scale = np.maximum(np.asarray(scale, dtype=float), 1e-9 * np.abs(p).max(axis=0))
+    scale = np.where(scale > 0, scale, 1.0)
     q = p / scale
     centres: list[np.ndarray] = []
     for x in q:
@@ -77,7 +79,9 @@ def poincare_count(res, tol: float = 1e-3) -> int:
     the trajectory (D2, dD2/dt) after the engagement (t > SETTLE)."""
     mid = 0.5 * (res.t[0] + res.t[-1])
     late = res.t > min(SETTLE, mid)
-    extent = [np.ptp(res.D2[late]), np.ptp(res.vD2[late])]
+    size = np.abs(res.D2[late]).max()                  # noise floor: 1e-6 of the displacement
+    extent = [max(np.ptp(res.D2[late]), 1e-6 * size),
+              max(np.ptp(res.vD2[late]), 1e-6 * size * 2 * np.pi / revolution(res))]
     return count_distinct(poincare(res, settle=mid), extent, tol)
 
 
