@@ -15,7 +15,10 @@ module spline_api
   implicit none
   private
   public :: api_sizes, api_simulate, api_rhs, api_start_state, api_write_defaults, api_names
-  public :: api_mesh_stiffness, api_tooth_stiffness
+  public :: api_mesh_stiffness, api_tooth_stiffness, api_load, api_rhs_loaded
+
+  type(model_t), save :: loaded          !< the case of api_load, for api_rhs_loaded
+  logical, save :: have_loaded = .false.
 
 contains
 
@@ -87,6 +90,33 @@ contains
     end if
     ierr = ie
   end subroutine api_rhs
+
+  !> Read a case once and keep it for api_rhs_loaded (peers calling the RHS per step).
+  subroutine api_load(path, ierr, errmsg)
+    character(len=*), intent(in) :: path
+    integer(c_int), intent(out) :: ierr
+    character(len=512), intent(out) :: errmsg
+    integer :: ie
+    call case_read_file(path, loaded, ie, errmsg)
+    have_loaded = ie == 0
+    ierr = ie
+  end subroutine api_load
+
+  !> SI right-hand side of the case loaded by api_load (contact states from the state): the
+  !> project's Fortran RHS for solvers driven from Python (scipy peers in the benchmarks).
+  subroutine api_rhs_loaded(t, y, ydot, ierr)
+    real(c_double), intent(in) :: t, y(14)
+    real(c_double), intent(out) :: ydot(14)
+    integer(c_int), intent(out) :: ierr
+    character(len=512) :: errmsg
+    integer :: ie
+    ydot = 0
+    ierr = 1
+    if (.not. have_loaded) return
+    ydot(1:ndof) = y(ndof+1:)
+    call accelerations(loaded, t, y(1:ndof), y(ndof+1:), ydot(ndof+1:), ie, errmsg)
+    ierr = ie
+  end subroutine api_rhs_loaded
 
   !> The start state of a case (SI): static equilibrium or rest, plus dq0, dv0.
   subroutine api_start_state(path, y, ierr, errmsg)

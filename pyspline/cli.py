@@ -84,6 +84,29 @@ def cmd_check_exe(args) -> int:
     return 0 if all(v == "identical" for v in rep.values()) else 1
 
 
+def cmd_bench(args) -> int:
+    from . import bench
+    out = Path(args.out)
+    if args.what == "wp":
+        rows, notes = bench.work_precision(out, quick=args.quick)
+        for n in notes:
+            print(n)
+        print(f"{'case':14s} {'method':28s} {'rtol':>7s} {'time [s]':>9s} {'RHS':>8s} "
+              f"{'err':>9s} {'scd':>5s}  status")
+        for r in rows:
+            err = max(r["err_Tm"], r["err_F"])
+            print(f"{r['case']:14s} {r['method']:28s} {r['rtol']:7.0e} {r['time_s']:9.4f} "
+                  f"{r['rhs_evals']:8d} {err:9.1e} {r['scd']:5.1f}  {r['status']}")
+        print(f"wrote {out}/work_precision.png and work_precision.csv")
+    else:
+        rows = bench.stability_map(out, quick=args.quick)
+        for r in rows:
+            print(f"{r['damping']:12s} k_m {r['k_m']:8.1e} {r['method']:24s} "
+                  f"{r['time_s']:8.3f} s  {r.get('rhs_evals', -1):>8}  {r['status']}")
+        print(f"wrote {out}/stability.png and stability.csv")
+    return 0
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="pyspline", description=__doc__)
     sub = p.add_subparsers(dest="cmd", required=True)
@@ -107,5 +130,11 @@ def main(argv=None) -> int:
     r.add_argument("--full", action="store_true", help="full length (default: 0.3 s)")
     r.add_argument("--cases")
     r.set_defaults(func=cmd_check_exe)
+    r = sub.add_parser("bench", help="speed against accuracy: wp (work-precision chart), "
+                       "stability (where methods fail)")
+    r.add_argument("what", choices=["wp", "stability"])
+    r.add_argument("--out", default="out/bench")
+    r.add_argument("--quick", action="store_true", help="small sizes (for CI)")
+    r.set_defaults(func=cmd_bench)
     args = p.parse_args(argv)
     return args.func(args)

@@ -142,3 +142,24 @@ def read_csv(path) -> tuple[list[str], np.ndarray]:
                 break
         data = np.loadtxt(f, delimiter=",", ndmin=2)
     return header, data
+
+
+class FortranRHS:
+    """The project's Fortran right-hand side (SI) as a Python callable f(t, y), for solvers
+    driven from Python (scipy.integrate.solve_ivp in the benchmarks). One case at a time."""
+
+    def __init__(self, case):
+        self.case = load_case(case)
+        self._tmp = tempfile.TemporaryDirectory(prefix="pyspline-")
+        path = os.path.join(self._tmp.name, "case.nml")
+        self.case.to_namelist(path)
+        ierr, msg = _api.api_load(path)
+        raise_for(ierr, msg)
+        self.calls = 0
+
+    def __call__(self, t, y):
+        self.calls += 1
+        ydot, ierr = _api.api_rhs_loaded(t, y)
+        if ierr:
+            raise_for(ierr, b"case " + self.case.name.encode() + b": RHS failed (thermal)")
+        return ydot

@@ -1,0 +1,265 @@
+"""Speed against accuracy (`pyspline bench wp`) and where methods fail (`pyspline bench
+stability`). Each writes a PNG and a CSV into --out; --quick is small enough for CI.
+
+Errors are the max relative error of T_m(t) and of the per-tooth F_j at the output times
+against a reference computed by CVODE BDF at rtol 1e-12 with root finding, itself checked against
+a different method (DOP853 on the Fortran RHS at rtol 1e-12). Significant correct digits
+scd = -log10(error). A failed run is recorded with its reason, never dropped.
+"""
+from __future__ import annotations
+
+import csv
+import importlib.util
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .case import SplineError, load_case
+from .core import FortranRHS, simulate, start_state
+from .paper import cases_dir
+
+SCIPY_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
+
+
+class Budget(Exception):
+    """A peer used up its RHS evaluation budget (counted as a failure: too much work)."""
+
+
+def _oracle():
+    """tests/oracle.py of a checkout (the numpy RHS peer), or None outside one."""
+    path = cases_dir().parent / "tests" / "oracle.py"
+    if not path.is_file():
+        return None
+    spec = importlib.util.spec_from_file_location("pyspline_oracle", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def _scaled_atol(case, rtol):
+    l, w = case["c0"], case["speed_rpm"] * np.pi / 30 or 1.0
+    return rtol * 1e-2 * np.r_[np.full(7, l), np.full(7, l * w)]
+
+
+def _mesh_outputs(case, t, y):
+    """T_m and F_j from states (Fortran core, contact states from the state)."""
+    from .core import _case_file, rhs_at_path
+    tm, F = np.empty(len(t)), np.empty((len(t), case["z"]))
+    with _case_file(case) as path:
+        for k, (tk, yk) in enumerate(zip(t, y)):
+            _, mesh, tm[k] = rhs_at_path(path, case["z"], tk, yk)
+            F[k] = mesh["F"]
+    return tm, F
+
+
+def run_scipy(case, method, rtol, rhs_kind, oracle, budget):
+    """solve_ivp on the Fortran RHS (through f2py) or the numpy oracle RHS."""
+    from scipy.integrate import solve_ivp
+    if rhs_kind == "fortran":
+        f = FortranRHS(case)
+    else:
+        p = oracle.prepare(dict(case))
+        f = lambda t, y: oracle.rhs(t, y, p)  # noqa: E731
+    calls = [0]
+
+    def counted(t, y):
+        calls[0] += 1
+        if calls[0] > budget:
+            raise Budget(f"more than {budget} RHS evaluations")
+        return f(t, y)
+
+    t_eval = np.linspace(case["t0"] + case["t_transient"], case["t_end"], case["n_out"])
+    t0 = time.perf_counter()
+    sol = solve_ivp(counted, (case["t0"], case["t_end"]), start_state(case), method=method,
+                    rtol=rtol, atol=_scaled_atol(case, rtol), t_eval=t_eval)
+    wall = time.perf_counter() - t0
+    if not sol.success:
+        raise SplineError(f"solve_ivp {method}: {sol.message}")
+    return wall, sol.t, sol.y.T, calls[0]
+
+
+def _errors(tm, F, ref_tm, ref_F):
+    e_tm = np.abs(tm - ref_tm).max() / np.abs(ref_tm).max()
+    e_f = np.abs(F - ref_F).max() / np.abs(ref_F).max()
+    return e_tm, e_f
+
+
+def reference(case):
+    ref = simulate(case.replace(method="bdf", roots=True, rtol=1e-12, atol=1e-14,
+                                max_steps=10**7))
+    wall, t, y, _ = run_scipy(case, "DOP853", 1e-12, "fortran", None, 10**9)
+    tm2, F2 = _mesh_outputs(case, t, y)
+    agree = _errors(tm2, F2, ref.Tm, ref.F)
+    return ref, agree
+
+
+def work_precision(out, quick=False, progress=True):
+    """The work-precision chart and table for paper_lx1e-4 and paper_T100."""
+    from tqdm import tqdm
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    oracle = _oracle()
+    t_end = 0.05 if quick else 0.3
+    rtols_cv = [1e-3, 1e-5, 1e-7] if quick else [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10]
+    rtols_sp = [1e-3, 1e-5] if quick else [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8]
+    budget = 20_000 if quick else 400_000
+    repeat = 1 if quick else 3
+    rows, notes = [], []
+    for name in ("paper_lx1e-4", "paper_T100"):
+        case = load_case(cases_dir() / f"{name}.nml", t_end=t_end,
+                         n_out=int(round(640 * t_end)) + 1)
+        ref, agree = reference(case)
+        notes.append(f"{name}: reference (CVODE BDF + roots, rtol 1e-12) vs DOP853 rtol 1e-12 on "
+                     f"the Fortran RHS: T_m {agree[0]:.1e}, F_j {agree[1]:.1e}")
+        jobs = [("cvode", m, r, rt) for m in ("bdf", "adams") for r in (False, True)
+                for rt in rtols_cv]
+        jobs += [("scipy", m, kind, rt) for m in SCIPY_METHODS for kind in ("fortran", "numpy")
+                 for rt in rtols_sp if kind == "fortran" or oracle is not None]
+        for solver, method, opt, rtol in tqdm(jobs, desc=f"work-precision {name}",
+                                              disable=not progress):
+            label = (f"CVODE {method}{' + roots' if opt else ''}" if solver == "cvode"
+                     else f"scipy {method} ({opt} RHS)")
+            row = dict(case=name, method=label, rtol=rtol)
+            try:
+                if solver == "cvode":
+                    c = case.replace(method=method, roots=opt, rtol=rtol, atol=rtol * 1e-2)
+                    times = []
+                    for _ in range(repeat):
+                        t0 = time.perf_counter()
+                        res = simulate(c)
+                        times.append(time.perf_counter() - t0)
+                    wall, tm, F, nfev = statistics.median(times), res.Tm, res.F, \
+                        res.stats["rhs_evals"]
+                else:
+                    wall, t, y, nfev = run_scipy(case, method, rtol, opt, oracle, budget)
+                    tm, F = _mesh_outputs(case, t, y)
+                e_tm, e_f = _errors(tm, F, ref.Tm, ref.F)
+                row.update(status="ok", time_s=wall, rhs_evals=nfev, err_Tm=e_tm, err_F=e_f,
+                           scd=-np.log10(max(e_tm, e_f, 1e-16)))
+            except (SplineError, Budget) as exc:
+                row.update(status=f"FAILED: {str(exc)[:120]}", time_s=float("nan"),
+                           rhs_evals=-1, err_Tm=float("nan"), err_F=float("nan"),
+                           scd=float("nan"))
+            rows.append(row)
+    _write_csv(out / "work_precision.csv", rows)
+    _plot_wp(rows, out / "work_precision.png", notes)
+    return rows, notes
+
+
+def _write_csv(path, rows):
+    keys = list(dict.fromkeys(k for r in rows for k in r))
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=keys)
+        w.writeheader()
+        w.writerows(rows)
+
+
+def _plot_wp(rows, path, notes):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    cases = list(dict.fromkeys(r["case"] for r in rows))
+    fig, axs = plt.subplots(1, len(cases), figsize=(8 * len(cases), 6.5), squeeze=False)
+    for ax, name in zip(axs[0], cases):
+        sub = [r for r in rows if r["case"] == name]
+        for i, method in enumerate(dict.fromkeys(r["method"] for r in sub)):
+            pts = [r for r in sub if r["method"] == method]
+            ok = [r for r in pts if r["status"] == "ok"]
+            style = "-" if "CVODE" in method else ("--" if "fortran" in method else ":")
+            line, = ax.plot([r["time_s"] for r in ok],
+                            [max(r["err_Tm"], r["err_F"]) for r in ok],
+                            style, marker="o", ms=3, label=method)
+            bad = [r for r in pts if r["status"] != "ok"]
+            if bad:   # failures drawn at the top edge, at their rtol's position in the legend
+                ax.plot([1e-3 * (1 + j) for j in range(len(bad))], [1.0] * len(bad), "x",
+                        color=line.get_color(), ms=8)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("CPU time (wall clock, median) [s]")
+        ax.set_ylabel("max relative error of T_m and F_j")
+        ax.set_title(name + " (x at error 1: failed runs)", fontsize=10)
+        ax.grid(True, which="both", lw=0.3)
+        ax.legend(fontsize=6, ncol=2)
+    fig.suptitle("Work-precision: " + " | ".join(notes), fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def stability_map(out, quick=False, progress=True):
+    """Sweep the mesh stiffness from the paper's calibrated value to the physical one and beyond,
+    with c_m as given and as a damping ratio, and record which methods succeed."""
+    from tqdm import tqdm
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    kms = [1e5, 1e7, 1e9] if quick else list(np.logspace(5, 10, 11))
+    t_end = 0.01 if quick else 0.05
+    budget = 20_000 if quick else 200_000
+    base = load_case(cases_dir() / "paper_lx1e-4.nml", t_end=t_end,
+                     n_out=int(round(6400 * t_end)) + 1, rtol=1e-6, atol=1e-8,
+                     max_steps=budget)
+    m_e = base["j_1"] * base["j_2"] / (base["j_1"] + base["j_2"]) \
+        / (base["z"] * (base["module_m"] * base["z"] / 2 * np.cos(np.radians(30))) ** 2)
+    methods = [("cvode", "bdf", False), ("cvode", "adams", False), ("cvode", "bdf", True),
+               ("cvode", "adams-fixedpoint", False)] + \
+              [("scipy", m, "fortran") for m in SCIPY_METHODS]
+    rows = []
+    jobs = [(d, k, m) for d in ("as given", "zeta = 0.05") for k in kms for m in methods]
+    for damping, km, (solver, method, opt) in tqdm(jobs, desc="stability map",
+                                                   disable=not progress):
+        c_m = base["c_m"] if damping == "as given" else 2 * 0.05 * np.sqrt(km * m_e)
+        case = base.replace(k_m=float(km), c_m=float(c_m))
+        label = (f"CVODE {method}{' + roots' if opt is True else ''}" if solver == "cvode"
+                 else f"scipy {method}")
+        row = dict(damping=damping, k_m=km, c_m=c_m, method=label)
+        t0 = time.perf_counter()
+        try:
+            if solver == "cvode":
+                kw = dict(method="adams", nonlinear="fixedpoint") if method == "adams-fixedpoint" \
+                    else dict(method=method)
+                res = simulate(case.replace(roots=bool(opt), **kw))
+                row.update(status="ok", steps=res.stats["steps"], rhs_evals=res.stats["rhs_evals"],
+                           err_test_fails=res.stats["err_test_fails"],
+                           conv_fails=res.stats["nonlin_conv_fails"])
+            else:
+                _, _, _, nfev = run_scipy(case, method, 1e-6, "fortran", None, budget)
+                row.update(status="ok", steps=-1, rhs_evals=nfev)
+        except (SplineError, Budget) as exc:
+            msg = str(exc)
+            flag = next((w for w in msg.replace("(", " ").split() if w.startswith("CV_")), None)
+            row.update(status=f"FAILED: {flag or msg[:100]}")
+        row["time_s"] = time.perf_counter() - t0
+        rows.append(row)
+    _write_csv(out / "stability.csv", rows)
+    _plot_stability(rows, out / "stability.png")
+    return rows
+
+
+def _plot_stability(rows, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    dampings = list(dict.fromkeys(r["damping"] for r in rows))
+    methods = list(dict.fromkeys(r["method"] for r in rows))
+    kms = sorted({r["k_m"] for r in rows})
+    fig, axs = plt.subplots(1, len(dampings), figsize=(7.5 * len(dampings), 5), squeeze=False)
+    for ax, d in zip(axs[0], dampings):
+        grid = np.full((len(methods), len(kms)), np.nan)
+        for r in rows:
+            if r["damping"] == d and r["status"] == "ok":
+                grid[methods.index(r["method"]), kms.index(r["k_m"])] = np.log10(r["time_s"])
+        im = ax.imshow(grid, aspect="auto", cmap="viridis", origin="upper")
+        for r in rows:
+            if r["damping"] == d and r["status"] != "ok":
+                ax.text(kms.index(r["k_m"]), methods.index(r["method"]), "X", ha="center",
+                        va="center", color="red", fontsize=11, fontweight="bold")
+        ax.set_xticks(range(len(kms)), [f"{k:.0e}" for k in kms], rotation=60, fontsize=7)
+        ax.set_yticks(range(len(methods)), methods, fontsize=7)
+        ax.set_xlabel("mesh stiffness k_m [N/m]")
+        ax.set_title(f"c_m {d}: log10(time [s]); X = failed", fontsize=9)
+        fig.colorbar(im, ax=ax)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
