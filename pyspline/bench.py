@@ -170,9 +170,9 @@ def _plot_wp(rows, path, notes):
             style = "-" if "CVODE" in method else ("--" if "fortran" in method else ":")
             line, = ax.plot([r["time_s"] for r in ok],
                             [max(r["err_Tm"], r["err_F"]) for r in ok],
-                            style, marker="o", ms=3, label=method)
+                            style, marker="o", ms=3, label=method, color=plt.cm.tab20(i % 20))
             bad = [r for r in pts if r["status"] != "ok"]
-            if bad:   # failures drawn at the top edge, at their rtol's position in the legend
+            if bad:   # failures drawn at error 1 (top edge), in the method's colour
                 ax.plot([1e-3 * (1 + j) for j in range(len(bad))], [1.0] * len(bad), "x",
                         color=line.get_color(), ms=8)
         ax.set_xscale("log")
