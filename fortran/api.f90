@@ -9,8 +9,7 @@ module spline_api
   use spline_case_io, only: model_t, case_read_file, case_write_defaults, nstate, ndof, nkterms
   use spline_stiffness, only: external_tooth_stiffness, internal_tooth_stiffness
   use spline_dynamics, only: accelerations, start_state
-  use spline_mesh, only: mesh_eval
-  use spline_run, only: run_case, ntooth_q, tooth_q_names, tooth_q_units
+  use spline_run, only: run_case, tooth_quantities, ntooth_q, tooth_q_names, tooth_q_units
   use spline_solver, only: nstats, stat_names
   implicit none
   private
@@ -70,7 +69,6 @@ contains
     integer(c_int), intent(out) :: ierr
     character(len=512), intent(out) :: errmsg
     type(model_t) :: m
-    real(wp) :: fx1, fy1, sp(z), cp(z)
     integer :: ie
     ydot = 0; mesh = 0; tm = 0
     call case_read_file(path, m, ie, errmsg)
@@ -81,13 +79,7 @@ contains
       ydot(1:ndof) = y(ndof+1:)
       call accelerations(m, t, y(1:ndof), y(ndof+1:), ydot(ndof+1:), ie, errmsg)
     end if
-    if (ie == 0) then
-      call mesh_eval(m, t, y(1:ndof), y(ndof+1:), fx1, fy1, tm, ie, errmsg, flash=.true., &
-           f=mesh(:, 1), dn=mesh(:, 4), c=mesh(:, 5), tf=mesh(:, 6), rc1=mesh(:, 7), &
-           rc2=mesh(:, 8), sphi_out=sp, cphi_out=cp)
-      mesh(:, 2) = mesh(:, 1)*sp
-      mesh(:, 3) = mesh(:, 1)*cp
-    end if
+    if (ie == 0) call tooth_quantities(m, t, y, mesh, tm, ie, errmsg)
     ierr = ie
   end subroutine api_rhs
 

@@ -9,7 +9,7 @@ module spline_run
   use spline_solver, only: integrate, nstats
   implicit none
   private
-  public :: run_case, output_times, tooth_outputs, ntooth_q, tooth_q_names, tooth_q_units
+  public :: run_case, output_times, tooth_outputs, tooth_quantities, ntooth_q, tooth_q_names, tooth_q_units
 
   integer, parameter :: ntooth_q = 8
   character(len=4), parameter :: tooth_q_names(ntooth_q) = [character(len=4) :: &
@@ -54,7 +54,8 @@ contains
     call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg)
   end subroutine run_case
 
-  !> Per-tooth quantities at the output times, with the contact states the integration used.
+  !> Per-tooth quantities at the output times, with the contact states the integration used
+  !> (2: decided by the state).
   subroutine tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t(:), y(:, :)
@@ -62,23 +63,35 @@ contains
     real(wp), intent(out) :: tooth(:, :, :), tm(:)
     integer, intent(out) :: ierr
     character(len=*), intent(inout) :: errmsg
-    real(wp) :: fx1, fy1, sp(m%z), cp(m%z)
+    real(wp) :: row(m%z, ntooth_q)
     integer :: k
     ierr = 0
     do k = 1, size(t)
       if (modes(1, k) == 2) then
-        call mesh_eval(m, t(k), y(1:ndof, k), y(ndof+1:, k), fx1, fy1, tm(k), ierr, errmsg, &
-             flash=.true., f=tooth(k, :, 1), dn=tooth(k, :, 4), c=tooth(k, :, 5), tf=tooth(k, :, 6), &
-             rc1=tooth(k, :, 7), rc2=tooth(k, :, 8), sphi_out=sp, cphi_out=cp)
+        call tooth_quantities(m, t(k), y(:, k), row, tm(k), ierr, errmsg)
       else
-        call mesh_eval(m, t(k), y(1:ndof, k), y(ndof+1:, k), fx1, fy1, tm(k), ierr, errmsg, &
-             mode=modes(:, k), flash=.true., f=tooth(k, :, 1), dn=tooth(k, :, 4), c=tooth(k, :, 5), &
-             tf=tooth(k, :, 6), rc1=tooth(k, :, 7), rc2=tooth(k, :, 8), sphi_out=sp, cphi_out=cp)
+        call tooth_quantities(m, t(k), y(:, k), row, tm(k), ierr, errmsg, modes(:, k))
       end if
       if (ierr /= 0) return
-      tooth(k, :, 2) = tooth(k, :, 1)*sp     ! F_jx (Eq. 19 with phi_j)
-      tooth(k, :, 3) = tooth(k, :, 1)*cp     ! F_jy
+      tooth(k, :, :) = row
     end do
   end subroutine tooth_outputs
+
+  !> Every per-tooth quantity (order of tooth_q_names) and the meshing torque at one state y (SI):
+  !> Eqs. 11, 15-17, 19-22 and, where the thermal level has them, Eqs. 1-7 and 12-14.
+  subroutine tooth_quantities(m, t, y, row, tm, ierr, errmsg, mode)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t, y(nstate)
+    real(wp), intent(out) :: row(m%z, ntooth_q), tm
+    integer, intent(out) :: ierr
+    character(len=*), intent(inout) :: errmsg
+    integer, intent(in), optional :: mode(m%z)
+    real(wp) :: fx1, fy1, sp(m%z), cp(m%z)
+    call mesh_eval(m, t, y(1:ndof), y(ndof+1:), fx1, fy1, tm, ierr, errmsg, mode=mode, &
+         flash=.true., f=row(:, 1), dn=row(:, 4), c=row(:, 5), tf=row(:, 6), rc1=row(:, 7), &
+         rc2=row(:, 8), sphi_out=sp, cphi_out=cp)
+    row(:, 2) = row(:, 1)*sp     ! F_jx (Eq. 19 with phi_j)
+    row(:, 3) = row(:, 1)*cp     ! F_jy
+  end subroutine tooth_quantities
 
 end module spline_run
