@@ -5,8 +5,7 @@
 program spline_dyn
   use spline_kinds, only: wp
   use spline_case_io, only: model_t, case_read_file, case_name_of, nstate, nkterms, kterm_names
-  use spline_run, only: run_case, ntooth_q, tooth_q_names, tooth_q_units
-  use spline_solver, only: nstats, stat_names
+  use spline_run, only: nstats, stat_names, run_case, ntooth_q, tooth_q_names, tooth_q_units
   implicit none
   character(len=1024) :: path, out, arg
   character(len=512) :: errmsg

@@ -8,13 +8,12 @@ module spline_api
   use spline_kinds, only: wp
   use spline_case_io, only: model_t, case_read_file, case_write_defaults, nstate, ndof, nkterms
   use spline_stiffness, only: external_tooth_stiffness, internal_tooth_stiffness
-  use spline_dynamics, only: accelerations, start_state
-  use spline_run, only: run_case, tooth_quantities, ntooth_q, tooth_q_names, tooth_q_units
-  use spline_solver, only: nstats, stat_names
+  use spline_dynamics, only: accelerations, start_state, rhs_scaled, to_scaled
+  use spline_run, only: nstats, stat_names, run_case, tooth_quantities, ntooth_q, tooth_q_names, tooth_q_units
   implicit none
   private
   public :: api_sizes, api_simulate, api_rhs, api_start_state, api_write_defaults, api_names
-  public :: api_mesh_stiffness, api_tooth_stiffness, api_load, api_rhs_loaded
+  public :: api_mesh_stiffness, api_tooth_stiffness, api_load, api_rhs_loaded, api_time_rhs
 
   type(model_t), save :: loaded          !< the case of api_load, for api_rhs_loaded
   logical, save :: have_loaded = .false.
@@ -189,5 +188,72 @@ contains
       if (i >= 1 .and. i <= nstats) name = stat_names(i)
     end select
   end subroutine api_names
+
+  !> Cost anatomy: CPU seconds per call of the scaled right-hand side (Eq. 25) of a case at its
+  !> start state (time advanced per call, contact states from the state), and of the flop floor:
+  !> a kernel doing only the arithmetic the mesh cannot avoid (angles by rotation, Eq. 11 and its
+  !> rate, Eqs. 15-17 with every tooth in contact, Eqs. 19-22), branch-free. flops: its count.
+  subroutine api_time_rhs(path, n, t_rhs, t_floor, flops, ierr, errmsg)
+    character(len=*), intent(in) :: path
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(out) :: t_rhs, t_floor, flops
+    integer(c_int), intent(out) :: ierr
+    character(len=512), intent(out) :: errmsg
+    type(model_t) :: m
+    real(wp) :: y(nstate), ys(nstate), f(nstate), acc, dt
+    integer :: ie, k
+    integer(8) :: c0, c1, rate
+    t_rhs = 0; t_floor = 0; flops = 0
+    call case_read_file(path, m, ie, errmsg)
+    if (ie == 0) call start_state(m, y, ie, errmsg)
+    ierr = ie
+    if (ie /= 0 .or. n < 1) return
+    call to_scaled(m, y, ys)
+    dt = 1.0e-3_wp/n
+    acc = 0
+    call system_clock(c0, rate)
+    do k = 1, n
+      call rhs_scaled(m, m%t0*m%w_ref + k*dt, ys, f, ie, errmsg)
+      acc = acc + f(nstate)
+    end do
+    call system_clock(c1)
+    t_rhs = real(c1 - c0, wp)/rate/n
+    if (ie /= 0) then
+      ierr = ie; return
+    end if
+    call system_clock(c0)
+    do k = 1, n
+      acc = acc + floor_kernel(m%z, k*dt, y)
+    end do
+    call system_clock(c1)
+    t_floor = real(c1 - c0, wp)/rate/n
+    flops = 28.0_wp*m%z + 2*nstate + 40.0_wp
+    if (acc == 1.2345e300_wp) errmsg = 'unreachable'     ! keeps both loops from being optimised out
+  contains
+    !> 28 flops per tooth (rotation 6, dn 4, its rate 9, force 4, sums 5), the torsional and
+    !> lateral accelerations and scalings (about 40 + 2 nstate), one sin/cos pair.
+    real(wp) function floor_kernel(z, t, y) result(r)
+      integer, intent(in) :: z
+      real(wp), intent(in) :: t, y(nstate)
+      real(wp) :: s, c, s1, ex, ey, evx, evy, dn, ddn, fj, fx, fy, fs
+      integer :: j
+      real(wp), parameter :: sd = 0.38268343236508978_wp, cd = 0.92387953251128674_wp
+      s = sin(628.3_wp*t); c = cos(628.3_wp*t)
+      ex = y(1) - y(3); ey = y(2) - y(4); evx = y(8) - y(10); evy = y(9) - y(11)
+      fx = 0; fy = 0; fs = 0
+      do j = 1, z
+        dn = ex*s - ey*c + y(6)
+        ddn = evx*s - evy*c + y(13) + 628.3_wp*(ex*c + ey*s)
+        fj = 2.5e5_wp*(dn - 2.0e-4_wp) + 0.053_wp*ddn
+        fx = fx - fj*s
+        fy = fy + fj*c
+        fs = fs + fj
+        s1 = s*cd + c*sd
+        c = c*cd - s*sd
+        s = s1
+      end do
+      r = fx + fy + fs + sum(y)*1.0e-3_wp + y(5)*7.855_wp + y(7)*7.856_wp
+    end function floor_kernel
+  end subroutine api_time_rhs
 
 end module spline_api

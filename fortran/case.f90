@@ -44,6 +44,7 @@ module spline_case_io
   real(wp) :: speed_rpm                     ! shaft speed [r/min]
   real(wp) :: grav                          ! gravity [m/s^2]
   real(wp) :: l_x, l_y                      ! parallel misalignment of spline 1 [m]
+  integer  :: dof                           ! 7 (bending-torsion, Eq. 24) | 3 (torsional only: lateral frozen)
   character(len=16) :: thermal              ! none | bulk | oneway | coupled
   real(wp) :: t_bulk                        ! bulk temperature rise T_M [degC]
   real(wp) :: f_m, u_flash, eta_hertz       ! friction coefficient, Blok factor u, Hertz factor eta [-]
@@ -59,12 +60,15 @@ module spline_case_io
   character(len=16) :: start                ! equilibrium | rest
   real(wp) :: dq0(ndof), dv0(ndof)          ! added to the start state [m], [m/s]
   real(wp) :: l_ref, w_ref                  ! scales (Eq. 25): length [m] (0 = c0), frequency [rad/s] (0 = shaft speed)
+  character(len=16) :: fidelity             ! given (run dof and thermal as set) | auto (cheapest level within fidelity_tol)
+  real(wp) :: fidelity_tol                  ! auto: allowed relative error of T_m and F_j against the level set [-]
 
   namelist /spline_case/ name, z, module_m, alpha_deg, b, s, c0, e_mod, nu, lambda_th, &
        k_cond, rho, c_heat, j_m, j_l, j_1, j_2, m_1, m_2, k_p1, k_p2, c_p1, c_p2, &
        k_t1, k_t2, c_t1, c_t2, k_m, c_m, t_d, t_l, speed_rpm, grav, l_x, l_y, &
        thermal, t_bulk, f_m, u_flash, eta_hertz, method, jacobian, nonlinear, roots, rtol, atol, &
-       max_steps, t0, t_end, t_transient, n_out, start, dq0, dv0, l_ref, w_ref
+       max_steps, t0, t_end, t_transient, n_out, start, dq0, dv0, l_ref, w_ref, &
+       dof, fidelity, fidelity_tol
 
   !> Model parameters derived from a validated case (SI, radians, rad/s).
   type :: model_t
@@ -74,6 +78,9 @@ module spline_case_io
     real(wp) :: j_m, j_l, j_1, j_2, m_1, m_2, k_p1, k_p2, c_p1, c_p2
     real(wp) :: k_t1, k_t2, c_t1, c_t2, k_m, c_m, t_d, t_l, omega, grav, l_x, l_y
     integer  :: thermal = thermal_none
+    integer  :: dof = 7                     !< 7: bending-torsion, 3: torsional (lateral frozen)
+    logical  :: auto = .false.              !< fidelity = auto
+    real(wp) :: fidelity_tol = 1.0e-3_wp
     real(wp) :: t_bulk, f_m, u_flash, eta_hertz
     integer  :: method_bdf = 1              !< 1 = BDF, 0 = Adams
     logical  :: newton = .true.             !< Newton + dense solver, else fixed-point iteration
@@ -115,6 +122,7 @@ contains
     t0 = 0.0_wp; t_end = 0.1_wp; t_transient = 0.0_wp; n_out = 1001
     start = 'equilibrium'; dq0 = 0.0_wp; dv0 = 0.0_wp
     l_ref = 0.0_wp; w_ref = 0.0_wp
+    dof = 7; fidelity = 'given'; fidelity_tol = 1.0e-3_wp
   end subroutine case_defaults
 
   !> Read a case from a namelist file (group &spline_case). Fields not given keep their defaults.
@@ -191,13 +199,13 @@ contains
     type(model_t), intent(out) :: m
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
-    real(wp) :: reals(48)
-    character(len=12), parameter :: real_names(48) = [character(len=12) :: &
+    real(wp) :: reals(49)
+    character(len=12), parameter :: real_names(49) = [character(len=12) :: &
          'module_m', 'alpha_deg', 'b', 's', 'c0', 'e_mod', 'nu', 'lambda_th', 'k_cond', 'rho', &
          'c_heat', 'j_m', 'j_l', 'j_1', 'j_2', 'm_1', 'm_2', 'k_p1', 'k_p2', 'c_p1', 'c_p2', &
          'k_t1', 'k_t2', 'c_t1', 'c_t2', 'k_m', 'c_m', 't_d', 't_l', 'speed_rpm', 'grav', &
          'l_x', 'l_y', 't_bulk', 'f_m', 'u_flash', 'eta_hertz', 'rtol', 'atol', 't0', 't_end', &
-         't_transient', 'l_ref', 'w_ref', 'dq0', 'dv0', 'dq0', 'dv0']
+         't_transient', 'l_ref', 'w_ref', 'dq0', 'dv0', 'dq0', 'dv0', 'fidelity_tol']
     integer :: i
 
     ierr = 1
@@ -205,7 +213,7 @@ contains
     reals = [module_m, alpha_deg, b, s, c0, e_mod, nu, lambda_th, k_cond, rho, c_heat, &
          j_m, j_l, j_1, j_2, m_1, m_2, k_p1, k_p2, c_p1, c_p2, k_t1, k_t2, c_t1, c_t2, k_m, c_m, &
          t_d, t_l, speed_rpm, grav, l_x, l_y, t_bulk, f_m, u_flash, eta_hertz, rtol, atol, t0, &
-         t_end, t_transient, l_ref, w_ref, sum(dq0), sum(dv0), maxval(abs(dq0)), maxval(abs(dv0))]
+         t_end, t_transient, l_ref, w_ref, sum(dq0), sum(dv0), maxval(abs(dq0)), maxval(abs(dv0)), fidelity_tol]
     do i = 1, size(reals)
       if (.not. ieee_is_finite(reals(i))) then
         call fail(real_names(i), 'is not a finite number'); return
@@ -260,6 +268,10 @@ contains
     end if
     if (.not. nonneg(l_ref, 'l_ref')) return
     if (.not. nonneg(w_ref, 'w_ref')) return
+    if (dof /= 3 .and. dof /= 7) then
+      call fail('dof', 'must be 7 (bending-torsion) or 3 (torsional only)'); return
+    end if
+    if (.not. in_range(fidelity_tol, 1.0e-12_wp, 1.0_wp, 'fidelity_tol', 'a relative error')) return
 
     m%name = name
     m%z = z; m%m_n = module_m; m%alpha = alpha_deg*pi/180.0_wp; m%b = b; m%s = s; m%c0 = c0
@@ -293,6 +305,7 @@ contains
     m%rtol = rtol; m%atol = atol; m%max_steps = max_steps; m%n_out = n_out
     m%t0 = t0; m%t_end = t_end; m%t_transient = t_transient
     m%roots = roots; m%dq0 = dq0; m%dv0 = dv0
+    m%dof = dof; m%fidelity_tol = fidelity_tol
 
     select case (trim(thermal))
     case ('none');    m%thermal = thermal_none
@@ -301,6 +314,12 @@ contains
     case ('coupled'); m%thermal = thermal_coupled
     case default
       call fail('thermal', 'is "'//trim(thermal)//'": use none, bulk, oneway or coupled'); return
+    end select
+    select case (trim(fidelity))
+    case ('given'); m%auto = .false.
+    case ('auto');  m%auto = .true.
+    case default
+      call fail('fidelity', 'is "'//trim(fidelity)//'": use given or auto'); return
     end select
     select case (trim(method))
     case ('bdf');   m%method_bdf = 1

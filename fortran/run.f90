@@ -3,13 +3,22 @@
 !> (Eqs. 11, 15-22 and, for the thermal levels that have it, Eqs. 1-7) at every output time.
 module spline_run
   use spline_kinds, only: wp
-  use spline_case_io, only: model_t, nstate, ndof
+  use spline_case_io, only: model_t, nstate, ndof, thermal_none, thermal_bulk, thermal_oneway, &
+       thermal_coupled
   use spline_dynamics, only: start_state
   use spline_mesh, only: mesh_eval
-  use spline_solver, only: integrate, nstats
+  use spline_solver, only: integrate, nsolver_stats => nstats, solver_stat_names => stat_names
+  use spline_fidelity, only: lateral_estimate, backlash_estimate
   implicit none
   private
   public :: run_case, output_times, tooth_outputs, tooth_quantities, ntooth_q, tooth_q_names, tooth_q_units
+  public :: nstats, stat_names
+
+  !> Statistics of a run: the solver's, then the core's CPU time, the model level that ran
+  !> (dof, thermal 0 none .. 3 coupled) and the fidelity estimates of spline_fidelity.
+  integer, parameter :: nstats = nsolver_stats + 5
+  character(len=24), parameter :: stat_names(nstats) = [solver_stat_names, [character(len=24) :: &
+       'core_cpu_s', 'dof', 'thermal_level', 'fidelity_eps_lateral', 'fidelity_eps_thermal']]
 
   integer, parameter :: ntooth_q = 8
   character(len=4), parameter :: tooth_q_names(ntooth_q) = [character(len=4) :: &
@@ -36,7 +45,52 @@ contains
 
   !> Run a validated case: y(:, k) is the SI state at t(k), tooth(k, j, :) the quantities named
   !> in tooth_q_names for tooth j, tm(k) the meshing torque (Eq. 22).
+  !> fidelity = 'auto' runs the cheapest level of the ladder whose estimated error against the
+  !> level the case sets is within fidelity_tol, and that reports the same quantities:
+  !>  - dof 7 -> 3 when lateral_estimate <= tol;
+  !>  - thermal bulk -> none when backlash_estimate(T_M) <= tol;
+  !>  - thermal coupled -> oneway (same T_f output, no iteration in the RHS), checked afterwards:
+  !>    if backlash_estimate(max T_f of the one-way run) > tol the case is run coupled.
   subroutine run_case(m, t, y, tooth, tm, stats, ierr, errmsg)
+    type(model_t), intent(in) :: m
+    real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
+    real(wp), intent(out) :: tm(m%n_out), stats(nstats)
+    integer, intent(out) :: ierr
+    character(len=*), intent(out) :: errmsg
+    type(model_t) :: run
+    real(wp) :: eps_lat, eps_th, tol
+    integer(8) :: c0, c1, rate
+    call system_clock(c0, rate)
+    run = m
+    eps_lat = 0.0_wp; eps_th = 0.0_wp
+    tol = m%fidelity_tol
+    if (m%auto) then
+      eps_lat = lateral_estimate(m)
+      if (m%dof == 7 .and. eps_lat <= tol) run%dof = 3
+      if (m%thermal == thermal_bulk) then
+        eps_th = backlash_estimate(m, m%t_bulk)
+        if (eps_th <= tol) then
+          run%thermal = thermal_none
+          run%c_bulk = m%c0
+        end if
+      end if
+      if (m%thermal == thermal_coupled) run%thermal = thermal_oneway
+    end if
+    call run_level(run, t, y, tooth, tm, stats, ierr, errmsg)
+    if (ierr == 0 .and. m%auto .and. m%thermal == thermal_coupled) then
+      eps_th = backlash_estimate(m, maxval(abs(tooth(:, :, 6))))
+      if (eps_th > tol) then
+        run%thermal = thermal_coupled
+        call run_level(run, t, y, tooth, tm, stats, ierr, errmsg)
+      end if
+    end if
+    call system_clock(c1)
+    stats(nsolver_stats+1:) = [real(c1 - c0, wp)/rate, real(run%dof, wp), real(run%thermal, wp), &
+         eps_lat, eps_th]
+  end subroutine run_case
+
+  !> One run of the model at the level m sets.
+  subroutine run_level(m, t, y, tooth, tm, stats, ierr, errmsg)
     type(model_t), intent(in) :: m
     real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
     real(wp), intent(out) :: tm(m%n_out), stats(nstats)
@@ -49,10 +103,10 @@ contains
     call output_times(m, t)
     call start_state(m, y0, ierr, errmsg)
     if (ierr /= 0) return
-    call integrate(m, y0, m%n_out, t, y, modes, stats, ierr, errmsg)
+    call integrate(m, y0, m%n_out, t, y, modes, stats(1:nsolver_stats), ierr, errmsg)
     if (ierr /= 0) return
     call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg)
-  end subroutine run_case
+  end subroutine run_level
 
   !> Per-tooth quantities at the output times, with the contact states the integration used
   !> (2: decided by the state).

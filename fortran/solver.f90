@@ -32,7 +32,11 @@ module spline_solver
   ! integrated, the frozen contact states between located switches (allocated only when
   ! root finding is on: an unallocated array is an absent optional argument), the frozen
   ! root/tip branches of Eqs. 13-14 (coupled flash temperature only), and the first error.
+  ! The integrated states are ys_full(idx): all 14 for dof = 7; the torsional level (dof = 3)
+  ! integrates D1, D2, D3 and their velocities and holds the lateral states at ys_full.
   type(model_t), save :: mdl
+  integer, allocatable, save :: idx(:)
+  real(c_double), save :: ys_full(nstate)
   integer, allocatable, save :: modes(:), branches(:, :)
   logical, save :: frozen = .false.
   integer, save :: cb_ierr = 0
@@ -53,7 +57,8 @@ contains
     real(wp), intent(out) :: stats(nstats)
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
-    real(c_double), target :: ys(nstate)
+    real(c_double) :: ys(nstate)
+    real(c_double), allocatable, target :: yr(:)
     real(c_double) :: tau, tau_out, tret(1), hlast(1)
     type(c_ptr) :: ctx, mem
     type(N_Vector), pointer :: sv
@@ -85,14 +90,22 @@ contains
     end if
     allocate(rootsfound(nroot))
     call to_scaled(m, y0, ys)
+    if (m%dof == 3) then
+      idx = [5, 6, 7, 12, 13, 14]
+      ys(ndof+1:ndof+4) = 0.0_wp                 ! lateral states frozen at the start displacement
+    else
+      idx = [(k, k = 1, nstate)]
+    end if
+    ys_full = ys
+    yr = ys(idx)
     tau = m%t0*m%w_ref
     k = 0
     if (frozen) call sync_modes(tau, ys, k)
 
     ctx = sundials_context_new()
-    sv => FN_VMake_Serial(int(nstate, c_long), ys, ctx)
+    sv => FN_VMake_Serial(int(size(idx), c_long), yr, ctx)
     flag = FN_VEnableFusedOps_Serial(sv, 1)   ! fused vector kernels: less overhead per step
-    amat => FSUNDenseMatrix(int(nstate, c_long), int(nstate, c_long), ctx)
+    amat => FSUNDenseMatrix(int(size(idx), c_long), int(size(idx), c_long), ctx)
     ls => FSUNLinSol_Dense(sv, amat, ctx)
     if (m%method_bdf == 1) then
       mem = FCVodeCreate(CV_BDF, ctx)
@@ -135,6 +148,7 @@ contains
           exit
         end if
         ! Safety net: a grazing contact can touch a switch without a sign change over a step.
+        ys(idx) = yr
         if (frozen) then
           k0 = nresync
           call sync_modes(tau, ys, nresync)
@@ -270,10 +284,14 @@ contains
     type(N_Vector) :: sv_y, sv_f
     type(c_ptr), value :: udata
     real(c_double), pointer :: ys(:), fs(:)
+    real(c_double) :: yf(nstate), ff(nstate)
     integer :: ierr
     ys => FN_VGetArrayPointer(sv_y)
     fs => FN_VGetArrayPointer(sv_f)
-    call rhs_scaled(mdl, tau, ys, fs, ierr, cb_msg, modes, branches)   ! absent if unallocated
+    yf = ys_full
+    yf(idx) = ys
+    call rhs_scaled(mdl, tau, yf, ff, ierr, cb_msg, modes, branches)   ! absent if unallocated
+    fs = ff(idx)
     ret = 0
     if (ierr /= 0) then
       cb_ierr = ierr
@@ -287,10 +305,13 @@ contains
     real(c_double) :: gout(*)
     type(c_ptr), value :: udata
     real(c_double), pointer :: ys(:)
+    real(c_double) :: yf(nstate)
     real(wp) :: y(nstate)
     integer :: z
     ys => FN_VGetArrayPointer(sv_y)
-    call from_scaled(mdl, ys, y)
+    yf = ys_full
+    yf(idx) = ys
+    call from_scaled(mdl, yf, y)
     z = mdl%z
     if (allocated(branches)) then
       call mesh_switch_functions(mdl, tau/mdl%w_ref, y(1:ndof), gout(1:2*z), y(ndof+1:), &

@@ -76,8 +76,8 @@ def simulate(case) -> Result:
         wall = time.perf_counter() - t0
         raise_for(ierr, msg)
     qnames = [n for n, _ in _names("tooth", nq)]
-    stats = {n: (float(v) if n.endswith(("_s", "_degC")) else int(v))
-             for (n, _), v in zip(_names("stats", ns), stats)}
+    stats = {n: (float(v) if n.endswith(("_s", "_degC")) or n.startswith("fidelity_eps")
+                 else int(v)) for (n, _), v in zip(_names("stats", ns), stats)}
     stats["wall_s"] = wall
     return Result(case=case, t=t, y=y, tooth={n: tooth[:, :, i] for i, n in enumerate(qnames)},
                   Tm=tm, stats=stats)

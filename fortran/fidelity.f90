@@ -1,0 +1,53 @@
+!> The fidelity ladder ("model no more than a scene needs"): error estimates for the cheaper
+!> model levels against the level a case sets, used by fidelity = 'auto' (spline_run).
+!>
+!> Both estimates are relative to the static tooth load F0 = |T_d| / (Z r_b) (Eq. 22 with every
+!> tooth equal) and bound the change of a tooth force as k_m times a displacement the cheaper
+!> level leaves out (Eqs. 15-17):
+!>  - torsional only (dof 3) leaves out the lateral motion. Its drivers are the misalignment
+!>    (l_x, l_y), the difference of the gravity sags g |m_1/k_p1 - m_2/k_p2| and a lateral start
+!>    offset. Without them every tooth sees the same dn_j, sum_j F_j sin(phi_j) = 0 (Z >= 3) and
+!>    the lateral states never move: dof 3 is then exact.
+!>  - a temperature dT left out of Eq. 2 moves the backlash by kappa dT, kappa = 2 lambda s cos(alpha).
+module spline_fidelity
+  use spline_kinds, only: wp
+  use spline_case_io, only: model_t
+  implicit none
+  private
+  public :: static_tooth_load, lateral_estimate, backlash_estimate
+
+contains
+
+  !> F0 = |T_d| / (Z r_b): the tooth load of the static, aligned mesh (Eq. 22) [N].
+  pure real(wp) function static_tooth_load(m) result(f0)
+    type(model_t), intent(in) :: m
+    f0 = abs(m%t_d)/(m%z*m%r_b)
+  end function static_tooth_load
+
+  !> Estimated relative tooth-force error of the torsional level: k_m e / F0, with e the lateral
+  !> excitation |(l_x, l_y)| + g |m_1/k_p1 - m_2/k_p2| + |lateral dq0|. Huge (never reduce) for a
+  !> lateral start velocity, a free lateral body (k_p = 0) or no load.
+  pure real(wp) function lateral_estimate(m) result(eps)
+    type(model_t), intent(in) :: m
+    real(wp) :: e, f0
+    f0 = static_tooth_load(m)
+    eps = huge(1.0_wp)
+    if (f0 == 0.0_wp .or. m%k_p1 == 0.0_wp .or. m%k_p2 == 0.0_wp) return
+    if (any(m%dv0(1:4) /= 0.0_wp)) return
+    e = hypot(m%l_x, m%l_y) + m%grav*abs(m%m_1/m%k_p1 - m%m_2/m%k_p2) + norm2(m%dq0(1:4))
+    eps = m%k_m*e/f0
+  end function lateral_estimate
+
+  !> Estimated relative tooth-force error of leaving a temperature dtemp [degC] out of the
+  !> backlash (Eq. 2): k_m kappa |dtemp| / F0. Huge with no load.
+  pure real(wp) function backlash_estimate(m, dtemp) result(eps)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: dtemp
+    real(wp) :: f0
+    f0 = static_tooth_load(m)
+    eps = huge(1.0_wp)
+    if (f0 == 0.0_wp) return
+    eps = m%k_m*m%kappa*abs(dtemp)/f0
+  end function backlash_estimate
+
+end module spline_fidelity
