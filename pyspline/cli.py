@@ -98,6 +98,20 @@ def cmd_bench(args) -> int:
             print(f"{r['case']:14s} {r['method']:28s} {r['rtol']:7.0e} {r['time_s']:9.4f} "
                   f"{r['rhs_evals']:8d} {err:9.1e} {r['scd']:5.1f}  {r['status']}")
         print(f"wrote {out}/work_precision.png and work_precision.csv")
+    elif args.what == "ladder":
+        from . import ladder
+        rows = ladder.ladder(out, quick=args.quick)
+        print("\n".join(ladder.format_rows(rows)))
+        missed = [r for r in rows if r.get("within_tol") is False]
+        print(f"auto: {sum('picked' in r for r in rows) - len(missed)} of "
+              f"{sum('picked' in r for r in rows)} picks within tolerance")
+        print(f"wrote {out}/ladder.png and ladder.csv")
+        return 1 if missed else 0
+    elif args.what == "anatomy":
+        from . import anatomy
+        rows = anatomy.anatomy(out, quick=args.quick)
+        print("\n".join(anatomy.format_rows(rows)))
+        print(f"wrote {out}/anatomy.png and anatomy.csv")
     else:
         rows = bench.stability_map(out, quick=args.quick)
         for r in rows:
@@ -131,8 +145,9 @@ def main(argv=None) -> int:
     r.add_argument("--cases")
     r.set_defaults(func=cmd_check_exe)
     r = sub.add_parser("bench", help="speed against accuracy: wp (work-precision chart), "
-                       "stability (where methods fail)")
-    r.add_argument("what", choices=["wp", "stability"])
+                       "stability (where methods fail), ladder (model levels, auto fidelity), "
+                       "anatomy (where the time goes)")
+    r.add_argument("what", choices=["wp", "stability", "ladder", "anatomy"])
     r.add_argument("--out", default="out/bench")
     r.add_argument("--quick", action="store_true", help="small sizes (for CI)")
     r.set_defaults(func=cmd_bench)

@@ -25,6 +25,9 @@ from conftest import CASES, PAPER
     (dict(z=16.5), ["z", "whole number"]),
     (dict(dq0=[0.0, 1.0]), ["dq0", "7 numbers"]),
     (dict(speed_rpm=-100.0), ["speed_rpm"]),
+    (dict(dof=5), ["field dof", "7 (bending-torsion) or 3"]),
+    (dict(fidelity="fast"), ["field fidelity", "given or auto"]),
+    (dict(fidelity_tol=0.0), ["fidelity_tol", "relative error"]),
 ])
 def test_bad_field(fields, words):
     with pytest.raises(pyspline.CaseError) as exc:

@@ -1,0 +1,105 @@
+"""Cost anatomy (`pyspline bench anatomy`): where the time of a run goes.
+
+For each case: the time per right-hand-side call (ns) measured in a Fortran loop, against the
+flop floor (a branch-free kernel doing only the arithmetic the mesh cannot avoid, with its flop
+count; fortran/api.f90 api_time_rhs); then one run's time per step and its shares: RHS (the
+integrator's calls), Jacobian (difference-quotient calls), solver (CVODE's own work: the rest of
+the core time) and Python (wall time outside the core: case file, f2py, result arrays).
+"""
+from __future__ import annotations
+
+import statistics
+import time
+from pathlib import Path
+
+from .bench import _write_csv
+from .case import raise_for, load_case
+from .core import _api, _case_file, simulate
+from .paper import cases_dir
+
+CASES = ("paper_lx1e-4", "paper_T100", "physical_lx1e-4")
+
+
+def rhs_cost(case, n=200_000, repeat=5):
+    """Median seconds per RHS call and per floor-kernel call, and the floor's flop count."""
+    with _case_file(case) as path:
+        samples = []
+        for _ in range(repeat):
+            t_rhs, t_floor, flops, ierr, msg = _api.api_time_rhs(path, n)
+            raise_for(ierr, msg)
+            samples.append((t_rhs, t_floor))
+    return (statistics.median(s[0] for s in samples), statistics.median(s[1] for s in samples),
+            flops)
+
+
+def anatomy(out, quick=False, cases=CASES):
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    n = 20_000 if quick else 200_000
+    repeat = 3 if quick else 5
+    rows = []
+    for name in cases:
+        case = load_case(cases_dir() / f"{name}.nml")
+        if quick:
+            case = case.replace(t_end=min(case["t_end"], 0.1), n_out=65)
+        t_rhs, t_floor, flops = rhs_cost(case, n, repeat)
+        runs = []
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            res = simulate(case)
+            runs.append((time.perf_counter() - t0, res))
+        wall, res = sorted(runs, key=lambda r: r[0])[len(runs) // 2]
+        s = res.stats
+        core = s["core_cpu_s"]
+        rhs = s["rhs_evals"] * t_rhs
+        jac = s["lin_rhs_evals"] * t_rhs
+        rows.append(dict(
+            case=name, z=case["z"], thermal=case["thermal"], method=case["method"],
+            rhs_ns=t_rhs * 1e9, floor_ns=t_floor * 1e9, floor_flops=flops,
+            rhs_over_floor=t_rhs / t_floor, steps=s["steps"], rhs_evals=s["rhs_evals"],
+            lin_rhs_evals=s["lin_rhs_evals"], wall_s=wall, core_s=core,
+            us_per_step=core / max(s["steps"], 1) * 1e6,
+            share_rhs=rhs / wall, share_jacobian=jac / wall,
+            share_solver=max(core - rhs - jac, 0.0) / wall,
+            share_python=max(wall - core, 0.0) / wall))
+    _write_csv(out / "anatomy.csv", rows)
+    _plot(rows, out / "anatomy.png")
+    return rows
+
+
+def _plot(rows, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 3.8))
+    names = [r["case"] for r in rows]
+    left = [0.0] * len(rows)
+    for key, color in (("share_rhs", "tab:blue"), ("share_jacobian", "tab:orange"),
+                       ("share_solver", "tab:green"), ("share_python", "tab:gray")):
+        vals = [r[key] for r in rows]
+        a1.barh(names, vals, left=left, color=color, label=key.removeprefix("share_"))
+        left = [a + b for a, b in zip(left, vals)]
+    a1.set_xlabel("share of the wall time of one run")
+    a1.legend(fontsize=8, loc="lower right")
+    a1.set_title("where a run's time goes", fontsize=10)
+    x = range(len(rows))
+    a2.bar([i - 0.2 for i in x], [r["rhs_ns"] for r in rows], 0.4, label="RHS call")
+    a2.bar([i + 0.2 for i in x], [r["floor_ns"] for r in rows], 0.4, label="flop floor")
+    a2.set_xticks(list(x), names, fontsize=8)
+    a2.set_ylabel("ns per call")
+    a2.set_title("RHS against the flop-count floor", fontsize=10)
+    a2.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def format_rows(rows) -> list[str]:
+    lines = [f"{'case':18s} {'RHS ns':>7s} {'floor ns':>8s} {'ratio':>5s} {'flops':>5s} "
+             f"{'steps':>7s} {'us/step':>7s} {'RHS':>5s} {'Jac':>5s} {'solver':>6s} {'Python':>6s}"]
+    for r in rows:
+        lines.append(f"{r['case']:18s} {r['rhs_ns']:7.0f} {r['floor_ns']:8.0f} "
+                     f"{r['rhs_over_floor']:5.1f} {r['floor_flops']:5.0f} {r['steps']:7d} "
+                     f"{r['us_per_step']:7.2f} {r['share_rhs']:5.0%} {r['share_jacobian']:5.0%} "
+                     f"{r['share_solver']:6.0%} {r['share_python']:6.0%}")
+    return lines
