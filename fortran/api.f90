@@ -6,7 +6,9 @@
 module spline_api
   use, intrinsic :: iso_c_binding, only: c_double, c_int
   use spline_kinds, only: wp
-  use spline_case_io, only: model_t, case_read_file, case_write_defaults, nstate, ndof, nkterms
+  use spline_case_io, only: model_t, case_read_file, case_write_defaults, nstate, ndof, nkterms, &
+       thermal_coupled
+  use spline_mesh, only: mesh_switch_functions
   use spline_stiffness, only: external_tooth_stiffness, internal_tooth_stiffness
   use spline_dynamics, only: accelerations, start_state, rhs_scaled, to_scaled
   use spline_run, only: nstats, stat_names, run_case, tooth_quantities, ntooth_q, tooth_q_names, tooth_q_units
@@ -190,21 +192,26 @@ contains
   end subroutine api_names
 
   !> Cost anatomy: CPU seconds per call of the scaled right-hand side (Eq. 25) of a case at its
-  !> start state (time advanced per call, contact states from the state), and of the flop floor:
+  !> static equilibrium (every tooth in contact, as in a running drive; time advanced per call,
+  !> contact states from the state), and of the flop floor:
   !> a kernel doing only the arithmetic the mesh cannot avoid (angles by rotation, Eq. 11 and its
   !> rate, Eqs. 15-17 with every tooth in contact, Eqs. 19-22), branch-free. flops: its count.
-  subroutine api_time_rhs(path, n, t_rhs, t_floor, flops, ierr, errmsg)
+  !> t_roots: one evaluation of the root functions (contact switches, and in the coupled level
+  !> the root/tip branch switches).
+  subroutine api_time_rhs(path, n, t_rhs, t_floor, flops, t_roots, ierr, errmsg)
     character(len=*), intent(in) :: path
     integer(c_int), intent(in) :: n
-    real(c_double), intent(out) :: t_rhs, t_floor, flops
+    real(c_double), intent(out) :: t_rhs, t_floor, flops, t_roots
     integer(c_int), intent(out) :: ierr
     character(len=512), intent(out) :: errmsg
     type(model_t) :: m
-    real(wp) :: y(nstate), ys(nstate), f(nstate), acc, dt
+    real(wp) :: y(nstate), ys(nstate), f(nstate), acc, dt, g(2*1000), gb(2*1000)
     integer :: ie, k
     integer(8) :: c0, c1, rate
-    t_rhs = 0; t_floor = 0; flops = 0
+    t_rhs = 0; t_floor = 0; flops = 0; t_roots = 0
     call case_read_file(path, m, ie, errmsg)
+    m%start_equilibrium = .true.
+    m%dq0 = 0; m%dv0 = 0
     if (ie == 0) call start_state(m, y, ie, errmsg)
     ierr = ie
     if (ie /= 0 .or. n < 1) return
@@ -228,6 +235,17 @@ contains
     call system_clock(c1)
     t_floor = real(c1 - c0, wp)/rate/n
     flops = 28.0_wp*m%z + 2*nstate + 40.0_wp
+    call system_clock(c0)
+    do k = 1, n
+      if (m%thermal == thermal_coupled) then
+        call mesh_switch_functions(m, m%t0 + k*dt, y(1:ndof), g, y(ndof+1:), gb)
+      else
+        call mesh_switch_functions(m, m%t0 + k*dt, y(1:ndof), g)
+      end if
+      acc = acc + g(1)
+    end do
+    call system_clock(c1)
+    t_roots = real(c1 - c0, wp)/rate/n
     if (acc == 1.2345e300_wp) errmsg = 'unreachable'     ! keeps both loops from being optimised out
   contains
     !> 28 flops per tooth (rotation 6, dn 4, its rate 9, force 4, sums 5), the torsional and

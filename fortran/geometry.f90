@@ -39,13 +39,19 @@ contains
 
   !> Eqs. 13-14: radius of the contact point of a spline with pitch radius r (R = m Z / 2) whose
   !> profile is shifted by delta. Moving towards the root (ddelta < 0): law of cosines (Eq. 13);
-  !> otherwise towards the tip: law of sines (Eq. 14).
+  !> otherwise towards the tip: law of sines (Eq. 14),
+  !>   rc = R sin(pi - alpha - beta) / sin(alpha),  sin(beta) = Delta sin(alpha) / R,
+  !> evaluated in the exact equivalent form rc = R cos(beta) + Delta cos(alpha) (expand
+  !> sin(alpha + beta); |beta| < pi/2), which needs no inverse sine.
   pure real(wp) function contact_radius(delta, ddelta, r, alpha) result(rc)
     real(wp), intent(in) :: delta, ddelta, r, alpha
+    real(wp) :: ca, sb
+    ca = cos(alpha)
     if (ddelta < 0.0_wp) then
-      rc = sqrt(delta**2 + r**2 - 2.0_wp*r*delta*cos(alpha))
+      rc = sqrt(delta**2 + r**2 - 2.0_wp*r*delta*ca)
     else
-      rc = r*sin(pi - alpha - asin(delta*sin(alpha)/r))/sin(alpha)
+      sb = delta*sin(alpha)/r
+      rc = r*sqrt(1.0_wp - sb*sb) + delta*ca
     end if
   end function contact_radius
 

@@ -156,15 +156,18 @@ contains
   !> Secant iteration from T = 0 and T = T_f(F(0)); it stops when a step is below
   !> 1e-14 (1 + T) degC. The map T -> T_f(F(T)) contracts by about k_m kappa dT_f/dF (~1e-3 for the
   !> paper's k_m), so 3-5 iterations reach round-off. ierr = 1: backlash closed; 2: no convergence.
+  !> Eqs. 3-4 make T_f a power of the load at a given contact point: f_e / sqrt(B) ~ f_e^(3/4), so
+  !> T_f(F) = T_f(1 N) |F|^(3/4). Eqs. 3-7 are evaluated once per tooth, each iteration costs two sqrt.
   subroutine solve_coupled(m, dn, ddn, mode, r1, r2, f, t, ierr)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: dn, ddn, r1, r2
     integer, intent(in) :: mode
     real(wp), intent(out) :: f, t
     integer, intent(out) :: ierr
-    real(wp) :: ta, ga, tb, gb, tn
+    real(wp) :: ta, ga, tb, gb, tn, tf_unit
     integer :: k
     ierr = 0
+    tf_unit = flash_of(m, 1.0_wp, r1, r2)
     ta = 0.0_wp
     ga = -tf_at(ta)
     tb = -ga
@@ -195,13 +198,14 @@ contains
   contains
     real(wp) function tf_at(tt)
       real(wp), intent(in) :: tt
-      real(wp) :: cc
+      real(wp) :: cc, q
       cc = thermal_backlash(m%c_bulk, m%kappa, tt)
       tf_at = 0.0_wp
       if (cc <= 0.0_wp) then
         ierr = 1; return
       end if
-      tf_at = flash_of(m, contact_force(m, dn, ddn, mode, cc), r1, r2)
+      q = sqrt(sqrt(abs(contact_force(m, dn, ddn, mode, cc))))
+      tf_at = tf_unit*q*q*q
     end function tf_at
   end subroutine solve_coupled
 

@@ -32,8 +32,8 @@ contains
     tf = 0.0_wp
     bh = 0.0_wp
     if (fe == 0.0_wp .or. v1 + v2 <= 0.0_wp) return
-    rr1 = rc1*sin(acos(min(1.0_wp, r_b/rc1)))
-    rr2 = rc2*sin(acos(min(1.0_wp, r_b/rc2)))
+    rr1 = sqrt(max(0.0_wp, rc1**2 - r_b**2))     ! rc sin(acos(r_b / rc)), exactly
+    rr2 = sqrt(max(0.0_wp, rc2**2 - r_b**2))
     bh = eta*sqrt(2.0_wp*(1.0_wp - nu**2)/e_mod*fe*rr1*rr2/(rr1 + rr2))
     tf = u*f_m*fe*abs(v1 - v2)/(sqrt(bh)*(sqrt(k_cond*rho*c_heat*v1) + sqrt(k_cond*rho*c_heat*v2)))
   end subroutine flash_temperature

@@ -3,8 +3,9 @@
 For each case: the time per right-hand-side call (ns) measured in a Fortran loop, against the
 flop floor (a branch-free kernel doing only the arithmetic the mesh cannot avoid, with its flop
 count; fortran/api.f90 api_time_rhs); then one run's time per step and its shares: RHS (the
-integrator's calls), Jacobian (difference-quotient calls), solver (CVODE's own work: the rest of
-the core time) and Python (wall time outside the core: case file, f2py, result arrays).
+integrator's calls), Jacobian (difference-quotient calls), roots (root-function evaluations,
+where the case locates switches), solver (CVODE's own work and the per-tooth outputs: the rest
+of the core time) and Python (wall time outside the core: case file, f2py, result arrays).
 """
 from __future__ import annotations
 
@@ -21,15 +22,16 @@ CASES = ("paper_lx1e-4", "paper_T100", "physical_lx1e-4")
 
 
 def rhs_cost(case, n=200_000, repeat=5):
-    """Median seconds per RHS call and per floor-kernel call, and the floor's flop count."""
+    """Median seconds per RHS call, per floor-kernel call and per root-function evaluation,
+    and the floor's flop count."""
     with _case_file(case) as path:
         samples = []
         for _ in range(repeat):
-            t_rhs, t_floor, flops, ierr, msg = _api.api_time_rhs(path, n)
+            t_rhs, t_floor, flops, t_roots, ierr, msg = _api.api_time_rhs(path, n)
             raise_for(ierr, msg)
-            samples.append((t_rhs, t_floor))
-    return (statistics.median(s[0] for s in samples), statistics.median(s[1] for s in samples),
-            flops)
+            samples.append((t_rhs, t_floor, t_roots))
+    med = [statistics.median(s[i] for s in samples) for i in range(3)]
+    return med[0], med[1], flops, med[2]
 
 
 def anatomy(out, quick=False, cases=CASES):
@@ -42,7 +44,7 @@ def anatomy(out, quick=False, cases=CASES):
         case = load_case(cases_dir() / f"{name}.nml")
         if quick:
             case = case.replace(t_end=min(case["t_end"], 0.1), n_out=65)
-        t_rhs, t_floor, flops = rhs_cost(case, n, repeat)
+        t_rhs, t_floor, flops, t_roots = rhs_cost(case, n, repeat)
         runs = []
         for _ in range(repeat):
             t0 = time.perf_counter()
@@ -53,14 +55,16 @@ def anatomy(out, quick=False, cases=CASES):
         core = s["core_cpu_s"]
         rhs = s["rhs_evals"] * t_rhs
         jac = s["lin_rhs_evals"] * t_rhs
+        roots = s["root_fn_evals"] * t_roots
         rows.append(dict(
             case=name, z=case["z"], thermal=case["thermal"], method=case["method"],
             rhs_ns=t_rhs * 1e9, floor_ns=t_floor * 1e9, floor_flops=flops,
             rhs_over_floor=t_rhs / t_floor, steps=s["steps"], rhs_evals=s["rhs_evals"],
             lin_rhs_evals=s["lin_rhs_evals"], wall_s=wall, core_s=core,
             us_per_step=core / max(s["steps"], 1) * 1e6,
-            share_rhs=rhs / wall, share_jacobian=jac / wall,
-            share_solver=max(core - rhs - jac, 0.0) / wall,
+            roots_ns=t_roots * 1e9, root_fn_evals=s["root_fn_evals"],
+            share_rhs=rhs / wall, share_jacobian=jac / wall, share_roots=roots / wall,
+            share_solver=max(core - rhs - jac - roots, 0.0) / wall,
             share_python=max(wall - core, 0.0) / wall))
     _write_csv(out / "anatomy.csv", rows)
     _plot(rows, out / "anatomy.png")
@@ -75,7 +79,8 @@ def _plot(rows, path):
     names = [r["case"] for r in rows]
     left = [0.0] * len(rows)
     for key, color in (("share_rhs", "tab:blue"), ("share_jacobian", "tab:orange"),
-                       ("share_solver", "tab:green"), ("share_python", "tab:gray")):
+                       ("share_roots", "tab:purple"), ("share_solver", "tab:green"),
+                       ("share_python", "tab:gray")):
         vals = [r[key] for r in rows]
         a1.barh(names, vals, left=left, color=color, label=key.removeprefix("share_"))
         left = [a + b for a, b in zip(left, vals)]
@@ -96,10 +101,12 @@ def _plot(rows, path):
 
 def format_rows(rows) -> list[str]:
     lines = [f"{'case':18s} {'RHS ns':>7s} {'floor ns':>8s} {'ratio':>5s} {'flops':>5s} "
-             f"{'steps':>7s} {'us/step':>7s} {'RHS':>5s} {'Jac':>5s} {'solver':>6s} {'Python':>6s}"]
+             f"{'steps':>7s} {'us/step':>7s} {'RHS':>5s} {'Jac':>5s} {'roots':>5s} {'solver':>6s} "
+             f"{'Python':>6s}"]
     for r in rows:
         lines.append(f"{r['case']:18s} {r['rhs_ns']:7.0f} {r['floor_ns']:8.0f} "
                      f"{r['rhs_over_floor']:5.1f} {r['floor_flops']:5.0f} {r['steps']:7d} "
                      f"{r['us_per_step']:7.2f} {r['share_rhs']:5.0%} {r['share_jacobian']:5.0%} "
+                     f"{r['share_roots']:5.0%} "
                      f"{r['share_solver']:6.0%} {r['share_python']:6.0%}")
     return lines
