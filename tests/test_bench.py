@@ -41,3 +41,39 @@ def test_work_precision_quick(tmp_path):
                     key=lambda r: -r["rtol"])
         errs = [max(r["err_Tm"], r["err_F"]) for r in cv]
         assert errs[0] > errs[-1]
+
+
+def test_ladder_quick(tmp_path):
+    """Every level of every quick case is a row; each case's own level has error 0; the
+    torsional level is exact on the aligned case and misses on the misaligned one; every auto
+    pick is within its tolerance (the CSV says so, and the error column agrees)."""
+    from pyspline import ladder
+    rows = ladder.ladder(tmp_path, quick=True, progress=False)
+    assert (tmp_path / "ladder.png").stat().st_size > 20_000
+    table = list(csv.DictReader(open(tmp_path / "ladder.csv")))
+    assert len(table) == len(rows) == len(ladder.QUICK_CASES) * (8 + len(ladder.TOLS))
+    by = {(r["case"], r["level"]): r for r in rows}
+    for name in ladder.QUICK_CASES:
+        own = [r for r in rows if r["case"] == name and r["own"]]
+        assert len(own) == 1 and own[0]["error"] == 0.0
+    assert by[("paper_ideal", "3-DOF none")]["error"] < 1e-6
+    assert by[("paper_lx1e-4", "3-DOF none")]["error"] > 1e-2
+    picks = [r for r in rows if "picked" in r]
+    assert len(picks) == len(ladder.QUICK_CASES) * len(ladder.TOLS)
+    assert all(r["within_tol"] and r["error"] <= r["tol"] for r in picks)
+    assert by[("paper_ideal", "auto 0.01")]["picked"] == "3-DOF none"
+
+
+def test_anatomy_quick(tmp_path):
+    """The cost anatomy: positive costs, the shares of one run add up to at most 1, and the
+    flop count of the floor grows with the number of teeth."""
+    from pyspline import anatomy
+    rows = anatomy.anatomy(tmp_path, quick=True, cases=("paper_lx1e-4",))
+    assert (tmp_path / "anatomy.png").stat().st_size > 10_000
+    (r,) = rows
+    assert r["rhs_ns"] > 0 and r["floor_ns"] > 0 and r["us_per_step"] > 0
+    shares = [r[k] for k in r if k.startswith("share_")]
+    assert all(s >= 0 for s in shares) and sum(shares) <= 1.0 + 1e-9
+    case = pyspline.load_case(CASES / "paper_lx1e-4.nml")
+    assert anatomy.rhs_cost(case.replace(z=32), n=10, repeat=1)[2] > \
+        anatomy.rhs_cost(case, n=10, repeat=1)[2]
