@@ -109,7 +109,8 @@ def _plot(rows, names, path):
             if r["level"].startswith("auto"):
                 ax.plot(r["cost_s"], err, "kx", ms=10, mew=2)
                 ax.annotate(f"auto {r['tol']:g}", (r["cost_s"], err), fontsize=7,
-                            xytext=(4, -10), textcoords="offset points")
+                            xytext=(5, -11 if r["tol"] == TOLS[0] else 4),
+                            textcoords="offset points")
                 continue
             marker = "^" if r["dof"] == 3 else "o"
             face = colors[r["thermal"]] if r["eligible"] else "none"
