@@ -144,8 +144,32 @@ def work_precision(out, quick=False, progress=True):
                            scd=float("nan"))
             rows.append(row)
     _write_csv(out / "work_precision.csv", rows)
+    _write_csv(out / "speed_ratios.csv", speed_ratios(rows))
     _plot_wp(rows, out / "work_precision.png", notes)
     return rows, notes
+
+
+def speed_ratios(rows, accuracy=1e-6):
+    """At equal accuracy (the cheapest run of each method whose error is at most `accuracy`;
+    1e-6 is what CVODE reaches at rtol 1e-8), the time of the fastest scipy peer on each RHS
+    over the time of the fastest CVODE variant, per case. None where no run reached it."""
+    out = []
+    for name in dict.fromkeys(r["case"] for r in rows):
+        good = [r for r in rows if r["case"] == name and r["status"] == "ok"
+                and max(r["err_Tm"], r["err_F"]) <= accuracy]
+
+        def best(pred):
+            cand = [r for r in good if pred(r["method"])]
+            return min(cand, key=lambda r: r["time_s"]) if cand else None
+        cv = best(lambda m: m.startswith("CVODE"))
+        for kind in ("numpy", "fortran"):
+            peer = best(lambda m, k=kind: m.startswith("scipy") and f"({k} RHS)" in m)
+            out.append(dict(case=name, accuracy=accuracy, peer_rhs=kind,
+                            cvode=cv and cv["method"], cvode_rtol=cv and cv["rtol"],
+                            cvode_s=cv and cv["time_s"], peer=peer and peer["method"],
+                            peer_rtol=peer and peer["rtol"], peer_s=peer and peer["time_s"],
+                            ratio=(peer["time_s"] / cv["time_s"]) if cv and peer else None))
+    return out
 
 
 def _write_csv(path, rows):

@@ -15,6 +15,7 @@ def _summary(res) -> str:
             f"T_m [{res.Tm.min():7.2f}, {res.Tm.max():7.2f}] N m  "
             f"k_v [{res.kv.min():.3f}, {res.kv.max():.3f}]  "
             f"D2 [{res.D2.min():.4e}, {res.D2.max():.4e}] m  "
+            f"{s['dof']}-DOF {('none', 'bulk', 'oneway', 'coupled')[s['thermal_level']]}  "
             f"steps {s['steps']}  {s['wall_s']*1e3:.0f} ms")
 
 
@@ -97,7 +98,15 @@ def cmd_bench(args) -> int:
             err = max(r["err_Tm"], r["err_F"])
             print(f"{r['case']:14s} {r['method']:28s} {r['rtol']:7.0e} {r['time_s']:9.4f} "
                   f"{r['rhs_evals']:8d} {err:9.1e} {r['scd']:5.1f}  {r['status']}")
-        print(f"wrote {out}/work_precision.png and work_precision.csv")
+        for r in bench.speed_ratios(rows):
+            if r["ratio"] is None:
+                print(f"{r['case']}: at error <= {r['accuracy']:g} no {r['peer_rhs']}-RHS peer "
+                      f"(or no CVODE run) reached it")
+            else:
+                print(f"{r['case']}: at error <= {r['accuracy']:g}, {r['cvode']} (rtol "
+                      f"{r['cvode_rtol']:g}) {r['cvode_s']:.4f} s vs {r['peer']} (rtol "
+                      f"{r['peer_rtol']:g}) {r['peer_s']:.4f} s: {r['ratio']:.1f}x")
+        print(f"wrote {out}/work_precision.png, work_precision.csv and speed_ratios.csv")
     elif args.what == "ladder":
         from . import ladder
         rows = ladder.ladder(out, quick=args.quick)
