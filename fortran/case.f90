@@ -52,6 +52,7 @@ module spline_case_io
   character(len=16) :: jacobian             ! dq (difference quotients)
   character(len=16) :: nonlinear            ! newton (dense direct) | fixedpoint (no Jacobian: non-stiff scenes)
   logical  :: roots                         ! locate contact switches |dn_j| = c_j by root finding
+  logical  :: stald                         ! BDF stability-limit detection (CVodeSetStabLimDet)
   real(wp) :: rtol, atol                    ! tolerances on the scaled states [-]
   integer  :: max_steps                     ! CVODE steps allowed between two output times
   real(wp) :: t0, t_end                     ! start and end time [s]
@@ -68,7 +69,7 @@ module spline_case_io
        k_t1, k_t2, c_t1, c_t2, k_m, c_m, t_d, t_l, speed_rpm, grav, l_x, l_y, &
        thermal, t_bulk, f_m, u_flash, eta_hertz, method, jacobian, nonlinear, roots, rtol, atol, &
        max_steps, t0, t_end, t_transient, n_out, start, dq0, dv0, l_ref, w_ref, &
-       dof, fidelity, fidelity_tol
+       dof, fidelity, fidelity_tol, stald
 
   !> Model parameters derived from a validated case (SI, radians, rad/s).
   type :: model_t
@@ -85,6 +86,7 @@ module spline_case_io
     integer  :: method_bdf = 1              !< 1 = BDF, 0 = Adams
     logical  :: newton = .true.             !< Newton + dense solver, else fixed-point iteration
     logical  :: roots = .false.
+    logical  :: stald = .false.
     real(wp) :: rtol, atol
     integer  :: max_steps, n_out
     real(wp) :: t0, t_end, t_transient
@@ -117,7 +119,7 @@ contains
     t_d = 30.7_wp; t_l = 30.7_wp; speed_rpm = 6000.0_wp; grav = 9.81_wp
     l_x = 0.0_wp; l_y = 0.0_wp
     thermal = 'none'; t_bulk = 0.0_wp; f_m = 0.1_wp; u_flash = 0.83_wp; eta_hertz = 1.127_wp
-    method = 'bdf'; jacobian = 'dq'; nonlinear = 'newton'; roots = .false.
+    method = 'bdf'; jacobian = 'dq'; nonlinear = 'newton'; roots = .false.; stald = .false.
     rtol = 1.0e-8_wp; atol = 1.0e-10_wp; max_steps = 100000
     t0 = 0.0_wp; t_end = 0.1_wp; t_transient = 0.0_wp; n_out = 1001
     start = 'equilibrium'; dq0 = 0.0_wp; dv0 = 0.0_wp
@@ -304,7 +306,7 @@ contains
     m%t_bulk = t_bulk; m%f_m = f_m; m%u_flash = u_flash; m%eta_hertz = eta_hertz
     m%rtol = rtol; m%atol = atol; m%max_steps = max_steps; m%n_out = n_out
     m%t0 = t0; m%t_end = t_end; m%t_transient = t_transient
-    m%roots = roots; m%dq0 = dq0; m%dv0 = dv0
+    m%roots = roots; m%stald = stald; m%dq0 = dq0; m%dv0 = dv0
     m%dof = dof; m%fidelity_tol = fidelity_tol
 
     select case (trim(thermal))

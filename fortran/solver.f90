@@ -122,6 +122,7 @@ contains
       if (flag == 0) flag = FCVodeSetNonlinearSolver(mem, nls)
     end if
     if (flag == 0) flag = FCVodeSetMaxNumSteps(mem, int(m%max_steps, c_long))
+    if (flag == 0 .and. m%stald .and. m%method_bdf == 1) flag = FCVodeSetStabLimDet(mem, 1)
     if (flag == 0 .and. frozen) flag = FCVodeRootInit(mem, nroot, c_funloc(roots_cb))
     if (flag == 0 .and. frozen) flag = FCVodeSetNoInactiveRootWarn(mem)
     if (flag /= 0) then

@@ -227,7 +227,7 @@ def stability_map(out, quick=False, progress=True):
     m_e = base["j_1"] * base["j_2"] / (base["j_1"] + base["j_2"]) \
         / (base["z"] * (base["module_m"] * base["z"] / 2 * np.cos(np.radians(30))) ** 2)
     methods = [("cvode", "bdf", False), ("cvode", "adams", False), ("cvode", "bdf", True),
-               ("cvode", "adams-fixedpoint", False)] + \
+               ("cvode", "bdf-stald", False), ("cvode", "adams-fixedpoint", False)] + \
               [("scipy", m, "fortran") for m in SCIPY_METHODS]
     rows = []
     jobs = [(d, k, m) for d in ("as given", "zeta = 0.05") for k in kms for m in methods]
@@ -242,6 +242,7 @@ def stability_map(out, quick=False, progress=True):
         try:
             if solver == "cvode":
                 kw = dict(method="adams", nonlinear="fixedpoint") if method == "adams-fixedpoint" \
+                    else dict(method="bdf", stald=True) if method == "bdf-stald" \
                     else dict(method=method)
                 res = simulate(case.replace(roots=bool(opt), **kw))
                 row.update(status="ok", steps=res.stats["steps"], rhs_evals=res.stats["rhs_evals"],
