@@ -12,7 +12,7 @@ module spline_case_io
   private
   public :: model_t, case_read_file, case_read_string, case_write_defaults, case_to_model
   public :: nstate, ndof, thermal_none, thermal_bulk, thermal_oneway, thermal_coupled
-  public :: case_name_of, nkterms, kterm_names
+  public :: case_name_of, nkterms, kterm_names, set_thermal_level
 
   integer, parameter :: ndof = 7            !< x1, y1, x2, y2, D1, D2, D3 (Eq. 24)
   integer, parameter :: nstate = 2*ndof     !< displacements then velocities
@@ -352,8 +352,7 @@ contains
     m%r_b = m%r_pitch*cos(m%alpha)
     m%theta0 = pi/(2.0_wp*m%z)
     m%kappa = 2.0_wp*m%lambda_th*m%s*cos(m%alpha)
-    m%c_bulk = m%c0
-    if (m%thermal /= thermal_none) m%c_bulk = m%c0 - m%kappa*m%t_bulk
+    call set_thermal_level(m, m%thermal)
     if (m%c_bulk <= 0.0_wp) then
       write(errmsg, '(a,es10.3,a,es10.3,a)') 'case '//trim(m%name)//': thermal interference: '// &
            't_bulk = ', m%t_bulk, ' degC closes the backlash (c = ', m%c_bulk, ' m, Eq. 2)'
@@ -402,5 +401,15 @@ contains
     end function in_range
 
   end subroutine case_to_model
+
+  !> Set the thermal level of a model and the backlash it implies at the bulk temperature:
+  !> Eq. 2 with T_B = T_M, or c_0 for the level none.
+  pure subroutine set_thermal_level(m, level)
+    type(model_t), intent(inout) :: m
+    integer, intent(in) :: level
+    m%thermal = level
+    m%c_bulk = m%c0
+    if (level /= thermal_none) m%c_bulk = m%c0 - m%kappa*m%t_bulk
+  end subroutine set_thermal_level
 
 end module spline_case_io

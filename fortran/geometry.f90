@@ -10,7 +10,7 @@ contains
   !> Eqs. 8-9: line-of-action angle of every tooth pair, phi_j = 2 pi j / Z + omega t + theta_0 - alpha,
   !> returned as sin and cos (what the mesh needs). Two sin/cos pairs per call instead of Z: the
   !> teeth are equally spaced, so phi_{j+1} = phi_j + 2 pi / Z is a rotation (round-off grows
-  !> like j eps, below 1e-14 for any spline).
+  !> like j eps: 1e-15 at Z = 16, 1.4e-14 at Z = 1000, the most a case allows).
   pure subroutine tooth_angles(z, omega, t, theta0, alpha, sphi, cphi)
     integer, intent(in) :: z
     real(wp), intent(in) :: omega, t, theta0, alpha

@@ -4,7 +4,7 @@
 module spline_run
   use spline_kinds, only: wp
   use spline_case_io, only: model_t, nstate, ndof, thermal_none, thermal_bulk, thermal_oneway, &
-       thermal_coupled
+       thermal_coupled, set_thermal_level
   use spline_dynamics, only: start_state
   use spline_mesh, only: mesh_eval
   use spline_solver, only: integrate, nsolver_stats => nstats, solver_stat_names => stat_names
@@ -14,14 +14,15 @@ module spline_run
   public :: run_case, output_times, tooth_outputs, tooth_quantities, ntooth_q, tooth_q_names, tooth_q_units
   public :: nstats, stat_names
 
-  !> Statistics of a run: the solver's, then the core's CPU time, the model level that ran
+  !> Statistics of a run: the solver's, then the core's elapsed time, the model level that ran
   !> (dof, thermal 0 none .. 3 coupled) and the fidelity estimates of spline_fidelity.
   real(wp), parameter :: fidelity_margin = 0.5_wp   !< auto reduces when estimate <= margin * tol
   integer, parameter :: nstats = nsolver_stats + 5
   character(len=24), parameter :: stat_names(nstats) = [solver_stat_names, [character(len=24) :: &
-       'core_cpu_s', 'dof', 'thermal_level', 'fidelity_eps_lateral', 'fidelity_eps_thermal']]
+       'core_wall_s', 'dof', 'thermal_level', 'fidelity_eps_lateral', 'fidelity_eps_thermal']]
 
   integer, parameter :: ntooth_q = 8
+  integer, parameter :: iq_tf = 6                  !< position of T_f in tooth_q_names
   character(len=4), parameter :: tooth_q_names(ntooth_q) = [character(len=4) :: &
        'F', 'Fx', 'Fy', 'dn', 'c', 'Tf', 'rc1', 'rc2']
   character(len=4), parameter :: tooth_q_units(ntooth_q) = [character(len=4) :: &
@@ -49,7 +50,7 @@ contains
   !> fidelity = 'auto' runs the cheapest level of the ladder whose estimated error against the
   !> level the case sets is within fidelity_tol, and that reports the same quantities. With
   !> tol = fidelity_margin * fidelity_tol (the estimates are not bounds: measured errors reach
-  !> 0.9 of them, `pyspline bench ladder`):
+  !> 1.3 of them, paper_T50/T100 one-way over 1 s, `pyspline bench ladder`):
   !>  - dof 7 -> 3 when lateral_estimate <= tol;
   !>  - thermal bulk -> none when backlash_estimate(T_M) <= tol;
   !>  - thermal coupled -> oneway (same T_f output, no iteration in the RHS), checked afterwards:
@@ -72,18 +73,15 @@ contains
       if (m%dof == 7 .and. eps_lat <= tol) run%dof = 3
       if (m%thermal == thermal_bulk) then
         eps_th = backlash_estimate(m, m%t_bulk)
-        if (eps_th <= tol) then
-          run%thermal = thermal_none
-          run%c_bulk = m%c0
-        end if
+        if (eps_th <= tol) call set_thermal_level(run, thermal_none)
       end if
-      if (m%thermal == thermal_coupled) run%thermal = thermal_oneway
+      if (m%thermal == thermal_coupled) call set_thermal_level(run, thermal_oneway)
     end if
     call run_level(run, t, y, tooth, tm, stats, ierr, errmsg)
     if (ierr == 0 .and. m%auto .and. m%thermal == thermal_coupled) then
-      eps_th = backlash_estimate(m, maxval(abs(tooth(:, :, 6))))
+      eps_th = backlash_estimate(m, maxval(abs(tooth(:, :, iq_tf))))
       if (eps_th > tol) then
-        run%thermal = thermal_coupled
+        call set_thermal_level(run, thermal_coupled)
         call run_level(run, t, y, tooth, tm, stats, ierr, errmsg)
       end if
     end if

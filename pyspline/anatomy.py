@@ -52,7 +52,7 @@ def anatomy(out, quick=False, cases=CASES):
             runs.append((time.perf_counter() - t0, res))
         wall, res = sorted(runs, key=lambda r: r[0])[len(runs) // 2]
         s = res.stats
-        core = s["core_cpu_s"]
+        core = s["core_wall_s"]
         rhs = s["rhs_evals"] * t_rhs
         jac = s["lin_rhs_evals"] * t_rhs
         roots = s["root_fn_evals"] * t_roots

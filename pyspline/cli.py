@@ -15,7 +15,7 @@ def _summary(res) -> str:
             f"T_m [{res.Tm.min():7.2f}, {res.Tm.max():7.2f}] N m  "
             f"k_v [{res.kv.min():.3f}, {res.kv.max():.3f}]  "
             f"D2 [{res.D2.min():.4e}, {res.D2.max():.4e}] m  "
-            f"{s['dof']}-DOF {('none', 'bulk', 'oneway', 'coupled')[s['thermal_level']]}  "
+            f"{res.level}  "
             f"steps {s['steps']}  {s['wall_s']*1e3:.0f} ms")
 
 

@@ -19,6 +19,12 @@ from .case import Case, load_case, raise_for
 
 _api = _core.spline_api
 STATE_NAMES = ("x1", "y1", "x2", "y2", "D1", "D2", "D3")
+THERMAL_LEVELS = ("none", "bulk", "oneway", "coupled")   #: stats["thermal_level"] 0..3
+
+
+def level_name(dof: int, thermal: str) -> str:
+    """A model level of the fidelity ladder, e.g. '7-DOF coupled'."""
+    return f"{dof}-DOF {thermal}"
 
 
 @functools.cache
@@ -47,6 +53,11 @@ class Result:
     tooth: dict              #: per-tooth quantities by name: F, Fx, Fy [N], dn, c [m], Tf [degC], rc1, rc2 [m]
     Tm: np.ndarray           #: meshing torque T_m (Eq. 22) [N m]
     stats: dict = field(default_factory=dict)   #: CVODE statistics and run time
+
+    @property
+    def level(self) -> str:
+        """The model level that ran (differs from the case's under fidelity = 'auto')."""
+        return level_name(self.stats["dof"], THERMAL_LEVELS[self.stats["thermal_level"]])
 
     @property
     def kv(self) -> np.ndarray:

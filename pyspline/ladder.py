@@ -17,10 +17,9 @@ import numpy as np
 
 from .bench import _errors, _write_csv
 from .case import SplineError, load_case
-from .core import simulate
+from .core import THERMAL_LEVELS as THERMAL, level_name, simulate
 from .paper import cases_dir
 
-THERMAL = ("none", "bulk", "oneway", "coupled")
 #: thermal levels that report what a case's own level reports (auto chooses among these)
 ELIGIBLE = {"none": ("none",), "bulk": ("none", "bulk"), "oneway": ("oneway",),
             "coupled": ("oneway", "coupled")}
@@ -30,13 +29,9 @@ QUICK_CASES = ("paper_ideal", "paper_lx1e-4", "paper_T100")
 TOLS = (1e-2, 1e-3)
 
 
-def level_name(dof: int, thermal: str) -> str:
-    return f"{dof}-DOF {thermal}"
-
-
 def _timed(case, repeat):
     runs = [simulate(case) for _ in range(repeat)]
-    return runs[-1], statistics.median(r.stats["core_cpu_s"] for r in runs)
+    return runs[-1], statistics.median(r.stats["core_wall_s"] for r in runs)
 
 
 def _error(res, ref):
@@ -83,7 +78,7 @@ def ladder(out, quick=False, progress=True, cases=None):
                              thermal=THERMAL[s["thermal_level"]], own=False, eligible=True,
                              status="ok", cost_s=cost, steps=s["steps"],
                              rhs_evals=s["rhs_evals"], error=err, tol=tol,
-                             picked=level_name(s["dof"], THERMAL[s["thermal_level"]]),
+                             picked=res.level,
                              eps_lateral=s["fidelity_eps_lateral"],
                              eps_thermal=s["fidelity_eps_thermal"],
                              within_tol=bool(err <= tol), speedup=ref_cost / cost))
