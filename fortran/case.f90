@@ -95,6 +95,7 @@ module spline_case_io
     real(wp) :: l_ref, w_ref                !< scales of Eq. 25
     ! derived geometry
     real(wp) :: r_pitch                     !< R = m Z / 2
+    real(wp) :: cos_alpha, sin_alpha        !< of the pressure angle (once per case, not per tooth)
     real(wp) :: r_b                         !< base radius R cos(alpha)
     real(wp) :: theta0                      !< pi / (2 Z)  (Eq. 9)
     real(wp) :: kappa                       !< 2 lambda s cos(alpha): backlash loss per degC (Eq. 2)
@@ -349,7 +350,9 @@ contains
 
     ! derived geometry (MODEL.md Section 2 and Eq. 9)
     m%r_pitch = 0.5_wp*m%m_n*m%z
-    m%r_b = m%r_pitch*cos(m%alpha)
+    m%cos_alpha = cos(m%alpha)
+    m%sin_alpha = sin(m%alpha)
+    m%r_b = m%r_pitch*m%cos_alpha
     m%theta0 = pi/(2.0_wp*m%z)
     m%kappa = 2.0_wp*m%lambda_th*m%s*cos(m%alpha)
     call set_thermal_level(m, m%thermal)

@@ -42,15 +42,15 @@ contains
   !> otherwise towards the tip: law of sines (Eq. 14),
   !>   rc = R sin(pi - alpha - beta) / sin(alpha),  sin(beta) = Delta sin(alpha) / R,
   !> evaluated in the exact equivalent form rc = R cos(beta) + Delta cos(alpha) (expand
-  !> sin(alpha + beta); |beta| < pi/2), which needs no inverse sine.
-  pure real(wp) function contact_radius(delta, ddelta, r, alpha) result(rc)
-    real(wp), intent(in) :: delta, ddelta, r, alpha
-    real(wp) :: ca, sb
-    ca = cos(alpha)
+  !> sin(alpha + beta); |beta| < pi/2), which needs no inverse sine. The pressure angle comes in
+  !> as ca = cos(alpha), sa = sin(alpha) (computed once per case, not per tooth).
+  pure real(wp) function contact_radius(delta, ddelta, r, ca, sa) result(rc)
+    real(wp), intent(in) :: delta, ddelta, r, ca, sa
+    real(wp) :: sb
     if (ddelta < 0.0_wp) then
       rc = sqrt(delta**2 + r**2 - 2.0_wp*r*delta*ca)
     else
-      sb = delta*sin(alpha)/r
+      sb = delta*sa/r
       rc = r*sqrt(1.0_wp - sb*sb) + delta*ca
     end if
   end function contact_radius

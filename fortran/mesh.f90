@@ -135,10 +135,10 @@ contains
     real(wp) :: d, dd
     call profile_shift(q(1) + m%l_x, q(2) + m%l_y, v(1), v(2), m%omega, sp, cp, d, dd)
     if (present(br)) dd = br(1)
-    r1 = contact_radius(d, dd, m%r_pitch, m%alpha)
+    r1 = contact_radius(d, dd, m%r_pitch, m%cos_alpha, m%sin_alpha)
     call profile_shift(q(3), q(4), v(3), v(4), m%omega, sp, cp, d, dd)
     if (present(br)) dd = br(2)
-    r2 = contact_radius(d, dd, m%r_pitch, m%alpha)
+    r2 = contact_radius(d, dd, m%r_pitch, m%cos_alpha, m%sin_alpha)
   end subroutine contact_radii
 
   !> Eqs. 3-7 for one tooth with the model's material data.
@@ -146,7 +146,7 @@ contains
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: f, r1, r2
     real(wp) :: bh
-    call flash_temperature(f, r1, r2, m%r_b, m%alpha, m%omega, m%b, m%e_mod, m%nu, m%eta_hertz, &
+    call flash_temperature(f, r1, r2, m%r_b, m%cos_alpha, m%omega, m%b, m%e_mod, m%nu, m%eta_hertz, &
          m%u_flash, m%f_m, m%k_cond, m%rho, m%c_heat, tf, bh)
   end function flash_of
 

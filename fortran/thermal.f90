@@ -20,15 +20,16 @@ contains
   !>   alpha_mi = acos(r_b/rc_i) (Eqs. 5-6), B = eta sqrt(2(1-nu^2)/E f_e R1 R2/(R1+R2)) (Eq. 4),
   !>   T_f = u f_m f_e |v1 - v2| / (sqrt(B) (sqrt(g rho c v1) + sqrt(g rho c v2))).
   !> No load or no motion: T_f = 0. Also returns the Hertz width B (0 when unloaded).
-  pure subroutine flash_temperature(f, rc1, rc2, r_b, alpha, omega, b, e_mod, nu, eta, u, f_m, &
+  !> The pressure angle comes in as ca = cos(alpha).
+  pure subroutine flash_temperature(f, rc1, rc2, r_b, ca, omega, b, e_mod, nu, eta, u, f_m, &
        k_cond, rho, c_heat, tf, bh)
-    real(wp), intent(in) :: f, rc1, rc2, r_b, alpha, omega, b, e_mod, nu, eta, u, f_m
+    real(wp), intent(in) :: f, rc1, rc2, r_b, ca, omega, b, e_mod, nu, eta, u, f_m
     real(wp), intent(in) :: k_cond, rho, c_heat
     real(wp), intent(out) :: tf, bh
     real(wp) :: fe, v1, v2, rr1, rr2
     fe = abs(f)/b
-    v1 = omega*rc1*cos(alpha)
-    v2 = omega*rc2*cos(alpha)
+    v1 = omega*rc1*ca
+    v2 = omega*rc2*ca
     tf = 0.0_wp
     bh = 0.0_wp
     if (fe == 0.0_wp .or. v1 + v2 <= 0.0_wp) return

@@ -38,10 +38,13 @@ def _names(kind: str, n: int) -> tuple:
 
 @contextlib.contextmanager
 def _case_file(case: Case):
-    with tempfile.TemporaryDirectory(prefix="pyspline-") as tmp:
-        path = os.path.join(tmp, f"{case.name or 'case'}.nml")
+    fd, path = tempfile.mkstemp(prefix=f"pyspline-{case.name or 'case'}-", suffix=".nml")
+    os.close(fd)
+    try:
         case.to_namelist(path)
         yield path
+    finally:
+        os.unlink(path)
 
 
 @dataclass
@@ -142,6 +145,17 @@ def tooth_stiffness(z, module, alpha_deg, b, r_root, r_contact, e_mod=2.1e11, nu
         r_contact, nquad)
     raise_for(ierr, msg)
     return {"k_b": kb, "k_s": ks, "k_a": ka}
+
+
+def cvode_library() -> str:
+    """Path of the CVODE shared library this process runs (Linux: from /proc/self/maps), and
+    the SUNDIALS build it belongs to: 'optimised' (built by scripts/setup.sh) or 'debian'."""
+    from ._build_info import SUNDIALS_LIBDIR
+    with open("/proc/self/maps") as maps:
+        paths = {line.split()[-1] for line in maps if "libsundials_cvode.so" in line}
+    path = paths.pop() if len(paths) == 1 else ", ".join(sorted(paths)) or "not loaded"
+    kind = "optimised" if SUNDIALS_LIBDIR and path.startswith(SUNDIALS_LIBDIR) else "debian"
+    return f"{path} ({kind})"
 
 
 def read_csv(path) -> tuple[list[str], np.ndarray]:

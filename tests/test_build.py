@@ -1,0 +1,40 @@
+"""The build links the SUNDIALS it was configured with, and the optimised CVODE that
+scripts/setup.sh builds gives the same numbers as Debian's unoptimised one."""
+import os
+import subprocess
+from pathlib import Path
+
+import pytest
+
+import pyspline
+from pyspline._build_info import SUNDIALS_LIBDIR
+from pyspline.core import cvode_library
+from conftest import CASES
+
+DEBIAN_LIBDIR = "/usr/lib/x86_64-linux-gnu"
+
+
+def test_loaded_cvode_is_the_configured_one():
+    pyspline.simulate(pyspline.load_case(CASES / "paper_lx1e-4.nml", t_end=1e-3, n_out=2))
+    path = cvode_library()
+    if SUNDIALS_LIBDIR:
+        assert path.startswith(SUNDIALS_LIBDIR) and path.endswith("(optimised)"), path
+    else:
+        assert "libsundials_cvode.so" in path and path.endswith("(debian)"), path
+
+
+@pytest.mark.skipif(not SUNDIALS_LIBDIR or not Path(DEBIAN_LIBDIR, "libsundials_cvode.so.6").exists(),
+                    reason="needs both the optimised CVODE and Debian's")
+def test_optimised_cvode_gives_bit_identical_numbers(exe, tmp_path):
+    # LD_LIBRARY_PATH outranks the executable's RUNPATH: the same binary on Debian's libraries.
+    case = pyspline.load_case(CASES / "paper_T100.nml", t_end=0.02, n_out=41)
+    case.to_namelist(tmp_path / "c.nml")
+    outs = []
+    for name, env in (("opt", {}), ("deb", {"LD_LIBRARY_PATH": DEBIAN_LIBDIR})):
+        out = tmp_path / f"{name}.csv"
+        subprocess.run([exe, str(tmp_path / "c.nml"), "-o", str(out)], check=True,
+                       capture_output=True, env={**os.environ, **env})
+        lines = out.read_text().splitlines()
+        outs.append([ln for ln in lines if not ln.startswith("# stats")])   # stats hold the time
+    assert len(outs[0]) > 41
+    assert outs[0] == outs[1]
