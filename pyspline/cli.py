@@ -87,7 +87,13 @@ def cmd_check_exe(args) -> int:
 
 def cmd_bench(args) -> int:
     from . import bench
+    from .core import cvode_library
     out = Path(args.out)
+    lib = cvode_library()
+    print(f"CVODE library: {lib}")
+    if lib.endswith("(debian)"):
+        print("note: Debian's SUNDIALS is compiled without optimisation; CVODE's share of a run is "
+              "about 2.4x what scripts/setup.sh's -O2 build gives")
     if args.what == "wp":
         rows, notes = bench.work_precision(out, quick=args.quick)
         for n in notes:
