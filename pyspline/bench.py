@@ -54,6 +54,16 @@ def _mesh_outputs(case, t, y):
     return tm, F
 
 
+def _cvode_kw(variant):
+    """Case fields of a CVODE variant: 'bdf', 'adams', 'adams-fixedpoint' (functional
+    iteration, no Jacobian) or 'bdf-stald' (stability-limit detection)."""
+    if variant == "adams-fixedpoint":
+        return dict(method="adams", nonlinear="fixedpoint")
+    if variant == "bdf-stald":
+        return dict(method="bdf", stald=True)
+    return dict(method=variant, nonlinear="newton", stald=False)
+
+
 def run_scipy(case, method, rtol, rhs_kind, oracle, budget):
     """solve_ivp on the Fortran RHS (through f2py) or the numpy oracle RHS."""
     from scipy.integrate import solve_ivp
@@ -113,8 +123,8 @@ def work_precision(out, quick=False, progress=True):
         ref, agree = reference(case)
         notes.append(f"{name}: reference (CVODE BDF + roots, rtol 1e-12) vs DOP853 rtol 1e-12 on "
                      f"the Fortran RHS: T_m {agree[0]:.1e}, F_j {agree[1]:.1e}")
-        jobs = [("cvode", m, r, rt) for m in ("bdf", "adams") for r in (False, True)
-                for rt in rtols_cv]
+        jobs = [("cvode", m, r, rt) for m in ("bdf", "adams", "adams-fixedpoint")
+                for r in (False, True) for rt in rtols_cv]
         jobs += [("scipy", m, kind, rt) for m in SCIPY_METHODS for kind in ("fortran", "numpy")
                  for rt in rtols_sp if kind == "fortran" or oracle is not None]
         for solver, method, opt, rtol in tqdm(jobs, desc=f"work-precision {name}",
@@ -124,7 +134,7 @@ def work_precision(out, quick=False, progress=True):
             row = dict(case=name, method=label, rtol=rtol)
             try:
                 if solver == "cvode":
-                    c = case.replace(method=method, roots=opt, rtol=rtol, atol=rtol * 1e-2)
+                    c = case.replace(roots=opt, rtol=rtol, atol=rtol * 1e-2, **_cvode_kw(method))
                     times = []
                     for _ in range(repeat):
                         t0 = time.perf_counter()
@@ -241,10 +251,7 @@ def stability_map(out, quick=False, progress=True):
         t0 = time.perf_counter()
         try:
             if solver == "cvode":
-                kw = dict(method="adams", nonlinear="fixedpoint") if method == "adams-fixedpoint" \
-                    else dict(method="bdf", stald=True) if method == "bdf-stald" \
-                    else dict(method=method)
-                res = simulate(case.replace(roots=bool(opt), **kw))
+                res = simulate(case.replace(roots=bool(opt), **_cvode_kw(method)))
                 row.update(status="ok", steps=res.stats["steps"], rhs_evals=res.stats["rhs_evals"],
                            err_test_fails=res.stats["err_test_fails"],
                            conv_fails=res.stats["nonlin_conv_fails"])
