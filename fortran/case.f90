@@ -354,7 +354,7 @@ contains
     m%sin_alpha = sin(m%alpha)
     m%r_b = m%r_pitch*m%cos_alpha
     m%theta0 = pi/(2.0_wp*m%z)
-    m%kappa = 2.0_wp*m%lambda_th*m%s*cos(m%alpha)
+    m%kappa = 2.0_wp*m%lambda_th*m%s*m%cos_alpha
     call set_thermal_level(m, m%thermal)
     if (m%c_bulk <= 0.0_wp) then
       write(errmsg, '(a,es10.3,a,es10.3,a)') 'case '//trim(m%name)//': thermal interference: '// &

@@ -55,11 +55,6 @@ def raise_for(ierr: int, errmsg) -> None:
 @functools.cache
 def defaults() -> dict:
     """Every case field with its default, as the Fortran core defines them."""
-    return dict(_defaults())
-
-
-@functools.cache
-def _defaults() -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         path = os.path.join(tmp, "defaults.nml")
         ierr, msg = _core.spline_api.api_write_defaults(path)
@@ -76,7 +71,7 @@ class Case(Mapping):
     """A validated set of case fields (SI units). Immutable; ``replace`` makes variants."""
 
     def __init__(self, fields: Mapping, name: str | None = None, source: str | None = None):
-        base = _defaults()
+        base = defaults()
         merged = dict(base)
         label = name or fields.get("name") or "unnamed"
         for key, value in fields.items():
@@ -111,7 +106,7 @@ class Case(Mapping):
 
     def changed(self) -> dict:
         """The fields that differ from the defaults (what a case file needs to say)."""
-        base = _defaults()
+        base = defaults()
         return {k: v for k, v in self._fields.items() if base[k] != v}
 
     def to_namelist(self, path) -> None:

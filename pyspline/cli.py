@@ -92,8 +92,8 @@ def cmd_bench(args) -> int:
     lib = cvode_library()
     print(f"CVODE library: {lib}")
     if lib.endswith("(debian)"):
-        print("note: Debian's SUNDIALS is compiled without optimisation; CVODE's share of a run is "
-              "about 2.4x what scripts/setup.sh's -O2 build gives")
+        print("note: Debian's SUNDIALS is compiled without optimisation; runs take up to 2.4x "
+              "longer than on the -O2 build that scripts/setup.sh makes")
     if args.what == "wp":
         rows, notes = bench.work_precision(out, quick=args.quick)
         for n in notes:

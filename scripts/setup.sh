@@ -7,9 +7,9 @@
 # (debian/rules sets CMAKE_C_FLAGS=-fcommon, which replaces the -O2 of dpkg-buildflags, and
 # no CMAKE_BUILD_TYPE), and CVODE's own work per step is most of a run. So this script takes
 # Debian's source package of the same version (apt-get source) and builds CVODE and its
-# Fortran modules with -O2 into $PYSPLINE_SUNDIALS (~10 s, once; default under ~/.cache). Same version, same numbers:
-# -O2 on x86-64 contracts no FMAs, so results are bit-identical to the Debian build, 2.4x
-# faster. If the source cannot be had, pyspline is built on Debian's libraries, with a warning.
+# Fortran modules with -O2 into $PYSPLINE_SUNDIALS (~15 s, once; default under ~/.cache).
+# Same version, same numbers: -O2 on x86-64 contracts no FMAs, so results are bit-identical
+# to the Debian build, and a run is up to 2.4x faster. If the source cannot be had, pyspline is built on Debian's libraries, with a warning.
 # PYSPLINE_SUNDIALS=system skips the build.
 set -euo pipefail
 cd "$(dirname "$0")/.."
