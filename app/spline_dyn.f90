@@ -4,11 +4,14 @@
 !>   usage: spline-dyn CASE.nml [-o OUT.csv]
 program spline_dyn
   use spline_kinds, only: wp
-  use spline_case_io, only: model_t, case_read_file, case_name_of, nstate, nkterms, kterm_names
+  use spline_errors, only: err_ok, err_exit_code, msglen
+  use spline_case, only: case_t, case_read_file, case_name_of
+  use spline_model, only: model_t, model_from_case, nstate, nkterms, kterm_names
   use spline_run, only: nstats, stat_names, run_case, ntooth_q, tooth_q_names, tooth_q_units
   implicit none
   character(len=1024) :: path, out, arg
-  character(len=512) :: errmsg
+  character(len=msglen) :: errmsg
+  type(case_t) :: c
   type(model_t) :: m
   real(wp), allocatable :: t(:), y(:, :), tooth(:, :, :), tm(:)
   real(wp) :: stats(nstats)
@@ -34,14 +37,15 @@ program spline_dyn
   if (len_trim(path) == 0) call usage(2)
   if (len_trim(out) == 0) out = trim(case_name_of(path))//'.csv'
 
-  call case_read_file(trim(path), m, ierr, errmsg)
-  if (ierr /= 0) call die(errmsg)
+  call case_read_file(trim(path), c, ierr, errmsg)
+  if (ierr == err_ok) call model_from_case(c, m, ierr, errmsg)
+  if (ierr /= err_ok) call die(errmsg, ierr)
   allocate(t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q), tm(m%n_out))
   call run_case(m, t, y, tooth, tm, stats, ierr, errmsg)
-  if (ierr /= 0) call die(errmsg)
+  if (ierr /= err_ok) call die(errmsg, ierr)
 
   open(newunit=u, file=trim(out), status='replace', action='write', iostat=ierr)
-  if (ierr /= 0) call die('cannot write '//trim(out))
+  if (ierr /= 0) call die('cannot write '//trim(out), 1)
   write(u, '(a)') '# spline-dyn output (pyspline): SI units, per-tooth columns Q_j for teeth j = 1..Z'
   write(u, '(a)') '# case: '//trim(m%name)//' ('//trim(path)//')'
   write(u, '(a,es24.16e3,a)') '# k_m: ', m%k_m, merge(' N/m (computed, Eq. 18)', ' N/m (case)            ', &
@@ -94,10 +98,12 @@ contains
     stop code
   end subroutine usage
 
-  subroutine die(msg)
+  !> Print the message to stderr and exit with the status of the error code (spline_errors).
+  subroutine die(msg, ierr)
     character(len=*), intent(in) :: msg
+    integer, intent(in) :: ierr
     write(0, '(a)') 'spline-dyn: error: '//trim(msg)
-    stop 1, quiet=.true.
+    error stop err_exit_code(ierr), quiet=.true.
   end subroutine die
 
 end program spline_dyn

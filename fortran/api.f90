@@ -1,148 +1,246 @@
-!> The thin interface that f2py wraps: flat arrays in C kinds, sizes passed in, and an error
-!> code with a message (0 = ok; 1 bad case, 2 solver, 3 thermal interference). A case is given
-!> as the path of a namelist file. State vectors have nstate = 14 entries, written as a literal
-!> in the dummy arguments because f2py cannot see imported parameters.
-!> Nothing here computes physics: it reads the case and calls the modules.
+!> The thin interface that f2py wraps (signatures and GIL release: fortran/_core.pyf).
+!>
+!> A case is handed over in memory as namelist text (api_load) and comes back as a loaded
+!> model: the bytes of its model_t, owned by the caller (a numpy int32 array: f2py maps no
+!> 1-byte integer kind to C correctly). Every other entry
+!> point takes those bytes, so nothing here keeps state between calls: any number of loaded
+!> cases can be used at once, from any thread, and a loaded case can be pickled to another
+!> process of the same build. The bytes are checked (size and a marker) on every call.
+!> Errors: ierr (spline_errors: 1 bad case, 2 solver, 3 thermal interference, 4 interrupted)
+!> with a message. State vectors have 14 entries, literal here because f2py cannot see
+!> imported parameters. Nothing here computes physics: it calls the modules.
 module spline_api
   use, intrinsic :: iso_c_binding, only: c_double, c_int
   use spline_kinds, only: wp
-  use spline_case_io, only: model_t, case_read_file, case_write_defaults, nstate, ndof, nkterms, &
-       thermal_coupled
+  use spline_errors, only: err_ok, err_case, nerr, err_names, msglen
+  use spline_case, only: case_t, case_read_text, case_write_text
+  use spline_model, only: model_t, model_from_case, model_magic, nstate, ndof, nkterms, &
+       kterm_names, thermal_coupled
   use spline_mesh, only: mesh_switch_functions
   use spline_stiffness, only: external_tooth_stiffness, internal_tooth_stiffness
   use spline_dynamics, only: accelerations, start_state, rhs_scaled, to_scaled
-  use spline_run, only: nstats, stat_names, run_case, tooth_quantities, ntooth_q, tooth_q_names, tooth_q_units
+  use spline_run, only: nstats, stat_names, run_case, tooth_quantities, ntooth_q, tooth_q_names, &
+       tooth_q_units, output_times
   implicit none
   private
-  public :: api_sizes, api_simulate, api_rhs, api_start_state, api_write_defaults, api_names
-  public :: api_mesh_stiffness, api_tooth_stiffness, api_load, api_rhs_loaded, api_time_rhs
+  public :: api_load, api_model_size, api_simulate, api_rhs, api_rhs_mesh, api_start_state
+  public :: api_output_times, api_model_info, api_defaults, api_names, api_tooth_stiffness
+  public :: api_time_rhs
 
-  type(model_t), save :: loaded          !< the case of api_load, for api_rhs_loaded
-  logical, save :: have_loaded = .false.
+  integer, parameter :: ninfo = 10   !< entries of api_model_info
 
 contains
 
-  !> Number of teeth and of output times of a case (to size the arrays of api_simulate).
-  subroutine api_sizes(path, z, nt, nq, ns, ierr, errmsg)
-    character(len=*), intent(in) :: path
-    integer(c_int), intent(out) :: z, nt, nq, ns, ierr
-    character(len=512), intent(out) :: errmsg
+  !> 4-byte words in a loaded model (the size of the array api_load fills).
+  integer(c_int) function api_model_size() result(nb)
+    type(model_t) :: m
+    nb = int((storage_size(m) + 31)/32, c_int)
+  end function api_model_size
+
+  !> Read a case from namelist text, validate it and build its model (model_from_case).
+  !> model: the loaded model's bytes; z, nt: teeth and output times (to size api_simulate).
+  subroutine api_load(text, nb, model, z, nt, ierr, errmsg)
+    character(len=*), intent(in) :: text
+    integer(c_int), intent(in) :: nb
+    integer(c_int), intent(out) :: model(nb)
+    integer(c_int), intent(out) :: z, nt, ierr
+    character(len=msglen), intent(out) :: errmsg
+    type(case_t) :: c
     type(model_t) :: m
     integer :: ie
-    call case_read_file(path, m, ie, errmsg)
+    model = 0; z = 0; nt = 0
+    call case_read_text(text, c, ie, errmsg)
+    if (ie == err_ok) call model_from_case(c, m, ie, errmsg)
+    if (ie == err_ok .and. nb /= api_model_size()) then
+      ie = err_case; errmsg = 'api_load: the model array has the wrong size (api_model_size)'
+    end if
+    if (ie == err_ok) then
+      model = transfer(m, model)
+      z = m%z; nt = m%n_out
+    end if
     ierr = ie
-    z = m%z; nt = m%n_out; nq = ntooth_q; ns = nstats
-  end subroutine api_sizes
+  end subroutine api_load
 
-  !> Simulate a case: output times t, SI states y (nt x 14), per-tooth quantities tooth
-  !> (nt x z x nq, order of api_names('tooth')), meshing torque tm and solver statistics.
-  subroutine api_simulate(path, z, nt, nq, ns, t, y, tooth, tm, stats, ierr, errmsg)
-    character(len=*), intent(in) :: path
-    integer(c_int), intent(in) :: z, nt, nq, ns
+  !> The model_t in the bytes of a loaded model; ierr = err_case if they are not one.
+  subroutine unpack(model, m, ierr, errmsg)
+    integer(c_int), intent(in) :: model(:)
+    type(model_t), intent(out) :: m
+    integer, intent(out) :: ierr
+    character(len=*), intent(out) :: errmsg
+    ierr = err_ok
+    errmsg = ''
+    if (size(model) == api_model_size()) then
+      m = transfer(model, m)
+      if (m%magic == model_magic) return
+    end if
+    ierr = err_case
+    errmsg = 'not a loaded case of this build of pyspline (load the case again)'
+  end subroutine unpack
+
+  !> Simulate a loaded model: output times t, SI states y (nt x 14), per-tooth quantities tooth
+  !> (nt x z x nq, order of api_names('tooth')), meshing torque tm and run statistics.
+  !> A SIGINT during the run stops it (ierr 4). Called without the GIL.
+  subroutine api_simulate(model, nb, z, nt, nq, ns, t, y, tooth, tm, stats, ierr, errmsg)
+    integer(c_int), intent(in) :: nb, z, nt, nq, ns
+    integer(c_int), intent(in) :: model(nb)
     real(c_double), intent(out) :: t(nt), y(nt, 14), tooth(nt, z, nq), tm(nt), stats(ns)
     integer(c_int), intent(out) :: ierr
-    character(len=512), intent(out) :: errmsg
+    character(len=msglen), intent(out) :: errmsg
     type(model_t) :: m
     real(wp), allocatable :: ycol(:, :)
     integer :: ie
     t = 0; y = 0; tooth = 0; tm = 0; stats = 0
-    call case_read_file(path, m, ie, errmsg)
-    if (ie == 0 .and. (m%z /= z .or. m%n_out /= nt .or. nq /= ntooth_q .or. ns /= nstats)) then
-      ie = 1
-      errmsg = 'api_simulate: array sizes do not match the case (call api_sizes first)'
+    call unpack(model, m, ie, errmsg)
+    if (ie == err_ok .and. (m%z /= z .or. m%n_out /= nt .or. nq /= ntooth_q .or. ns /= nstats)) then
+      ie = err_case
+      errmsg = 'api_simulate: array sizes do not match the loaded case'
     end if
-    if (ie == 0) then
+    if (ie == err_ok) then
       allocate(ycol(nstate, nt))
-      call run_case(m, t, ycol, tooth, tm, stats, ie, errmsg)
+      call run_case(m, t, ycol, tooth, tm, stats, ie, errmsg, interruptible=.true.)
       y = transpose(ycol)
     end if
     ierr = ie
   end subroutine api_simulate
 
-  !> Right-hand side in SI units at (t, y) with the contact states decided by the state, plus
-  !> the mesh: per-tooth mesh(:, k) in the order of api_names('tooth') and the torque tm.
-  !> Exposed so that tests can hold it against the independent numpy oracle.
-  subroutine api_rhs(path, z, nq, t, y, ydot, mesh, tm, ierr, errmsg)
-    character(len=*), intent(in) :: path
-    integer(c_int), intent(in) :: z, nq
-    real(c_double), intent(in) :: t, y(14)
-    real(c_double), intent(out) :: ydot(14), mesh(z, nq), tm
-    integer(c_int), intent(out) :: ierr
-    character(len=512), intent(out) :: errmsg
-    type(model_t) :: m
-    integer :: ie
-    ydot = 0; mesh = 0; tm = 0
-    call case_read_file(path, m, ie, errmsg)
-    if (ie == 0 .and. (m%z /= z .or. nq /= ntooth_q)) then
-      ie = 1; errmsg = 'api_rhs: array sizes do not match the case'
-    end if
-    if (ie == 0) then
-      ydot(1:ndof) = y(ndof+1:)
-      call accelerations(m, t, y(1:ndof), y(ndof+1:), ydot(ndof+1:), ie, errmsg)
-    end if
-    if (ie == 0) call tooth_quantities(m, t, y, mesh, tm, ie, errmsg)
-    ierr = ie
-  end subroutine api_rhs
-
-  !> Read a case once and keep it for api_rhs_loaded (peers calling the RHS per step).
-  subroutine api_load(path, ierr, errmsg)
-    character(len=*), intent(in) :: path
-    integer(c_int), intent(out) :: ierr
-    character(len=512), intent(out) :: errmsg
-    integer :: ie
-    call case_read_file(path, loaded, ie, errmsg)
-    have_loaded = ie == 0
-    ierr = ie
-  end subroutine api_load
-
-  !> SI right-hand side of the case loaded by api_load (contact states from the state): the
-  !> project's Fortran RHS for solvers driven from Python (scipy peers in the benchmarks).
-  subroutine api_rhs_loaded(t, y, ydot, ierr)
+  !> SI right-hand side dy/dt at (t, y) of a loaded model, contact states from the state:
+  !> the project's Fortran RHS for solvers driven from Python (the benchmarks' peers).
+  subroutine api_rhs(model, nb, t, y, ydot, ierr)
+    integer(c_int), intent(in) :: nb
+    integer(c_int), intent(in) :: model(nb)
     real(c_double), intent(in) :: t, y(14)
     real(c_double), intent(out) :: ydot(14)
     integer(c_int), intent(out) :: ierr
-    character(len=512) :: errmsg
+    character(len=msglen) :: errmsg
+    type(model_t) :: m
     integer :: ie
     ydot = 0
-    ierr = 1
-    if (.not. have_loaded) return
-    ydot(1:ndof) = y(ndof+1:)
-    call accelerations(loaded, t, y(1:ndof), y(ndof+1:), ydot(ndof+1:), ie, errmsg)
+    call unpack(model, m, ie, errmsg)
+    if (ie == err_ok) then
+      ydot(1:ndof) = y(ndof+1:)
+      call accelerations(m, t, y(1:ndof), y(ndof+1:), ydot(ndof+1:), ie, errmsg)
+    end if
     ierr = ie
-  end subroutine api_rhs_loaded
+  end subroutine api_rhs
 
-  !> The start state of a case (SI): static equilibrium or rest, plus dq0, dv0.
-  subroutine api_start_state(path, y, ierr, errmsg)
-    character(len=*), intent(in) :: path
+  !> api_rhs plus the mesh: per-tooth mesh(:, k) in the order of api_names('tooth') and the
+  !> torque tm, for tests that hold the core against the independent numpy oracle.
+  subroutine api_rhs_mesh(model, nb, z, nq, t, y, ydot, mesh, tm, ierr, errmsg)
+    integer(c_int), intent(in) :: nb, z, nq
+    integer(c_int), intent(in) :: model(nb)
+    real(c_double), intent(in) :: t, y(14)
+    real(c_double), intent(out) :: ydot(14), mesh(z, nq), tm
+    integer(c_int), intent(out) :: ierr
+    character(len=msglen), intent(out) :: errmsg
+    type(model_t) :: m
+    integer :: ie
+    ydot = 0; mesh = 0; tm = 0
+    call unpack(model, m, ie, errmsg)
+    if (ie == err_ok .and. (m%z /= z .or. nq /= ntooth_q)) then
+      ie = err_case; errmsg = 'api_rhs_mesh: array sizes do not match the loaded case'
+    end if
+    if (ie == err_ok) then
+      ydot(1:ndof) = y(ndof+1:)
+      call accelerations(m, t, y(1:ndof), y(ndof+1:), ydot(ndof+1:), ie, errmsg)
+    end if
+    if (ie == err_ok) call tooth_quantities(m, t, y, mesh, tm, ie, errmsg)
+    ierr = ie
+  end subroutine api_rhs_mesh
+
+  !> The start state of a loaded model (SI): static equilibrium or rest, plus dq0, dv0.
+  subroutine api_start_state(model, nb, y, ierr, errmsg)
+    integer(c_int), intent(in) :: nb
+    integer(c_int), intent(in) :: model(nb)
     real(c_double), intent(out) :: y(14)
     integer(c_int), intent(out) :: ierr
-    character(len=512), intent(out) :: errmsg
+    character(len=msglen), intent(out) :: errmsg
     type(model_t) :: m
     integer :: ie
     y = 0
-    call case_read_file(path, m, ie, errmsg)
-    if (ie == 0) call start_state(m, y, ie, errmsg)
+    call unpack(model, m, ie, errmsg)
+    if (ie == err_ok) call start_state(m, y, ie, errmsg)
     ierr = ie
   end subroutine api_start_state
 
-  !> Eq. 18 terms of a case (k_h, k_b1, k_s1, k_a1, k_b2, k_s2, k_a2, k_m of the geometry) and
-  !> the k_m the case uses (computed when the case leaves k_m = 0).
-  subroutine api_mesh_stiffness(path, terms, k_used, computed, ierr, errmsg)
-    character(len=*), intent(in) :: path
-    real(c_double), intent(out) :: terms(8), k_used
-    integer(c_int), intent(out) :: computed, ierr
-    character(len=512), intent(out) :: errmsg
+  !> The output times of a loaded model (uniform after the transient).
+  subroutine api_output_times(model, nb, nt, t, ierr, errmsg)
+    integer(c_int), intent(in) :: nb, nt
+    integer(c_int), intent(in) :: model(nb)
+    real(c_double), intent(out) :: t(nt)
+    integer(c_int), intent(out) :: ierr
+    character(len=msglen), intent(out) :: errmsg
     type(model_t) :: m
     integer :: ie
-    terms = 0; k_used = 0; computed = 0
-    call case_read_file(path, m, ie, errmsg)
-    if (ie == 0) then
-      terms = m%k_terms(1:nkterms)
-      k_used = m%k_m
-      computed = merge(1, 0, m%k_m_computed)
+    t = 0
+    call unpack(model, m, ie, errmsg)
+    if (ie == err_ok .and. m%n_out /= nt) then
+      ie = err_case; errmsg = 'api_output_times: nt does not match the loaded case'
+    end if
+    if (ie == err_ok) call output_times(m, t)
+    ierr = ie
+  end subroutine api_output_times
+
+  !> Derived quantities of a loaded model, in the order of api_names('info'): base radius r_b
+  !> [m], pitch radius [m], shaft speed omega [rad/s], the scales of Eq. 25 l_ref [m] and
+  !> w_ref [rad/s], the backlash at the bulk temperature [m], kappa [m/degC] (Eq. 2), the
+  !> k_m used [N/m], 1 if it is computed (Eq. 18), the thermal level (0 none .. 3 coupled);
+  !> and the Eq. 18 terms (order of api_names('kterms')).
+  subroutine api_model_info(model, nb, info, terms, ierr, errmsg)
+    integer(c_int), intent(in) :: nb
+    integer(c_int), intent(in) :: model(nb)
+    real(c_double), intent(out) :: info(ninfo), terms(nkterms)
+    integer(c_int), intent(out) :: ierr
+    character(len=msglen), intent(out) :: errmsg
+    type(model_t) :: m
+    integer :: ie
+    info = 0; terms = 0
+    call unpack(model, m, ie, errmsg)
+    if (ie == err_ok) then
+      info = [m%r_b, m%r_pitch, m%omega, m%l_ref, m%w_ref, m%c_bulk, m%kappa, m%k_m, &
+           merge(1.0_wp, 0.0_wp, m%k_m_computed), real(m%thermal, wp)]
+      terms = m%k_terms
     end if
     ierr = ie
-  end subroutine api_mesh_stiffness
+  end subroutine api_model_info
+
+  !> Every case field with its default, as namelist text (Python reads its defaults here).
+  subroutine api_defaults(text)
+    character(len=8192), intent(out) :: text
+    character(len=:), allocatable :: full
+    call case_write_text(case_t(), full)
+    text = full
+  end subroutine api_defaults
+
+  !> Name (and unit) number i of a list: 'tooth' (per-tooth quantities), 'stats', 'info'
+  !> (api_model_info), 'kterms' (Eq. 18 terms) or 'errors' (error codes 0..nerr, i = code + 1).
+  subroutine api_names(kind, i, name, unit)
+    character(len=*), intent(in) :: kind
+    integer(c_int), intent(in) :: i
+    character(len=32), intent(out) :: name, unit
+    character(len=16), parameter :: info_names(ninfo) = [character(len=16) :: 'r_b', 'r_pitch', &
+         'omega', 'l_ref', 'w_ref', 'c_bulk', 'kappa', 'k_m', 'k_m_computed', 'thermal_level']
+    character(len=8), parameter :: info_units(ninfo) = [character(len=8) :: 'm', 'm', 'rad/s', &
+         'm', 'rad/s', 'm', 'm/degC', 'N/m', '', '']
+    name = ''; unit = ''
+    select case (kind)
+    case ('tooth')
+      if (i >= 1 .and. i <= ntooth_q) then
+        name = tooth_q_names(i); unit = tooth_q_units(i)
+      end if
+    case ('stats')
+      if (i >= 1 .and. i <= nstats) name = stat_names(i)
+    case ('info')
+      if (i >= 1 .and. i <= ninfo) then
+        name = info_names(i); unit = info_units(i)
+      end if
+    case ('kterms')
+      if (i >= 1 .and. i <= nkterms) then
+        name = kterm_names(i); unit = 'N/m'
+      end if
+    case ('errors')
+      if (i >= 1 .and. i <= nerr + 1) name = err_names(i - 1)
+    end select
+  end subroutine api_names
 
   !> Bending, shear and axial stiffness of one involute tooth (potential energy method) for any
   !> gear: external (internal = 0; r_tip unused) or internal (ring) tooth. Angles in radians.
@@ -152,7 +250,7 @@ contains
     real(c_double), intent(in) :: z, m, alpha, b, r_root, r_tip, e, nu, r_contact
     real(c_double), intent(out) :: kb, ks, ka
     integer(c_int), intent(out) :: ierr
-    character(len=512), intent(out) :: errmsg
+    character(len=msglen), intent(out) :: errmsg
     integer :: ie
     if (internal /= 0) then
       call internal_tooth_stiffness(z, m, alpha, b, r_root, r_tip, e, nu, r_contact, nquad, &
@@ -165,56 +263,30 @@ contains
     if (ie == 0) errmsg = ''
   end subroutine api_tooth_stiffness
 
-  !> Write the default case (every field) as a namelist file.
-  subroutine api_write_defaults(path, ierr, errmsg)
-    character(len=*), intent(in) :: path
+  !> Instrumentation for the cost anatomy (bench/): elapsed seconds per call of the scaled
+  !> right-hand side (Eq. 25) of a loaded model at its static equilibrium (every tooth in
+  !> contact, time advanced per call), and of the root functions. No physics of its own.
+  subroutine api_time_rhs(model, nb, n, t_rhs, t_roots, ierr, errmsg)
+    integer(c_int), intent(in) :: nb, n
+    integer(c_int), intent(in) :: model(nb)
+    real(c_double), intent(out) :: t_rhs, t_roots
     integer(c_int), intent(out) :: ierr
-    character(len=512), intent(out) :: errmsg
-    integer :: ie
-    call case_write_defaults(path, ie, errmsg)
-    ierr = ie
-  end subroutine api_write_defaults
-
-  !> Name (and unit) number i of a list: kind 'tooth' (per-tooth quantities) or 'stats'.
-  subroutine api_names(kind, i, name, unit)
-    character(len=*), intent(in) :: kind
-    integer(c_int), intent(in) :: i
-    character(len=32), intent(out) :: name, unit
-    name = ''; unit = ''
-    select case (kind)
-    case ('tooth')
-      if (i >= 1 .and. i <= ntooth_q) then
-        name = tooth_q_names(i); unit = tooth_q_units(i)
-      end if
-    case ('stats')
-      if (i >= 1 .and. i <= nstats) name = stat_names(i)
-    end select
-  end subroutine api_names
-
-  !> Cost anatomy: CPU seconds per call of the scaled right-hand side (Eq. 25) of a case at its
-  !> static equilibrium (every tooth in contact, as in a running drive; time advanced per call,
-  !> contact states from the state), and of the flop floor:
-  !> a kernel doing only the arithmetic the mesh cannot avoid (angles by rotation, Eq. 11 and its
-  !> rate, Eqs. 15-17 with every tooth in contact, Eqs. 19-22), branch-free. flops: its count.
-  !> t_roots: one evaluation of the root functions (contact switches, and in the coupled level
-  !> the root/tip branch switches).
-  subroutine api_time_rhs(path, n, t_rhs, t_floor, flops, t_roots, ierr, errmsg)
-    character(len=*), intent(in) :: path
-    integer(c_int), intent(in) :: n
-    real(c_double), intent(out) :: t_rhs, t_floor, flops, t_roots
-    integer(c_int), intent(out) :: ierr
-    character(len=512), intent(out) :: errmsg
+    character(len=msglen), intent(out) :: errmsg
     type(model_t) :: m
-    real(wp) :: y(nstate), ys(nstate), f(nstate), acc, dt, g(2*1000), gb(2*1000)
+    real(wp) :: y(nstate), ys(nstate), f(nstate), acc, dt
+    real(wp), allocatable :: g(:), gb(:)
     integer :: ie, k
     integer(8) :: c0, c1, rate
-    t_rhs = 0; t_floor = 0; flops = 0; t_roots = 0
-    call case_read_file(path, m, ie, errmsg)
-    m%start_equilibrium = .true.
-    m%dq0 = 0; m%dv0 = 0
-    if (ie == 0) call start_state(m, y, ie, errmsg)
+    t_rhs = 0; t_roots = 0
+    call unpack(model, m, ie, errmsg)
+    if (ie == err_ok) then
+      m%start_equilibrium = .true.
+      m%dq0 = 0; m%dv0 = 0
+      call start_state(m, y, ie, errmsg)
+    end if
     ierr = ie
-    if (ie /= 0 .or. n < 1) return
+    if (ie /= err_ok .or. n < 1) return
+    allocate(g(2*m%z), gb(2*m%z))
     call to_scaled(m, y, ys)
     dt = 1.0e-3_wp/n
     acc = 0
@@ -225,16 +297,9 @@ contains
     end do
     call system_clock(c1)
     t_rhs = real(c1 - c0, wp)/rate/n
-    if (ie /= 0) then
+    if (ie /= err_ok) then
       ierr = ie; return
     end if
-    call system_clock(c0)
-    do k = 1, n
-      acc = acc + floor_kernel(m%z, k*dt, y)
-    end do
-    call system_clock(c1)
-    t_floor = real(c1 - c0, wp)/rate/n
-    flops = 28.0_wp*m%z + 2*nstate + 40.0_wp
     call system_clock(c0)
     do k = 1, n
       if (m%thermal == thermal_coupled) then
@@ -247,31 +312,6 @@ contains
     call system_clock(c1)
     t_roots = real(c1 - c0, wp)/rate/n
     if (acc == 1.2345e300_wp) errmsg = 'unreachable'     ! keeps both loops from being optimised out
-  contains
-    !> 28 flops per tooth (rotation 6, dn 4, its rate 9, force 4, sums 5), the torsional and
-    !> lateral accelerations and scalings (about 40 + 2 nstate), one sin/cos pair.
-    real(wp) function floor_kernel(z, t, y) result(r)
-      integer, intent(in) :: z
-      real(wp), intent(in) :: t, y(nstate)
-      real(wp) :: s, c, s1, ex, ey, evx, evy, dn, ddn, fj, fx, fy, fs
-      integer :: j
-      real(wp), parameter :: sd = 0.38268343236508978_wp, cd = 0.92387953251128674_wp
-      s = sin(628.3_wp*t); c = cos(628.3_wp*t)
-      ex = y(1) - y(3); ey = y(2) - y(4); evx = y(8) - y(10); evy = y(9) - y(11)
-      fx = 0; fy = 0; fs = 0
-      do j = 1, z
-        dn = ex*s - ey*c + y(6)
-        ddn = evx*s - evy*c + y(13) + 628.3_wp*(ex*c + ey*s)
-        fj = 2.5e5_wp*(dn - 2.0e-4_wp) + 0.053_wp*ddn
-        fx = fx - fj*s
-        fy = fy + fj*c
-        fs = fs + fj
-        s1 = s*cd + c*sd
-        c = c*cd - s*sd
-        s = s1
-      end do
-      r = fx + fy + fs + sum(y)*1.0e-3_wp + y(5)*7.855_wp + y(7)*7.856_wp
-    end function floor_kernel
   end subroutine api_time_rhs
 
 end module spline_api

@@ -2,11 +2,12 @@
 !> coordinates of Eq. 24, its scaled first-order form (Eq. 25), and the static equilibrium.
 module spline_dynamics
   use spline_kinds, only: wp
-  use spline_case_io, only: model_t, ndof, nstate
-  use spline_mesh, only: mesh_eval
+  use spline_model, only: model_t, ndof, nstate
+  use spline_mesh, only: mesh_eval, coupling_stats_t
   implicit none
   private
-  public :: accelerations, rhs_scaled, to_scaled, from_scaled, static_equilibrium, start_state
+  public :: accelerations, rhs_scaled, to_scaled, from_scaled, static_equilibrium, start_state, &
+       integrated_states
 
 contains
 
@@ -18,15 +19,16 @@ contains
   !>   D1'' = r_b ((T_m - S1)/J_1 - (T_d + S1)/J_M)
   !>   D2'' = r_b ((-T_m - S3)/J_2 - (T_m - S1)/J_1)
   !>   D3'' = r_b ((-T_m - S3)/J_2 - (S3 - T_L)/J_L)
-  subroutine accelerations(m, t, q, v, a, ierr, errmsg, mode, branch)
+  pure subroutine accelerations(m, t, q, v, a, ierr, errmsg, mode, branch, cstats)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(ndof), v(ndof)
     real(wp), intent(out) :: a(ndof)
     integer, intent(out) :: ierr
     character(len=*), intent(inout) :: errmsg
     integer, intent(in), optional :: mode(m%z), branch(2, m%z)
+    type(coupling_stats_t), intent(inout), optional :: cstats
     real(wp) :: fx1, fy1, tm, s1, s3, th1dd
-    call mesh_eval(m, t, q, v, fx1, fy1, tm, ierr, errmsg, mode=mode, branch=branch)
+    call mesh_eval(m, t, q, v, fx1, fy1, tm, ierr, errmsg, mode=mode, branch=branch, cstats=cstats)
     if (ierr /= 0) return
     a(1) = (fx1 - m%c_p1*v(1) - m%k_p1*q(1))/m%m_1
     a(2) = (fy1 - m%c_p1*v(2) - m%k_p1*q(2))/m%m_1 - m%grav
@@ -58,19 +60,36 @@ contains
   end subroutine from_scaled
 
   !> Eq. 25: d(ys)/d(tau) for the scaled state, ys' = (vs, a / (l w^2)).
-  subroutine rhs_scaled(m, tau, ys, dys, ierr, errmsg, mode, branch)
+  pure subroutine rhs_scaled(m, tau, ys, dys, ierr, errmsg, mode, branch, cstats)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: tau, ys(nstate)
     real(wp), intent(out) :: dys(nstate)
     integer, intent(out) :: ierr
     character(len=*), intent(inout) :: errmsg
     integer, intent(in), optional :: mode(m%z), branch(2, m%z)
+    type(coupling_stats_t), intent(inout), optional :: cstats
     real(wp) :: y(nstate), a(ndof)
     call from_scaled(m, ys, y)
-    call accelerations(m, tau/m%w_ref, y(1:ndof), y(ndof+1:), a, ierr, errmsg, mode, branch)
+    call accelerations(m, tau/m%w_ref, y(1:ndof), y(ndof+1:), a, ierr, errmsg, mode, branch, cstats)
     dys(1:ndof) = ys(ndof+1:)
     dys(ndof+1:) = a/(m%l_ref*m%w_ref**2)
   end subroutine rhs_scaled
+
+  !> The states the integrator carries, as indices into the full state (Eq. 24): all 14 at
+  !> dof = 7; at dof = 3 (torsional level) D1, D2, D3 and their velocities, the lateral states
+  !> being held at their start values.
+  pure subroutine integrated_states(m, idx, n)
+    type(model_t), intent(in) :: m
+    integer, intent(out) :: idx(nstate), n
+    integer :: k
+    if (m%dof == 3) then
+      n = 6
+      idx(1:n) = [5, 6, 7, 12, 13, 14]
+    else
+      n = nstate
+      idx = [(k, k = 1, nstate)]
+    end if
+  end subroutine integrated_states
 
   !> Start state (SI): the static equilibrium at t0 or rest, plus the case's offsets dq0, dv0.
   subroutine start_state(m, y, ierr, errmsg)

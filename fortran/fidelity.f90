@@ -11,7 +11,7 @@
 !>  - a temperature dT left out of Eq. 2 moves the backlash by kappa dT, kappa = 2 lambda s cos(alpha).
 module spline_fidelity
   use spline_kinds, only: wp
-  use spline_case_io, only: model_t
+  use spline_model, only: model_t
   implicit none
   private
   public :: static_tooth_load, lateral_estimate, backlash_estimate

@@ -3,9 +3,22 @@ module spline_geometry
   use spline_kinds, only: wp, pi
   implicit none
   private
-  public :: tooth_angles, contact_radius, profile_shift
+  public :: tooth_angles, contact_radius, profile_shift, iso4156_radii
 
 contains
+
+  !> ISO 4156 flat-root (30 deg) spline radii for module m and Z teeth (MODEL.md Section 8):
+  !> pitch R = m Z / 2, external minor (root) m (Z - 1.5) / 2, internal major (root)
+  !> m (Z + 1.5) / 2 and internal minor (tip) m (Z - 1) / 2.
+  pure subroutine iso4156_radii(z, m, r_pitch, rf_ext, rf_int, ra_int)
+    integer, intent(in) :: z
+    real(wp), intent(in) :: m
+    real(wp), intent(out) :: r_pitch, rf_ext, rf_int, ra_int
+    r_pitch = 0.5_wp*m*z
+    rf_ext = 0.5_wp*m*(z - 1.5_wp)
+    rf_int = 0.5_wp*m*(z + 1.5_wp)
+    ra_int = 0.5_wp*m*(z - 1.0_wp)
+  end subroutine iso4156_radii
 
   !> Eqs. 8-9: line-of-action angle of every tooth pair, phi_j = 2 pi j / Z + omega t + theta_0 - alpha,
   !> returned as sin and cos (what the mesh needs). Two sin/cos pairs per call instead of Z: the

@@ -3,18 +3,22 @@
 !> (Eqs. 1, 3-7, 12-14) and the energy-consistent mesh forces on the bodies (Eqs. 19-22, corrected).
 module spline_mesh
   use spline_kinds, only: wp
-  use spline_case_io, only: model_t, thermal_oneway, thermal_coupled
+  use spline_errors, only: err_thermal
+  use spline_model, only: model_t, thermal_oneway, thermal_coupled
   use spline_geometry, only: tooth_angles, profile_shift, contact_radius
   use spline_thermal, only: thermal_backlash, flash_temperature
   implicit none
   private
-  public :: mesh_eval, mesh_switch_functions, coupling_stats_reset, coupling_worst_residual, &
-       coupling_max_iterations
+  public :: mesh_eval, mesh_switch_functions, coupling_stats_t
 
   integer, parameter :: max_coupling_iter = 60
   real(wp), parameter :: coupling_tol = 1.0e-14_wp   !< relative step tolerance on T_f
-  real(wp), save :: worst_residual = 0.0_wp          !< largest |T - T_f(F(T))| accepted [degC]
-  integer, save :: worst_iterations = 0
+
+  !> How hard the flash-temperature coupling worked over a run (held by the caller's context).
+  type :: coupling_stats_t
+    real(wp) :: worst_residual = 0.0_wp   !< largest |T - T_f(F(T))| accepted [degC]
+    integer :: max_iterations = 0         !< most secant iterations on one tooth
+  end type coupling_stats_t
 
 contains
 
@@ -27,8 +31,9 @@ contains
   !> level does not feed them back (one-way post-processing and output).
   !> branch (optional): frozen root (-1) / tip (+1) branch of Eqs. 13-14 for spline 1 (row 1) and
   !> 2 (row 2) of every tooth, used between located branch switches; else the sign of dDelta/dt.
-  subroutine mesh_eval(m, t, q, v, fx1, fy1, tm, ierr, errmsg, mode, flash, dn, c, f, tf, rc1, rc2, &
-       sphi_out, cphi_out, branch)
+  !> cstats (optional): updated with the work of the flash-temperature coupling.
+  pure subroutine mesh_eval(m, t, q, v, fx1, fy1, tm, ierr, errmsg, mode, flash, dn, c, f, tf, &
+       rc1, rc2, sphi_out, cphi_out, branch, cstats)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(7), v(7)
     real(wp), intent(out) :: fx1, fy1, tm
@@ -38,9 +43,10 @@ contains
     logical, intent(in), optional :: flash
     integer, intent(in), optional :: branch(2, m%z)
     real(wp), intent(out), optional, dimension(m%z) :: dn, c, f, tf, rc1, rc2, sphi_out, cphi_out
+    type(coupling_stats_t), intent(inout), optional :: cstats
     real(wp) :: sp(m%z), cp(m%z)
-    real(wp) :: ex, ey, evx, evy, dnj, ddnj, cj, fj, tfj, r1, r2, sumf
-    integer :: j, mj
+    real(wp) :: ex, ey, evx, evy, dnj, ddnj, cj, fj, tfj, r1, r2, sumf, resid
+    integer :: j, mj, iters
     logical :: want_flash, coupled
 
     ierr = 0
@@ -75,14 +81,18 @@ contains
       end if
       if (mj /= 0) then
         if (coupled) then
-          call solve_coupled(m, dnj, ddnj, mj, r1, r2, fj, tfj, ierr)
+          call solve_coupled(m, dnj, ddnj, mj, r1, r2, fj, tfj, iters, resid, ierr)
+          if (present(cstats)) then
+            cstats%max_iterations = max(cstats%max_iterations, iters)
+            cstats%worst_residual = max(cstats%worst_residual, resid)
+          end if
           if (ierr /= 0) then
             write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': thermal interference: '// &
                  'the flash temperature closes the backlash of tooth ', j, ' at t = ', t, &
                  ' s (Eq. 2: c_j <= 0)'
             if (ierr == 2) write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)// &
                  ': flash-temperature coupling did not converge on tooth ', j, ' at t = ', t, ' s'
-            ierr = 3                                   ! a thermal failure, for the caller
+            ierr = err_thermal
             return
           end if
           cj = thermal_backlash(m%c_bulk, m%kappa, tfj)
@@ -158,37 +168,46 @@ contains
   !> paper's k_m), so 3-5 iterations reach round-off. ierr = 1: backlash closed; 2: no convergence.
   !> Eqs. 3-4 make T_f a power of the load at a given contact point: f_e / sqrt(B) ~ f_e^(3/4), so
   !> T_f(F) = T_f(1 N) |F|^(3/4). Eqs. 3-7 are evaluated once per tooth, each iteration costs two sqrt.
-  subroutine solve_coupled(m, dn, ddn, mode, r1, r2, f, t, ierr)
+  !> iters, resid: the secant iterations taken and the residual |g| accepted.
+  pure subroutine solve_coupled(m, dn, ddn, mode, r1, r2, f, t, iters, resid, ierr)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: dn, ddn, r1, r2
     integer, intent(in) :: mode
-    real(wp), intent(out) :: f, t
-    integer, intent(out) :: ierr
-    real(wp) :: ta, ga, tb, gb, tn, tf_unit
+    real(wp), intent(out) :: f, t, resid
+    integer, intent(out) :: iters, ierr
+    real(wp) :: ta, ga, tb, gb, tn, tf_unit, tfb
     integer :: k
     ierr = 0
+    iters = 0
+    resid = 0.0_wp
     tf_unit = flash_of(m, 1.0_wp, r1, r2)
     ta = 0.0_wp
-    ga = -tf_at(ta)
+    ga = -tf_at(ta)             ! the backlash at T = 0 (the bulk level) is open: c_bulk > 0
     tb = -ga
     t = ta
     if (ga /= 0.0_wp) then
-      gb = tb - tf_at(tb)
-      if (ierr /= 0) return
+      tfb = tf_at(tb)
+      if (tfb < 0.0_wp) then
+        ierr = 1; return
+      end if
+      gb = tb - tfb
       do k = 1, max_coupling_iter
         if (gb == 0.0_wp .or. gb == ga) exit
         tn = tb - gb*(tb - ta)/(gb - ga)
         ta = tb; ga = gb
         tb = tn
-        gb = tb - tf_at(tb)
-        if (ierr /= 0) return
+        tfb = tf_at(tb)
+        if (tfb < 0.0_wp) then
+          ierr = 1; return
+        end if
+        gb = tb - tfb
         if (abs(tb - ta) <= coupling_tol*(1.0_wp + abs(tb))) exit
       end do
       if (k > max_coupling_iter) then
         ierr = 2; return
       end if
-      worst_iterations = max(worst_iterations, k)
-      worst_residual = max(worst_residual, abs(gb))
+      iters = k
+      resid = abs(gb)
       t = tb
     end if
     if (thermal_backlash(m%c_bulk, m%kappa, t) <= 0.0_wp) then
@@ -196,14 +215,13 @@ contains
     end if
     f = contact_force(m, dn, ddn, mode, thermal_backlash(m%c_bulk, m%kappa, t))
   contains
-    real(wp) function tf_at(tt)
+    !> T_f(F(T)) >= 0, or -1 where the backlash at T is closed.
+    pure real(wp) function tf_at(tt)
       real(wp), intent(in) :: tt
       real(wp) :: cc, q
       cc = thermal_backlash(m%c_bulk, m%kappa, tt)
-      tf_at = 0.0_wp
-      if (cc <= 0.0_wp) then
-        ierr = 1; return
-      end if
+      tf_at = -1.0_wp
+      if (cc <= 0.0_wp) return
       q = sqrt(sqrt(abs(contact_force(m, dn, ddn, mode, cc))))
       tf_at = tf_unit*q*q*q
     end function tf_at
@@ -213,7 +231,7 @@ contains
   !> (with the backlash at the bulk temperature, which decides the contact state), and, if gb is
   !> present, for the root/tip branch switches of Eqs. 13-14: gb_{2j-1} = dDelta_1j/dt,
   !> gb_{2j} = dDelta_2j/dt (needs the velocities v).
-  subroutine mesh_switch_functions(m, t, q, g, v, gb)
+  pure subroutine mesh_switch_functions(m, t, q, g, v, gb)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(7)
     real(wp), intent(out) :: g(2*m%z)
@@ -235,18 +253,5 @@ contains
       end if
     end do
   end subroutine mesh_switch_functions
-
-  subroutine coupling_stats_reset()
-    worst_residual = 0.0_wp
-    worst_iterations = 0
-  end subroutine coupling_stats_reset
-
-  real(wp) function coupling_worst_residual()
-    coupling_worst_residual = worst_residual
-  end function coupling_worst_residual
-
-  integer function coupling_max_iterations()
-    coupling_max_iterations = worst_iterations
-  end function coupling_max_iterations
 
 end module spline_mesh

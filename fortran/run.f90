@@ -3,7 +3,8 @@
 !> (Eqs. 11, 15-22 and, for the thermal levels that have it, Eqs. 1-7) at every output time.
 module spline_run
   use spline_kinds, only: wp
-  use spline_case_io, only: model_t, nstate, ndof, thermal_none, thermal_bulk, thermal_oneway, &
+  use spline_errors, only: err_ok
+  use spline_model, only: model_t, nstate, ndof, thermal_none, thermal_bulk, thermal_oneway, &
        thermal_coupled, set_thermal_level
   use spline_dynamics, only: start_state
   use spline_mesh, only: mesh_eval
@@ -55,12 +56,14 @@ contains
   !>  - thermal bulk -> none when backlash_estimate(T_M) <= tol;
   !>  - thermal coupled -> oneway (same T_f output, no iteration in the RHS), checked afterwards:
   !>    if backlash_estimate(max T_f of the one-way run) > tol the case is run coupled.
-  subroutine run_case(m, t, y, tooth, tm, stats, ierr, errmsg)
+  !> interruptible: a SIGINT stops the run with err_interrupted (callers that can raise it).
+  subroutine run_case(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible)
     type(model_t), intent(in) :: m
     real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
     real(wp), intent(out) :: tm(m%n_out), stats(nstats)
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
+    logical, intent(in), optional :: interruptible
     type(model_t) :: run
     real(wp) :: eps_lat, eps_th, tol
     integer(8) :: c0, c1, rate
@@ -77,12 +80,12 @@ contains
       end if
       if (m%thermal == thermal_coupled) call set_thermal_level(run, thermal_oneway)
     end if
-    call run_level(run, t, y, tooth, tm, stats, ierr, errmsg)
-    if (ierr == 0 .and. m%auto .and. m%thermal == thermal_coupled) then
+    call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible)
+    if (ierr == err_ok .and. m%auto .and. m%thermal == thermal_coupled) then
       eps_th = backlash_estimate(m, maxval(abs(tooth(:, :, iq_tf))))
       if (eps_th > tol) then
         call set_thermal_level(run, thermal_coupled)
-        call run_level(run, t, y, tooth, tm, stats, ierr, errmsg)
+        call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible)
       end if
     end if
     call system_clock(c1)
@@ -91,20 +94,23 @@ contains
   end subroutine run_case
 
   !> One run of the model at the level m sets.
-  subroutine run_level(m, t, y, tooth, tm, stats, ierr, errmsg)
+  subroutine run_level(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible)
     type(model_t), intent(in) :: m
     real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
     real(wp), intent(out) :: tm(m%n_out), stats(nstats)
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
+    logical, intent(in), optional :: interruptible
     real(wp) :: y0(nstate)
-    integer :: modes(m%z, m%n_out)
+    integer, allocatable :: modes(:, :)
     errmsg = ''
     stats = 0.0_wp
+    t = 0.0_wp; y = 0.0_wp; tooth = 0.0_wp; tm = 0.0_wp
+    allocate(modes(m%z, m%n_out))
     call output_times(m, t)
     call start_state(m, y0, ierr, errmsg)
     if (ierr /= 0) return
-    call integrate(m, y0, m%n_out, t, y, modes, stats(1:nsolver_stats), ierr, errmsg)
+    call integrate(m, y0, m%n_out, t, y, modes, stats(1:nsolver_stats), ierr, errmsg, interruptible)
     if (ierr /= 0) return
     call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg)
   end subroutine run_level

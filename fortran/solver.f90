@@ -1,6 +1,10 @@
 !> Time integration with CVODE (SUNDIALS 6.4, Fortran 2003 interface) of the scaled system of
-!> Eq. 25, with optional root finding on the contact switches of Eq. 16. Version-specific calls
-!> (context creation) are kept in sundials_context_new.
+!> Eq. 25, with optional root finding on the contact switches of Eq. 16 (and, at the coupled
+!> thermal level, on the root/tip branch switches of Eqs. 13-14).
+!>
+!> Reentrant: all run state sits in a solver_ctx_t local to `integrate`, which CVODE hands to
+!> the callbacks as their user data. No module variable changes during a run. Every SUNDIALS
+!> return value is checked. Version-specific calls (context creation) are in sundials_context_new.
 module spline_solver
   use, intrinsic :: iso_c_binding
   use fcvode_mod
@@ -14,10 +18,10 @@ module spline_solver
   use fsundials_nonlinearsolver_mod
   use fsunnonlinsol_fixedpoint_mod
   use spline_kinds, only: wp
-  use spline_case_io, only: model_t, nstate, ndof, thermal_coupled
-  use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled
-  use spline_mesh, only: mesh_switch_functions, coupling_stats_reset, coupling_worst_residual, &
-       coupling_max_iterations
+  use spline_errors, only: err_ok, err_solver, err_interrupted, msglen
+  use spline_model, only: model_t, nstate, ndof, thermal_coupled
+  use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, integrated_states
+  use spline_mesh, only: mesh_switch_functions, coupling_stats_t
   implicit none
   private
   public :: integrate, nstats, stat_names
@@ -28,26 +32,40 @@ module spline_solver
        'nonlin_conv_fails', 'roots_found', 'root_fn_evals', 'last_step_s', &
        'mode_resyncs', 'coupling_residual_degC', 'coupling_iterations']
 
-  ! What the C callbacks see (CVODE calls them without our arguments): the model being
-  ! integrated, the frozen contact states between located switches (allocated only when
-  ! root finding is on: an unallocated array is an absent optional argument), the frozen
-  ! root/tip branches of Eqs. 13-14 (coupled flash temperature only), and the first error.
-  ! The integrated states are ys_full(idx): all 14 for dof = 7; the torsional level (dof = 3)
-  ! integrates D1, D2, D3 and their velocities and holds the lateral states at ys_full.
-  type(model_t), save :: mdl
-  integer, allocatable, save :: idx(:)
-  real(c_double), save :: ys_full(nstate)
-  integer, allocatable, save :: modes(:), branches(:, :)
-  logical, save :: frozen = .false.
-  integer, save :: cb_ierr = 0
-  character(len=512), save :: cb_msg = ''
-  character(len=512), save :: cvode_msg = ''
+  !> Everything a run changes, owned by `integrate` and given to CVODE as user data.
+  type :: solver_ctx_t
+    type(model_t) :: m                      !< the model integrated
+    integer :: n = nstate                   !< integrated states: ys_full(idx(1:n))
+    integer :: idx(nstate)
+    real(c_double) :: ys_full(nstate)       !< scaled full state; the frozen entries stay here
+    logical :: frozen = .false.             !< root finding: contact states frozen between switches
+    integer, allocatable :: modes(:)        !< contact state per tooth (+1, 0, -1), if frozen
+    integer, allocatable :: branches(:, :)  !< root (-1) / tip (+1) branch, coupled level only
+    type(coupling_stats_t) :: cstats        !< work of the flash-temperature coupling
+    logical :: watch = .false.              !< stop on SIGINT (callers that can raise it)
+    integer(c_int) :: sigint0 = 0           !< SIGINT count when the run began
+    integer :: cb_ierr = err_ok             !< first error raised inside a callback
+    character(len=msglen) :: cb_msg = ''
+    character(len=msglen) :: cvode_msg = '' !< CVODE's own last error text
+  end type solver_ctx_t
+
+  interface   ! fortran/interrupt.c
+    integer(c_int) function sigint_watch() bind(C, name='spline_sigint_watch')
+      import :: c_int
+    end function sigint_watch
+    subroutine sigint_unwatch() bind(C, name='spline_sigint_unwatch')
+    end subroutine sigint_unwatch
+    integer(c_int) function sigint_count() bind(C, name='spline_sigint_count')
+      import :: c_int
+    end function sigint_count
+  end interface
 
 contains
 
   !> Integrate the model from y0 (SI, at m%t0) and return the SI state at the times tout(1:nt)
-  !> (ascending, >= t0) in yout(:, k), the final contact states and the solver statistics.
-  subroutine integrate(m, y0, nt, tout, yout, modes_out, stats, ierr, errmsg)
+  !> (ascending, >= t0) in yout(:, k), the contact states there (2: decided by the state) and
+  !> the solver statistics. interruptible: a SIGINT during the run stops it (err_interrupted).
+  subroutine integrate(m, y0, nt, tout, yout, modes_out, stats, ierr, errmsg, interruptible)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: y0(nstate)
     integer, intent(in) :: nt
@@ -57,10 +75,12 @@ contains
     real(wp), intent(out) :: stats(nstats)
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
+    logical, intent(in), optional :: interruptible
+    type(solver_ctx_t), target :: ctx
     real(c_double) :: ys(nstate)
     real(c_double), allocatable, target :: yr(:)
     real(c_double) :: tau, tau_out, tret(1), hlast(1)
-    type(c_ptr) :: ctx, mem
+    type(c_ptr) :: sunctx, mem
     type(N_Vector), pointer :: sv
     type(SUNMatrix), pointer :: amat
     type(SUNLinearSolver), pointer :: ls
@@ -68,118 +88,163 @@ contains
     integer(c_int) :: flag, nroot
     integer(c_int), allocatable :: rootsfound(:)
     integer :: k, k0, nroots, nresync
+    character(len=40) :: stage
 
-    ierr = 0
+    ierr = err_ok
     errmsg = ''
     stats = 0.0_wp
-    mdl = m
-    cb_ierr = 0; cb_msg = ''; cvode_msg = ''
+    yout = 0.0_wp
+    modes_out = 2
+    ctx%m = m
     nroots = 0; nresync = 0
-    call coupling_stats_reset()
-    if (allocated(modes)) deallocate(modes)
-    if (allocated(branches)) deallocate(branches)
-    frozen = m%roots
+    ctx%frozen = m%roots
     nroot = 0
-    if (frozen) then
-      allocate(modes(m%z))
+    if (ctx%frozen) then
+      allocate(ctx%modes(m%z))
       nroot = 2*m%z
       if (m%thermal == thermal_coupled) then
-        allocate(branches(2, m%z))
+        allocate(ctx%branches(2, m%z))
         nroot = 4*m%z
       end if
     end if
     allocate(rootsfound(nroot))
     call to_scaled(m, y0, ys)
-    if (m%dof == 3) then
-      idx = [5, 6, 7, 12, 13, 14]
-      ys(ndof+1:ndof+4) = 0.0_wp                 ! lateral states frozen at the start displacement
-    else
-      idx = [(k, k = 1, nstate)]
-    end if
-    ys_full = ys
-    yr = ys(idx)
+    call integrated_states(m, ctx%idx, ctx%n)
+    if (ctx%n < nstate) ys(ndof+1:ndof+4) = 0.0_wp   ! lateral states frozen at the start displacement
+    ctx%ys_full = ys
+    yr = ys(ctx%idx(1:ctx%n))
     tau = m%t0*m%w_ref
     k = 0
-    if (frozen) call sync_modes(tau, ys, k)
+    if (ctx%frozen) call sync_modes(ctx, tau, ys, k)
+    if (present(interruptible)) ctx%watch = interruptible
+    if (ctx%watch) ctx%sigint0 = sigint_watch()
 
-    ctx = sundials_context_new()
-    sv => FN_VMake_Serial(int(size(idx), c_long), yr, ctx)
-    flag = FN_VEnableFusedOps_Serial(sv, 1)   ! fused vector kernels: less overhead per step
-    amat => FSUNDenseMatrix(int(size(idx), c_long), int(size(idx), c_long), ctx)
-    ls => FSUNLinSol_Dense(sv, amat, ctx)
-    if (m%method_bdf == 1) then
-      mem = FCVodeCreate(CV_BDF, ctx)
-    else
-      mem = FCVodeCreate(CV_ADAMS, ctx)
+    ! set-up: each call checked in turn (stage names the first one that failed)
+    nullify(sv, amat, ls, nls)
+    mem = c_null_ptr
+    stage = 'creating the SUNDIALS context'
+    flag = sundials_context_new(sunctx)
+    if (flag == 0) then
+      stage = 'creating the state vector'
+      sv => FN_VMake_Serial(int(ctx%n, c_long), yr, sunctx)
+      if (.not. associated(sv)) flag = -1
     end if
-    flag = FCVodeInit(mem, c_funloc(rhs_cb), tau, sv)
-    if (flag == 0) flag = FCVodeSetErrHandlerFn(mem, c_funloc(err_cb), c_null_ptr)
-    if (flag == 0) flag = FCVodeSStolerances(mem, real(m%rtol, c_double), real(m%atol, c_double))
-    if (m%newton) then
-      if (flag == 0) flag = FCVodeSetLinearSolver(mem, ls, amat)
-    else
-      nls => FSUNNonlinSol_FixedPoint(sv, 0, ctx)   ! functional iteration, no Anderson acceleration
-      if (flag == 0) flag = FCVodeSetNonlinearSolver(mem, nls)
+    if (flag == 0) flag = FN_VEnableFusedOps_Serial(sv, 1)   ! fused kernels: less work per step
+    if (flag == 0) then
+      stage = 'creating CVODE'
+      if (m%method_bdf == 1) then
+        mem = FCVodeCreate(CV_BDF, sunctx)
+      else
+        mem = FCVodeCreate(CV_ADAMS, sunctx)
+      end if
+      if (.not. c_associated(mem)) flag = -1
     end if
-    if (flag == 0) flag = FCVodeSetMaxNumSteps(mem, int(m%max_steps, c_long))
+    if (flag == 0) then
+      stage = 'initialising CVODE'
+      flag = FCVodeInit(mem, c_funloc(rhs_cb), tau, sv)
+    end if
+    if (flag == 0) flag = FCVodeSetUserData(mem, c_loc(ctx))
+    if (flag == 0) flag = FCVodeSetErrHandlerFn(mem, c_funloc(err_cb), c_loc(ctx))
+    if (flag == 0) then
+      stage = 'setting the tolerances'
+      flag = FCVodeSStolerances(mem, real(m%rtol, c_double), real(m%atol, c_double))
+    end if
+    if (flag == 0) then
+      stage = 'attaching the (non)linear solver'
+      if (m%newton) then
+        amat => FSUNDenseMatrix(int(ctx%n, c_long), int(ctx%n, c_long), sunctx)
+        if (associated(amat)) ls => FSUNLinSol_Dense(sv, amat, sunctx)
+        if (associated(ls)) then
+          flag = FCVodeSetLinearSolver(mem, ls, amat)
+        else
+          flag = -1
+        end if
+      else
+        nls => FSUNNonlinSol_FixedPoint(sv, 0, sunctx)   ! functional iteration, no Anderson acceleration
+        if (associated(nls)) then
+          flag = FCVodeSetNonlinearSolver(mem, nls)
+        else
+          flag = -1
+        end if
+      end if
+    end if
+    if (flag == 0) then
+      stage = 'setting the solver options'
+      flag = FCVodeSetMaxNumSteps(mem, int(m%max_steps, c_long))
+    end if
     if (flag == 0 .and. m%stald .and. m%method_bdf == 1) flag = FCVodeSetStabLimDet(mem, 1)
-    if (flag == 0 .and. frozen) flag = FCVodeRootInit(mem, nroot, c_funloc(roots_cb))
-    if (flag == 0 .and. frozen) flag = FCVodeSetNoInactiveRootWarn(mem)
+    if (flag == 0 .and. ctx%frozen) then
+      stage = 'setting up root finding'
+      flag = FCVodeRootInit(mem, nroot, c_funloc(roots_cb))
+      if (flag == 0) flag = FCVodeSetNoInactiveRootWarn(mem)
+    end if
     if (flag /= 0) then
-      call fail(flag, tau, 'setting up CVODE')
-      ierr = 2
+      call fail(flag, tau, trim(stage))
     else
-      do k = 1, nt
+      outputs: do k = 1, nt
         tau_out = tout(k)*m%w_ref
         do while (tau < tau_out)
           flag = FCVode(mem, tau_out, sv, tret, CV_NORMAL)
-          if (flag < 0) exit
+          if (flag < 0) then
+            call fail(flag, tret(1), 'integrating')
+            exit outputs
+          end if
           tau = tret(1)
           if (flag == CV_ROOT_RETURN) then
             ! Step onto the switch, flip the states of the teeth that crossed, restart.
             flag = FCVodeGetRootInfo(mem, rootsfound)
-            call apply_roots(rootsfound, nroots)
-            call add_counters(mem, stats)           ! CVodeReInit zeroes CVODE's counters
+            if (flag /= 0) then
+              call fail(flag, tau, 'reading the roots found')
+              exit outputs
+            end if
+            call apply_roots(ctx, rootsfound, nroots)
+            call add_counters(ctx, mem, stats)        ! CVodeReInit zeroes CVODE's counters
             flag = FCVodeReInit(mem, tau, sv)
-            if (flag < 0) exit
+            if (flag /= 0) then
+              call fail(flag, tau, 'restarting at a contact switch')
+              exit outputs
+            end if
           end if
         end do
-        if (flag < 0) then
-          call fail(flag, tau, 'integrating')
-          exit
+        if (interrupted(ctx)) then
+          call fail(-1_c_int, tau, 'integrating')
+          exit outputs
         end if
         ! Safety net: a grazing contact can touch a switch without a sign change over a step.
-        ys(idx) = yr
-        if (frozen) then
+        ys(ctx%idx(1:ctx%n)) = yr
+        if (ctx%frozen) then
           k0 = nresync
-          call sync_modes(tau, ys, nresync)
+          call sync_modes(ctx, tau, ys, nresync)
           if (nresync > k0 .and. k < nt) then
-            call add_counters(mem, stats)
+            call add_counters(ctx, mem, stats)
             flag = FCVodeReInit(mem, tau, sv)
+            if (flag /= 0) then
+              call fail(flag, tau, 'restarting after a missed switch')
+              exit outputs
+            end if
           end if
         end if
         call from_scaled(m, ys, yout(:, k))
-        if (frozen) then
-          modes_out(:, k) = modes
-        else
-          modes_out(:, k) = 2     ! 2: decided by the state
-        end if
-      end do
+        if (ctx%frozen) modes_out(:, k) = ctx%modes
+      end do outputs
     end if
 
-    call add_counters(mem, stats)
+    if (c_associated(mem)) then
+      call add_counters(ctx, mem, stats)
+      flag = FCVodeGetLastStep(mem, hlast)
+      if (flag == 0) stats(9) = hlast(1)/m%w_ref
+      call FCVodeFree(mem)
+    end if
     stats(7) = nroots
-    flag = FCVodeGetLastStep(mem, hlast);              stats(9) = hlast(1)/m%w_ref
     stats(10) = nresync
-    stats(11) = coupling_worst_residual()
-    stats(12) = coupling_max_iterations()
-
-    call FCVodeFree(mem)
-    flag = FSUNLinSolFree(ls)
-    if (.not. m%newton) flag = FSUNNonlinSolFree(nls)
-    call FSUNMatDestroy(amat)
-    call FN_VDestroy(sv)
-    flag = FSUNContext_Free(ctx)
+    stats(11) = ctx%cstats%worst_residual
+    stats(12) = ctx%cstats%max_iterations
+    if (ctx%watch) call sigint_unwatch()
+    if (associated(ls)) flag = FSUNLinSolFree(ls)
+    if (associated(nls)) flag = FSUNNonlinSolFree(nls)
+    if (associated(amat)) call FSUNMatDestroy(amat)
+    if (associated(sv)) call FN_VDestroy(sv)
+    flag = FSUNContext_Free(sunctx)
 
   contains
 
@@ -188,72 +253,90 @@ contains
       real(c_double), intent(in) :: tau
       character(len=*), intent(in) :: what
       character(len=:), allocatable :: fname
-      fname = FCVodeGetReturnFlagName(int(flag, c_long))
-      ierr = 2
-      if (cb_ierr /= 0) then
-        ierr = 3
-        errmsg = cb_msg                       ! the physics said why (e.g. thermal interference)
+      if (ierr /= err_ok) return
+      ierr = err_solver
+      if (ctx%cb_ierr /= err_ok) then
+        ierr = ctx%cb_ierr
+        errmsg = ctx%cb_msg                  ! the physics said why (e.g. thermal interference)
         return
       end if
+      if (interrupted(ctx)) then
+        ierr = err_interrupted
+        write(errmsg, '(a,es12.5,a)') 'case '//trim(m%name)//': interrupted (SIGINT) at t = ', &
+             tau/m%w_ref, ' s'
+        return
+      end if
+      fname = FCVodeGetReturnFlagName(int(flag, c_long))
       write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': CVODE failed while '//what// &
            ' with flag '//fname//' (', flag, ') at t = ', tau/m%w_ref, ' s'
-      if (len_trim(cvode_msg) > 0) errmsg = trim(errmsg)//': '//trim(cvode_msg)
+      if (len_trim(ctx%cvode_msg) > 0) errmsg = trim(errmsg)//': '//trim(ctx%cvode_msg)
     end subroutine fail
 
   end subroutine integrate
 
+  !> A SIGINT arrived since the run began (only for runs that watch).
+  logical function interrupted(ctx)
+    type(solver_ctx_t), intent(in) :: ctx
+    interrupted = .false.
+    if (ctx%watch) interrupted = sigint_count() /= ctx%sigint0
+  end function interrupted
+
   !> Add CVODE's counters since the last (re)initialisation to stats (order of stat_names).
-  subroutine add_counters(mem, stats)
+  !> A counter that cannot be read (nonzero flag) adds nothing.
+  subroutine add_counters(ctx, mem, stats)
+    type(solver_ctx_t), intent(in) :: ctx
     type(c_ptr), intent(in) :: mem
     real(wp), intent(inout) :: stats(nstats)
     integer(c_long) :: cnt(1)
-    integer(c_int) :: flag
-    cnt = 0
-    flag = FCVodeGetNumSteps(mem, cnt);                stats(1) = stats(1) + cnt(1)
-    flag = FCVodeGetNumRhsEvals(mem, cnt);             stats(2) = stats(2) + cnt(1)
-    if (mdl%newton) then
-      flag = FCVodeGetNumJacEvals(mem, cnt);           stats(3) = stats(3) + cnt(1)
-      flag = FCVodeGetNumLinRhsEvals(mem, cnt);        stats(4) = stats(4) + cnt(1)
+    call add(1, FCVodeGetNumSteps(mem, cnt))
+    call add(2, FCVodeGetNumRhsEvals(mem, cnt))
+    if (ctx%m%newton) then
+      call add(3, FCVodeGetNumJacEvals(mem, cnt))
+      call add(4, FCVodeGetNumLinRhsEvals(mem, cnt))
     end if
-    flag = FCVodeGetNumErrTestFails(mem, cnt);         stats(5) = stats(5) + cnt(1)
-    flag = FCVodeGetNumNonlinSolvConvFails(mem, cnt);  stats(6) = stats(6) + cnt(1)
-    if (frozen) then
-      flag = FCVodeGetNumGEvals(mem, cnt);             stats(8) = stats(8) + cnt(1)
-    end if
+    call add(5, FCVodeGetNumErrTestFails(mem, cnt))
+    call add(6, FCVodeGetNumNonlinSolvConvFails(mem, cnt))
+    if (ctx%frozen) call add(8, FCVodeGetNumGEvals(mem, cnt))
+  contains
+    subroutine add(i, flag)          ! the getter has filled cnt by the time this runs
+      integer, intent(in) :: i
+      integer(c_int), intent(in) :: flag
+      if (flag == 0) stats(i) = stats(i) + cnt(1)
+    end subroutine add
   end subroutine add_counters
 
   !> SUNDIALS 6.x context (SUNDIALS 7 takes SUN_COMM_NULL here): the one version-specific call.
-  function sundials_context_new() result(ctx)
-    type(c_ptr) :: ctx
-    integer(c_int) :: flag
-    flag = FSUNContext_Create(c_null_ptr, ctx)
+  integer(c_int) function sundials_context_new(sunctx) result(flag)
+    type(c_ptr), intent(out) :: sunctx
+    flag = FSUNContext_Create(c_null_ptr, sunctx)
   end function sundials_context_new
 
   !> Contact states (and branches) from the sign of the switch functions. Counts the switches
   !> whose stored state disagreed clearly (beyond round-off) with the state: a missed switch.
-  subroutine sync_modes(tau, ys, nchanged)
+  subroutine sync_modes(ctx, tau, ys, nchanged)
+    type(solver_ctx_t), intent(inout) :: ctx
     real(c_double), intent(in) :: tau, ys(nstate)
     integer, intent(inout) :: nchanged
-    real(wp) :: y(nstate), g(2*mdl%z), gb(2*mdl%z), eps, epsv
+    real(wp) :: y(nstate), g(2*ctx%m%z), gb(2*ctx%m%z), eps, epsv
     integer :: j, i, want
-    call from_scaled(mdl, ys, y)
-    call mesh_switch_functions(mdl, tau/mdl%w_ref, y(1:ndof), g, y(ndof+1:), gb)
-    eps = 1.0e-9_wp*mdl%c_bulk
-    epsv = eps*mdl%w_ref
-    do j = 1, mdl%z
+    call from_scaled(ctx%m, ys, y)
+    call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), g, y(ndof+1:), gb)
+    eps = 1.0e-9_wp*ctx%m%c_bulk
+    epsv = eps*ctx%m%w_ref
+    do j = 1, ctx%m%z
       want = 0
       if (g(2*j - 1) > 0.0_wp) want = 1
       if (g(2*j) < 0.0_wp) want = -1
-      if (want /= modes(j)) then
+      if (want /= ctx%modes(j)) then
         if (abs(g(2*j - 1)) > eps .and. abs(g(2*j)) > eps) nchanged = nchanged + 1
-        modes(j) = want
+        ctx%modes(j) = want
       end if
-      if (.not. allocated(branches)) cycle
+      if (.not. allocated(ctx%branches)) cycle
       do i = 1, 2
         want = merge(-1, 1, gb(2*j - 2 + i) < 0.0_wp)
-        if (want /= branches(i, j)) then
+        if (want /= ctx%branches(i, j)) then
           if (abs(gb(2*j - 2 + i)) > epsv) nchanged = nchanged + 1
-          branches(i, j) = want
+          ctx%branches(i, j) = want
         end if
       end do
     end do
@@ -262,40 +345,51 @@ contains
   !> A located root of g_{2j-1} = dn_j - c_j (rising: drive flank engages, falling: it opens)
   !> or of g_{2j} = dn_j + c_j (falling: back flank engages, rising: it opens); then, in coupled
   !> mode, of dDelta_ij/dt (rising: the contact point moves to the tip, falling: to the root).
-  subroutine apply_roots(rootsfound, nroots)
+  subroutine apply_roots(ctx, rootsfound, nroots)
+    type(solver_ctx_t), intent(inout) :: ctx
     integer(c_int), intent(in) :: rootsfound(:)
     integer, intent(inout) :: nroots
     integer :: j, i, z
-    z = size(modes)
+    z = ctx%m%z
     do j = 1, z
-      if (rootsfound(2*j - 1) == 1) modes(j) = 1
-      if (rootsfound(2*j - 1) == -1) modes(j) = 0
-      if (rootsfound(2*j) == -1) modes(j) = -1
-      if (rootsfound(2*j) == 1) modes(j) = 0
-      if (.not. allocated(branches)) cycle
+      if (rootsfound(2*j - 1) == 1) ctx%modes(j) = 1
+      if (rootsfound(2*j - 1) == -1) ctx%modes(j) = 0
+      if (rootsfound(2*j) == -1) ctx%modes(j) = -1
+      if (rootsfound(2*j) == 1) ctx%modes(j) = 0
+      if (.not. allocated(ctx%branches)) cycle
       do i = 1, 2
-        if (rootsfound(2*z + 2*j - 2 + i) /= 0) branches(i, j) = rootsfound(2*z + 2*j - 2 + i)
+        if (rootsfound(2*z + 2*j - 2 + i) /= 0) ctx%branches(i, j) = rootsfound(2*z + 2*j - 2 + i)
       end do
     end do
     nroots = nroots + count(rootsfound /= 0)
   end subroutine apply_roots
 
+  !> CVODE's right-hand side: Eq. 25 on the integrated states, the others held in ys_full.
+  !> Returns -1 (unrecoverable) on a physics error or a SIGINT, kept in the context.
   integer(c_int) function rhs_cb(tau, sv_y, sv_f, udata) result(ret) bind(C)
     real(c_double), value :: tau
     type(N_Vector) :: sv_y, sv_f
     type(c_ptr), value :: udata
+    type(solver_ctx_t), pointer :: ctx
     real(c_double), pointer :: ys(:), fs(:)
     real(c_double) :: yf(nstate), ff(nstate)
     integer :: ierr
+    call c_f_pointer(udata, ctx)
     ys => FN_VGetArrayPointer(sv_y)
     fs => FN_VGetArrayPointer(sv_f)
-    yf = ys_full
-    yf(idx) = ys
-    call rhs_scaled(mdl, tau, yf, ff, ierr, cb_msg, modes, branches)   ! absent if unallocated
-    fs = ff(idx)
+    yf = ctx%ys_full
+    yf(ctx%idx(1:ctx%n)) = ys
+    if (ctx%frozen) then
+      call rhs_scaled(ctx%m, tau, yf, ff, ierr, ctx%cb_msg, ctx%modes, ctx%branches, ctx%cstats)
+    else
+      call rhs_scaled(ctx%m, tau, yf, ff, ierr, ctx%cb_msg, cstats=ctx%cstats)
+    end if
+    fs = ff(ctx%idx(1:ctx%n))
     ret = 0
     if (ierr /= 0) then
-      cb_ierr = ierr
+      ctx%cb_ierr = ierr
+      ret = -1
+    else if (interrupted(ctx)) then
       ret = -1
     end if
   end function rhs_cb
@@ -305,20 +399,22 @@ contains
     type(N_Vector) :: sv_y
     real(c_double) :: gout(*)
     type(c_ptr), value :: udata
+    type(solver_ctx_t), pointer :: ctx
     real(c_double), pointer :: ys(:)
     real(c_double) :: yf(nstate)
     real(wp) :: y(nstate)
     integer :: z
+    call c_f_pointer(udata, ctx)
     ys => FN_VGetArrayPointer(sv_y)
-    yf = ys_full
-    yf(idx) = ys
-    call from_scaled(mdl, yf, y)
-    z = mdl%z
-    if (allocated(branches)) then
-      call mesh_switch_functions(mdl, tau/mdl%w_ref, y(1:ndof), gout(1:2*z), y(ndof+1:), &
+    yf = ctx%ys_full
+    yf(ctx%idx(1:ctx%n)) = ys
+    call from_scaled(ctx%m, yf, y)
+    z = ctx%m%z
+    if (allocated(ctx%branches)) then
+      call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), gout(1:2*z), y(ndof+1:), &
            gout(2*z+1:4*z))
     else
-      call mesh_switch_functions(mdl, tau/mdl%w_ref, y(1:ndof), gout(1:2*z))
+      call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), gout(1:2*z))
     end if
     ret = 0
   end function roots_cb
@@ -327,7 +423,9 @@ contains
   subroutine err_cb(error_code, module, function, msg, udata) bind(C)
     integer(c_int), value :: error_code
     type(c_ptr), value :: module, function, msg, udata
-    cvode_msg = c_string(msg)
+    type(solver_ctx_t), pointer :: ctx
+    call c_f_pointer(udata, ctx)
+    ctx%cvode_msg = c_string(msg)
   end subroutine err_cb
 
   function c_string(p) result(s)

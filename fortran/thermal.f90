@@ -3,9 +3,16 @@ module spline_thermal
   use spline_kinds, only: wp
   implicit none
   private
-  public :: thermal_backlash, flash_temperature
+  public :: thermal_backlash, backlash_coefficient, flash_temperature
 
 contains
+
+  !> Eq. 2's coefficient: kappa = 2 lambda s cos(alpha), the backlash lost per degC of contact
+  !> temperature [m/degC].
+  pure real(wp) function backlash_coefficient(lambda_th, s, cos_alpha) result(kappa)
+    real(wp), intent(in) :: lambda_th, s, cos_alpha
+    kappa = 2.0_wp*lambda_th*s*cos_alpha
+  end function backlash_coefficient
 
   !> Eq. 2: backlash of a tooth pair at contact temperature T_B = T_M + T_f (Eq. 1):
   !> c = c_0 - 2 lambda s T_B cos(alpha) = c_0 - kappa T_B.

@@ -1,11 +1,11 @@
 """pyspline: nonlinear dynamics of an involute spline coupling with parallel misalignment and
 flash temperature (Xue, Shen & Xue 2025). The physics lives in the Fortran core (fortran/);
 this package reads cases, runs them and plots them."""
-from .case import (Case, CaseError, SolverError, SplineError, ThermalInterferenceError,
-                   defaults, load_case)
-from .core import Result, mesh_stiffness, rhs, simulate, start_state, tooth_stiffness
+from .case import Case, defaults, load_case
+from .core import Model, Result, load, mesh_stiffness, rhs, simulate, start_state, tooth_stiffness
+from .errors import CaseError, SolverError, SplineError, SplineWarning, ThermalInterferenceError
 
-__all__ = ["Case", "CaseError", "Result", "SolverError", "SplineError",
-           "ThermalInterferenceError", "defaults", "load_case", "mesh_stiffness", "rhs", "simulate",
-           "start_state", "tooth_stiffness"]
+__all__ = ["Case", "CaseError", "Model", "Result", "SolverError", "SplineError", "SplineWarning",
+           "ThermalInterferenceError", "defaults", "load", "load_case", "mesh_stiffness", "rhs",
+           "simulate", "start_state", "tooth_stiffness"]
 __version__ = "0.1.0"

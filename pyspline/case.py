@@ -1,15 +1,14 @@
-"""Case input: Fortran namelist files (group ``&spline_case``) read with f90nml.
+"""Case input: the fields of a case (namelist group ``&spline_case``), read from files with
+f90nml or given as a dict, and handed to the core in memory as namelist text.
 
-The defaults live in the Fortran core only (``case_defaults`` in fortran/case.f90): Python asks
-the core to write them out once and reads them back, so a field that Python knows is a field the
-executable knows, with the same default.
+The defaults live in the Fortran core only (``case_t`` in fortran/case.f90): Python reads them
+from the core once, so a field that Python knows is a field the executable knows, with the same
+default. Ranges are checked by the core (the same check for Python and the executable).
 """
 from __future__ import annotations
 
 import functools
 import math
-import os
-import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -23,43 +22,17 @@ except ImportError as exc:  # the source tree shadows the installed package
         "not the installed package. Run `bash scripts/setup.sh` (pip install .) and import "
         "pyspline from outside the repository root (or use the `pyspline` command).") from exc
 
+from .errors import CaseError
+
 GROUP = "spline_case"
-
-
-class SplineError(RuntimeError):
-    """Any failure of a pyspline case; the message names the case."""
-
-
-class CaseError(SplineError, ValueError):
-    """A bad case: unknown or ill-typed field, value out of range (the message names the field)."""
-
-
-class SolverError(SplineError):
-    """CVODE (or the static-equilibrium solve) failed; the message names the flag and the time."""
-
-
-class ThermalInterferenceError(SplineError):
-    """Thermal growth closed the backlash of a tooth pair (Eq. 2: c_j <= 0)."""
-
-
-_ERRORS = {1: CaseError, 2: SolverError, 3: ThermalInterferenceError}
-
-
-def raise_for(ierr: int, errmsg) -> None:
-    """Turn the core's (ierr, message) into the matching exception."""
-    if ierr != 0:
-        msg = errmsg.decode() if isinstance(errmsg, bytes) else str(errmsg)
-        raise _ERRORS.get(int(ierr), SplineError)(msg.strip())
+NAME_BYTES = 128   #: longest case name (UTF-8 bytes; fortran/case.f90 namelen)
 
 
 @functools.cache
 def defaults() -> dict:
     """Every case field with its default, as the Fortran core defines them."""
-    with tempfile.TemporaryDirectory() as tmp:
-        path = os.path.join(tmp, "defaults.nml")
-        ierr, msg = _core.spline_api.api_write_defaults(path)
-        raise_for(ierr, msg)
-        nml = f90nml.read(path)
+    text = _core.spline_api.api_defaults().decode()
+    nml = f90nml.reads(text)
     return {k.lower(): _clean(v) for k, v in nml[GROUP].items()}
 
 
@@ -67,8 +40,20 @@ def _clean(v):
     return v.strip() if isinstance(v, str) else v
 
 
+def _fortran(v) -> str:
+    """A field value as namelist text (floats by repr: shortest, exact round trip)."""
+    if isinstance(v, bool):
+        return ".true." if v else ".false."
+    if isinstance(v, (list, tuple)):
+        return ", ".join(_fortran(x) for x in v)
+    if isinstance(v, str):
+        return "'" + v.replace("'", "''") + "'"
+    return repr(v)
+
+
 class Case(Mapping):
-    """A validated set of case fields (SI units). Immutable; ``replace`` makes variants."""
+    """A validated set of case fields (SI units). Immutable; ``replace`` makes variants.
+    ``case.model`` is the case loaded into the core (built once, on first use)."""
 
     def __init__(self, fields: Mapping, name: str | None = None, source: str | None = None):
         base = defaults()
@@ -77,13 +62,17 @@ class Case(Mapping):
         for key, value in fields.items():
             k = key.lower()
             if k not in base:
-                raise CaseError(f"case {label}: unknown field '{key}' (see cases/README or "
+                raise CaseError(f"case {label}: unknown field '{key}' (see cases/template.nml or "
                                 f"pyspline.defaults() for the fields)")
             merged[k] = _coerce(label, k, value, base[k])
         if name is not None and "name" not in {k.lower() for k in fields}:
             merged["name"] = name
+        if len(merged["name"].encode()) > NAME_BYTES:
+            raise CaseError(f"case {merged['name'][:40]}...: field name is longer than "
+                            f"{NAME_BYTES} bytes (UTF-8)")
         self._fields = merged
         self.source = source
+        self._model = None
 
     # Mapping protocol
     def __getitem__(self, key):
@@ -95,9 +84,20 @@ class Case(Mapping):
     def __len__(self):
         return len(self._fields)
 
+    def __getstate__(self):          # a loaded model is rebuilt where the case is used
+        return {"_fields": self._fields, "source": self.source, "_model": None}
+
     @property
     def name(self) -> str:
         return self._fields["name"]
+
+    @property
+    def model(self):
+        """The case loaded into the core (pyspline.Model), built on first use and kept."""
+        if self._model is None:
+            from .core import Model
+            self._model = Model(self)
+        return self._model
 
     def replace(self, **changes) -> "Case":
         """A copy with some fields changed, e.g. ``case.replace(l_x=5e-5, name='lx5e-5')``."""
@@ -109,22 +109,28 @@ class Case(Mapping):
         base = defaults()
         return {k: v for k, v in self._fields.items() if base[k] != v}
 
+    def text(self) -> str:
+        """The case as namelist text: the name and the fields that differ from the defaults."""
+        body = "\n".join(f"  {k} = {_fortran(v)}" for k, v in
+                         {"name": self.name, **self.changed()}.items())
+        return f"&{GROUP}\n{body}\n/\n"
+
     def to_namelist(self, path) -> None:
-        """Write the case as a namelist file that spline-dyn reads: the name and the fields
-        that differ from the defaults, like the files in cases/ (and 6x faster to write)."""
-        nml = f90nml.Namelist({GROUP: {"name": self.name, **self.changed()}})
-        nml.float_format = ".17g"
-        nml.write(str(path), force=True)
+        """Write the case as a namelist file that spline-dyn reads (like the files in cases/)."""
+        Path(path).write_text(self.text(), encoding="utf-8")
 
     def __repr__(self):
         return f"Case({self.changed()!r})"
 
 
 def _coerce(label, key, value, default):
-    """Check a field's type against its default's (the core validates ranges)."""
+    """Check a field's type against its default's (the core validates ranges). numpy scalars
+    and arrays count as the Python numbers and lists they hold."""
     def bad(why):
         return CaseError(f"case {label}: field {key} = {value!r} {why}")
 
+    if hasattr(value, "tolist") and not isinstance(value, (str, bytes)):
+        value = value.tolist()          # numpy scalar -> int/float/bool, array -> list
     if isinstance(default, bool):
         if not isinstance(value, bool):
             raise bad("must be .true. or .false.")

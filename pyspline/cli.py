@@ -85,57 +85,6 @@ def cmd_check_exe(args) -> int:
     return 0 if all(v == "identical" for v in rep.values()) else 1
 
 
-def cmd_bench(args) -> int:
-    from . import bench
-    from .core import cvode_library
-    out = Path(args.out)
-    lib = cvode_library()
-    print(f"CVODE library: {lib}")
-    if lib.endswith("(debian)"):
-        print("note: Debian's SUNDIALS is compiled without optimisation; runs take up to 2.4x "
-              "longer than on the -O2 build that scripts/setup.sh makes")
-    if args.what == "wp":
-        rows, notes = bench.work_precision(out, quick=args.quick)
-        for n in notes:
-            print(n)
-        print(f"{'case':14s} {'method':28s} {'rtol':>7s} {'time [s]':>9s} {'RHS':>8s} "
-              f"{'err':>9s} {'scd':>5s}  status")
-        for r in rows:
-            err = max(r["err_Tm"], r["err_F"])
-            print(f"{r['case']:14s} {r['method']:28s} {r['rtol']:7.0e} {r['time_s']:9.4f} "
-                  f"{r['rhs_evals']:8d} {err:9.1e} {r['scd']:5.1f}  {r['status']}")
-        for r in bench.speed_ratios(rows):
-            if r["ratio"] is None:
-                print(f"{r['case']}: at error <= {r['accuracy']:g} no {r['peer_rhs']}-RHS peer "
-                      f"(or no CVODE run) reached it")
-            else:
-                print(f"{r['case']}: at error <= {r['accuracy']:g}, {r['cvode']} (rtol "
-                      f"{r['cvode_rtol']:g}) {r['cvode_s']:.4f} s vs {r['peer']} (rtol "
-                      f"{r['peer_rtol']:g}) {r['peer_s']:.4f} s: {r['ratio']:.1f}x")
-        print(f"wrote {out}/work_precision.png, work_precision.csv and speed_ratios.csv")
-    elif args.what == "ladder":
-        from . import ladder
-        rows = ladder.ladder(out, quick=args.quick)
-        print("\n".join(ladder.format_rows(rows)))
-        missed = [r for r in rows if r.get("within_tol") is False]
-        print(f"auto: {sum('picked' in r for r in rows) - len(missed)} of "
-              f"{sum('picked' in r for r in rows)} picks within tolerance")
-        print(f"wrote {out}/ladder.png and ladder.csv")
-        return 1 if missed else 0
-    elif args.what == "anatomy":
-        from . import anatomy
-        rows = anatomy.anatomy(out, quick=args.quick)
-        print("\n".join(anatomy.format_rows(rows)))
-        print(f"wrote {out}/anatomy.png and anatomy.csv")
-    else:
-        rows = bench.stability_map(out, quick=args.quick)
-        for r in rows:
-            print(f"{r['damping']:12s} k_m {r['k_m']:8.1e} {r['method']:24s} "
-                  f"{r['time_s']:8.3f} s  {r.get('rhs_evals', -1):>8}  {r['status']}")
-        print(f"wrote {out}/stability.png and stability.csv")
-    return 0
-
-
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="pyspline", description=__doc__)
     sub = p.add_subparsers(dest="cmd", required=True)
@@ -159,12 +108,5 @@ def main(argv=None) -> int:
     r.add_argument("--full", action="store_true", help="full length (default: 0.3 s)")
     r.add_argument("--cases")
     r.set_defaults(func=cmd_check_exe)
-    r = sub.add_parser("bench", help="speed against accuracy: wp (work-precision chart), "
-                       "stability (where methods fail), ladder (model levels, auto fidelity), "
-                       "anatomy (where the time goes)")
-    r.add_argument("what", choices=["wp", "stability", "ladder", "anatomy"])
-    r.add_argument("--out", default="out/bench")
-    r.add_argument("--quick", action="store_true", help="small sizes (for CI)")
-    r.set_defaults(func=cmd_bench)
     args = p.parse_args(argv)
     return args.func(args)

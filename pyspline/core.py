@@ -1,25 +1,50 @@
-"""Python face of the Fortran core: simulate a case, evaluate the right-hand side.
+"""Python face of the Fortran core: load a case, simulate it, evaluate its right-hand side.
 
-Nothing here computes physics. Each call writes the case as a namelist file and hands its path
-to the f2py-wrapped API (fortran/api.f90), the same reader the executable uses.
+Nothing here computes physics. A case goes to the core in memory as namelist text (the reader
+the executable uses) and comes back as a loaded model: the bytes of its model_t, held by the
+caller (``Model``). Every call takes those bytes, so loaded cases never alias, any number can
+be used at once, and simulate and start_state release the GIL: a thread pool runs scenes in
+parallel. A SIGINT during a run stops it within one right-hand-side call (KeyboardInterrupt).
 """
 from __future__ import annotations
 
-import contextlib
 import functools
-import os
-import tempfile
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from . import _core
-from .case import Case, load_case, raise_for
+from .case import Case, load_case
+from .errors import BY_NAME, SplineError, decode
 
 _api = _core.spline_api
 STATE_NAMES = ("x1", "y1", "x2", "y2", "D1", "D2", "D3")
 THERMAL_LEVELS = ("none", "bulk", "oneway", "coupled")   #: stats["thermal_level"] 0..3
+_MODEL_BYTES = int(_api.api_model_size())
+
+
+@functools.cache
+def _names(kind: str) -> tuple:
+    out = []
+    for i in range(1, 100):
+        name, unit = (decode(s) for s in _api.api_names(kind, i))
+        if not name:
+            break
+        out.append((name, unit))
+    return tuple(out)
+
+
+@functools.cache
+def _errors() -> dict:
+    """Error code of the core -> exception class (codes and names from fortran/errors.f90)."""
+    return {i: BY_NAME.get(name, SplineError) for i, (name, _) in enumerate(_names("errors"))}
+
+
+def raise_for(ierr: int, errmsg) -> None:
+    """Turn the core's (ierr, message) into the matching exception."""
+    if ierr != 0:
+        raise _errors().get(int(ierr), SplineError)(decode(errmsg))
 
 
 def level_name(dof: int, thermal: str) -> str:
@@ -27,24 +52,79 @@ def level_name(dof: int, thermal: str) -> str:
     return f"{dof}-DOF {thermal}"
 
 
-@functools.cache
-def _names(kind: str, n: int) -> tuple:
-    out = []
-    for i in range(1, n + 1):
-        name, unit = _api.api_names(kind, i)
-        out.append((name.decode().strip(), unit.decode().strip()))
-    return tuple(out)
+class Model:
+    """A case loaded into the core once (validated, geometry and stiffness derived): use it for
+    repeated calls (``simulate``, ``rhs``, ``start_state``). It holds the core's model as bytes
+    that the caller owns: it can be copied, pickled to another process and used from many
+    threads at once. ``Case.model`` keeps one per case."""
+
+    __slots__ = ("case", "bytes", "z", "n_out", "__weakref__")
+
+    def __init__(self, case):
+        case = load_case(case)
+        data, z, nt, ierr, msg = _api.api_load(case.text().encode("utf-8"), _MODEL_BYTES)
+        raise_for(ierr, msg)
+        data.flags.writeable = False
+        self.case, self.bytes, self.z, self.n_out = case, data, int(z), int(nt)
+
+    def __getstate__(self):
+        return {"case": self.case, "bytes": self.bytes, "z": self.z, "n_out": self.n_out}
+
+    def __setstate__(self, state):
+        for k, v in state.items():
+            object.__setattr__(self, k, v)
+
+    def __repr__(self):
+        return f"Model({self.case.name!r}, z={self.z}, n_out={self.n_out})"
+
+    def simulate(self) -> "Result":
+        return simulate(self)
+
+    def start_state(self) -> np.ndarray:
+        """The start state (SI): the static equilibrium (default) or rest, plus dq0, dv0."""
+        y, ierr, msg = _api.api_start_state(self.bytes)
+        raise_for(ierr, msg)
+        return y
+
+    def rhs(self, t: float, y) -> np.ndarray:
+        """dy/dt in SI units at (t, y), contact states decided by the state (Eqs. 8-24)."""
+        ydot, ierr = _api.api_rhs(self.bytes, t, y)
+        if ierr:
+            raise_for(ierr, f"case {self.case.name}: the right-hand side failed at t = {t} s "
+                      "(thermal interference)")
+        return ydot
+
+    __call__ = rhs
+
+    def rhs_mesh(self, t: float, y) -> tuple[np.ndarray, dict, float]:
+        """rhs plus the mesh at (t, y): (dy/dt, per-tooth dict as Result.tooth but 1-D, T_m)."""
+        q = _names("tooth")
+        ydot, mesh, tm, ierr, msg = _api.api_rhs_mesh(self.bytes, self.z, len(q), t,
+                                                      np.asarray(y, dtype=float))
+        raise_for(ierr, msg)
+        return ydot, {n: mesh[:, i] for i, (n, _) in enumerate(q)}, float(tm)
+
+    def output_times(self) -> np.ndarray:
+        t, ierr, msg = _api.api_output_times(self.bytes, self.n_out)
+        raise_for(ierr, msg)
+        return t
+
+    def info(self) -> dict:
+        """Derived quantities (SI): r_b, r_pitch, omega, the Eq. 25 scales l_ref and w_ref,
+        c_bulk, kappa, the k_m used, k_m_computed, thermal_level, and the Eq. 18 terms as a
+        dict 'k_terms' (k_h, k_b1, ..., k_m of the geometry)."""
+        info, terms, ierr, msg = _api.api_model_info(self.bytes)
+        raise_for(ierr, msg)
+        out = {n: float(v) for (n, _), v in zip(_names("info"), info)}
+        out["k_m_computed"] = bool(out["k_m_computed"])
+        out["thermal_level"] = int(out["thermal_level"])
+        out["k_terms"] = {n: float(v) for (n, _), v in zip(_names("kterms"), terms)}
+        return out
 
 
-@contextlib.contextmanager
-def _case_file(case: Case):
-    fd, path = tempfile.mkstemp(prefix=f"pyspline-{case.name or 'case'}-", suffix=".nml")
-    os.close(fd)
-    try:
-        case.to_namelist(path)
-        yield path
-    finally:
-        os.unlink(path)
+def load(case) -> Model:
+    """Load a case (a Case, a dict of fields or a namelist path) into the core."""
+    return case if isinstance(case, Model) else load_case(case).model
 
 
 @dataclass
@@ -78,61 +158,45 @@ class Result:
         raise AttributeError(name)
 
 
+_FLOAT_STATS = ("_s", "_degC")
+
+
 def simulate(case) -> Result:
-    """Run one case (a Case, a dict of fields or a namelist path) and return a Result.
-    Raises CaseError, SolverError or ThermalInterferenceError with a message naming the case."""
-    case = load_case(case)
-    with _case_file(case) as path:
-        z, nt, nq, ns, ierr, msg = _api.api_sizes(path)
-        raise_for(ierr, msg)
-        t0 = time.perf_counter()
-        t, y, tooth, tm, stats, ierr, msg = _api.api_simulate(path, z, nt, nq, ns)
-        wall = time.perf_counter() - t0
-        raise_for(ierr, msg)
-    qnames = [n for n, _ in _names("tooth", nq)]
-    stats = {n: (float(v) if n.endswith(("_s", "_degC")) or n.startswith("fidelity_eps")
-                 else int(v)) for (n, _), v in zip(_names("stats", ns), stats)}
-    stats["wall_s"] = wall
-    return Result(case=case, t=t, y=y, tooth={n: tooth[:, :, i] for i, n in enumerate(qnames)},
-                  Tm=tm, stats=stats)
+    """Run one case (a Case, a dict of fields, a namelist path or a loaded Model) and return a
+    Result. Raises CaseError, SolverError or ThermalInterferenceError with a message naming the
+    case; KeyboardInterrupt if SIGINT arrives during the run. Releases the GIL while it runs."""
+    model = load(case)
+    q, s = _names("tooth"), _names("stats")
+    t0 = time.perf_counter()
+    t, y, tooth, tm, stats, ierr, msg = _api.api_simulate(model.bytes, model.z, model.n_out,
+                                                          len(q), len(s))
+    wall = time.perf_counter() - t0
+    raise_for(ierr, msg)
+    st = {n: (float(v) if n.endswith(_FLOAT_STATS) or n.startswith("fidelity_eps") else int(v))
+          for (n, _), v in zip(s, stats)}
+    st["wall_s"] = wall
+    return Result(case=model.case, t=t, y=y, tooth={n: tooth[:, :, i] for i, (n, _) in enumerate(q)},
+                  Tm=tm, stats=st)
 
 
 def rhs(case, t: float, y) -> tuple[np.ndarray, dict, float]:
     """The Fortran right-hand side in SI units at (t, y), contact states from the state.
     Returns (dy/dt, per-tooth dict as in Result.tooth but 1-D, T_m). For tests and peers."""
-    case = load_case(case)
-    with _case_file(case) as path:
-        return rhs_at_path(path, case["z"], t, y)
-
-
-def rhs_at_path(path: str, z: int, t: float, y):
-    """rhs() on a namelist file that already exists (no temporary file per call)."""
-    nq = len(_names("tooth", 8))
-    ydot, mesh, tm, ierr, msg = _api.api_rhs(path, z, nq, t, np.asarray(y, dtype=float))
-    raise_for(ierr, msg)
-    return ydot, {n: mesh[:, i] for i, (n, _) in enumerate(_names("tooth", nq))}, float(tm)
+    return load(case).rhs_mesh(t, y)
 
 
 def start_state(case) -> np.ndarray:
     """The case's start state (SI): the static equilibrium (default) or rest, plus dq0, dv0."""
-    case = load_case(case)
-    with _case_file(case) as path:
-        y, ierr, msg = _api.api_start_state(path)
-    raise_for(ierr, msg)
-    return y
+    return load(case).start_state()
 
 
 def mesh_stiffness(case) -> dict:
     """Eq. 18 by the potential energy method at the pitch point: every term [N/m] (k_h; bending,
     shear, axial of the external (1) and internal (2) tooth; k_m), the k_m the case uses
     ('k_m_used') and whether it is the computed one ('computed')."""
-    case = load_case(case)
-    with _case_file(case) as path:
-        terms, k_used, computed, ierr, msg = _api.api_mesh_stiffness(path)
-    raise_for(ierr, msg)
-    names = ("k_h", "k_b1", "k_s1", "k_a1", "k_b2", "k_s2", "k_a2", "k_m")
-    out = dict(zip(names, map(float, terms)))
-    out.update(k_m_used=float(k_used), computed=bool(computed))
+    info = load(case).info()
+    out = dict(info["k_terms"])
+    out.update(k_m_used=info["k_m"], computed=info["k_m_computed"])
     return out
 
 
@@ -167,24 +231,3 @@ def read_csv(path) -> tuple[list[str], np.ndarray]:
                 break
         data = np.loadtxt(f, delimiter=",", ndmin=2)
     return header, data
-
-
-class FortranRHS:
-    """The project's Fortran right-hand side (SI) as a Python callable f(t, y), for solvers
-    driven from Python (scipy.integrate.solve_ivp in the benchmarks). One case at a time."""
-
-    def __init__(self, case):
-        self.case = load_case(case)
-        self._tmp = tempfile.TemporaryDirectory(prefix="pyspline-")
-        path = os.path.join(self._tmp.name, "case.nml")
-        self.case.to_namelist(path)
-        ierr, msg = _api.api_load(path)
-        raise_for(ierr, msg)
-        self.calls = 0
-
-    def __call__(self, t, y):
-        self.calls += 1
-        ydot, ierr = _api.api_rhs_loaded(t, y)
-        if ierr:
-            raise_for(ierr, b"case " + self.case.name.encode() + b": RHS failed (thermal)")
-        return ydot

@@ -1,8 +1,9 @@
-"""Cost anatomy (`pyspline bench anatomy`): where the time of a run goes.
+"""Cost anatomy (`python bench/run.py anatomy`): where the time of a run goes.
 
-For each case: the time per right-hand-side call (ns) measured in a Fortran loop, against the
-flop floor (a branch-free kernel doing only the arithmetic the mesh cannot avoid, with its flop
-count; fortran/api.f90 api_time_rhs); then one run's time per step and its shares: RHS (the
+For each case: the time per right-hand-side call (ns) measured in a Fortran loop (the core's
+instrumentation call api_time_rhs), against the flop floor (bench/floor.f90: a branch-free
+kernel doing only the arithmetic the mesh cannot avoid, with its flop count; built here on
+demand with f2py into bench/build/); then one run's time per step and its shares: RHS (the
 integrator's calls), Jacobian (difference-quotient calls), roots (root-function evaluations,
 where the case locates switches), solver (CVODE's own work and the per-tooth outputs: the rest
 of the core time) and Python (wall time outside the core: case file, f2py, result arrays).
@@ -13,10 +14,29 @@ import statistics
 import time
 from pathlib import Path
 
-from .bench import _write_csv
-from .case import raise_for, load_case
-from .core import _api, _case_file, simulate
-from .paper import cases_dir
+from pyspline import load, load_case, simulate
+from pyspline.core import _api, raise_for
+from pyspline.paper import cases_dir
+from speed import _write_csv
+
+HERE = Path(__file__).resolve().parent
+
+
+def _floor_module():
+    """bench/floor.f90 compiled with f2py (once, into bench/build/)."""
+    import importlib
+    import subprocess
+    import sys
+    build = HERE / "build"
+    build.mkdir(exist_ok=True)
+    if str(build) not in sys.path:
+        sys.path.insert(0, str(build))
+    try:
+        return importlib.import_module("_floor")
+    except ImportError:
+        subprocess.run([sys.executable, "-m", "numpy.f2py", "-c", str(HERE / "floor.f90"),
+                        "-m", "_floor", "--opt=-O2"], cwd=build, check=True, capture_output=True)
+        return importlib.import_module("_floor")
 
 CASES = ("paper_lx1e-4", "paper_T100", "physical_lx1e-4")
 
@@ -24,12 +44,15 @@ CASES = ("paper_lx1e-4", "paper_T100", "physical_lx1e-4")
 def rhs_cost(case, n=200_000, repeat=5):
     """Median seconds per RHS call, per floor-kernel call and per root-function evaluation,
     and the floor's flop count."""
-    with _case_file(case) as path:
-        samples = []
-        for _ in range(repeat):
-            t_rhs, t_floor, flops, t_roots, ierr, msg = _api.api_time_rhs(path, n)
-            raise_for(ierr, msg)
-            samples.append((t_rhs, t_floor, t_roots))
+    model = load(case)
+    y = load(case.replace(start="equilibrium", dq0=[0.0] * 7, dv0=[0.0] * 7)).start_state()
+    floor = _floor_module()
+    samples = []
+    for _ in range(repeat):
+        t_rhs, t_roots, ierr, msg = _api.api_time_rhs(model.bytes, n)
+        raise_for(ierr, msg)
+        t_floor, flops = floor.time_floor(case["z"], n, y)
+        samples.append((t_rhs, t_floor, t_roots))
     med = [statistics.median(s[i] for s in samples) for i in range(3)]
     return med[0], med[1], flops, med[2]
 

@@ -1,4 +1,4 @@
-"""Speed against accuracy (`pyspline bench wp`) and where methods fail (`pyspline bench
+"""Speed against accuracy (`python bench/run.py wp`) and where methods fail (`python bench/run.py
 stability`). Each writes a PNG and a CSV into --out; --quick is small enough for CI.
 
 Errors are the max relative error of T_m(t) and of the per-tooth F_j at the output times
@@ -16,9 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .case import SplineError, load_case
-from .core import FortranRHS, simulate, start_state
-from .paper import cases_dir
+from pyspline import SplineError, load, load_case, simulate, start_state
+from pyspline.paper import cases_dir
 
 SCIPY_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
 
@@ -27,9 +26,22 @@ class Budget(Exception):
     """A peer used up its RHS evaluation budget (counted as a failure: too much work)."""
 
 
+class FortranRHS:
+    """The project's Fortran right-hand side (SI) of a loaded case as a callable f(t, y) for
+    solvers driven from Python (scipy.integrate.solve_ivp), counting its calls."""
+
+    def __init__(self, case):
+        self.model = load(case)
+        self.calls = 0
+
+    def __call__(self, t, y):
+        self.calls += 1
+        return self.model.rhs(t, y)
+
+
 def _oracle():
-    """tests/oracle.py of a checkout (the numpy RHS peer), or None outside one."""
-    path = cases_dir().parent / "tests" / "oracle.py"
+    """tests/oracle.py of this checkout (the numpy RHS peer), or None."""
+    path = Path(__file__).resolve().parent.parent / "tests" / "oracle.py"
     if not path.is_file():
         return None
     spec = importlib.util.spec_from_file_location("pyspline_oracle", path)
@@ -39,18 +51,19 @@ def _oracle():
 
 
 def _scaled_atol(case, rtol):
-    l, w = case["c0"], case["speed_rpm"] * np.pi / 30 or 1.0
+    """atol = 1e-2 rtol on the states scaled as in Eq. 25 (the core's scales)."""
+    info = load(case).info()
+    l, w = info["l_ref"], info["w_ref"]
     return rtol * 1e-2 * np.r_[np.full(7, l), np.full(7, l * w)]
 
 
 def _mesh_outputs(case, t, y):
     """T_m and F_j from states (Fortran core, contact states from the state)."""
-    from .core import _case_file, rhs_at_path
+    model = load(case)
     tm, F = np.empty(len(t)), np.empty((len(t), case["z"]))
-    with _case_file(case) as path:
-        for k, (tk, yk) in enumerate(zip(t, y)):
-            _, mesh, tm[k] = rhs_at_path(path, case["z"], tk, yk)
-            F[k] = mesh["F"]
+    for k, (tk, yk) in enumerate(zip(t, y)):
+        _, mesh, tm[k] = model.rhs_mesh(tk, yk)
+        F[k] = mesh["F"]
     return tm, F
 
 
@@ -80,7 +93,7 @@ def run_scipy(case, method, rtol, rhs_kind, oracle, budget):
             raise Budget(f"more than {budget} RHS evaluations")
         return f(t, y)
 
-    t_eval = np.linspace(case["t0"] + case["t_transient"], case["t_end"], case["n_out"])
+    t_eval = load(case).output_times()
     t0 = time.perf_counter()
     sol = solve_ivp(counted, (case["t0"], case["t_end"]), start_state(case), method=method,
                     rtol=rtol, atol=_scaled_atol(case, rtol), t_eval=t_eval)
@@ -234,8 +247,8 @@ def stability_map(out, quick=False, progress=True):
     base = load_case(cases_dir() / "paper_lx1e-4.nml", t_end=t_end,
                      n_out=int(round(6400 * t_end)) + 1, rtol=1e-6, atol=1e-8,
                      max_steps=budget)
-    m_e = base["j_1"] * base["j_2"] / (base["j_1"] + base["j_2"]) \
-        / (base["z"] * (base["module_m"] * base["z"] / 2 * np.cos(np.radians(30))) ** 2)
+    r_b = load(base).info()["r_b"]
+    m_e = base["j_1"] * base["j_2"] / (base["j_1"] + base["j_2"]) / (base["z"] * r_b ** 2)
     methods = [("cvode", "bdf", False), ("cvode", "adams", False), ("cvode", "bdf", True),
                ("cvode", "bdf-stald", False), ("cvode", "adams-fixedpoint", False)] + \
               [("scipy", m, "fortran") for m in SCIPY_METHODS]

@@ -9,7 +9,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .paper import SETTLE, poincare, poincare_count  # noqa: E402
+from . import SETTLE, poincare, poincare_count  # noqa: E402
 
 
 def _time_panel(ax, res, y, label, unit):

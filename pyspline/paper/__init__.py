@@ -23,8 +23,8 @@ from typing import Callable
 
 import numpy as np
 
-from .case import load_case
-from .core import mesh_stiffness, read_csv, simulate
+from ..case import load_case
+from ..core import mesh_stiffness, read_csv, simulate
 
 # ---------------------------------------------------------------------------------------------
 # Scenarios and the paper's values
@@ -172,7 +172,7 @@ def cases_dir(path=None) -> Path:
     here = Path.cwd() / "cases"
     if (here / "paper_ideal.nml").is_file():
         return here
-    return Path(__file__).resolve().parent / "cases"
+    return Path(__file__).resolve().parent.parent / "cases"   # installed with the package
 
 
 def load_paper_case(name, directory, quick: bool):

@@ -1,11 +1,11 @@
-"""The fidelity ladder (`pyspline bench ladder`): what each model level costs and how far it
+"""The fidelity ladder (`python bench/run.py ladder`): what each model level costs and how far it
 is from the level a paper case sets, and what `fidelity = 'auto'` picks.
 
 Levels: dof 3 (torsional only, lateral states frozen at the start state) or 7 (bending-torsion),
 times the thermal levels none, bulk, oneway, coupled. A level is *eligible* for a case when it
 reports the quantities the case's own level reports (T_f needs oneway or coupled). The error is
 the max relative error of T_m(t) and of the per-tooth F_j at the output times against the
-case's own level (bench._errors); the cost is the core's median run time. The auto rule lives in
+case's own level (speed._errors); the cost is the core's median run time. The auto rule lives in
 the Fortran core (fortran/fidelity.f90, run.f90); this module measures it.
 """
 from __future__ import annotations
@@ -15,10 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .bench import _errors, _write_csv
-from .case import SplineError, load_case
-from .core import THERMAL_LEVELS as THERMAL, level_name, simulate
-from .paper import cases_dir
+from pyspline import SplineError, load_case, simulate
+from pyspline.core import THERMAL_LEVELS as THERMAL, level_name
+from pyspline.paper import cases_dir
+from speed import _errors, _write_csv
 
 #: thermal levels that report what a case's own level reports (auto chooses among these)
 ELIGIBLE = {"none": ("none",), "bulk": ("none", "bulk"), "oneway": ("oneway",),

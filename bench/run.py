@@ -1,0 +1,82 @@
+"""Benchmarks of pyspline (not installed with the package): run from a checkout,
+    python bench/run.py wp|stability|ladder|anatomy|parallel [--out DIR] [--quick]
+wp: work-precision chart against scipy and numbalsoda peers; stability: where methods fail;
+ladder: model levels and fidelity = auto; anatomy: where a run's time goes; parallel: scenes
+serially, on threads and on processes, fixed cost per call, RHS call cost.
+Each writes a PNG and/or CSV into --out (default out/bench) and prints a table."""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+
+def cmd_bench(args) -> int:
+    import speed as bench
+    from pyspline.core import cvode_library
+    out = Path(args.out)
+    lib = cvode_library()
+    print(f"CVODE library: {lib}")
+    if lib.endswith("(debian)"):
+        print("note: Debian's SUNDIALS is compiled without optimisation; runs take up to 2.4x "
+              "longer than on the -O2 build that scripts/setup.sh makes")
+    if args.what == "wp":
+        rows, notes = bench.work_precision(out, quick=args.quick)
+        for n in notes:
+            print(n)
+        print(f"{'case':14s} {'method':28s} {'rtol':>7s} {'time [s]':>9s} {'RHS':>8s} "
+              f"{'err':>9s} {'scd':>5s}  status")
+        for r in rows:
+            err = max(r["err_Tm"], r["err_F"])
+            print(f"{r['case']:14s} {r['method']:28s} {r['rtol']:7.0e} {r['time_s']:9.4f} "
+                  f"{r['rhs_evals']:8d} {err:9.1e} {r['scd']:5.1f}  {r['status']}")
+        for r in bench.speed_ratios(rows):
+            if r["ratio"] is None:
+                print(f"{r['case']}: at error <= {r['accuracy']:g} no {r['peer_rhs']}-RHS peer "
+                      f"(or no CVODE run) reached it")
+            else:
+                print(f"{r['case']}: at error <= {r['accuracy']:g}, {r['cvode']} (rtol "
+                      f"{r['cvode_rtol']:g}) {r['cvode_s']:.4f} s vs {r['peer']} (rtol "
+                      f"{r['peer_rtol']:g}) {r['peer_s']:.4f} s: {r['ratio']:.1f}x")
+        print(f"wrote {out}/work_precision.png, work_precision.csv and speed_ratios.csv")
+    elif args.what == "ladder":
+        import ladder
+        rows = ladder.ladder(out, quick=args.quick)
+        print("\n".join(ladder.format_rows(rows)))
+        missed = [r for r in rows if r.get("within_tol") is False]
+        print(f"auto: {sum('picked' in r for r in rows) - len(missed)} of "
+              f"{sum('picked' in r for r in rows)} picks within tolerance")
+        print(f"wrote {out}/ladder.png and ladder.csv")
+        return 1 if missed else 0
+    elif args.what == "anatomy":
+        import anatomy
+        rows = anatomy.anatomy(out, quick=args.quick)
+        print("\n".join(anatomy.format_rows(rows)))
+        print(f"wrote {out}/anatomy.png and anatomy.csv")
+    else:
+        rows = bench.stability_map(out, quick=args.quick)
+        for r in rows:
+            print(f"{r['damping']:12s} k_m {r['k_m']:8.1e} {r['method']:24s} "
+                  f"{r['time_s']:8.3f} s  {r.get('rhs_evals', -1):>8}  {r['status']}")
+        print(f"wrote {out}/stability.png and stability.csv")
+    return 0
+
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(prog="bench/run.py", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("what", choices=["wp", "stability", "ladder", "anatomy", "parallel"])
+    p.add_argument("--out", default="out/bench", help="output directory (default out/bench)")
+    p.add_argument("--quick", action="store_true", help="small sizes (for CI)")
+    args = p.parse_args(argv)
+    if args.what == "parallel":
+        import parallel
+        return parallel.main(args)
+    return cmd_bench(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,37 @@
+!> Error codes shared by every layer (core, f2py API, executable, Python exceptions).
+!> A routine that can fail returns ierr (one of these) and a message naming the case and the
+!> field, or the CVODE flag and the time. Python maps them to exceptions (pyspline.errors),
+!> the executable to exit codes (err_exit_code).
+module spline_errors
+  implicit none
+  private
+  public :: err_ok, err_case, err_solver, err_thermal, err_interrupted, nerr, err_names
+  public :: msglen, err_exit_code
+
+  integer, parameter :: err_ok = 0           !< success
+  integer, parameter :: err_case = 1         !< bad case: field missing, ill-typed, out of range
+  integer, parameter :: err_solver = 2       !< CVODE failed, or no static equilibrium
+  integer, parameter :: err_thermal = 3      !< heat closed the backlash (Eq. 2: c_j <= 0)
+  integer, parameter :: err_interrupted = 4  !< SIGINT arrived during a run (Python: KeyboardInterrupt)
+  integer, parameter :: nerr = 4
+  character(len=12), parameter :: err_names(0:nerr) = [character(len=12) :: 'ok', 'case', &
+       'solver', 'thermal', 'interrupted']
+  integer, parameter :: msglen = 512         !< length of every error message buffer
+
+contains
+
+  !> Exit status of spline-dyn for an error code: 0 ok, 2 bad input (also usage), 3 solver
+  !> failure, 4 thermal interference, 130 interrupted (128 + SIGINT, the shell convention).
+  pure integer function err_exit_code(ierr) result(code)
+    integer, intent(in) :: ierr
+    select case (ierr)
+    case (err_ok);          code = 0
+    case (err_case);        code = 2
+    case (err_solver);      code = 3
+    case (err_thermal);     code = 4
+    case (err_interrupted); code = 130
+    case default;           code = 1
+    end select
+  end function err_exit_code
+
+end module spline_errors

@@ -1,0 +1,154 @@
+!> The model: parameters of one scene derived from a validated case (SI units, radians, rad/s).
+!> model_from_case is the constructor; each piece of physics it needs lives in its physics
+!> module (geometry, stiffness, thermal). A model_t holds no pointers or allocatables, so it can
+!> be copied bitwise (the Python layer keeps a loaded case as such a copy: spline_api).
+module spline_model
+  use spline_kinds, only: wp, pi
+  use spline_errors, only: err_ok, err_case, err_thermal
+  use spline_case, only: case_t, case_validate, namelen, option_index, thermal_values, &
+       method_values, nonlinear_values, start_values, fidelity_values
+  use spline_geometry, only: iso4156_radii
+  use spline_stiffness, only: spline_mesh_stiffness
+  use spline_thermal, only: backlash_coefficient, thermal_backlash
+  implicit none
+  private
+  public :: model_t, model_from_case, set_thermal_level, model_magic
+  public :: nstate, ndof, thermal_none, thermal_bulk, thermal_oneway, thermal_coupled
+  public :: nkterms, kterm_names
+
+  integer, parameter :: ndof = 7            !< x1, y1, x2, y2, D1, D2, D3 (Eq. 24)
+  integer, parameter :: nstate = 2*ndof     !< displacements then velocities
+  !> thermal levels, in the order of spline_case's thermal_values
+  integer, parameter :: thermal_none = 0, thermal_bulk = 1, thermal_oneway = 2, thermal_coupled = 3
+  integer, parameter :: nkterms = 8         !< terms of Eq. 18 reported with every case
+  character(len=4), parameter :: kterm_names(nkterms) = [character(len=4) :: &
+       'k_h', 'k_b1', 'k_s1', 'k_a1', 'k_b2', 'k_s2', 'k_a2', 'k_m']
+  integer, parameter :: stiffness_nquad = 32   !< Gauss points: converged to 1e-15 from 16 on
+  !> Marks a model_t built by this build's constructor (layout version in the last digits):
+  !> a copy handed back from outside is checked against it.
+  integer, parameter :: model_magic = 517730001
+
+  type :: model_t
+    integer  :: magic = 0
+    character(len=namelen) :: name = ''
+    integer  :: z = 0
+    real(wp) :: m_n, alpha, b, s, c0, e_mod, nu, lambda_th, k_cond, rho, c_heat
+    real(wp) :: j_m, j_l, j_1, j_2, m_1, m_2, k_p1, k_p2, c_p1, c_p2
+    real(wp) :: k_t1, k_t2, c_t1, c_t2, k_m, c_m, t_d, t_l, omega, grav, l_x, l_y
+    integer  :: thermal = thermal_none
+    integer  :: dof = 7                     !< 7: bending-torsion, 3: torsional (lateral frozen)
+    logical  :: auto = .false.              !< fidelity = auto
+    real(wp) :: fidelity_tol = 1.0e-3_wp
+    real(wp) :: t_bulk, f_m, u_flash, eta_hertz
+    integer  :: method_bdf = 1              !< 1 = BDF, 0 = Adams
+    logical  :: newton = .true.             !< Newton + dense solver, else fixed-point iteration
+    logical  :: roots = .false.
+    logical  :: stald = .false.
+    real(wp) :: rtol, atol
+    integer  :: max_steps, n_out
+    real(wp) :: t0, t_end, t_transient
+    logical  :: start_equilibrium = .true.
+    real(wp) :: dq0(ndof), dv0(ndof)
+    real(wp) :: l_ref, w_ref                !< scales of Eq. 25
+    ! derived geometry
+    real(wp) :: r_pitch                     !< R = m Z / 2
+    real(wp) :: cos_alpha, sin_alpha        !< of the pressure angle (once per case, not per tooth)
+    real(wp) :: r_b                         !< base radius R cos(alpha)
+    real(wp) :: theta0                      !< pi / (2 Z)  (Eq. 9)
+    real(wp) :: kappa                       !< 2 lambda s cos(alpha): backlash loss per degC (Eq. 2)
+    real(wp) :: c_bulk                      !< backlash with the bulk rise only [m]
+    logical  :: k_m_computed = .false.      !< k_m from Eq. 18 (the case left k_m = 0)
+    real(wp) :: k_terms(nkterms) = 0.0_wp   !< Eq. 18 terms k_h, k_b1, ..., k_m (0: not computable)
+  end type model_t
+
+contains
+
+  !> Build the model of a case: validate it, derive the geometry (MODEL.md Section 2, Eq. 9),
+  !> the mesh stiffness (Eq. 18; used when the case leaves k_m = 0), the thermal constants
+  !> (Eq. 2) and the scales of Eq. 25. ierr: err_case (bad field) or err_thermal (the bulk
+  !> temperature alone closes the backlash).
+  subroutine model_from_case(c, m, ierr, errmsg)
+    type(case_t), intent(in) :: c
+    type(model_t), intent(out) :: m
+    integer, intent(out) :: ierr
+    character(len=*), intent(out) :: errmsg
+    real(wp) :: rf1, rf2, ra2
+
+    call case_validate(c, ierr, errmsg)
+    if (ierr /= err_ok) return
+
+    m%name = c%name
+    m%z = c%z; m%m_n = c%module_m; m%alpha = c%alpha_deg*pi/180.0_wp; m%b = c%b; m%s = c%s
+    m%c0 = c%c0; m%e_mod = c%e_mod; m%nu = c%nu; m%lambda_th = c%lambda_th
+    m%k_cond = c%k_cond; m%rho = c%rho; m%c_heat = c%c_heat
+    m%j_m = c%j_m; m%j_l = c%j_l; m%j_1 = c%j_1; m%j_2 = c%j_2; m%m_1 = c%m_1; m%m_2 = c%m_2
+    m%k_p1 = c%k_p1; m%k_p2 = c%k_p2; m%c_p1 = c%c_p1; m%c_p2 = c%c_p2
+    m%k_t1 = c%k_t1; m%k_t2 = c%k_t2; m%c_t1 = c%c_t1; m%c_t2 = c%c_t2
+    m%k_m = c%k_m; m%c_m = c%c_m; m%t_d = c%t_d; m%t_l = c%t_l
+    m%omega = c%speed_rpm*2.0_wp*pi/60.0_wp; m%grav = c%grav; m%l_x = c%l_x; m%l_y = c%l_y
+    m%t_bulk = c%t_bulk; m%f_m = c%f_m; m%u_flash = c%u_flash; m%eta_hertz = c%eta_hertz
+    m%rtol = c%rtol; m%atol = c%atol; m%max_steps = c%max_steps; m%n_out = c%n_out
+    m%t0 = c%t0; m%t_end = c%t_end; m%t_transient = c%t_transient
+    m%roots = c%roots; m%stald = c%stald; m%dq0 = c%dq0; m%dv0 = c%dv0
+    m%dof = c%dof; m%fidelity_tol = c%fidelity_tol
+    m%auto = option_index(fidelity_values, c%fidelity) == 2
+    m%method_bdf = merge(1, 0, option_index(method_values, c%method) == 1)
+    m%newton = option_index(nonlinear_values, c%nonlinear) == 1
+    m%start_equilibrium = option_index(start_values, c%start) == 1
+
+    ! geometry (MODEL.md Sections 2 and 8, Eq. 9)
+    call iso4156_radii(m%z, m%m_n, m%r_pitch, rf1, rf2, ra2)
+    m%cos_alpha = cos(m%alpha)
+    m%sin_alpha = sin(m%alpha)
+    m%r_b = m%r_pitch*m%cos_alpha
+    m%theta0 = pi/(2.0_wp*m%z)
+
+    ! Eq. 18 at the pitch point: always reported; used if the case leaves k_m = 0
+    call spline_mesh_stiffness(real(m%z, wp), m%m_n, m%alpha, m%b, m%e_mod, m%nu, rf1, rf2, ra2, &
+         stiffness_nquad, m%k_terms(1), m%k_terms(2), m%k_terms(3), m%k_terms(4), m%k_terms(5), &
+         m%k_terms(6), m%k_terms(7), m%k_terms(8), ierr, errmsg)
+    if (ierr /= 0) then
+      m%k_terms = 0.0_wp
+      if (c%k_m == 0.0_wp) then
+        errmsg = 'case '//trim(m%name)//': field k_m = 0 asks for the potential-energy stiffness '// &
+             '(Eq. 18), which fails for this geometry: '//trim(errmsg)//'; set k_m in N/m'
+        ierr = err_case; return
+      end if
+    end if
+    if (c%k_m == 0.0_wp) then
+      m%k_m = m%k_terms(8)
+      m%k_m_computed = .true.
+    end if
+
+    ! thermal (Eq. 2)
+    m%kappa = backlash_coefficient(m%lambda_th, m%s, m%cos_alpha)
+    call set_thermal_level(m, option_index(thermal_values, c%thermal) - 1)
+    if (m%c_bulk <= 0.0_wp) then
+      write(errmsg, '(a,es10.3,a,es10.3,a)') 'case '//trim(m%name)//': thermal interference: '// &
+           't_bulk = ', m%t_bulk, ' degC closes the backlash (c = ', m%c_bulk, ' m, Eq. 2)'
+      ierr = err_thermal
+      return
+    end if
+
+    ! scales of Eq. 25
+    m%l_ref = c%l_ref
+    if (m%l_ref == 0.0_wp) m%l_ref = m%c0
+    m%w_ref = c%w_ref
+    if (m%w_ref == 0.0_wp) m%w_ref = m%omega
+    if (m%w_ref == 0.0_wp) m%w_ref = sqrt(max(m%k_p1, m%k_m)/m%m_1)
+    m%magic = model_magic
+    errmsg = ''
+    ierr = err_ok
+  end subroutine model_from_case
+
+  !> Set the thermal level of a model and the backlash it implies at the bulk temperature:
+  !> Eq. 2 with T_B = T_M, or c_0 for the level none.
+  pure subroutine set_thermal_level(m, level)
+    type(model_t), intent(inout) :: m
+    integer, intent(in) :: level
+    m%thermal = level
+    m%c_bulk = m%c0
+    if (level /= thermal_none) m%c_bulk = thermal_backlash(m%c0, m%kappa, m%t_bulk)
+  end subroutine set_thermal_level
+
+end module spline_model

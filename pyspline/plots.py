@@ -1,0 +1,378 @@
+"""Figures of parameter sweeps and single runs: bifurcation diagrams, Lyapunov exponents,
+waterfalls of spectra and a one-page "scene" of a run.
+
+Each function takes numpy arrays, or an xarray.Dataset (any mapping from names to arrays works
+the same way; with a Dataset the units come from each variable's ``attrs['units']``), returns a
+matplotlib Figure and, when given `path`, writes it there as PNG. Figures are built on
+`matplotlib.figure.Figure` and rendered by Agg, independent of pyplot and of the interactive
+backend, so sweeps do not accumulate open figures.
+
+This module imports only numpy and matplotlib: spectra, periods and exponents are computed by
+pyspline.analysis and passed in as arrays.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from matplotlib.colors import LogNorm
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+
+__all__ = ["bifurcation", "lyapunov_vs_param", "scene", "waterfall"]
+
+# Colours of periods 1, 2, 3, 4 and > 4 (colour-blind safe, Okabe-Ito); not periodic is grey.
+PERIOD_COLOURS = {1: "#0072B2", 2: "#D55E00", 3: "#009E73", 4: "#CC79A7", 5: "#E69F00"}
+NOT_PERIODIC = "0.6"
+SHAFT_STYLE = dict(color="0.25", ls=(0, (4, 3)), lw=0.9)
+TOOTH_STYLE = dict(color="tab:red", ls=(0, (6, 3)), lw=1.1)
+
+_PREFIXES = ((1e-9, "n"), (1e-6, "µ"), (1e-3, "m"), (1.0, ""), (1e3, "k"), (1e6, "M"))
+_PREFIXABLE = {"m", "m/s", "N", "N m", "N*m", "Nm", "s"}
+
+
+def _finish(fig: Figure, path) -> Figure:
+    if path is not None:
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fig.savefig(path, dpi=110)
+    return fig
+
+
+def _array(ds, name, dims=None) -> np.ndarray:
+    """ds[name] as a float array; for an xarray object, `dims` first in that order."""
+    v = ds[name]
+    if dims is not None and hasattr(v, "dims") and hasattr(v, "transpose"):
+        v = v.transpose(*dims, ..., missing_dims="ignore")
+    return np.asarray(v, dtype=float)
+
+
+def _units(ds, name, default="") -> str:
+    try:
+        return str(ds[name].attrs.get("units", default))
+    except AttributeError:
+        return default
+
+
+def _label(ds, name, default_units="") -> str:
+    """'long_name [units]' from a variable's attrs, else 'name [units]'."""
+    try:
+        long = ds[name].attrs.get("long_name", name)
+    except AttributeError:
+        long = name
+    u = _units(ds, name, default_units)
+    return f"{long} [{u}]" if u else str(long)
+
+
+def _prefix(values, unit: str) -> tuple[float, str]:
+    """(factor, unit) with an SI prefix so that the largest |value| / factor is in [1, 1000);
+    only for the units in _PREFIXABLE (angles, rpm, degC stay as they are)."""
+    a = np.abs(np.asarray(values, dtype=float))
+    a = a[np.isfinite(a)]
+    if unit not in _PREFIXABLE or a.size == 0 or a.max() == 0:
+        return 1.0, unit
+    big = a.max()
+    factor, p = _PREFIXES[0]
+    for f, sym in _PREFIXES:
+        if big >= f:
+            factor, p = f, sym
+    return factor, p + unit
+
+
+def _order_lines(ax, f_shaft_hz, z, x_max, vertical=True, y_text=0.98):
+    """Dashed lines at shaft orders 1x, 2x and tooth-pass orders Zx, 2Zx (Hz) below x_max."""
+    marks = [(1, "1x", SHAFT_STYLE), (2, "2x", SHAFT_STYLE)]
+    if z:
+        marks += [(z, f"{z}x (tooth pass)", TOOTH_STYLE), (2 * z, f"{2 * z}x", TOOTH_STYLE)]
+    for k, text, style in marks:
+        f = k * f_shaft_hz
+        if f <= x_max:
+            ax.axvline(f, **style)
+            ax.text(f, y_text, " " + text, transform=ax.get_xaxis_transform(), rotation=90,
+                    va="top", ha="left", fontsize=8, color=style["color"])
+
+
+# --------------------------------------------------------------------------- bifurcation
+
+def bifurcation(ds, param: str, coord: str = "section_D2", period: str = "period",
+                path=None, title: str | None = None) -> Figure:
+    """Bifurcation diagram: the section coordinate ``ds[coord]`` (dims (param,
+    'section_point'), NaN-padded) against the swept ``ds[param]`` (dim (param,)), each point
+    coloured by ``ds[period]`` (dim (param,)): period 1, 2, 3, 4, > 4 in distinct colours, not
+    periodic (0, negative or NaN) in grey. A coordinate in m or m/s is shown with a readable SI
+    prefix (um, mm, mm/s)."""
+    p = _array(ds, param)
+    y = _array(ds, coord, dims=(param, "section_point") if hasattr(ds, "dims") else None)
+    per = _array(ds, period)
+    if y.ndim == 1:
+        y = y[:, None]
+    if y.shape[0] != p.shape[0] or per.shape != p.shape:
+        raise ValueError(f"{coord} must have shape ({len(p)}, n_points) and {period} ({len(p)},),"
+                         f" got {y.shape} and {per.shape}")
+    factor, unit = _prefix(y, _units(ds, coord, "m"))
+    try:
+        long = ds[coord].attrs.get("long_name", coord)
+    except AttributeError:
+        long = coord
+    cls = np.where(np.isfinite(per) & (per > 0), np.minimum(np.nan_to_num(per), 5), 0).astype(int)
+    fig = Figure(figsize=(9, 5.5))
+    ax = fig.add_subplot()
+    handles = []
+    for c in (0, 1, 2, 3, 4, 5):
+        rows = cls == c
+        if not rows.any():
+            continue
+        xs = np.repeat(p[rows], y.shape[1])
+        ys = y[rows].ravel() / factor
+        ok = np.isfinite(ys)
+        colour = NOT_PERIODIC if c == 0 else PERIOD_COLOURS[c]
+        ax.scatter(xs[ok], ys[ok], s=2.5 if c == 0 else 9, c=colour, lw=0,
+                   alpha=0.6 if c == 0 else 1.0, zorder=1 if c == 0 else 2, rasterized=True)
+        name = "not periodic" if c == 0 else ("period > 4" if c == 5 else f"period {c}")
+        handles.append(Line2D([], [], ls="", marker="o", ms=6, color=colour,
+                              label=f"{name} ({rows.sum()})"))
+    ax.set_xlabel(_label(ds, param))
+    ax.set_ylabel(f"{long} [{unit}]" if unit else long)
+    ax.legend(handles=handles, fontsize=8, loc="best", title="runs by period",
+              title_fontsize=8, framealpha=0.9)
+    ax.grid(alpha=0.3, lw=0.5)
+    ax.set_title(title or f"bifurcation diagram: {long} on the section vs {param}")
+    fig.tight_layout()
+    return _finish(fig, path)
+
+
+# --------------------------------------------------------------------------- Lyapunov
+
+def lyapunov_vs_param(ds, param: str, var: str = "lyapunov", path=None,
+                      title: str | None = None) -> Figure:
+    """Largest Lyapunov exponent ``ds[var]`` [1/s] against the swept ``ds[param]``, with a zero
+    line (above it: chaos) and, on the right axis (log scale), the predictability horizon
+    1/lambda [s] of the runs with lambda > 0. Error bars from ``ds[var + '_spread']`` when the
+    dataset has it (e.g. the spread of `largest_lyapunov_fit`)."""
+    p = _array(ds, param)
+    lam = _array(ds, var)
+    unit = _units(ds, var, "1/s")
+    fig = Figure(figsize=(9, 5))
+    ax = fig.add_subplot()
+    ax.axhline(0, color="k", lw=0.8)
+    err = _array(ds, var + "_spread") if var + "_spread" in ds else None
+    ax.errorbar(p, lam, yerr=None if err is None else err / 2, fmt="o-", ms=4, lw=1,
+                color="tab:blue", ecolor="0.5", capsize=2, label="largest Lyapunov exponent")
+    pos = np.isfinite(lam) & (lam > 0)
+    if pos.any():
+        lo, hi = ax.get_ylim()
+        ax.axhspan(0, hi, color="tab:red", alpha=0.06, lw=0)
+        ax.set_ylim(lo, hi)
+        ax.text(0.01, 0.98, "lambda > 0: chaotic", transform=ax.transAxes, va="top",
+                fontsize=8, color="tab:red")
+    ax.set_xlabel(_label(ds, param))
+    ax.set_ylabel(f"largest Lyapunov exponent lambda [{unit}]")
+    ax.grid(alpha=0.3, lw=0.5)
+    h_unit = "s" if unit == "1/s" else f"1/({unit})"
+    handles = [Line2D([], [], marker="o", color="tab:blue", label="lambda (left axis)")]
+    if pos.any():
+        ax2 = ax.twinx()
+        ax2.plot(p[pos], 1.0 / lam[pos], "s", mfc="none", mec="tab:orange", ms=6)
+        ax2.set_yscale("log")
+        ax2.set_ylabel(f"predictability horizon 1/lambda [{h_unit}]", color="tab:orange")
+        ax2.tick_params(axis="y", colors="tab:orange", which="both")
+        handles.append(Line2D([], [], ls="", marker="s", mfc="none", mec="tab:orange",
+                              label="1/lambda where lambda > 0 (right axis)"))
+    ax.legend(handles=handles, fontsize=8, loc="lower right")
+    ax.set_title(title or f"largest Lyapunov exponent vs {param}")
+    fig.tight_layout()
+    return _finish(fig, path)
+
+
+# --------------------------------------------------------------------------- waterfall
+
+def waterfall(ds, speed: str = "speed_rpm", freq: str = "freq_hz", amp: str = "amplitude",
+              z: int | None = None, max_order: float | None = None, path=None,
+              style: str = "map", floor: float = 1e-4, title: str | None = None) -> Figure:
+    """Spectra against speed: frequency [Hz] on x, speed [rpm] on y.
+
+    ``ds[amp]`` has dims (speed, freq); ``ds[freq]`` is 1-D (one frequency grid for all) or
+    (speed, freq). style 'map' (default) shows the amplitude as colour on a log scale down to
+    `floor` times the largest amplitude; 'lines' draws each spectrum as a line offset to its
+    speed (height: the largest amplitude spans the smallest speed step). Shaft orders 1x, 2x and,
+    given `z`, the tooth-pass order Zx (and 2Zx) are dashed diagonal lines f = k rpm / 60. The
+    frequency axis ends at `max_order` shaft orders of the highest speed (default 2.5 Z if `z` is
+    given, else the whole spectrum)."""
+    rpm = _array(ds, speed)
+    a = _array(ds, amp, dims=(speed, freq) if hasattr(ds, "dims") else None)
+    f = _array(ds, freq)
+    if f.ndim == 1:
+        f = np.broadcast_to(f, a.shape)
+    if a.shape != f.shape or a.shape[0] != rpm.shape[0]:
+        raise ValueError(f"{amp} must have shape ({len(rpm)}, n_freq) matching {freq}, got "
+                         f"{a.shape} and {f.shape}")
+    order = np.argsort(rpm)
+    rpm, a, f = rpm[order], a[order], f[order]
+    if max_order is None and z:
+        max_order = 2.5 * z
+    f_max = np.nanmax(f) if max_order is None else max_order * np.abs(rpm).max() / 60.0
+    amp_unit = _units(ds, amp, "")
+    fig = Figure(figsize=(10, 6))
+    ax = fig.add_subplot()
+    if style == "map":
+        top = np.nanmax(a)
+        norm = LogNorm(vmin=top * floor, vmax=top) if top > 0 else None
+        rr = np.broadcast_to(rpm[:, None], a.shape)
+        mesh = ax.pcolormesh(f, rr, np.clip(a, top * floor, None) if top > 0 else a,
+                             norm=norm, cmap="magma", shading="nearest", rasterized=True)
+        cb = fig.colorbar(mesh, ax=ax, pad=0.02)
+        cb.set_label(f"amplitude [{amp_unit}]" if amp_unit else "amplitude")
+    elif style == "lines":
+        step = np.diff(rpm).min() if len(rpm) > 1 else 1.0
+        top = np.nanmax(a) or 1.0
+        for r, fi, ai in zip(rpm, f, a):
+            ax.plot(fi, r + 0.9 * step * ai / top, lw=0.8, color="tab:blue")
+            ax.axhline(r, color="0.85", lw=0.5, zorder=0)
+        ax.text(0.99, 0.01, f"line height: {top:.3g} {amp_unit} = {0.9 * step:g} rpm",
+                transform=ax.transAxes, ha="right", va="bottom", fontsize=8)
+    else:
+        raise ValueError(f"style must be 'map' or 'lines', got {style!r}")
+    ax.set_xlim(0, f_max)
+    y_lo, y_hi = ax.get_ylim()
+    speeds = np.array([0.0, max(y_hi, 0.0)])
+    marks = [(1, "1x", SHAFT_STYLE), (2, "2x", SHAFT_STYLE)]
+    if z:
+        marks += [(z, f"{z}x (tooth pass)", TOOTH_STYLE), (2 * z, f"{2 * z}x", TOOTH_STYLE)]
+    for k, text, st in marks:
+        fk = k * speeds / 60.0
+        line_style = dict(st, color="w" if style == "map" and st is SHAFT_STYLE else st["color"])
+        ax.plot(fk, speeds, **line_style)
+        f_top = k * y_hi / 60.0
+        if f_top <= f_max:
+            ax.text(f_top, y_hi, text, ha="center", va="bottom", fontsize=8, color=st["color"])
+        else:                              # the line leaves through the right edge
+            ax.text(f_max, 60.0 * f_max / k, text + " ", ha="right", va="bottom", fontsize=8,
+                    color=line_style["color"])
+    ax.set_ylim(y_lo, y_hi)
+    ax.set_xlabel(_label(ds, freq, "Hz") if _units(ds, freq) else "frequency [Hz]")
+    ax.set_ylabel(_label(ds, speed, "rpm") if _units(ds, speed) else "shaft speed [rpm]")
+    ax.set_title(title or "spectrum vs speed (dashed: shaft and tooth-pass orders)", pad=14)
+    fig.tight_layout()
+    return _finish(fig, path)
+
+
+# --------------------------------------------------------------------------- scene
+
+def _tooth_map(fig, ax, t, q, label, cmap):
+    q = np.asarray(q, dtype=float)
+    if q.ndim == 1:                      # a per-time summary (e.g. max over teeth)
+        ax.plot(t, q, lw=0.7, color="tab:red")
+        ax.set_xlabel("time t [s]")
+        ax.set_ylabel(label)
+        return
+    zt = q.shape[1]
+    im = ax.imshow(q.T, aspect="auto", origin="lower", cmap=cmap, interpolation="nearest",
+                   extent=(t[0], t[-1], 0.5, zt + 0.5))
+    ax.set_xlabel("time t [s]")
+    ax.set_ylabel("tooth j")
+    ticks = np.unique(np.linspace(1, zt, min(zt, 8)).round().astype(int))
+    ax.set_yticks(ticks)
+    cb = fig.colorbar(im, ax=ax, pad=0.02)
+    cb.set_label(label)
+
+
+def _absent(ax, text):
+    ax.set_axis_off()
+    ax.text(0.5, 0.5, text, ha="center", va="center", fontsize=9, color="0.4",
+            transform=ax.transAxes, wrap=True)
+
+
+def scene(t, D2, vD2, Tm, F, Tf=None, section=None, spectrum=None, speed_rpm=None,
+          z: int | None = None, path=None, title: str | None = None) -> Figure:
+    """One page on one run.
+
+    t [s] (nt,); D2 [m] and vD2 = dD2/dt [m/s] (nt,); Tm, the meshing torque [N m] (nt,);
+    F, the tooth loads [N] (nt, Z); Tf, flash temperatures [degC] (nt, Z) or their maximum
+    over the teeth (nt,); section, Poincare points (n, 2) as (D2 [m], dD2/dt [m/s]); spectrum,
+    ``(freq_hz, amplitude)`` of Tm [Hz, N m] (e.g. from analysis.amplitude_spectrum);
+    speed_rpm [rpm] and z (teeth) for the order marks (z defaults to F.shape[1]).
+
+    Panels: D2(t); T_m(t); phase plane (D2, dD2/dt) with the section points; tooth x time map
+    of F; the same of T_f (or its max over teeth); spectrum of T_m with shaft orders (1x, 2x)
+    and tooth-pass orders (Zx, 2Zx)."""
+    t = np.asarray(t, dtype=float)
+    D2 = np.asarray(D2, dtype=float)
+    vD2 = np.asarray(vD2, dtype=float)
+    Tm = np.asarray(Tm, dtype=float)
+    F = np.asarray(F, dtype=float)
+    if F.ndim == 1:
+        F = F[:, None]
+    for name, arr in (("D2", D2), ("vD2", vD2), ("Tm", Tm), ("F", F)):
+        if arr.shape[0] != t.shape[0]:
+            raise ValueError(f"{name} has {arr.shape[0]} samples, t has {t.shape[0]}")
+    if z is None:
+        z = F.shape[1]
+    fig = Figure(figsize=(16, 11))
+    gs = fig.add_gridspec(3, 3, height_ratios=(1, 1, 1.25), hspace=0.45, wspace=0.32)
+    ax_d = fig.add_subplot(gs[0, :2])
+    ax_t = fig.add_subplot(gs[1, :2], sharex=ax_d)
+    ax_p = fig.add_subplot(gs[:2, 2])
+    ax_f = fig.add_subplot(gs[2, 0])
+    ax_tf = fig.add_subplot(gs[2, 1])
+    ax_s = fig.add_subplot(gs[2, 2])
+
+    kd, ud = _prefix(D2, "m")
+    kv, uv = _prefix(vD2, "m/s")
+    ax_d.plot(t, D2 / kd, lw=0.7)
+    ax_d.set_ylabel(f"D_2 [{ud}]")
+    ax_d.set_title("relative displacement on the line of action", fontsize=10)
+    ax_d.tick_params(labelbottom=False)
+    ax_t.plot(t, Tm, lw=0.7, color="tab:green")
+    ax_t.set_ylabel("T_m [N m]")
+    ax_t.set_xlabel("time t [s]")
+    ax_t.set_title("meshing torque", fontsize=10)
+    for ax in (ax_d, ax_t):
+        ax.grid(alpha=0.3, lw=0.5)
+        ax.ticklabel_format(axis="y", useOffset=False)
+
+    ax_p.plot(D2 / kd, vD2 / kv, lw=0.4, color="0.55", label="trajectory")
+    if section is not None:
+        s = np.asarray(section, dtype=float).reshape(-1, 2)
+        ax_p.plot(s[:, 0] / kd, s[:, 1] / kv, "o", ms=3.5, color="tab:red",
+                  label=f"section points ({len(s)})")
+        ax_p.legend(fontsize=8, loc="upper right")
+    ax_p.set_xlabel(f"D_2 [{ud}]")
+    ax_p.set_ylabel(f"dD_2/dt [{uv}]")
+    ax_p.set_title("phase plane", fontsize=10)
+    ax_p.grid(alpha=0.3, lw=0.5)
+
+    _tooth_map(fig, ax_f, t, F, "tooth load F_j [N]", "viridis")
+    ax_f.set_title("tooth load", fontsize=10)
+    if Tf is None:
+        _absent(ax_tf, "flash temperature T_f\nnot given")
+    else:
+        Tf = np.asarray(Tf, dtype=float)
+        _tooth_map(fig, ax_tf, t, Tf, "flash temperature T_f [°C]" if Tf.ndim == 2
+                   else "max over teeth of T_f [°C]", "inferno")
+        ax_tf.set_title("flash temperature", fontsize=10)
+
+    if spectrum is None:
+        _absent(ax_s, "spectrum of T_m not given\n(pass spectrum=amplitude_spectrum(t, Tm))")
+    else:
+        fr, am = (np.asarray(v, dtype=float) for v in spectrum)
+        f_shaft = None if speed_rpm is None else abs(float(speed_rpm)) / 60.0
+        f_max = fr.max() if f_shaft is None else min(fr.max(), 2.5 * z * f_shaft)
+        keep = (fr > 0) & (fr <= f_max)
+        ax_s.semilogy(fr[keep], am[keep], lw=0.8, color="tab:green")
+        pos = am[keep][am[keep] > 0]
+        if pos.size:
+            ax_s.set_ylim(max(pos.min(), pos.max() * 1e-6), pos.max() * 3)
+        ax_s.set_xlim(0, f_max)
+        if f_shaft:
+            _order_lines(ax_s, f_shaft, z, f_max)
+            sec = ax_s.secondary_xaxis("top", functions=(lambda f: f / f_shaft,
+                                                         lambda o: o * f_shaft))
+            sec.set_xlabel("shaft order", fontsize=8)
+            sec.tick_params(labelsize=8)
+        ax_s.set_xlabel("frequency [Hz]")
+        ax_s.set_ylabel("amplitude of T_m [N m]")
+        ax_s.set_title("spectrum of T_m", fontsize=10)
+        ax_s.grid(alpha=0.3, lw=0.5, which="both")
+    if title:
+        fig.suptitle(title)
+    return _finish(fig, path)
