@@ -35,7 +35,8 @@ def median_time(fn, repeat):
 def scipy_run(case, method, rtol, t_eval):
     p = oracle.prepare(dict(case))
     y0 = pyspline.start_state(case)
-    l, w = case["c0"], case["speed_rpm"] * np.pi / 30
+    info = pyspline.load(case).info()                 # the core's Eq. 25 scales
+    l, w = info["l_ref"], info["w_ref"]
     atol = case["atol"] * np.r_[np.full(7, l), np.full(7, l * w)]   # the same scaled atol
     sol = solve_ivp(lambda t, y: oracle.rhs(t, y, p), (case["t0"], case["t_end"]), y0,
                     method=method, rtol=rtol, atol=atol, t_eval=t_eval)

@@ -1,0 +1,160 @@
+"""The reentrant core (issue 10): loaded cases never alias, scenes run in parallel threads with
+the same numbers as serially, the GIL is released during a run, SIGINT stops a long run, and
+case names may hold any characters."""
+import concurrent.futures as cf
+import os
+import pickle
+import random
+import signal
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import pyspline
+from conftest import CASES, PAPER
+
+SHORT = dict(t_end=0.02, n_out=81)
+SCENES = {   # one of each: mechanical, coupled flash temperature, a mid-run failure, Z = 7
+    "lx1e-4": pyspline.load_case(CASES / "paper_lx1e-4.nml", **SHORT),
+    "T100 coupled": pyspline.load_case(CASES / "paper_T100.nml", **SHORT),
+    "runaway": pyspline.load_case(dict(PAPER, name="runaway", l_x=1e-4, start="rest",
+                                       thermal="coupled", t_bulk=3000.0, f_m=1e5, t_end=0.1,
+                                       n_out=641)),
+    "physical z7": pyspline.load_case(CASES / "physical_lx1e-4.nml", z=7, name="physical z7",
+                                      **SHORT),
+}
+TIMING = ("wall_s", "core_wall_s")
+
+
+def outcome(case):
+    """Everything a run returns (arrays, statistics but the timings), or its error."""
+    try:
+        r = pyspline.simulate(case)
+    except pyspline.SplineError as exc:
+        return (type(exc).__name__, str(exc))
+    stats = {k: v for k, v in r.stats.items() if k not in TIMING}
+    return (r.t, r.y, r.Tm, {k: v.copy() for k, v in r.tooth.items()}, stats)
+
+
+def same(a, b):
+    if isinstance(a[0], str):
+        return a == b
+    return (all(np.array_equal(x, y) for x, y in zip(a[:3], b[:3]))
+            and all(np.array_equal(a[3][k], b[3][k]) for k in a[3]) and a[4] == b[4])
+
+
+def test_scenes_in_threads_equal_serial_runs():
+    serial = {name: outcome(c) for name, c in SCENES.items()}
+    assert serial["runaway"][0] == "ThermalInterferenceError"
+    assert "tooth" in serial["runaway"][1]
+    assert serial["T100 coupled"][4]["coupling_iterations"] > 0       # the coupled level ran
+    jobs = [name for name in SCENES for _ in range(6)]
+    random.Random(1).shuffle(jobs)
+    with cf.ThreadPoolExecutor(4) as pool:
+        results = list(pool.map(lambda n: (n, outcome(SCENES[n])), jobs))
+    for name, res in results:
+        assert same(res, serial[name]), name
+
+
+def test_loaded_cases_never_alias():
+    a = pyspline.load(dict(PAPER, name="a", l_x=1e-4))
+    y = a.start_state()
+    before = a.rhs(1e-3, y).copy()
+    b = pyspline.load(dict(PAPER, name="b", l_x=0.0, t_d=10.0))
+    assert not np.array_equal(b.rhs(1e-3, y), before)
+    np.testing.assert_array_equal(a.rhs(1e-3, y), before)
+    np.testing.assert_array_equal(a.rhs_mesh(1e-3, y)[0], before)
+
+
+def test_loaded_model_survives_pickling():
+    """A loaded case is caller-owned bytes: it crosses to another process (Dask, pools)."""
+    case = SCENES["lx1e-4"]
+    m2 = pickle.loads(pickle.dumps(case.model))
+    assert same(outcome(m2), outcome(case))
+    with cf.ProcessPoolExecutor(1) as pool:
+        res = pool.submit(pyspline.simulate, case.model).result()
+    np.testing.assert_array_equal(res.Tm, pyspline.simulate(case).Tm)
+
+
+def test_bytes_that_are_no_model_are_refused():
+    m = pyspline.load(SCENES["lx1e-4"])
+    bad = pickle.loads(pickle.dumps(m))
+    object.__setattr__(bad, "bytes", np.zeros_like(m.bytes))
+    with pytest.raises(pyspline.CaseError, match="not a loaded case"):
+        pyspline.simulate(bad)
+
+
+def test_heartbeat_ticks_during_a_simulate():
+    """The GIL is released while the core runs: a 1 ms heartbeat thread keeps ticking."""
+    case = pyspline.load_case(CASES / "paper_T100.nml", t_end=0.3, n_out=11)
+    case.model                                          # load outside the timed window
+    ticks, stop = [0], threading.Event()
+
+    def beat():
+        while not stop.is_set():
+            time.sleep(0.001)
+            ticks[0] += 1
+
+    th = threading.Thread(target=beat)
+    th.start()
+    t0 = time.perf_counter()
+    pyspline.simulate(case)
+    wall = time.perf_counter() - t0
+    stop.set()
+    th.join()
+    assert wall > 0.03, wall
+    # a held GIL gives ~1 tick per run; free, about one per 1.1 ms of wall time
+    assert ticks[0] > 0.3 * wall / 1.1e-3, (ticks[0], wall)
+
+
+def _sigint_after(delay):
+    timer = threading.Timer(delay, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    return timer
+
+
+LONG = dict(t_end=60.0, n_out=3)    # about 15 s of work: the test fails by time if SIGINT is lost
+
+
+def test_sigint_stops_a_long_run_quickly():
+    case = pyspline.load_case(CASES / "paper_T100.nml", **LONG)
+    case.model
+    timer = _sigint_after(0.3)
+    t0 = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt, match="interrupted"):
+        pyspline.simulate(case)
+    late = time.perf_counter() - t0 - 0.3
+    timer.join()
+    assert late < 1.0, late
+    # the core is usable afterwards, and a run without SIGINT is not disturbed
+    assert np.isfinite(pyspline.simulate(SCENES["lx1e-4"]).Tm).all()
+
+
+def test_sigint_stops_runs_in_worker_threads():
+    case = pyspline.load_case(CASES / "paper_T100.nml", **LONG)
+    case.model
+    with cf.ThreadPoolExecutor(2) as pool:
+        futs = [pool.submit(pyspline.simulate, case) for _ in range(2)]
+        time.sleep(0.3)
+        t0 = time.perf_counter()
+        os.kill(os.getpid(), signal.SIGINT)
+        for f in futs:
+            with pytest.raises(KeyboardInterrupt):
+                f.result(timeout=5)
+    assert time.perf_counter() - t0 < 1.0
+
+
+@pytest.mark.parametrize("name", ["run/one", "with spaces", "Zähne – 齿轮", "it's \"quoted\""])
+def test_any_case_name(name):
+    r = pyspline.simulate(dict(PAPER, name=name, t_end=1e-3, n_out=3))
+    assert r.case.name == name and np.isfinite(r.Tm).all()
+    with pytest.raises(pyspline.CaseError) as exc:
+        pyspline.simulate(dict(PAPER, name=name, b=-1.0))
+    assert f"case {name}: field b" in str(exc.value)
+
+
+def test_a_name_longer_than_the_core_holds_is_refused():
+    with pytest.raises(pyspline.CaseError, match="field name is longer than 128 bytes"):
+        pyspline.load_case(dict(PAPER, name="ü" * 65))
