@@ -20,12 +20,12 @@ module spline_api
   use spline_stiffness, only: external_tooth_stiffness, internal_tooth_stiffness
   use spline_dynamics, only: accelerations, start_state, rhs_scaled, to_scaled
   use spline_run, only: nstats, stat_names, run_case, tooth_quantities, ntooth_q, tooth_q_names, &
-       tooth_q_units, output_times
+       tooth_q_units, output_times, section_count, lyapunov_count
   implicit none
   private
   public :: api_load, api_model_size, api_simulate, api_rhs, api_rhs_mesh, api_start_state
   public :: api_output_times, api_model_info, api_defaults, api_names, api_tooth_stiffness
-  public :: api_time_rhs
+  public :: api_time_rhs, api_counts
 
   integer, parameter :: ninfo = 10   !< entries of api_model_info
 
@@ -77,28 +77,52 @@ contains
     errmsg = 'not a loaded case of this build of pyspline (load the case again)'
   end subroutine unpack
 
+  !> Sizes of a loaded model's extras: Poincare section points nsec and Benettin
+  !> renormalisations nlyap (0 when the case asks for none).
+  subroutine api_counts(model, nb, nsec, nlyap, ierr, errmsg)
+    integer(c_int), intent(in) :: nb
+    integer(c_int), intent(in) :: model(nb)
+    integer(c_int), intent(out) :: nsec, nlyap, ierr
+    character(len=msglen), intent(out) :: errmsg
+    type(model_t) :: m
+    integer :: ie
+    nsec = 0; nlyap = 0
+    call unpack(model, m, ie, errmsg)
+    if (ie == err_ok) then
+      nsec = section_count(m); nlyap = lyapunov_count(m)
+    end if
+    ierr = ie
+  end subroutine api_counts
+
   !> Simulate a loaded model: output times t, SI states y (nt x 14), per-tooth quantities tooth
-  !> (nt x z x nq, order of api_names('tooth')), meshing torque tm and run statistics.
+  !> (nt x z x nq, order of api_names('tooth')), meshing torque tm and run statistics; the
+  !> Poincare section (times sec_t, SI states sec_y: nsec x 14) and the Benettin record (times
+  !> lyap_t, cumulative log growth lyap_g), sized by api_counts.
   !> A SIGINT during the run stops it (ierr 4). Called without the GIL.
-  subroutine api_simulate(model, nb, z, nt, nq, ns, t, y, tooth, tm, stats, ierr, errmsg)
-    integer(c_int), intent(in) :: nb, z, nt, nq, ns
+  subroutine api_simulate(model, nb, z, nt, nq, ns, nsec, nlyap, t, y, tooth, tm, stats, &
+       sec_t, sec_y, lyap_t, lyap_g, ierr, errmsg)
+    integer(c_int), intent(in) :: nb, z, nt, nq, ns, nsec, nlyap
     integer(c_int), intent(in) :: model(nb)
     real(c_double), intent(out) :: t(nt), y(nt, 14), tooth(nt, z, nq), tm(nt), stats(ns)
+    real(c_double), intent(out) :: sec_t(nsec), sec_y(nsec, 14), lyap_t(nlyap), lyap_g(nlyap)
     integer(c_int), intent(out) :: ierr
     character(len=msglen), intent(out) :: errmsg
     type(model_t) :: m
-    real(wp), allocatable :: ycol(:, :)
+    real(wp), allocatable :: ycol(:, :), scol(:, :)
     integer :: ie
-    t = 0; y = 0; tooth = 0; tm = 0; stats = 0
+    t = 0; y = 0; tooth = 0; tm = 0; stats = 0; sec_t = 0; sec_y = 0; lyap_t = 0; lyap_g = 0
     call unpack(model, m, ie, errmsg)
-    if (ie == err_ok .and. (m%z /= z .or. m%n_out /= nt .or. nq /= ntooth_q .or. ns /= nstats)) then
+    if (ie == err_ok .and. (m%z /= z .or. m%n_out /= nt .or. nq /= ntooth_q .or. ns /= nstats &
+         .or. nsec /= section_count(m) .or. nlyap /= lyapunov_count(m))) then
       ie = err_case
       errmsg = 'api_simulate: array sizes do not match the loaded case'
     end if
     if (ie == err_ok) then
-      allocate(ycol(nstate, nt))
-      call run_case(m, t, ycol, tooth, tm, stats, ie, errmsg, interruptible=.true.)
+      allocate(ycol(nstate, nt), scol(nstate, nsec))
+      call run_case(m, t, ycol, tooth, tm, stats, ie, errmsg, interruptible=.true., &
+           sec_t=sec_t, sec_y=scol, lyap_t=lyap_t, lyap_g=lyap_g)
       y = transpose(ycol)
+      sec_y = transpose(scol)
     end if
     ierr = ie
   end subroutine api_simulate

@@ -13,7 +13,7 @@ module spline_case
   private
   public :: case_t, case_read_file, case_read_text, case_write_text, case_validate, case_name_of
   public :: namelen, ndof_case, thermal_values, method_values, nonlinear_values, start_values, &
-       fidelity_values, option_index
+       fidelity_values, section_values, option_index
 
   integer, parameter :: namelen = 128
   integer, parameter :: ndof_case = 7        !< entries of dq0, dv0: x1, y1, x2, y2, D1, D2, D3
@@ -28,6 +28,8 @@ module spline_case
        'equilibrium', 'rest']
   character(len=optlen), parameter :: fidelity_values(2) = [character(len=optlen) :: 'given', 'auto']
   character(len=optlen), parameter :: jacobian_values(1) = [character(len=optlen) :: 'dq']
+  character(len=optlen), parameter :: section_values(3) = [character(len=optlen) :: &
+       'none', 'shaft', 'tooth']
 
   !> The fields of a case with their defaults: the paper's spline and drive (MODEL.md Section 8).
   type :: case_t
@@ -75,6 +77,10 @@ module spline_case
     real(wp) :: l_ref = 0.0_wp, w_ref = 0.0_wp     !< scales of Eq. 25 [m], [rad/s]; 0 = c0, shaft speed
     character(len=optlen) :: fidelity = 'given'    !< given | auto
     real(wp) :: fidelity_tol = 1.0e-3_wp    !< auto: allowed relative error of T_m and F_j [-]
+    character(len=optlen) :: section = 'none'      !< Poincare section: none | shaft | tooth (pass)
+    logical  :: lyapunov = .false.          !< largest Lyapunov exponent (Benettin) over the output window
+    real(wp) :: lyapunov_interval = 1.0_wp  !< renormalisation interval [shaft revolutions]
+    real(wp) :: lyapunov_d0 = 1.0e-8_wp     !< initial separation, in the scaled states of Eq. 25 [-]
   end type case_t
 
 contains
@@ -175,13 +181,15 @@ contains
          j_2, m_1, m_2, k_p1, k_p2, c_p1, c_p2, k_t1, k_t2, c_t1, c_t2, k_m, c_m, t_d, t_l, &
          speed_rpm, grav, l_x, l_y, t_bulk, f_m, u_flash, eta_hertz, rtol, atol, t0, t_end, &
          t_transient, dq0(ndof_case), dv0(ndof_case), l_ref, w_ref, fidelity_tol
-    character(len=optlen) :: thermal, method, jacobian, nonlinear, start, fidelity
-    logical :: roots, stald
+    character(len=optlen) :: thermal, method, jacobian, nonlinear, start, fidelity, section
+    logical :: roots, stald, lyapunov
+    real(wp) :: lyapunov_interval, lyapunov_d0
     namelist /spline_case/ name, z, module_m, alpha_deg, b, s, c0, e_mod, nu, lambda_th, k_cond, rho, c_heat, j_m, &
          j_l, j_1, j_2, m_1, m_2, k_p1, k_p2, c_p1, c_p2, k_t1, k_t2, c_t1, c_t2, k_m, c_m, t_d, &
          t_l, speed_rpm, grav, l_x, l_y, dof, thermal, t_bulk, f_m, u_flash, eta_hertz, method, &
          jacobian, nonlinear, roots, stald, rtol, atol, max_steps, t0, t_end, t_transient, n_out, &
-         start, dq0, dv0, l_ref, w_ref, fidelity, fidelity_tol
+         start, dq0, dv0, l_ref, w_ref, fidelity, fidelity_tol, section, lyapunov, &
+         lyapunov_interval, lyapunov_d0
     name = c%name; z = c%z; module_m = c%module_m; alpha_deg = c%alpha_deg; b = c%b; s = c%s
     c0 = c%c0; e_mod = c%e_mod; nu = c%nu; lambda_th = c%lambda_th; k_cond = c%k_cond
     rho = c%rho; c_heat = c%c_heat; j_m = c%j_m; j_l = c%j_l; j_1 = c%j_1; j_2 = c%j_2
@@ -193,7 +201,8 @@ contains
     roots = c%roots; stald = c%stald; rtol = c%rtol; atol = c%atol; max_steps = c%max_steps
     t0 = c%t0; t_end = c%t_end; t_transient = c%t_transient; n_out = c%n_out; start = c%start
     dq0 = c%dq0; dv0 = c%dv0; l_ref = c%l_ref; w_ref = c%w_ref; fidelity = c%fidelity
-    fidelity_tol = c%fidelity_tol
+    fidelity_tol = c%fidelity_tol; section = c%section; lyapunov = c%lyapunov
+    lyapunov_interval = c%lyapunov_interval; lyapunov_d0 = c%lyapunov_d0
     iomsg = ''
     if (present(out)) then
       write(out, nml=spline_case, iostat=ierr, iomsg=iomsg)
@@ -217,6 +226,8 @@ contains
     c%max_steps = max_steps; c%t0 = t0; c%t_end = t_end; c%t_transient = t_transient
     c%n_out = n_out; c%start = start; c%dq0 = dq0; c%dv0 = dv0; c%l_ref = l_ref
     c%w_ref = w_ref; c%fidelity = fidelity; c%fidelity_tol = fidelity_tol
+    c%section = section; c%lyapunov = lyapunov; c%lyapunov_interval = lyapunov_interval
+    c%lyapunov_d0 = lyapunov_d0
   end subroutine nml_io
 
   !> The file name without directory and extension: the case name unless the file sets one.
@@ -325,6 +336,18 @@ contains
     if (.not. one_of(jacobian_values, c%jacobian, 'jacobian')) return
     if (.not. one_of(nonlinear_values, c%nonlinear, 'nonlinear')) return
     if (.not. one_of(start_values, c%start, 'start')) return
+    if (.not. one_of(section_values, c%section, 'section')) return
+    if (.not. ieee_is_finite(c%lyapunov_interval) .or. .not. ieee_is_finite(c%lyapunov_d0)) then
+      call fail('lyapunov_interval', 'and lyapunov_d0 must be finite numbers'); return
+    end if
+    if (.not. in_range(c%lyapunov_interval, 1.0e-3_wp, 1.0e3_wp, 'lyapunov_interval', &
+         'shaft revolutions')) return
+    if (.not. in_range(c%lyapunov_d0, 1.0e-12_wp, 1.0e-3_wp, 'lyapunov_d0', &
+         'a separation of the scaled states')) return
+    if ((c%lyapunov .or. option_index(section_values, c%section) > 1) .and. c%speed_rpm <= 0.0_wp) then
+      call fail('speed_rpm', 'must be positive for a Poincare section or a Lyapunov exponent '// &
+           '(both are timed by the shaft revolution)'); return
+    end if
     ierr = err_ok
 
   contains

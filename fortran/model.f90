@@ -6,7 +6,7 @@ module spline_model
   use spline_kinds, only: wp, pi
   use spline_errors, only: err_ok, err_case, err_thermal
   use spline_case, only: case_t, case_validate, namelen, option_index, thermal_values, &
-       method_values, nonlinear_values, start_values, fidelity_values
+       method_values, nonlinear_values, start_values, fidelity_values, section_values
   use spline_geometry, only: iso4156_radii
   use spline_stiffness, only: spline_mesh_stiffness
   use spline_thermal, only: backlash_coefficient, thermal_backlash
@@ -26,7 +26,7 @@ module spline_model
   integer, parameter :: stiffness_nquad = 32   !< Gauss points: converged to 1e-15 from 16 on
   !> Marks a model_t built by this build's constructor (layout version in the last digits):
   !> a copy handed back from outside is checked against it.
-  integer, parameter :: model_magic = 517730001
+  integer, parameter :: model_magic = 517730002
 
   type :: model_t
     integer  :: magic = 0
@@ -50,6 +50,10 @@ module spline_model
     logical  :: start_equilibrium = .true.
     real(wp) :: dq0(ndof), dv0(ndof)
     real(wp) :: l_ref, w_ref                !< scales of Eq. 25
+    integer  :: section = 0                 !< Poincare section: 0 none, 1 shaft, 2 tooth pass
+    logical  :: lyapunov = .false.          !< largest Lyapunov exponent (Benettin)
+    real(wp) :: lyap_dt = 0.0_wp            !< renormalisation interval [s]
+    real(wp) :: lyap_d0 = 0.0_wp            !< initial separation (scaled states, Eq. 25)
     ! derived geometry
     real(wp) :: r_pitch                     !< R = m Z / 2
     real(wp) :: cos_alpha, sin_alpha        !< of the pressure angle (once per case, not per tooth)
@@ -95,6 +99,10 @@ contains
     m%method_bdf = merge(1, 0, option_index(method_values, c%method) == 1)
     m%newton = option_index(nonlinear_values, c%nonlinear) == 1
     m%start_equilibrium = option_index(start_values, c%start) == 1
+    m%section = option_index(section_values, c%section) - 1
+    m%lyapunov = c%lyapunov
+    m%lyap_d0 = c%lyapunov_d0
+    if (m%omega > 0.0_wp) m%lyap_dt = c%lyapunov_interval*2.0_wp*pi/m%omega
 
     ! geometry (MODEL.md Sections 2 and 8, Eq. 9)
     call iso4156_radii(m%z, m%m_n, m%r_pitch, rf1, rf2, ra2)

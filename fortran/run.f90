@@ -2,18 +2,18 @@
 !> start state (static equilibrium by default), integration, and the per-tooth quantities
 !> (Eqs. 11, 15-22 and, for the thermal levels that have it, Eqs. 1-7) at every output time.
 module spline_run
-  use spline_kinds, only: wp
+  use spline_kinds, only: wp, pi
   use spline_errors, only: err_ok
   use spline_model, only: model_t, nstate, ndof, thermal_none, thermal_bulk, thermal_oneway, &
        thermal_coupled, set_thermal_level
-  use spline_dynamics, only: start_state
+  use spline_dynamics, only: start_state, to_scaled, integrated_states
   use spline_mesh, only: mesh_eval
   use spline_solver, only: integrate, nsolver_stats => nstats, solver_stat_names => stat_names
   use spline_fidelity, only: lateral_estimate, backlash_estimate
   implicit none
   private
   public :: run_case, output_times, tooth_outputs, tooth_quantities, ntooth_q, tooth_q_names, tooth_q_units
-  public :: nstats, stat_names
+  public :: nstats, stat_names, section_count, section_times, lyapunov_count
 
   !> Statistics of a run: the solver's, then the core's elapsed time, the model level that ran
   !> (dof, thermal 0 none .. 3 coupled) and the fidelity estimates of spline_fidelity.
@@ -57,13 +57,18 @@ contains
   !>  - thermal coupled -> oneway (same T_f output, no iteration in the RHS), checked afterwards:
   !>    if backlash_estimate(max T_f of the one-way run) > tol the case is run coupled.
   !> interruptible: a SIGINT stops the run with err_interrupted (callers that can raise it).
-  subroutine run_case(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible)
+  !> Optional extras, sized by the caller: sec_t(section_count(m)), sec_y(nstate, ...) get the
+  !> Poincare section (times, SI states); lyap_t(lyapunov_count(m)), lyap_g(...) the Benettin
+  !> renormalisation times and the cumulative log growth of the separation (lyapunov_benettin).
+  subroutine run_case(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
+       lyap_t, lyap_g)
     type(model_t), intent(in) :: m
     real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
     real(wp), intent(out) :: tm(m%n_out), stats(nstats)
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
     logical, intent(in), optional :: interruptible
+    real(wp), intent(out), optional :: sec_t(:), sec_y(:, :), lyap_t(:), lyap_g(:)
     type(model_t) :: run
     real(wp) :: eps_lat, eps_th, tol
     integer(8) :: c0, c1, rate
@@ -80,13 +85,18 @@ contains
       end if
       if (m%thermal == thermal_coupled) call set_thermal_level(run, thermal_oneway)
     end if
-    call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible)
+    call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y)
     if (ierr == err_ok .and. m%auto .and. m%thermal == thermal_coupled) then
       eps_th = backlash_estimate(m, maxval(abs(tooth(:, :, iq_tf))))
       if (eps_th > tol) then
         call set_thermal_level(run, thermal_coupled)
-        call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible)
+        call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y)
       end if
+    end if
+    if (present(lyap_t)) then
+      lyap_t = 0.0_wp; lyap_g = 0.0_wp
+      if (ierr == err_ok .and. m%lyapunov) &
+           call lyapunov_benettin(run, t(1), y(:, 1), lyap_t, lyap_g, ierr, errmsg, interruptible)
     end if
     call system_clock(c1)
     stats(nsolver_stats+1:) = [real(c1 - c0, wp)/rate, real(run%dof, wp), real(run%thermal, wp), &
@@ -94,13 +104,14 @@ contains
   end subroutine run_case
 
   !> One run of the model at the level m sets.
-  subroutine run_level(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible)
+  subroutine run_level(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y)
     type(model_t), intent(in) :: m
     real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
     real(wp), intent(out) :: tm(m%n_out), stats(nstats)
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
     logical, intent(in), optional :: interruptible
+    real(wp), intent(out), optional :: sec_t(:), sec_y(:, :)
     real(wp) :: y0(nstate)
     integer, allocatable :: modes(:, :)
     errmsg = ''
@@ -110,10 +121,135 @@ contains
     call output_times(m, t)
     call start_state(m, y0, ierr, errmsg)
     if (ierr /= 0) return
-    call integrate(m, y0, m%n_out, t, y, modes, stats(1:nsolver_stats), ierr, errmsg, interruptible)
+    if (present(sec_t)) then
+      call section_times(m, sec_t)
+      call integrate(m, y0, m%n_out, t, y, modes, stats(1:nsolver_stats), ierr, errmsg, &
+           interruptible, sec_t, sec_y)
+    else
+      call integrate(m, y0, m%n_out, t, y, modes, stats(1:nsolver_stats), ierr, errmsg, &
+           interruptible)
+    end if
     if (ierr /= 0) return
     call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg)
   end subroutine run_level
+
+  !> Period of the Poincare section [s]: the shaft revolution 2 pi / omega (section 1) or the
+  !> tooth pass 2 pi / (Z omega) (section 2); 0 without a section.
+  pure real(wp) function section_period(m) result(p)
+    type(model_t), intent(in) :: m
+    p = 0.0_wp
+    if (m%section == 1) p = 2.0_wp*pi/m%omega
+    if (m%section == 2) p = 2.0_wp*pi/(m%z*m%omega)
+  end function section_period
+
+  !> Range k0..k1 of the section times k p in the output window [t0 + t_transient, t_end]
+  !> (after t0; a relative 1e-9 of p absorbs the round-off of t/p).
+  pure subroutine section_range(m, k0, k1)
+    type(model_t), intent(in) :: m
+    integer(8), intent(out) :: k0, k1
+    real(wp) :: p
+    p = section_period(m)
+    k0 = 1; k1 = 0
+    if (p <= 0.0_wp) return
+    k0 = ceiling((m%t0 + m%t_transient)/p - 1.0e-9_wp, 8)
+    if (k0*p <= m%t0) k0 = k0 + 1
+    k1 = floor(m%t_end/p + 1.0e-9_wp, 8)
+  end subroutine section_range
+
+  !> Number of Poincare section points of a run.
+  pure integer function section_count(m) result(n)
+    type(model_t), intent(in) :: m
+    integer(8) :: k0, k1
+    call section_range(m, k0, k1)
+    n = int(max(k1 - k0 + 1, 0_8))
+  end function section_count
+
+  !> The section times: the instants at which the shaft (or the tooth pass) angle omega t is a
+  !> whole number of turns. The shaft turns at the constant speed omega (Eqs. 8-9), so the
+  !> section condition omega t = 2 pi k has these roots in closed form.
+  pure subroutine section_times(m, ts)
+    type(model_t), intent(in) :: m
+    real(wp), intent(out) :: ts(:)
+    integer(8) :: k0, k1, k
+    call section_range(m, k0, k1)
+    do k = k0, k1
+      ts(k - k0 + 1) = min(k*section_period(m), m%t_end)
+    end do
+  end subroutine section_times
+
+  !> Number of Benettin renormalisations over the output window (0 without lyapunov).
+  pure integer function lyapunov_count(m) result(n)
+    type(model_t), intent(in) :: m
+    n = 0
+    if (m%lyapunov .and. m%lyap_dt > 0.0_wp) &
+         n = max(1, ceiling((m%t_end - m%t0 - m%t_transient)/m%lyap_dt - 1.0e-9_wp))
+  end function lyapunov_count
+
+  !> Largest Lyapunov exponent by Benettin's method: from the state y_start at t_start, a
+  !> reference and a copy perturbed by d0 (in the scaled states of Eq. 25, along a fixed
+  !> direction) are integrated over intervals of lyap_dt; after each the separation d is
+  !> measured, ln(d / d0) added to the sum g, and the copy pulled back to distance d0 along the
+  !> separation. lam(t) = g(t) / (t - t_start) converges to the exponent [1/s]. Both
+  !> trajectories restart at every renormalisation, with the same settings, so they see the
+  !> same integrator. The frozen states of the torsional level (dof 3) are left out of d.
+  subroutine lyapunov_benettin(m, t_start, y_start, lt, lg, ierr, errmsg, interruptible)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t_start, y_start(nstate)
+    real(wp), intent(out) :: lt(:), lg(:)
+    integer, intent(out) :: ierr
+    character(len=*), intent(out) :: errmsg
+    logical, intent(in), optional :: interruptible
+    type(model_t) :: mm
+    real(wp) :: y(nstate), yp(nstate), t0, t1, ys(nstate), yps(nstate), dv(nstate), d, g
+    real(wp) :: tout(1), y1(nstate, 1), yp1(nstate, 1), st(nsolver_stats)
+    integer :: idx(nstate), n, k, i, modes(m%z, 1)
+    call integrated_states(m, idx, n)
+    mm = m
+    y = y_start
+    dv = 0.0_wp
+    dv(idx(1:n)) = 1.0_wp/sqrt(real(n, wp))         ! unit direction in the scaled states
+    call to_scaled(m, y, ys)
+    yps = ys + m%lyap_d0*dv
+    call from_scaled_local(yps, yp)
+    t0 = t_start
+    g = 0.0_wp
+    do k = 1, size(lt)
+      t1 = min(t_start + k*m%lyap_dt, m%t_end)
+      mm%t0 = t0
+      tout = t1
+      call integrate(mm, y, 1, tout, y1, modes, st, ierr, errmsg, interruptible)
+      if (ierr /= err_ok) return
+      call integrate(mm, yp, 1, tout, yp1, modes, st, ierr, errmsg, interruptible)
+      if (ierr /= err_ok) return
+      call to_scaled(m, y1(:, 1), ys)
+      call to_scaled(m, yp1(:, 1), yps)
+      dv = 0.0_wp
+      dv(idx(1:n)) = yps(idx(1:n)) - ys(idx(1:n))
+      d = norm2(dv)
+      if (.not. (d > 0.0_wp)) then       ! the copy fell onto the reference: perturb afresh
+        dv = 0.0_wp
+        dv(idx(1:n)) = 1.0_wp/sqrt(real(n, wp))
+        d = m%lyap_d0
+      end if
+      g = g + log(d/m%lyap_d0)
+      lt(k) = t1
+      lg(k) = g
+      yps = ys
+      do i = 1, n
+        yps(idx(i)) = ys(idx(i)) + dv(idx(i))*(m%lyap_d0/d)
+      end do
+      y = y1(:, 1)
+      call from_scaled_local(yps, yp)
+      t0 = t1
+    end do
+  contains
+    subroutine from_scaled_local(a, b)     ! Eq. 25 back to SI
+      real(wp), intent(in) :: a(nstate)
+      real(wp), intent(out) :: b(nstate)
+      b(1:ndof) = a(1:ndof)*m%l_ref
+      b(ndof+1:) = a(ndof+1:)*(m%l_ref*m%w_ref)
+    end subroutine from_scaled_local
+  end subroutine lyapunov_benettin
 
   !> Per-tooth quantities at the output times, with the contact states the integration used
   !> (2: decided by the state).

@@ -65,7 +65,11 @@ contains
   !> Integrate the model from y0 (SI, at m%t0) and return the SI state at the times tout(1:nt)
   !> (ascending, >= t0) in yout(:, k), the contact states there (2: decided by the state) and
   !> the solver statistics. interruptible: a SIGINT during the run stops it (err_interrupted).
-  subroutine integrate(m, y0, nt, tout, yout, modes_out, stats, ierr, errmsg, interruptible)
+  !> tsec (optional, ascending, > t0): Poincare section times; ysec(:, i) gets the SI state at
+  !> tsec(i). The integrator is stopped exactly there (CVodeSetStopTime): the state is that of
+  !> a step ending at the section, not an interpolation between steps.
+  subroutine integrate(m, y0, nt, tout, yout, modes_out, stats, ierr, errmsg, interruptible, &
+       tsec, ysec)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: y0(nstate)
     integer, intent(in) :: nt
@@ -76,6 +80,8 @@ contains
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
     logical, intent(in), optional :: interruptible
+    real(wp), intent(in), optional :: tsec(:)
+    real(wp), intent(out), optional :: ysec(:, :)
     type(solver_ctx_t), target :: ctx
     real(c_double) :: ys(nstate)
     real(c_double), allocatable, target :: yr(:)
@@ -87,7 +93,7 @@ contains
     type(SUNNonlinearSolver), pointer :: nls
     integer(c_int) :: flag, nroot
     integer(c_int), allocatable :: rootsfound(:)
-    integer :: k, k0, nroots, nresync
+    integer :: k, k0, nroots, nresync, ks, nsec
     character(len=40) :: stage
 
     ierr = err_ok
@@ -108,6 +114,10 @@ contains
       end if
     end if
     allocate(rootsfound(nroot))
+    nsec = 0
+    if (present(tsec)) nsec = size(tsec)
+    if (present(ysec)) ysec = 0.0_wp
+    ks = 1
     call to_scaled(m, y0, ys)
     call integrated_states(m, ctx%idx, ctx%n)
     if (ctx%n < nstate) ys(ndof+1:ndof+4) = 0.0_wp   ! lateral states frozen at the start displacement
@@ -178,6 +188,10 @@ contains
       flag = FCVodeRootInit(mem, nroot, c_funloc(roots_cb))
       if (flag == 0) flag = FCVodeSetNoInactiveRootWarn(mem)
     end if
+    if (flag == 0 .and. ks <= nsec) then
+      stage = 'setting the first section time'
+      flag = next_section()
+    end if
     if (flag /= 0) then
       call fail(flag, tau, trim(stage))
     else
@@ -190,6 +204,17 @@ contains
             exit outputs
           end if
           tau = tret(1)
+          if (ks <= nsec) then
+            if (tau >= tsec(ks)*m%w_ref) then     ! stopped on the section (CV_TSTOP_RETURN)
+              ys(ctx%idx(1:ctx%n)) = yr
+              call from_scaled(m, ys, ysec(:, ks))
+              ks = ks + 1
+              if (next_section() /= 0) then
+                call fail(-1_c_int, tau, 'setting the next section time')
+                exit outputs
+              end if
+            end if
+          end if
           if (flag == CV_ROOT_RETURN) then
             ! Step onto the switch, flip the states of the teeth that crossed, restart.
             flag = FCVodeGetRootInfo(mem, rootsfound)
@@ -200,6 +225,7 @@ contains
             call apply_roots(ctx, rootsfound, nroots)
             call add_counters(ctx, mem, stats)        ! CVodeReInit zeroes CVODE's counters
             flag = FCVodeReInit(mem, tau, sv)
+            if (flag == 0) flag = next_section()
             if (flag /= 0) then
               call fail(flag, tau, 'restarting at a contact switch')
               exit outputs
@@ -218,6 +244,7 @@ contains
           if (nresync > k0 .and. k < nt) then
             call add_counters(ctx, mem, stats)
             flag = FCVodeReInit(mem, tau, sv)
+            if (flag == 0) flag = next_section()
             if (flag /= 0) then
               call fail(flag, tau, 'restarting after a missed switch')
               exit outputs
@@ -247,6 +274,12 @@ contains
     flag = FSUNContext_Free(sunctx)
 
   contains
+
+    !> Stop the integrator at the next section time (CVODE never steps past it), if any.
+    integer(c_int) function next_section() result(fl)
+      fl = 0
+      if (ks <= nsec) fl = FCVodeSetStopTime(mem, real(tsec(ks)*m%w_ref, c_double))
+    end function next_section
 
     subroutine fail(flag, tau, what)
       integer(c_int), intent(in) :: flag

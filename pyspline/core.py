@@ -58,17 +58,20 @@ class Model:
     that the caller owns: it can be copied, pickled to another process and used from many
     threads at once. ``Case.model`` keeps one per case."""
 
-    __slots__ = ("case", "bytes", "z", "n_out", "__weakref__")
+    __slots__ = ("case", "bytes", "z", "n_out", "n_section", "n_lyapunov", "__weakref__")
 
     def __init__(self, case):
         case = load_case(case)
         data, z, nt, ierr, msg = _api.api_load(case.text().encode("utf-8"), _MODEL_BYTES)
         raise_for(ierr, msg)
         data.flags.writeable = False
+        nsec, nlyap, ierr, msg = _api.api_counts(data)
+        raise_for(ierr, msg)
         self.case, self.bytes, self.z, self.n_out = case, data, int(z), int(nt)
+        self.n_section, self.n_lyapunov = int(nsec), int(nlyap)
 
     def __getstate__(self):
-        return {"case": self.case, "bytes": self.bytes, "z": self.z, "n_out": self.n_out}
+        return {k: getattr(self, k) for k in self.__slots__ if k != "__weakref__"}
 
     def __setstate__(self, state):
         for k, v in state.items():
@@ -136,6 +139,9 @@ class Result:
     tooth: dict              #: per-tooth quantities by name: F, Fx, Fy [N], dn, c [m], Tf [degC], rc1, rc2 [m]
     Tm: np.ndarray           #: meshing torque T_m (Eq. 22) [N m]
     stats: dict = field(default_factory=dict)   #: CVODE statistics and run time
+    section_t: np.ndarray = None   #: Poincare section times [s] (case field section)
+    section_y: np.ndarray = None   #: states at the section times (n, 14), SI, like y
+    lyapunov: dict = None    #: Benettin record (case field lyapunov): t [s], log_growth, exponent [1/s]
 
     @property
     def level(self) -> str:
@@ -168,15 +174,19 @@ def simulate(case) -> Result:
     model = load(case)
     q, s = _names("tooth"), _names("stats")
     t0 = time.perf_counter()
-    t, y, tooth, tm, stats, ierr, msg = _api.api_simulate(model.bytes, model.z, model.n_out,
-                                                          len(q), len(s))
+    t, y, tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, ierr, msg = _api.api_simulate(
+        model.bytes, model.z, model.n_out, len(q), len(s), model.n_section, model.n_lyapunov)
     wall = time.perf_counter() - t0
     raise_for(ierr, msg)
     st = {n: (float(v) if n.endswith(_FLOAT_STATS) or n.startswith("fidelity_eps") else int(v))
           for (n, _), v in zip(s, stats)}
     st["wall_s"] = wall
+    lyap = None
+    if model.n_lyapunov:
+        span = lyap_t - (t[0] if len(t) else 0.0)
+        lyap = dict(t=lyap_t, log_growth=lyap_g, exponent=float(lyap_g[-1] / span[-1]))
     return Result(case=model.case, t=t, y=y, tooth={n: tooth[:, :, i] for i, (n, _) in enumerate(q)},
-                  Tm=tm, stats=st)
+                  Tm=tm, stats=st, section_t=sec_t, section_y=sec_y, lyapunov=lyap)
 
 
 def rhs(case, t: float, y) -> tuple[np.ndarray, dict, float]:
