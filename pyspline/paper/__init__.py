@@ -12,6 +12,7 @@ printed). Every other row of the table is then a prediction.
 from __future__ import annotations
 
 import json
+import os
 import math
 import re
 import shutil
@@ -242,7 +243,7 @@ def write_table(rows, out: Path, quick: bool):
 def check_executable(directory, names, quick=True, exe=None):
     """Run cases through spline-dyn and compare every number with the Python path."""
     import tempfile
-    exe = exe or shutil.which("spline-dyn")
+    exe = exe or os.environ.get("SPLINE_DYN") or shutil.which("spline-dyn")
     if not exe:
         return {"status": "spline-dyn not found on PATH"}
     report = {}
