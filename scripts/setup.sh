@@ -25,6 +25,11 @@ fi
 python3 -m pip install -q --disable-pip-version-check \
   "numpy>=2.0" meson meson-python ninja pytest matplotlib scipy f90nml tqdm
 
+# Test-only cross-checks and benchmark peers (never imported by the package): ROSS (an
+# independent potential-energy stiffness; 2.3 needs plotly < 6), numba + numbalsoda (the
+# compiled-LSODA peer of bench/numba_peer.py).
+python3 -m pip install -q --disable-pip-version-check ross-rotordynamics "plotly<6" numba numbalsoda
+
 # The source of exactly the installed version: same interface, same numbers.
 version="$(dpkg-query -W -f='${Version}' libsundials-dev)"
 prefix="${PYSPLINE_SUNDIALS:-${XDG_CACHE_HOME:-$HOME/.cache}/pyspline/sundials-$version-O2}"

@@ -4,18 +4,22 @@
 !> Prints: the spline's terms (MODEL.md Section 8), a convergence table in nquad, the spur gear
 !> of Tian (2004) / Chen & Shao (2011) at its pitch point, two independent cross-checks
 !> (Tian's closed-form integrands in his angle variable, and the rack / trapezoid closed form
-!> that both tooth routines must approach for z -> infinity), and the error paths.
+!> that both tooth routines must approach for z -> infinity), the fillet-foundation terms of
+!> Sainsot et al. (2004) (MODEL.md Section 10) with their checks, the numbers that
+!> tests/test_ross.py compares with ROSS (lines starting with '@', key=value), the ISO 6336-1
+!> comparison of docs/stiffness.md, and the error paths.
 !> Exit status 1 if a cross-check fails (tolerances printed with each check).
 program stiffness_check
   use spline_kinds, only: wp, pi
   use spline_stiffness, only: hertz_stiffness, external_tooth_stiffness, &
-       internal_tooth_stiffness, spline_mesh_stiffness
+       internal_tooth_stiffness, spline_mesh_stiffness, sainsot_fillet_compliance, &
+       fillet_foundation_stiffness, fillet_foundation_stiffness_internal, spline_mesh_stiffness_fillet
   implicit none
   real(wp), parameter :: deg = pi/180.0_wp
   integer, parameter :: nref = 64
   integer :: ierr, i, nfail
   character(len=256) :: msg
-  real(wp) :: kh, kb1, ks1, ka1, kb2, ks2, ka2, km, ref(7), cur(7)
+  real(wp) :: kh, kb1, ks1, ka1, kb2, ks2, ka2, km, ref(7), cur(7), kf1, kf2
   real(wp) :: z, m, alpha, b, e, nu
   integer, parameter :: nq(5) = [8, 16, 32, 64, 128]
 
@@ -69,8 +73,16 @@ program stiffness_check
   ! ---------------- 5. rack limit (z -> infinity): trapezoidal cantilever closed form -----------
   call rack_limit()
 
-  ! ---------------- 6. error paths --------------------------------------------------------------
-  print '(/a)', '== Error reporting =='
+  ! ---------------- 6. fillet foundation (Sainsot et al. 2004), ROSS and ISO comparisons ------
+  call fillet_spline()
+  call ross_points('a', 62.0_wp, 2e-3_wp, 20.0_wp, 0.02_wp, 206e9_wp, 0.3_wp, 1.0_wp, 0.25_wp, &
+       17.5e-3_wp, [60.5e-3_wp, 62.0e-3_wp, 63.5e-3_wp])
+  call ross_points('spline', 16.0_wp, 2e-3_wp, 30.0_wp, 0.03_wp, 2.1e11_wp, 0.3_wp, 0.5_wp, 0.25_wp, &
+       7.25e-3_wp, [15.2e-3_wp, 16.0e-3_wp, 16.8e-3_wp])
+  call iso_table()
+
+  ! ---------------- 7. error paths --------------------------------------------------------------
+  print '(/a)', '== Error reporting ==' 
   call external_tooth_stiffness(2.0_wp, m, alpha, b, 14.5e-3_wp, e, nu, 16e-3_wp, nref, kb1, ks1, ka1, ierr, msg)
   call report_error(ierr, msg)
   call external_tooth_stiffness(z, m, alpha, b, 14.5e-3_wp, e, 0.5_wp, 16e-3_wp, nref, kb1, ks1, ka1, ierr, msg)
@@ -85,6 +97,31 @@ program stiffness_check
   call report_error(ierr, msg)
   call spline_mesh_stiffness(z, m, 0.0_wp, b, e, nu, 14.5e-3_wp, 17.5e-3_wp, 15e-3_wp, nref, &
        kh, kb1, ks1, ka1, kb2, ks2, ka2, km, ierr, msg)
+  call report_error(ierr, msg)
+  call fillet_foundation_stiffness(z, m, alpha, b, 14.5e-3_wp, 0.4e-3_wp, 14.5e-3_wp, e, nu, 16e-3_wp, &
+       kf1, ierr, msg)                                                    ! bore as large as the root
+  call report_error(ierr, msg)
+  call fillet_foundation_stiffness(z, m, alpha, b, 14.5e-3_wp, 4e-3_wp, 7e-3_wp, e, nu, 16e-3_wp, &
+       kf1, ierr, msg)                                                    ! fillet radius too large
+  call report_error(ierr, msg)
+  call fillet_foundation_stiffness(z, m, alpha, b, 16.5e-3_wp, 0.4e-3_wp, 7e-3_wp, e, nu, 16e-3_wp, &
+       kf1, ierr, msg)                                                    ! root outside the pitch circle
+  call report_error(ierr, msg)
+  call fillet_foundation_stiffness(z, m, alpha, b, 14.5e-3_wp, 0.4e-3_wp, 7e-3_wp, e, nu, 14.0e-3_wp, &
+       kf1, ierr, msg)                                                    ! contact below the root
+  call report_error(ierr, msg)
+  call fillet_foundation_stiffness_internal(z, m, alpha, b, 17.5e-3_wp, 0.4e-3_wp, 17e-3_wp, e, nu, &
+       16e-3_wp, kf2, ierr, msg)                                          ! body inside the root circle
+  call report_error(ierr, msg)
+  call fillet_foundation_stiffness_internal(z, m, alpha, b, 17.5e-3_wp, -1e-3_wp, 35e-3_wp, e, nu, &
+       16e-3_wp, kf2, ierr, msg)                                          ! negative fillet radius
+  call report_error(ierr, msg)
+  call fillet_foundation_stiffness_internal(z, m, alpha, -b, 17.5e-3_wp, 0.4e-3_wp, 35e-3_wp, e, nu, &
+       16e-3_wp, kf2, ierr, msg)                                          ! negative face width
+  call report_error(ierr, msg)
+  call spline_mesh_stiffness_fillet(z, m, alpha, b, e, nu, 14.5e-3_wp, 17.5e-3_wp, 15e-3_wp, &
+       0.4e-3_wp, 0.4e-3_wp, 7.25e-3_wp, 17e-3_wp, .true., nref, kh, kb1, ks1, ka1, kf1, kb2, ks2, &
+       ka2, kf2, km, ierr, msg)                                           ! rout2 < rf2
   call report_error(ierr, msg)
 
   print '(/a,i0)', 'failed checks: ', nfail
@@ -231,5 +268,120 @@ contains
     call must(all(abs(dev_ext(:, 2)/dev_ext(:, 3) - 10) < 2) .and. &
          all(abs(dev_int(:, 2)/dev_int(:, 3) - 10) < 2), 'rack limit not approached as 1/z')
   end subroutine rack_limit
+
+  !> The spline's fillet-foundation terms (MODEL.md Section 10; docs/stiffness.md): ISO 4156 flat
+  !> root, fillet radius 0.2 m on both splines, bore r_int = r_root/2 (external), body outer radius
+  !> r_out = 2 r_root (internal), pitch point. Checks: fillet = .false. reproduces
+  !> spline_mesh_stiffness bit for bit; u_f equals the independent construction x_c - h_c tan(alpha_m)
+  !> from the contact point's coordinates; k_f scales as 1/b and as 1/E.
+  subroutine fillet_spline()
+    real(wp), parameter :: zz = 16, mm = 2e-3_wp, aa = 30*deg, bb = 0.03_wp, ee = 2.1e11_wp, vv = 0.3_wp
+    real(wp), parameter :: rf1 = 14.5e-3_wp, rf2 = 17.5e-3_wp, ra2 = 15e-3_wp, rho = 0.2_wp*mm
+    real(wp) :: k0(8), k1(10), d1(9), d2(9), kf, kfb, rp, rb, psic, xc, hc, tc, uf_geo, hf
+    real(wp), parameter :: hfs(5) = [1.4_wp, 2.0_wp, 3.0_wp, 5.0_wp, 7.0_wp]
+    integer :: j
+    rp = mm*zz/2; rb = rp*cos(aa)
+    call spline_mesh_stiffness(zz, mm, aa, bb, ee, vv, rf1, rf2, ra2, nref, k0(1), k0(2), k0(3), &
+         k0(4), k0(5), k0(6), k0(7), k0(8), ierr, msg)
+    call spline_mesh_stiffness_fillet(zz, mm, aa, bb, ee, vv, rf1, rf2, ra2, rho, rho, rf1/2, 2*rf2, &
+         .false., nref, k1(1), k1(2), k1(3), k1(4), k1(5), k1(6), k1(7), k1(8), k1(9), k1(10), ierr, msg)
+    call must(ierr == 0 .and. k1(10) == k0(8) .and. k1(5) == 0 .and. k1(9) == 0, &
+         'fillet = .false. must give spline_mesh_stiffness''s k_m bit for bit')
+    call spline_mesh_stiffness_fillet(zz, mm, aa, bb, ee, vv, rf1, rf2, ra2, rho, rho, rf1/2, 2*rf2, &
+         .true., nref, k1(1), k1(2), k1(3), k1(4), k1(5), k1(6), k1(7), k1(8), k1(9), k1(10), ierr, msg)
+    call must(ierr == 0, 'spline_mesh_stiffness_fillet: '//trim(msg))
+    call fillet_foundation_stiffness(zz, mm, aa, bb, rf1, rho, rf1/2, ee, vv, rp, kf, ierr, msg, d1)
+    call fillet_foundation_stiffness_internal(zz, mm, aa, bb, rf2, rho, 2*rf2, ee, vv, rp, kf, ierr, msg, d2)
+    print '(/a)', '== Fillet foundation (Sainsot, Velex & Duverger 2004), spline at the pitch point =='
+    print '(a)',  '   ISO 4156 flat root, rho_f = 0.2 m; bore r_int = r_root/2 (ext.), r_out = 2 r_root (int.)'
+    print '(a)',  '                 theta_f     h_f     u_f[mm]  S_f[mm]  alpha_m      L       M       P       Q'
+    print '(a,f9.5,f8.3,2f9.4,f9.5,4f8.4)', '   external ', d1(1:2), d1(3:4)*1e3_wp, d1(5:9)
+    print '(a,f9.5,f8.3,2f9.4,f9.5,4f8.4)', '   internal ', d2(1:2), d2(3:4)*1e3_wp, d2(5:9)
+    print '(a,es14.6,a,f7.2,a)', '   k_f1 ', k1(5), ' N/m  (', k1(5)/bb*1e-9_wp, ' N/(mm um) per mm face)'
+    print '(a,es14.6,a,f7.2,a)', '   k_f2 ', k1(9), ' N/m  (', k1(9)/bb*1e-9_wp, ' N/(mm um) per mm face)'
+    print '(a,es14.6,a,f7.2,a)', '   k_m without k_f ', k0(8), ' N/m  (', k0(8)/bb*1e-9_wp, ' N/(mm um))'
+    print '(a,es14.6,a,f7.2,a)', '   k_m with k_f    ', k1(10), ' N/m  (', k1(10)/bb*1e-9_wp, ' N/(mm um))'
+    ! u_f from the contact point's own coordinates: the line of action leaves (x_c, h_c) at alpha_m
+    tc = sqrt((rp/rb)**2 - 1)
+    psic = pi/(2*zz) + tan(aa) - aa - (tc - atan(tc)); xc = rp*cos(psic); hc = rp*sin(psic)
+    uf_geo = xc - hc*tan(atan(tc) - psic) - rf1
+    psic = pi/(2*zz) - (tan(aa) - aa) + (tc - atan(tc)); xc = rp*cos(psic); hc = rp*sin(psic)
+    print '(a,2es10.2,a)', '   u_f vs x_c -/+ h_c tan(alpha_m) (ext., int.): rel.diff', &
+         d1(3)/uf_geo - 1, d2(3)/(rf2 - xc - hc*tan(atan(tc) + psic)) - 1, '  (tolerance 1e-12)'
+    call must(abs(d1(3)/uf_geo - 1) < 1e-12_wp .and. &
+         abs(d2(3)/(rf2 - xc - hc*tan(atan(tc) + psic)) - 1) < 1e-12_wp, 'u_f construction')
+    call fillet_foundation_stiffness(zz, mm, aa, 2*bb, rf1, rho, rf1/2, 3*ee, vv, rp, kfb, ierr, msg)
+    call must(abs(kfb/(6*k1(5)) - 1) < 1e-14_wp, 'k_f must scale as E b')
+    ! spread with the unknown bore / sleeve radius (h_f), both teeth given the same h_f
+    print '(a)', '   h_f      k_f1 [N/m]    k_f2 [N/m]   k_m with k_f [N/(mm um)]'
+    do j = 1, 5
+      hf = hfs(j)
+      call spline_mesh_stiffness_fillet(zz, mm, aa, bb, ee, vv, rf1, rf2, ra2, rho, rho, rf1/hf, hf*rf2, &
+           .true., nref, k1(1), k1(2), k1(3), k1(4), k1(5), k1(6), k1(7), k1(8), k1(9), k1(10), ierr, msg)
+      print '(a,f4.1,2es14.5,f10.2)', '   ', hf, k1(5), k1(9), k1(10)/bb*1e-9_wp
+      print '(a,a,f3.1,4(a,es22.15))', '@hf ', 'hf=', hf, ' kf1=', k1(5), ' kf2=', k1(9), ' km=', k1(10), &
+           ' b=', bb
+    end do
+    print '(a,9(a,es22.15))', '@spline_iso4156 ', 'kh=', k0(1), ' kb1=', k0(2), ' ks1=', k0(3), &
+         ' ka1=', k0(4), ' kb2=', k0(5), ' ks2=', k0(6), ' ka2=', k0(7), ' km=', k0(8), ' b=', bb
+  end subroutine fillet_spline
+
+  !> The numbers tests/test_ross.py compares with ROSS's GearElementTVMS (ross-rotordynamics 2.3):
+  !> a gear cut by ROSS's basic rack (addendum ha m, clearance c m, tip radius rho = c m/(1 - sin a)),
+  !> at the contact radii rc(:). Printed per point: ours (clamped at the root circle, involute
+  !> extended down to it), ours clamped at ROSS's involute start r_s (the involute part alone), our
+  !> k_f, and k_f by the same formula with ROSS's conventions (theta_f of Ma et al.,
+  !> (pi/2 + 2 tan a (ha - rho/m) + 2 rho/(m cos a))/z, and u_f = y_c - r_f to the contact point).
+  subroutine ross_points(name, zz, mm, adeg, bb, ee, vv, ha, cc, rint, rc)
+    character(len=*), intent(in) :: name
+    real(wp), intent(in) :: zz, mm, adeg, bb, ee, vv, ha, cc, rint, rc(:)
+    real(wp) :: aa, rp, rb, rf, rho, rs, kb, ks, ka, kbi, ksi, kai, kf, d(9), tc, psic, am, thm, cf
+    integer :: j
+    aa = adeg*deg; rp = mm*zz/2; rb = rp*cos(aa); rf = rp - (ha + cc)*mm; rho = cc*mm/(1 - sin(aa))
+    rs = sqrt((rb*tan(aa) - ha*mm/sin(aa))**2 + rb**2)
+    thm = (pi/2 + 2*tan(aa)*(ha - rho/mm) + 2*rho/(mm*cos(aa)))/zz
+    print '(/a,a,a)', '== ROSS comparison points, gear ', name, ' (tests/test_ross.py) =='
+    print '(a,a,8(a,es22.15))', '@gear ', name, ' z=', zz, ' m=', mm, ' alpha_deg=', adeg, ' b=', bb, &
+         ' e=', ee, ' nu=', vv, ' ha=', ha, ' c=', cc
+    print '(a,a,4(a,es22.15))', '@geom ', name, ' r_int=', rint, ' r_root=', rf, ' rho=', rho, ' r_start=', rs
+    do j = 1, size(rc)
+      call external_tooth_stiffness(zz, mm, aa, bb, rf, ee, vv, rc(j), nref, kb, ks, ka, ierr, msg)
+      call must(ierr == 0, trim(msg))
+      call external_tooth_stiffness(zz, mm, aa, bb, rs, ee, vv, rc(j), nref, kbi, ksi, kai, ierr, msg)
+      call must(ierr == 0, trim(msg))
+      call fillet_foundation_stiffness(zz, mm, aa, bb, rf, rho, rint, ee, vv, rc(j), kf, ierr, msg, d)
+      call must(ierr == 0, trim(msg))
+      tc = sqrt((rc(j)/rb)**2 - 1); psic = pi/(2*zz) + tan(aa) - aa - (tc - atan(tc)); am = atan(tc) - psic
+      call sainsot_fillet_compliance(thm, rf/rint, rc(j)*cos(psic) - rf, 2*rf*thm, am, ee, bb, cf)
+      print '(a,a,12(a,es22.15))', '@point ', name, ' r=', rc(j), ' kb=', kb, ' ks=', ks, ' ka=', ka, &
+           ' kb_inv=', kbi, ' ks_inv=', ksi, ' ka_inv=', kai, ' kf=', kf, ' kf_rossconv=', 1/cf, &
+           ' theta_f=', d(1), ' u_f=', d(3), ' alpha_m=', d(5)
+      print '(a,f7.3,a,3es11.3,a,es11.3,a,es11.3)', '   r =', rc(j)*1e3_wp, ' mm  k_b, k_s, k_a', kb, ks, ka, &
+           '  k_f', kf, '  k_f (ROSS conventions)', 1/cf
+    end do
+  end subroutine ross_points
+
+  !> docs/stiffness.md table: per-mm single-pair stiffness at the pitch point (both teeth of gear (a)
+  !> identical; the spline's ISO 4156 teeth as in fillet_spline) and ISO 6336-1 c'_th, c'.
+  subroutine iso_table()
+    real(wp), parameter :: mm = 2e-3_wp
+    real(wp) :: kb, ks, ka, kf, khh, c0, c1, q
+    call external_tooth_stiffness(62.0_wp, mm, 20*deg, 0.02_wp, 59.5e-3_wp, 206e9_wp, 0.3_wp, 62e-3_wp, &
+         nref, kb, ks, ka, ierr, msg)
+    call fillet_foundation_stiffness(62.0_wp, mm, 20*deg, 0.02_wp, 59.5e-3_wp, 0.38_wp*mm, 17.5e-3_wp, &
+         206e9_wp, 0.3_wp, 62e-3_wp, kf, ierr, msg)
+    khh = hertz_stiffness(206e9_wp, 0.3_wp, 0.02_wp)
+    c0 = 1/(1/khh + 2/kb + 2/ks + 2/ka)/0.02_wp*1e-9_wp
+    c1 = 1/(1/khh + 2/kb + 2/ks + 2/ka + 2/kf)/0.02_wp*1e-9_wp
+    q = 0.04723_wp + 0.15551_wp/62 + 0.25791_wp/62
+    print '(/a)', '== docs/stiffness.md: single pair at the pitch point, N/(mm um) per mm face width =='
+    print '(a,4f8.2,a,2f8.2)', '   gear (a) pair: k_b k_s k_a k_f per tooth ', [kb, ks, ka, kf]/0.02_wp*1e-9_wp, &
+         ' | total w/o, with k_f', c0, c1
+    print '(a,f8.2,a,f8.2)', '   ISO 6336-1: c''_th = 1/q'' =', 1/q, '   c'' = 0.8 C_B c''_th =', &
+         iso_cprime(62.0_wp, 62.0_wp, 1.25_wp, 20.0_wp)
+    q = 0.04723_wp + 0.15551_wp/16
+    print '(a,f8.2,a,f8.2)', '   spline ISO 6336-1 (z2 = inf): c''_th =', 1/q, '   c'' =', &
+         iso_cprime(16.0_wp, huge(1.0_wp), 0.75_wp, 30.0_wp)
+  end subroutine iso_table
 
 end program stiffness_check

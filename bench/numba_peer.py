@@ -1,0 +1,398 @@
+"""The strongest "peer" a Python user could assemble: compiled LSODA (numbalsoda, ODEPACK's
+LSODA in C) driving a numba-compiled right-hand side written from /work/shared/spec/MODEL.md.
+
+Independent of the Fortran core and of the pyspline package (it imports neither). The case
+parameters come from tests/oracle.py's `prepare` (the same dict of case fields the oracle takes),
+so this RHS and the numpy oracle read one parameter set; the numbers are then packed into one
+float64 array `data` that numbalsoda hands to the compiled RHS at every call.
+
+Model (MODEL.md; equation numbers are the paper's):
+  phi_j = 2 pi j/Z + omega t + theta_0 - alpha, theta_0 = pi/(2Z)            Eqs. 8-9
+  dn_j  = (X1 - x2) sin phi_j - (Y1 - y2) cos phi_j + D2,  X1 = x1+l_x ...    Eq. 11
+          (r_b (th2 - th1) = D2, Eq. 24)
+  c_j   = c0 - 2 lambda s T_B cos(alpha)                                       Eq. 2
+  F_j   = k_m delta_j + c_m ddn_j  if |dn_j| > c_j, else 0 (dead zone)         Eqs. 15-17
+  F_x1  = -sum F_j sin phi_j, F_y1 = +sum F_j cos phi_j, T_m = r_b sum F_j    Eqs. 19-22 (MODEL s.4)
+  Eq. 23 reduced to D1, D2, D3 (Eq. 24, re-derived: the paper's T_L sign slip fixed).
+Thermal levels: 'none' (T_B = 0), 'bulk' (T_B = T_M), 'oneway' (dynamics identical to 'bulk';
+T_f is only reported, which this peer does not do), 'coupled' (T_B = T_M + T_fj with the Blok
+flash temperature, Eqs. 3-7, 12-14, solved per tooth by fixed-point iteration to 2 ulp as the
+oracle does, bisection fallback for teeth that do not converge in 60 iterations).
+
+Speed: the phase of tooth j is not re-evaluated with sin/cos per tooth: with a = omega t +
+theta_0 - alpha, sin phi_j = sin a cos(2 pi j/Z) + cos a sin(2 pi j/Z) (and likewise cos), the
+cos/sin(2 pi j/Z) are precomputed in `data`. One sin and one cos per call, a loop over teeth,
+no allocation.
+
+Scaling (Eq. 25): numbalsoda takes one scalar atol, so `solve` integrates the scaled system
+u = q / l, u' = q' / (l w), tau = w t (l = c0, w = shaft speed unless the case sets l_ref,
+w_ref), exactly as the project's CVODE integration does: atol is on the scaled states, i.e.
+atol*l [m] on lengths and atol*l*w [m/s] on velocities. The scaling is done inside the compiled
+RHS (a multiply per state); with l = w = 1 the same function is the plain SI right-hand side.
+
+Public functions:
+  make_rhs(params, scaled=True) -> (cfunc, data)     numbalsoda-compatible RHS and its data
+  solve(params, y0, t_eval, rtol=1e-8, atol=1e-10, mxstep=1_000_000, scaled=True)
+                                        -> (y, success, n_rhs)   y in SI, shape (len(t_eval), 14)
+  rhs_eval(params, t, y, scaled=False) -> dy/dt        one call of the compiled RHS (for tests)
+  load_case(path_or_dict, **overrides) -> dict         case fields with the core's defaults
+"""
+import ctypes
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import numba as nb
+from numba import cfunc, types
+
+ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT / "tests") not in sys.path:
+    sys.path.insert(0, str(ROOT / "tests"))
+import oracle  # noqa: E402
+
+__all__ = ["make_rhs", "solve", "rhs_eval", "load_case", "DEFAULTS", "lsoda_sig",
+           "COMPILE_SECONDS"]
+
+# numbalsoda's RHS signature: void f(double t, double *u, double *du, double *data)
+lsoda_sig = types.void(types.double, types.CPointer(types.double),
+                       types.CPointer(types.double), types.CPointer(types.double))
+
+# Defaults of every model field (fortran/case.f90 `case_defaults`, values only; MODEL.md s.8).
+DEFAULTS = dict(
+    z=16, module_m=2.0e-3, alpha_deg=30.0, b=0.03, s=3.14e-3, c0=2.0e-4, e_mod=2.1e11, nu=0.3,
+    lambda_th=1.2e-5, k_cond=46.47, rho=7800.0, c_heat=481.48,
+    j_m=7.54e-3, j_l=7.52e-3, j_1=3.43e-3, j_2=3.73e-3, m_1=2.0, m_2=2.0,
+    k_p1=5.0e6, k_p2=5.0e6, c_p1=5.0, c_p2=5.0, k_t1=7.855, k_t2=7.856, c_t1=0.191, c_t2=0.196,
+    k_m=0.0, c_m=0.053, t_d=30.7, t_l=30.7, speed_rpm=6000.0, grav=9.81, l_x=0.0, l_y=0.0,
+    thermal="none", t_bulk=0.0, f_m=0.1, u_flash=0.83, eta_hertz=1.127,
+    method="bdf", rtol=1.0e-8, atol=1.0e-10, t0=0.0, t_end=0.1, n_out=1001,
+    start="equilibrium", dq0=[0.0] * 7, dv0=[0.0] * 7, l_ref=0.0, w_ref=0.0,
+)
+
+
+def load_case(case, **overrides):
+    """Case fields as a dict: a namelist file (&spline_case, read with f90nml) or a dict, over
+    DEFAULTS, then `overrides`. k_m must be set (> 0): this peer does not compute Eq. 18."""
+    if isinstance(case, (str, Path)):
+        import f90nml
+        fields = dict(f90nml.read(str(case))["spline_case"])
+    else:
+        fields = dict(case)
+    out = dict(DEFAULTS)
+    out.update(fields)
+    out.update(overrides)
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# Layout of the parameter array `data` (float64). Slot 0 counts RHS calls, slot 1 is an error
+# flag (1: thermal interference, c_j <= 0, found inside the coupled iteration).
+# --------------------------------------------------------------------------------------------
+_NAMES = ("ncalls", "err", "z", "omega", "phase0", "l_x", "l_y", "c", "k_m", "c_m", "r_b",
+          "k_p1", "c_p1", "m_1", "k_p2", "c_p2", "m_2", "grav",
+          "k_t1", "c_t1", "k_t2", "c_t2", "j_1", "j_m", "j_2", "j_l", "t_d", "t_l",
+          "l_ref", "w_ref",
+          # coupled thermal level
+          "coupled", "c0", "th_coef", "t_bulk", "b", "eta_hertz", "hertz", "grc", "uf",
+          "R", "cos_a", "sin_a", "alpha")
+_I = {n: i for i, n in enumerate(_NAMES)}
+_NSCAL = len(_NAMES)
+# slot indices, in the order of _NAMES; after them cos(2 pi j/Z), j = 1..Z, then sin(2 pi j/Z)
+(_NCALLS, _ERR, _Z, _OMEGA, _PHASE0, _L_X, _L_Y, _C, _K_M, _C_M, _R_B, _K_P1, _C_P1, _M_1,
+ _K_P2, _C_P2, _M_2, _GRAV, _K_T1, _C_T1, _K_T2, _C_T2, _J_1, _J_M, _J_2, _J_L, _T_D, _T_L,
+ _L_REF, _W_REF, _COUPLED, _C0, _TH_COEF, _T_BULK, _B, _ETA_HERTZ, _HERTZ, _GRC, _UF, _R,
+ _COS_A, _SIN_A, _ALPHA) = range(_NSCAL)
+
+_FP_RTOL = 4.5e-16      # as tests/oracle.py: successive iterates within 2 ulp
+_FP_ATOL = 1.0e-300
+_FP_MAXIT = 60
+
+
+def _pack(params, scaled):
+    """Pack a case (dict or oracle.Prepared) into the `data` array of the compiled RHS."""
+    p = oracle.prepare(params)
+    if p.thermal == "coupled":
+        c = p.c0 - p.th_coef * p.t_bulk          # without flash: the largest the backlash gets
+    else:                                        # 'oneway': T_f does not feed back (MODEL s.6)
+        c = p.c0 - p.th_coef * (0.0 if p.thermal == "none" else p.t_bulk)     # Eq. 2
+    if not c > 0.0:
+        raise ValueError("thermal interference: backlash c_j <= 0 (Eq. 2), c_j = %r" % c)
+    if scaled:
+        l_ref = float(p.case.get("l_ref", 0.0) or 0.0) or p.c0
+        w_ref = float(p.case.get("w_ref", 0.0) or 0.0) or p.omega
+        if not w_ref > 0.0:
+            raise ValueError("scaled integration needs w_ref > 0 (shaft speed is 0): set w_ref")
+    else:
+        l_ref = w_ref = 1.0
+    d = np.zeros(_NSCAL + 2 * p.z)
+    v = dict(ncalls=0.0, err=0.0, z=p.z, omega=p.omega, phase0=p.theta_0 - p.alpha,
+             l_x=p.l_x, l_y=p.l_y, c=c, k_m=p.k_m, c_m=p.c_m, r_b=p.r_b,
+             k_p1=p.k_p1, c_p1=p.c_p1, m_1=p.m_1, k_p2=p.k_p2, c_p2=p.c_p2, m_2=p.m_2,
+             grav=p.grav, k_t1=p.k_t1, c_t1=p.c_t1, k_t2=p.k_t2, c_t2=p.c_t2,
+             j_1=p.j_1, j_m=p.j_m, j_2=p.j_2, j_l=p.j_l, t_d=p.t_d, t_l=p.t_l,
+             l_ref=l_ref, w_ref=w_ref,
+             coupled=1.0 if p.thermal == "coupled" else 0.0, c0=p.c0, th_coef=p.th_coef,
+             t_bulk=p.t_bulk, b=p.b, eta_hertz=p.eta_hertz, hertz=p.hertz, grc=p.grc,
+             uf=p.u_flash * p.f_m, R=p.R, cos_a=p.cos_a, sin_a=p.sin_a, alpha=p.alpha)
+    for k, x in v.items():
+        d[_I[k]] = x
+    ang = p.two_pi_j_over_z                       # 2 pi j / Z, j = 1..Z (Eq. 8)
+    d[_NSCAL:_NSCAL + p.z] = np.cos(ang)
+    d[_NSCAL + p.z:] = np.sin(ang)
+    return d
+
+
+# --------------------------------------------------------------------------------------------
+# Compiled pieces
+# --------------------------------------------------------------------------------------------
+@nb.njit(cache=False)
+def _contact_radius(delta, ddelta, R, cos_a, sin_a, alpha):
+    """Eq. 13 (root, dDelta/dt < 0) / Eq. 14 (tip, dDelta/dt >= 0)."""
+    if ddelta < 0.0:
+        return math.sqrt(delta * delta + R * R - 2.0 * R * delta * cos_a)
+    return R * math.sin(math.pi - alpha - math.asin(delta * sin_a / R)) / sin_a
+
+
+@nb.njit(cache=False)
+def _h(f, A, Req, dn, ddn, sigma, k_m, c_m, b, eta, hertz, c0, th, tb):
+    """Residual f - G(f) of the coupled tooth force (bisection fallback)."""
+    fe = abs(f) / b
+    Tf = 0.0
+    if fe > 0.0:
+        Tf = A * fe / math.sqrt(eta * math.sqrt(hertz * fe * Req))       # Eqs. 3-4
+    return f - (k_m * (dn - sigma * (c0 - th * (tb + Tf))) + c_m * ddn)
+
+
+@nb.njit(cache=False)
+def _coupled_force(d, dn, ddn, sp, cp, X1, Y1, x2, y2, vx1, vy1, vx2, vy2):
+    """Thermally coupled tooth force of one tooth in contact (MODEL.md s.6; Eqs. 1-7, 12-17).
+
+    F = k_m (dn - sigma c(F)) + c_m ddn, c = c0 - th_coef (T_M + T_f(|F|)). Fixed-point
+    iteration from the T_f = 0 force F0 until |F_{n+1} - F_n| <= 4.5e-16 |F_{n+1}| (2 ulp; the
+    map contracts with factor ~1e-3), at most 60 iterations; then bisection on the bracket
+    [F0, F0 + sigma aK M^(3/4)] (as the oracle's brentq fallback) to 4 eps. Returns F, or NaN
+    with d[err] = 1 if the backlash closes (thermal interference)."""
+    omega = d[_OMEGA]
+    R = d[_R]
+    cos_a = d[_COS_A]
+    sin_a = d[_SIN_A]
+    alpha = d[_ALPHA]
+    r_b = d[_R_B]
+    # Eq. 12 (simplified, MODEL s.6) and its total time derivative (branch of Eqs. 13-14)
+    d1 = X1 * cp + Y1 * sp
+    d2 = x2 * cp + y2 * sp
+    dd1 = vx1 * cp + vy1 * sp + omega * (-X1 * sp + Y1 * cp)
+    dd2 = vx2 * cp + vy2 * sp + omega * (-x2 * sp + y2 * cp)
+    rc1 = _contact_radius(d1, dd1, R, cos_a, sin_a, alpha)
+    rc2 = _contact_radius(d2, dd2, R, cos_a, sin_a, alpha)
+    Rc1 = rc1 * math.sin(math.acos(r_b / rc1))                         # Eqs. 5-6
+    Rc2 = rc2 * math.sin(math.acos(r_b / rc2))
+    v1 = omega * rc1 * cos_a                                             # Eq. 7
+    v2 = omega * rc2 * cos_a
+    Req = Rc1 * Rc2 / (Rc1 + Rc2)
+    grc = d[_GRC]
+    S = math.sqrt(grc * abs(v1)) + math.sqrt(grc * abs(v2))
+    A = d[_UF] * abs(v1 - v2) / S if S > 0.0 else 0.0
+    k_m = d[_K_M]
+    c_m = d[_C_M]
+    b = d[_B]
+    eta = d[_ETA_HERTZ]
+    hertz = d[_HERTZ]
+    c0 = d[_C0]
+    th = d[_TH_COEF]
+    tb = d[_T_BULK]
+    sigma = 1.0 if dn > 0.0 else -1.0
+    Fc = k_m * (dn - sigma * (c0 - th * tb)) + c_m * ddn                  # F0 (T_f = 0)
+    F0 = Fc
+    done = False
+    for _ in range(_FP_MAXIT):
+        fe = abs(Fc) / b
+        Tf = 0.0
+        if fe > 0.0:
+            B = eta * math.sqrt(hertz * fe * Req)                            # Eq. 4
+            Tf = A * fe / math.sqrt(B)                                       # Eq. 3
+        cv = c0 - th * (tb + Tf)                                             # Eqs. 1-2
+        if cv <= 0.0:
+            d[_ERR] = 1.0
+            return math.nan
+        Fn = k_m * (dn - sigma * cv) + c_m * ddn                             # Eqs. 15-17
+        done = abs(Fn - Fc) <= _FP_RTOL * abs(Fn) + _FP_ATOL
+        Fc = Fn
+        if done:
+            break
+    if done:
+        return Fc
+    # fallback (|F| ~ 1e-9 N or less): bisection on h(f) = f - G(f)
+    fe1 = 1.0 / b
+    aK = k_m * th * A * fe1 / math.sqrt(eta * math.sqrt(hertz * fe1 * Req))
+    M = max(2.0 * abs(F0), (2.0 * aK) ** 4)
+    F1 = F0 + sigma * aK * M ** 0.75
+    lo = min(F0, F1)
+    hi = max(F0, F1)
+    args = (A, Req, dn, ddn, sigma, k_m, c_m, b, eta, hertz, c0, th, tb)
+    hlo = _h(lo, *args)
+    if hlo == 0.0:
+        return lo
+    for _ in range(2000):
+        mid = 0.5 * (lo + hi)
+        if hi - lo <= 4.0 * 2.220446049250313e-16 * abs(mid) or mid == lo or mid == hi:
+            break
+        hm = _h(mid, *args)
+        if hm == 0.0:
+            return mid
+        if (hm > 0.0) == (hlo > 0.0):
+            lo = mid
+            hlo = hm
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def _rhs_py(tau, u, du, d):
+    """Right-hand side in the scaled variables of Eq. 25 (SI when l_ref = w_ref = 1):
+    u[0:7] = q / l, u[7:14] = q' / (l w), derivative with respect to tau = w t."""
+    d[_NCALLS] += 1.0
+    l = d[_L_REF]
+    w = d[_W_REF]
+    lw = l * w
+    t = tau / w
+    x1 = u[0] * l
+    y1 = u[1] * l
+    x2 = u[2] * l
+    y2 = u[3] * l
+    D1 = u[4] * l
+    D2 = u[5] * l
+    D3 = u[6] * l
+    vx1 = u[7] * lw
+    vy1 = u[8] * lw
+    vx2 = u[9] * lw
+    vy2 = u[10] * lw
+    dD1 = u[11] * lw
+    dD2 = u[12] * lw
+    dD3 = u[13] * lw
+
+    omega = d[_OMEGA]
+    c = d[_C]
+    k_m = d[_K_M]
+    c_m = d[_C_M]
+    r_b = d[_R_B]
+    z = int(d[_Z])
+    X1 = x1 + d[_L_X]
+    Y1 = y1 + d[_L_Y]
+    ex = X1 - x2
+    ey = Y1 - y2
+    dvx = vx1 - vx2
+    dvy = vy1 - vy2
+    a = omega * t + d[_PHASE0]                    # phi_j = 2 pi j/Z + a  (Eqs. 8-9)
+    sa = math.sin(a)
+    ca = math.cos(a)
+    coupled = d[_COUPLED] != 0.0
+    sumF = 0.0
+    sumFs = 0.0
+    sumFc = 0.0
+    for j in range(z):
+        cj = d[_NSCAL + j]
+        sj = d[_NSCAL + z + j]
+        sp = sa * cj + ca * sj                    # sin(a + 2 pi j/Z)
+        cp = ca * cj - sa * sj                    # cos(a + 2 pi j/Z)
+        dn = ex * sp - ey * cp + D2                                        # Eq. 11
+        if dn > c:
+            delta = dn - c
+        elif dn < -c:
+            delta = dn + c
+        else:
+            continue                              # dead zone: F_j = 0 (Eqs. 15-17)
+        ddn = dvx * sp - dvy * cp + dD2 + omega * (ex * cp + ey * sp)      # d/dt Eq. 11
+        if coupled:
+            F = _coupled_force(d, dn, ddn, sp, cp, X1, Y1, x2, y2, vx1, vy1, vx2, vy2)
+        else:
+            F = k_m * delta + c_m * ddn                                    # Eqs. 15-17
+        sumF += F
+        sumFs += F * sp
+        sumFc += F * cp
+    Tm = r_b * sumF                                                        # Eq. 22
+    Fx1 = -sumFs                                                           # MODEL s.4
+    Fy1 = sumFc
+
+    S1 = (d[_K_T1] * D1 + d[_C_T1] * dD1) / r_b
+    S2 = (d[_K_T2] * D3 + d[_C_T2] * dD3) / r_b
+    a1 = (Tm - S1) / d[_J_1]                     # th1''
+    aM = (d[_T_D] + S1) / d[_J_M]                # thM''
+    a2 = (-Tm - S2) / d[_J_2]                    # th2''
+    aL = (S2 - d[_T_L]) / d[_J_L]                # thL''
+    grav = d[_GRAV]
+    s_a = 1.0 / (lw * w)                         # d(q'/(l w))/dtau = q''/(l w^2); 1 in SI
+    for i in range(7):
+        du[i] = u[7 + i]                         # d(q/l)/dtau = q'/(l w) = u[7+i]
+    du[7] = ((Fx1 - d[_C_P1] * vx1 - d[_K_P1] * x1) / d[_M_1]) * s_a
+    du[8] = ((Fy1 - d[_C_P1] * vy1 - d[_K_P1] * y1) / d[_M_1] - grav) * s_a
+    du[9] = ((-Fx1 - d[_C_P2] * vx2 - d[_K_P2] * x2) / d[_M_2]) * s_a
+    du[10] = ((-Fy1 - d[_C_P2] * vy2 - d[_K_P2] * y2) / d[_M_2] - grav) * s_a
+    du[11] = (r_b * (a1 - aM)) * s_a             # D1'' = r_b (th1'' - thM'')  (Eq. 24)
+    du[12] = (r_b * (a2 - a1)) * s_a             # D2'' = r_b (th2'' - th1'')
+    du[13] = (r_b * (a2 - aL)) * s_a             # D3'' = r_b (th2'' - thL'')
+
+
+_CFUNC = []
+COMPILE_SECONDS = []      # wall time of the one numba compilation of the RHS (cfunc + helpers)
+
+
+def _compiled():
+    """The RHS compiled once per process (numba cfunc with numbalsoda's signature)."""
+    if not _CFUNC:
+        t0 = time.perf_counter()
+        _CFUNC.append(cfunc(lsoda_sig, nopython=True, cache=False)(_rhs_py))
+        COMPILE_SECONDS.append(time.perf_counter() - t0)
+    return _CFUNC[0]
+
+
+def make_rhs(params, scaled=True):
+    """numbalsoda-compatible compiled RHS for a case.
+
+    params: a dict of case fields (as tests/oracle.py's `prepare` takes; see load_case for the
+    defaults) or an oracle.Prepared. Returns (rhs, data): `rhs` is a numba cfunc with
+    numbalsoda's lsoda_sig (pass rhs.address to numbalsoda.lsoda), `data` the float64 parameter
+    array to pass as numbalsoda's `data` (data[0] counts RHS calls, data[1] is the thermal-
+    interference flag). scaled=True: the RHS is in the scaled states and time of Eq. 25 (l =
+    c0 or l_ref, w = shaft speed or w_ref); scaled=False: plain SI, y' = f(t, y) as oracle.rhs.
+    The function is compiled once per process; the parameters only change `data`."""
+    return _compiled(), _pack(params, scaled)
+
+
+def _scales(data):
+    l, w = data[_L_REF], data[_W_REF]
+    return np.r_[np.full(7, l), np.full(7, l * w)], w
+
+
+def rhs_eval(params, t, y, scaled=False):
+    """dy/dt of the compiled RHS at (t, y), called through ctypes (SI unless scaled)."""
+    fn, data = make_rhs(params, scaled=scaled)
+    u = np.ascontiguousarray(y, dtype=float).copy()
+    du = np.zeros(14)
+    P = ctypes.POINTER(ctypes.c_double)
+    fn.ctypes(float(t), u.ctypes.data_as(P), du.ctypes.data_as(P), data.ctypes.data_as(P))
+    if data[_ERR] != 0.0:
+        raise ValueError("thermal interference: backlash c_j <= 0 (Eq. 2)")
+    return du
+
+
+def solve(params, y0, t_eval, rtol=1e-8, atol=1e-10, mxstep=1_000_000, scaled=True):
+    """Integrate with numbalsoda's LSODA. y0 (14, SI) and t_eval (s; t_eval[0] is the start
+    time) as for oracle.rhs. atol is on the scaled states of Eq. 25 (atol*l [m] on lengths,
+    atol*l*w [m/s] on velocities) when scaled=True, else in SI for every state. mxstep: steps
+    allowed between two output times.
+    Returns (y, success, n_rhs): y of shape (len(t_eval), 14) in SI, LSODA's success flag, the
+    number of RHS calls (counted in data[0]; includes the Jacobian's difference quotients)."""
+    import numbalsoda
+    fn, data = make_rhs(params, scaled=scaled)
+    scale, w = _scales(data)
+    t_eval = np.asarray(t_eval, dtype=float)
+    u0 = np.asarray(y0, dtype=float) / scale
+    tau = t_eval * w
+    usol, success = numbalsoda.lsoda(fn.address, u0, tau, data=data, rtol=float(rtol),
+                                     atol=float(atol), mxstep=int(mxstep))
+    if data[_ERR] != 0.0:
+        raise ValueError("thermal interference: backlash c_j <= 0 (Eq. 2) during the solve")
+    return usol * scale, bool(success), int(data[_NCALLS])

@@ -1,0 +1,101 @@
+"""The numba/numbalsoda peer (bench/numba_peer.py) against the independent numpy oracle
+(tests/oracle.py): the compiled RHS equals oracle.rhs to 1e-12 relative, and a short numbalsoda
+LSODA solve agrees with scipy's LSODA on the oracle RHS. Does not import pyspline."""
+import sys
+import zlib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("numba")
+pytest.importorskip("numbalsoda")
+
+import oracle  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "bench"))
+import numba_peer  # noqa: E402
+
+BASE = dict(k_m=2.3e5, m_1=2.0, m_2=2.0)      # conftest.PAPER, over the core's defaults
+CASES = {
+    "aligned": dict(BASE),
+    "misaligned": dict(BASE, l_x=1e-4),
+    "misaligned_xy": dict(BASE, l_x=1e-4, l_y=-3e-5),
+    "bulk": dict(BASE, l_x=1e-4, thermal="bulk", t_bulk=100.0),
+    "oneway": dict(BASE, l_x=1e-4, thermal="oneway", t_bulk=50.0),
+    "coupled": dict(BASE, l_x=1e-4, thermal="coupled", t_bulk=100.0, f_m=0.3),
+    "z7": dict(BASE, z=7, l_x=1e-4),
+    "slow_z7": dict(BASE, z=7, speed_rpm=300.0, l_x=5e-5, l_y=5e-5, grav=0.0),
+    "stiff": dict(BASE, k_m=5e8, l_x=1e-4),
+}
+
+
+def random_states(c0, n, rng):
+    """As tests/test_oracle.py: lateral states in and out of contact, D2 across the dead zone."""
+    ys = []
+    for _ in range(n):
+        q = np.r_[rng.uniform(-2, 2, 4) * c0, rng.uniform(-300, 300) * c0,
+                  rng.uniform(-6, 6) * c0, rng.uniform(-300, 300) * c0]
+        ys.append(np.r_[q, rng.uniform(-0.2, 0.2, 7)])
+    return ys
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_rhs_matches_oracle(name):
+    case = numba_peer.load_case(dict(CASES[name], name=name))
+    p = oracle.prepare(case)
+    rng = np.random.default_rng(zlib.crc32(name.encode()))
+    n_free = n_contact = 0
+    for y in random_states(case["c0"], 60, rng):
+        t = rng.uniform(0, 0.05)
+        f = numba_peer.rhs_eval(case, t, y)
+        fo = oracle.rhs(t, y, p)
+        np.testing.assert_allclose(f, fo, rtol=1e-12, atol=1e-12 * np.abs(fo).max())
+        # the scaled form (Eq. 25) used by solve() is the same function in other units
+        l, w = case["c0"], p.omega
+        sc = np.r_[np.full(7, l), np.full(7, l * w)]
+        fs = numba_peer.rhs_eval(case, t * w, y / sc, scaled=True)
+        np.testing.assert_allclose(fs * sc * w, fo, rtol=1e-12, atol=1e-12 * np.abs(fo).max())
+        m = oracle.mesh(t, y, p)
+        contact = np.abs(m["dn"]) > m["c"]
+        n_contact += contact.sum()
+        n_free += (~contact).sum()
+    assert n_contact > 20 and n_free > 20       # both sides of the dead zone exercised
+
+
+def test_thermal_interference_is_an_error():
+    with pytest.raises(ValueError, match="interference"):
+        numba_peer.make_rhs(numba_peer.load_case(BASE, thermal="bulk", t_bulk=1e4))
+
+
+def test_default_fields_match_template():
+    """DEFAULTS (copied from the core's case_defaults) agree with cases/template.nml."""
+    f90nml = pytest.importorskip("f90nml")
+    tmpl = f90nml.read(str(Path(__file__).resolve().parent.parent / "cases" / "template.nml"))
+    tmpl = tmpl["spline_case"]
+    for k, v in numba_peer.DEFAULTS.items():
+        if k in tmpl and not isinstance(v, (list, str)):
+            assert float(tmpl[k]) == float(v), k
+
+
+@pytest.mark.parametrize("name", ["misaligned", "z7", "bulk", "coupled"])
+def test_lsoda_agrees_with_scipy_lsoda_on_oracle(name):
+    from scipy.integrate import solve_ivp
+    case = numba_peer.load_case(dict(CASES[name], name=name))
+    p = oracle.prepare(case)
+    y0 = np.zeros(14)                             # start from rest: engagement transient
+    t_eval = np.linspace(0.0, 0.01, 41)
+    rtol, atol = 1e-10, 1e-12                     # atol on the scaled states (Eq. 25)
+    y, ok, nrhs = numba_peer.solve(case, y0, t_eval, rtol=rtol, atol=atol)
+    assert ok and nrhs > 100
+    sc = np.r_[np.full(7, case["c0"]), np.full(7, case["c0"] * p.omega)]
+    ref = solve_ivp(lambda t, yy: oracle.rhs(t, yy, p), (0.0, t_eval[-1]), y0,
+                    method="LSODA", rtol=rtol, atol=atol * sc, t_eval=t_eval)
+    assert ref.success
+    scale = np.abs(ref.y).max(axis=1)             # per state over the run
+    err = np.abs(y - ref.y.T).max(axis=0) / scale
+    assert err.max() < 1e-6, err
+    # tooth load: T_m agrees too
+    tm = np.array([oracle.mesh(t, yy, p)["Tm"] for t, yy in zip(t_eval, y)])
+    tmr = np.array([oracle.mesh(t, yy, p)["Tm"] for t, yy in zip(t_eval, ref.y.T)])
+    assert np.abs(tm - tmr).max() < 1e-6 * np.abs(tmr).max()
