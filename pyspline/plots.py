@@ -18,11 +18,13 @@ import numpy as np
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
+from matplotlib.ticker import MaxNLocator
 
 __all__ = ["bifurcation", "lyapunov_vs_param", "scene", "waterfall"]
 
-# Colours of periods 1, 2, 3, 4 and > 4 (colour-blind safe, Okabe-Ito); not periodic is grey.
-PERIOD_COLOURS = {1: "#0072B2", 2: "#D55E00", 3: "#009E73", 4: "#CC79A7", 5: "#E69F00"}
+# Colours of periods 1, 2, 3, 4 (Okabe-Ito, colour-blind safe) and > 4; not periodic is grey.
+PERIOD_COLOURS = {1: "#0072B2", 2: "#D55E00", 3: "#009E73", 4: "#CC79A7", 5: "#000000"}
 NOT_PERIODIC = "0.6"
 SHAFT_STYLE = dict(color="0.25", ls=(0, (4, 3)), lw=0.9)
 TOOTH_STYLE = dict(color="tab:red", ls=(0, (6, 3)), lw=1.1)
@@ -47,21 +49,29 @@ def _array(ds, name, dims=None) -> np.ndarray:
     return np.asarray(v, dtype=float)
 
 
-def _units(ds, name, default="") -> str:
+def _units(ds, name, default="", units=None) -> str:
+    """Units of ds[name]: `units[name]` if given, else attrs['units'], else `default`."""
+    if units and name in units:
+        return str(units[name])
     try:
         return str(ds[name].attrs.get("units", default))
     except AttributeError:
         return default
 
 
-def _label(ds, name, default_units="") -> str:
-    """'long_name [units]' from a variable's attrs, else 'name [units]'."""
+def _long_name(ds, name) -> str:
     try:
-        long = ds[name].attrs.get("long_name", name)
+        return str(ds[name].attrs.get("long_name", name))
     except AttributeError:
-        long = name
-    u = _units(ds, name, default_units)
-    return f"{long} [{u}]" if u else str(long)
+        return str(name)
+
+
+def _label(ds, name, default_units="", units=None, factor_unit=None) -> str:
+    """'long_name [units]' from a variable's attrs (or `units`), else 'name [units]';
+    `factor_unit` replaces the unit (an SI-prefixed one)."""
+    u = factor_unit if factor_unit is not None else _units(ds, name, default_units, units)
+    long = _long_name(ds, name)
+    return f"{long} [{u}]" if u else long
 
 
 def _prefix(values, unit: str) -> tuple[float, str]:
@@ -79,28 +89,40 @@ def _prefix(values, unit: str) -> tuple[float, str]:
     return factor, p + unit
 
 
-def _order_lines(ax, f_shaft_hz, z, x_max, vertical=True, y_text=0.98):
-    """Dashed lines at shaft orders 1x, 2x and tooth-pass orders Zx, 2Zx (Hz) below x_max."""
+def _order_marks(z):
+    """(order, label, style) of the shaft orders 1x, 2x and tooth-pass orders Zx, 2Zx."""
     marks = [(1, "1x", SHAFT_STYLE), (2, "2x", SHAFT_STYLE)]
     if z:
-        marks += [(z, f"{z}x (tooth pass)", TOOTH_STYLE), (2 * z, f"{2 * z}x", TOOTH_STYLE)]
-    for k, text, style in marks:
-        f = k * f_shaft_hz
-        if f <= x_max:
-            ax.axvline(f, **style)
-            ax.text(f, y_text, " " + text, transform=ax.get_xaxis_transform(), rotation=90,
-                    va="top", ha="left", fontsize=8, color=style["color"])
+        marks += [(z, f"{z}x", TOOTH_STYLE), (2 * z, f"{2 * z}x", TOOTH_STYLE)]
+    return marks
+
+
+def _peak_hold(f, a, f_max, columns=500):
+    """Keep the bins up to f_max; when there are more than `columns`, merge neighbours into
+    `columns` groups keeping the largest amplitude, so that narrow tones stay visible at screen
+    resolution. f, a: (rows, bins)."""
+    keep = (f <= f_max).any(axis=0)
+    f, a = f[:, keep], a[:, keep]
+    g = int(np.ceil(f.shape[1] / columns))
+    if g <= 1:
+        return f, a
+    pad = (-f.shape[1]) % g
+    f = np.pad(f, ((0, 0), (0, pad)), constant_values=np.nan)
+    a = np.pad(a, ((0, 0), (0, pad)), constant_values=np.nan)
+    shape = (f.shape[0], f.shape[1] // g, g)
+    return np.nanmean(f.reshape(shape), axis=2), np.nanmax(a.reshape(shape), axis=2)
 
 
 # --------------------------------------------------------------------------- bifurcation
 
 def bifurcation(ds, param: str, coord: str = "section_D2", period: str = "period",
-                path=None, title: str | None = None) -> Figure:
+                path=None, title: str | None = None, units: dict | None = None) -> Figure:
     """Bifurcation diagram: the section coordinate ``ds[coord]`` (dims (param,
     'section_point'), NaN-padded) against the swept ``ds[param]`` (dim (param,)), each point
     coloured by ``ds[period]`` (dim (param,)): period 1, 2, 3, 4, > 4 in distinct colours, not
-    periodic (0, negative or NaN) in grey. A coordinate in m or m/s is shown with a readable SI
-    prefix (um, mm, mm/s)."""
+    periodic (0, negative or NaN) in grey. Units come from each variable's attrs['units'] or
+    from `units` ({name: unit}, for a dict of arrays; the coordinate defaults to m). Axes in
+    m, m/s, N or N m get a readable SI prefix (um, mm/s, kN)."""
     p = _array(ds, param)
     y = _array(ds, coord, dims=(param, "section_point") if hasattr(ds, "dims") else None)
     per = _array(ds, period)
@@ -109,78 +131,76 @@ def bifurcation(ds, param: str, coord: str = "section_D2", period: str = "period
     if y.shape[0] != p.shape[0] or per.shape != p.shape:
         raise ValueError(f"{coord} must have shape ({len(p)}, n_points) and {period} ({len(p)},),"
                          f" got {y.shape} and {per.shape}")
-    factor, unit = _prefix(y, _units(ds, coord, "m"))
-    try:
-        long = ds[coord].attrs.get("long_name", coord)
-    except AttributeError:
-        long = coord
+    factor, unit = _prefix(y, _units(ds, coord, "m", units))
+    px, ux = _prefix(p, _units(ds, param, "", units))
+    long = _long_name(ds, coord)
     cls = np.where(np.isfinite(per) & (per > 0), np.minimum(np.nan_to_num(per), 5), 0).astype(int)
-    fig = Figure(figsize=(9, 5.5))
+    fig = Figure(figsize=(9, 5.5), layout="constrained")
     ax = fig.add_subplot()
     handles = []
     for c in (0, 1, 2, 3, 4, 5):
         rows = cls == c
         if not rows.any():
             continue
-        xs = np.repeat(p[rows], y.shape[1])
+        xs = np.repeat(p[rows] / px, y.shape[1])
         ys = y[rows].ravel() / factor
         ok = np.isfinite(ys)
         colour = NOT_PERIODIC if c == 0 else PERIOD_COLOURS[c]
-        ax.scatter(xs[ok], ys[ok], s=2.5 if c == 0 else 9, c=colour, lw=0,
+        ax.scatter(xs[ok], ys[ok], s=3 if c == 0 else 9, c=colour, lw=0,
                    alpha=0.6 if c == 0 else 1.0, zorder=1 if c == 0 else 2, rasterized=True)
         name = "not periodic" if c == 0 else ("period > 4" if c == 5 else f"period {c}")
         handles.append(Line2D([], [], ls="", marker="o", ms=6, color=colour,
                               label=f"{name} ({rows.sum()})"))
-    ax.set_xlabel(_label(ds, param))
-    ax.set_ylabel(f"{long} [{unit}]" if unit else long)
+    ax.set_xlabel(_label(ds, param, factor_unit=ux))
+    ax.set_ylabel(_label(ds, coord, factor_unit=unit))
     ax.legend(handles=handles, fontsize=8, loc="best", title="runs by period",
               title_fontsize=8, framealpha=0.9)
     ax.grid(alpha=0.3, lw=0.5)
-    ax.set_title(title or f"bifurcation diagram: {long} on the section vs {param}")
-    fig.tight_layout()
+    ax.set_title(title or f"bifurcation diagram: {long} vs {_long_name(ds, param)}")
     return _finish(fig, path)
 
 
 # --------------------------------------------------------------------------- Lyapunov
 
 def lyapunov_vs_param(ds, param: str, var: str = "lyapunov", path=None,
-                      title: str | None = None) -> Figure:
+                      title: str | None = None, units: dict | None = None) -> Figure:
     """Largest Lyapunov exponent ``ds[var]`` [1/s] against the swept ``ds[param]``, with a zero
-    line (above it: chaos) and, on the right axis (log scale), the predictability horizon
-    1/lambda [s] of the runs with lambda > 0. Error bars from ``ds[var + '_spread']`` when the
-    dataset has it (e.g. the spread of `largest_lyapunov_fit`)."""
+    line (above it, shaded: chaos) and, on the right axis (log scale), the predictability
+    horizon 1/lambda [s] of the runs with lambda > 0 (lambda <= 0: no horizon, infinite).
+    Error bars of half the spread ``ds[var + '_spread']`` when the dataset has it (e.g. the
+    spread of `largest_lyapunov_fit`). `units` as in `bifurcation`."""
     p = _array(ds, param)
     lam = _array(ds, var)
-    unit = _units(ds, var, "1/s")
-    fig = Figure(figsize=(9, 5))
+    unit = _units(ds, var, "1/s", units)
+    px, ux = _prefix(p, _units(ds, param, "", units))
+    x = p / px
+    fig = Figure(figsize=(9, 5.5), layout="constrained")
     ax = fig.add_subplot()
     ax.axhline(0, color="k", lw=0.8)
-    err = _array(ds, var + "_spread") if var + "_spread" in ds else None
-    ax.errorbar(p, lam, yerr=None if err is None else err / 2, fmt="o-", ms=4, lw=1,
-                color="tab:blue", ecolor="0.5", capsize=2, label="largest Lyapunov exponent")
+    err = _array(ds, var + "_spread") / 2 if var + "_spread" in ds else None
+    ax.errorbar(x, lam, yerr=err, fmt="o-", ms=4, lw=1, color="tab:blue", ecolor="0.5",
+                capsize=2)
     pos = np.isfinite(lam) & (lam > 0)
-    if pos.any():
-        lo, hi = ax.get_ylim()
+    lo, hi = ax.get_ylim()
+    if hi > 0:
         ax.axhspan(0, hi, color="tab:red", alpha=0.06, lw=0)
         ax.set_ylim(lo, hi)
-        ax.text(0.01, 0.98, "lambda > 0: chaotic", transform=ax.transAxes, va="top",
-                fontsize=8, color="tab:red")
-    ax.set_xlabel(_label(ds, param))
+    ax.set_xlabel(_label(ds, param, factor_unit=ux))
     ax.set_ylabel(f"largest Lyapunov exponent lambda [{unit}]")
     ax.grid(alpha=0.3, lw=0.5)
     h_unit = "s" if unit == "1/s" else f"1/({unit})"
-    handles = [Line2D([], [], marker="o", color="tab:blue", label="lambda (left axis)")]
+    handles = [Line2D([], [], marker="o", color="tab:blue", label="lambda (left axis)"),
+               Patch(facecolor="tab:red", alpha=0.15, label="lambda > 0: chaotic")]
     if pos.any():
         ax2 = ax.twinx()
-        ax2.plot(p[pos], 1.0 / lam[pos], "s", mfc="none", mec="tab:orange", ms=6)
+        ax2.plot(x[pos], 1.0 / lam[pos], "s", mfc="none", mec="tab:orange", ms=6)
         ax2.set_yscale("log")
         ax2.set_ylabel(f"predictability horizon 1/lambda [{h_unit}]", color="tab:orange")
         ax2.tick_params(axis="y", colors="tab:orange", which="both")
         handles.append(Line2D([], [], ls="", marker="s", mfc="none", mec="tab:orange",
-                              label="1/lambda where lambda > 0 (right axis)"))
-    ax.legend(handles=handles, fontsize=8, loc="lower right")
-    ax.set_title(title or f"largest Lyapunov exponent vs {param}")
-    fig.tight_layout()
+                              label="horizon 1/lambda where lambda > 0 (right axis)"))
+    fig.legend(handles=handles, fontsize=8, loc="outside lower center", ncols=3, frameon=False)
+    ax.set_title(title or f"largest Lyapunov exponent vs {_long_name(ds, param)}")
     return _finish(fig, path)
 
 
@@ -188,71 +208,77 @@ def lyapunov_vs_param(ds, param: str, var: str = "lyapunov", path=None,
 
 def waterfall(ds, speed: str = "speed_rpm", freq: str = "freq_hz", amp: str = "amplitude",
               z: int | None = None, max_order: float | None = None, path=None,
-              style: str = "map", floor: float = 1e-4, title: str | None = None) -> Figure:
+              style: str = "map", floor: float = 1e-4, title: str | None = None,
+              units: dict | None = None) -> Figure:
     """Spectra against speed: frequency [Hz] on x, speed [rpm] on y.
 
     ``ds[amp]`` has dims (speed, freq); ``ds[freq]`` is 1-D (one frequency grid for all) or
-    (speed, freq). style 'map' (default) shows the amplitude as colour on a log scale down to
-    `floor` times the largest amplitude; 'lines' draws each spectrum as a line offset to its
-    speed (height: the largest amplitude spans the smallest speed step). Shaft orders 1x, 2x and,
-    given `z`, the tooth-pass order Zx (and 2Zx) are dashed diagonal lines f = k rpm / 60. The
-    frequency axis ends at `max_order` shaft orders of the highest speed (default 2.5 Z if `z` is
-    given, else the whole spectrum)."""
+    (speed, freq). Amplitudes are on a log scale from `floor` times the largest one up: as
+    colour (style 'map', default) or as the height of one line per speed above its speed
+    (style 'lines', full height 0.9 of the smallest speed step). Neighbouring bins are merged
+    keeping the largest (peak hold) down to about 500 columns, so narrow tones stay visible.
+    Shaft orders 1x, 2x (grey/white) and, given `z`, the tooth-pass orders Zx, 2Zx (red) are
+    dashed diagonal lines f = k rpm / 60. The frequency axis ends at `max_order` shaft orders of
+    the highest speed (default 2.5 Z if `z` is given), or at the highest frequency."""
     rpm = _array(ds, speed)
     a = _array(ds, amp, dims=(speed, freq) if hasattr(ds, "dims") else None)
     f = _array(ds, freq)
     if f.ndim == 1:
         f = np.broadcast_to(f, a.shape)
-    if a.shape != f.shape or a.shape[0] != rpm.shape[0]:
+    if a.shape != f.shape or a.ndim != 2 or a.shape[0] != rpm.shape[0]:
         raise ValueError(f"{amp} must have shape ({len(rpm)}, n_freq) matching {freq}, got "
                          f"{a.shape} and {f.shape}")
+    if style not in ("map", "lines"):
+        raise ValueError(f"style must be 'map' or 'lines', got {style!r}")
     order = np.argsort(rpm)
     rpm, a, f = rpm[order], a[order], f[order]
     if max_order is None and z:
         max_order = 2.5 * z
-    f_max = np.nanmax(f) if max_order is None else max_order * np.abs(rpm).max() / 60.0
-    amp_unit = _units(ds, amp, "")
-    fig = Figure(figsize=(10, 6))
+    f_max = np.nanmax(f)
+    if max_order is not None:
+        f_max = min(f_max, max_order * np.abs(rpm).max() / 60.0)
+    f, a = _peak_hold(f, a, f_max)
+    amp_unit = _units(ds, amp, "", units)
+    top = np.nanmax(a)
+    top = top if top > 0 else 1.0
+    fig = Figure(figsize=(10, 6.5), layout="constrained")
     ax = fig.add_subplot()
-    if style == "map":
-        top = np.nanmax(a)
-        norm = LogNorm(vmin=top * floor, vmax=top) if top > 0 else None
+    dark = style == "map"
+    if dark:
         rr = np.broadcast_to(rpm[:, None], a.shape)
-        mesh = ax.pcolormesh(f, rr, np.clip(a, top * floor, None) if top > 0 else a,
-                             norm=norm, cmap="magma", shading="nearest", rasterized=True)
-        cb = fig.colorbar(mesh, ax=ax, pad=0.02)
+        mesh = ax.pcolormesh(f, rr, np.clip(a, top * floor, None), shading="nearest",
+                             norm=LogNorm(vmin=top * floor, vmax=top), cmap="magma",
+                             rasterized=True)
+        cb = fig.colorbar(mesh, ax=ax, pad=0.01)
         cb.set_label(f"amplitude [{amp_unit}]" if amp_unit else "amplitude")
-    elif style == "lines":
-        step = np.diff(rpm).min() if len(rpm) > 1 else 1.0
-        top = np.nanmax(a) or 1.0
-        for r, fi, ai in zip(rpm, f, a):
-            ax.plot(fi, r + 0.9 * step * ai / top, lw=0.8, color="tab:blue")
-            ax.axhline(r, color="0.85", lw=0.5, zorder=0)
-        ax.text(0.99, 0.01, f"line height: {top:.3g} {amp_unit} = {0.9 * step:g} rpm",
-                transform=ax.transAxes, ha="right", va="bottom", fontsize=8)
     else:
-        raise ValueError(f"style must be 'map' or 'lines', got {style!r}")
+        step = np.diff(rpm).min() if len(rpm) > 1 else 1.0
+        decades = -np.log10(floor)
+        for r, fi, ai in zip(rpm, f, a):
+            h = np.clip(np.log10(np.clip(ai, top * floor, None) / top) / decades + 1, 0, 1)
+            ax.fill_between(fi, r, r + 0.9 * step * h, color="tab:blue", alpha=0.25, lw=0)
+            ax.plot(fi, r + 0.9 * step * h, lw=0.7, color="tab:blue")
+        ax.text(0.99, 0.01, f"line height: log scale, {top * floor:.2g} to {top:.3g} "
+                f"{amp_unit}".rstrip(), transform=ax.transAxes, ha="right", va="bottom",
+                fontsize=8, bbox=dict(fc="w", ec="none", alpha=0.8))
     ax.set_xlim(0, f_max)
     y_lo, y_hi = ax.get_ylim()
-    speeds = np.array([0.0, max(y_hi, 0.0)])
-    marks = [(1, "1x", SHAFT_STYLE), (2, "2x", SHAFT_STYLE)]
-    if z:
-        marks += [(z, f"{z}x (tooth pass)", TOOTH_STYLE), (2 * z, f"{2 * z}x", TOOTH_STYLE)]
-    for k, text, st in marks:
-        fk = k * speeds / 60.0
-        line_style = dict(st, color="w" if style == "map" and st is SHAFT_STYLE else st["color"])
-        ax.plot(fk, speeds, **line_style)
-        f_top = k * y_hi / 60.0
-        if f_top <= f_max:
-            ax.text(f_top, y_hi, text, ha="center", va="bottom", fontsize=8, color=st["color"])
-        else:                              # the line leaves through the right edge
+    for k, text, st in _order_marks(z):
+        colour = "w" if dark and st is SHAFT_STYLE else st["color"]
+        ax.plot([0.0, k * y_hi / 60.0], [0.0, y_hi], **dict(st, color=colour))
+        if k * y_hi / 60.0 <= f_max:      # label where the line leaves the plot
+            ax.text(k * y_hi / 60.0, y_hi, text, ha="center", va="bottom", fontsize=8,
+                    color=st["color"])
+        else:
             ax.text(f_max, 60.0 * f_max / k, text + " ", ha="right", va="bottom", fontsize=8,
-                    color=line_style["color"])
+                    color=colour, fontweight="bold")
     ax.set_ylim(y_lo, y_hi)
-    ax.set_xlabel(_label(ds, freq, "Hz") if _units(ds, freq) else "frequency [Hz]")
-    ax.set_ylabel(_label(ds, speed, "rpm") if _units(ds, speed) else "shaft speed [rpm]")
-    ax.set_title(title or "spectrum vs speed (dashed: shaft and tooth-pass orders)", pad=14)
-    fig.tight_layout()
+    ax.set_xlabel(_label(ds, freq, units=units) if _units(ds, freq, "", units)
+                  else "frequency [Hz]")
+    ax.set_ylabel(_label(ds, speed, units=units) if _units(ds, speed, "", units)
+                  else "shaft speed [rpm]")
+    what = "" if not z else f", tooth pass {z}x"
+    ax.set_title(title or f"spectra vs speed (dashed: shaft orders 1x, 2x{what})", pad=16)
     return _finish(fig, path)
 
 
@@ -264,14 +290,14 @@ def _tooth_map(fig, ax, t, q, label, cmap):
         ax.plot(t, q, lw=0.7, color="tab:red")
         ax.set_xlabel("time t [s]")
         ax.set_ylabel(label)
+        ax.grid(alpha=0.3, lw=0.5)
         return
     zt = q.shape[1]
     im = ax.imshow(q.T, aspect="auto", origin="lower", cmap=cmap, interpolation="nearest",
                    extent=(t[0], t[-1], 0.5, zt + 0.5))
     ax.set_xlabel("time t [s]")
     ax.set_ylabel("tooth j")
-    ticks = np.unique(np.linspace(1, zt, min(zt, 8)).round().astype(int))
-    ax.set_yticks(ticks)
+    ax.yaxis.set_major_locator(MaxNLocator(nbins=8, integer=True, min_n_ticks=1))
     cb = fig.colorbar(im, ax=ax, pad=0.02)
     cb.set_label(label)
 
@@ -279,7 +305,7 @@ def _tooth_map(fig, ax, t, q, label, cmap):
 def _absent(ax, text):
     ax.set_axis_off()
     ax.text(0.5, 0.5, text, ha="center", va="center", fontsize=9, color="0.4",
-            transform=ax.transAxes, wrap=True)
+            transform=ax.transAxes)
 
 
 def scene(t, D2, vD2, Tm, F, Tf=None, section=None, spectrum=None, speed_rpm=None,
@@ -293,8 +319,9 @@ def scene(t, D2, vD2, Tm, F, Tf=None, section=None, spectrum=None, speed_rpm=Non
     speed_rpm [rpm] and z (teeth) for the order marks (z defaults to F.shape[1]).
 
     Panels: D2(t); T_m(t); phase plane (D2, dD2/dt) with the section points; tooth x time map
-    of F; the same of T_f (or its max over teeth); spectrum of T_m with shaft orders (1x, 2x)
-    and tooth-pass orders (Zx, 2Zx)."""
+    of F; the same of T_f (or its max over teeth); spectrum of T_m up to 2.5 Z shaft orders,
+    with shaft orders (1x, 2x) and tooth-pass orders (Zx, 2Zx) dashed and a shaft-order axis
+    on top. A panel whose data is not given says so."""
     t = np.asarray(t, dtype=float)
     D2 = np.asarray(D2, dtype=float)
     vD2 = np.asarray(vD2, dtype=float)
@@ -307,8 +334,8 @@ def scene(t, D2, vD2, Tm, F, Tf=None, section=None, spectrum=None, speed_rpm=Non
             raise ValueError(f"{name} has {arr.shape[0]} samples, t has {t.shape[0]}")
     if z is None:
         z = F.shape[1]
-    fig = Figure(figsize=(16, 11))
-    gs = fig.add_gridspec(3, 3, height_ratios=(1, 1, 1.25), hspace=0.45, wspace=0.32)
+    fig = Figure(figsize=(16, 11), layout="constrained")
+    gs = fig.add_gridspec(3, 3, height_ratios=(1, 1, 1.2), width_ratios=(1, 1, 1.05))
     ax_d = fig.add_subplot(gs[0, :2])
     ax_t = fig.add_subplot(gs[1, :2], sharex=ax_d)
     ax_p = fig.add_subplot(gs[:2, 2])
@@ -320,12 +347,12 @@ def scene(t, D2, vD2, Tm, F, Tf=None, section=None, spectrum=None, speed_rpm=Non
     kv, uv = _prefix(vD2, "m/s")
     ax_d.plot(t, D2 / kd, lw=0.7)
     ax_d.set_ylabel(f"D_2 [{ud}]")
-    ax_d.set_title("relative displacement on the line of action", fontsize=10)
+    ax_d.set_title("relative displacement D_2 on the line of action", fontsize=10)
     ax_d.tick_params(labelbottom=False)
     ax_t.plot(t, Tm, lw=0.7, color="tab:green")
     ax_t.set_ylabel("T_m [N m]")
     ax_t.set_xlabel("time t [s]")
-    ax_t.set_title("meshing torque", fontsize=10)
+    ax_t.set_title("meshing torque T_m", fontsize=10)
     for ax in (ax_d, ax_t):
         ax.grid(alpha=0.3, lw=0.5)
         ax.ticklabel_format(axis="y", useOffset=False)
@@ -333,38 +360,46 @@ def scene(t, D2, vD2, Tm, F, Tf=None, section=None, spectrum=None, speed_rpm=Non
     ax_p.plot(D2 / kd, vD2 / kv, lw=0.4, color="0.55", label="trajectory")
     if section is not None:
         s = np.asarray(section, dtype=float).reshape(-1, 2)
-        ax_p.plot(s[:, 0] / kd, s[:, 1] / kv, "o", ms=3.5, color="tab:red",
+        ax_p.plot(s[:, 0] / kd, s[:, 1] / kv, "o", ms=4, color="tab:red", zorder=3,
                   label=f"section points ({len(s)})")
-        ax_p.legend(fontsize=8, loc="upper right")
+    ax_p.legend(fontsize=8, loc="upper right")
     ax_p.set_xlabel(f"D_2 [{ud}]")
     ax_p.set_ylabel(f"dD_2/dt [{uv}]")
     ax_p.set_title("phase plane", fontsize=10)
     ax_p.grid(alpha=0.3, lw=0.5)
 
     _tooth_map(fig, ax_f, t, F, "tooth load F_j [N]", "viridis")
-    ax_f.set_title("tooth load", fontsize=10)
+    ax_f.set_title("tooth load F_j", fontsize=10)
     if Tf is None:
         _absent(ax_tf, "flash temperature T_f\nnot given")
     else:
         Tf = np.asarray(Tf, dtype=float)
-        _tooth_map(fig, ax_tf, t, Tf, "flash temperature T_f [°C]" if Tf.ndim == 2
+        two_d = Tf.ndim == 2
+        _tooth_map(fig, ax_tf, t, Tf, "flash temperature T_f [°C]" if two_d
                    else "max over teeth of T_f [°C]", "inferno")
-        ax_tf.set_title("flash temperature", fontsize=10)
+        ax_tf.set_title("flash temperature T_f" if two_d else "flash temperature, hottest tooth",
+                        fontsize=10)
 
     if spectrum is None:
-        _absent(ax_s, "spectrum of T_m not given\n(pass spectrum=amplitude_spectrum(t, Tm))")
+        _absent(ax_s, "spectrum of T_m not given\n(spectrum=amplitude_spectrum(t, Tm))")
     else:
         fr, am = (np.asarray(v, dtype=float) for v in spectrum)
         f_shaft = None if speed_rpm is None else abs(float(speed_rpm)) / 60.0
-        f_max = fr.max() if f_shaft is None else min(fr.max(), 2.5 * z * f_shaft)
+        f_max = fr.max() if not f_shaft else min(fr.max(), 2.5 * z * f_shaft)
         keep = (fr > 0) & (fr <= f_max)
         ax_s.semilogy(fr[keep], am[keep], lw=0.8, color="tab:green")
         pos = am[keep][am[keep] > 0]
         if pos.size:
-            ax_s.set_ylim(max(pos.min(), pos.max() * 1e-6), pos.max() * 3)
+            ax_s.set_ylim(max(pos.min(), pos.max() * 1e-4), pos.max() * 3)
         ax_s.set_xlim(0, f_max)
         if f_shaft:
-            _order_lines(ax_s, f_shaft, z, f_max)
+            handles = []
+            for k, text, st in _order_marks(z):
+                if k * f_shaft <= f_max:
+                    ax_s.axvline(k * f_shaft, **st)
+            handles.append(Line2D([], [], **SHAFT_STYLE, label="shaft orders 1x, 2x"))
+            handles.append(Line2D([], [], **TOOTH_STYLE, label=f"tooth pass {z}x, {2 * z}x"))
+            ax_s.legend(handles=handles, fontsize=8, loc="upper right", framealpha=0.9)
             sec = ax_s.secondary_xaxis("top", functions=(lambda f: f / f_shaft,
                                                          lambda o: o * f_shaft))
             sec.set_xlabel("shaft order", fontsize=8)
@@ -372,7 +407,7 @@ def scene(t, D2, vD2, Tm, F, Tf=None, section=None, spectrum=None, speed_rpm=Non
         ax_s.set_xlabel("frequency [Hz]")
         ax_s.set_ylabel("amplitude of T_m [N m]")
         ax_s.set_title("spectrum of T_m", fontsize=10)
-        ax_s.grid(alpha=0.3, lw=0.5, which="both")
+        ax_s.grid(alpha=0.3, lw=0.5, which="major")
     if title:
         fig.suptitle(title)
     return _finish(fig, path)
