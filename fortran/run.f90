@@ -113,6 +113,7 @@ contains
     logical, intent(in), optional :: interruptible
     real(wp), intent(out), optional :: sec_t(:), sec_y(:, :)
     real(wp) :: y0(nstate)
+    real(wp), allocatable :: ts(:), ysec(:, :)
     integer, allocatable :: modes(:, :)
     errmsg = ''
     stats = 0.0_wp
@@ -121,13 +122,17 @@ contains
     call output_times(m, t)
     call start_state(m, y0, ierr, errmsg)
     if (ierr /= 0) return
+    ! The section times stop the integrator, so they shape the steps: a run that asks for a
+    ! section takes them whether or not the caller keeps the points (same numbers everywhere).
     if (present(sec_t)) then
       call section_times(m, sec_t)
       call integrate(m, y0, m%n_out, t, y, modes, stats(1:nsolver_stats), ierr, errmsg, &
            interruptible, sec_t, sec_y)
     else
+      allocate(ts(section_count(m)), ysec(nstate, section_count(m)))
+      call section_times(m, ts)
       call integrate(m, y0, m%n_out, t, y, modes, stats(1:nsolver_stats), ierr, errmsg, &
-           interruptible)
+           interruptible, ts, ysec)
     end if
     if (ierr /= 0) return
     call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg)
