@@ -103,6 +103,32 @@ def run_scipy(case, method, rtol, rhs_kind, oracle, budget):
     return wall, sol.t, sol.y.T, calls[0]
 
 
+def _numba_peer():
+    """bench/numba_peer.py (compiled LSODA from numbalsoda on a numba RHS), or None without
+    numba/numbalsoda."""
+    try:
+        import numba_peer
+        import numbalsoda  # noqa: F401
+    except ImportError:
+        return None
+    return numba_peer
+
+
+def run_numbalsoda(case, rtol, peer):
+    """numbalsoda LSODA on the numba RHS (scaled states, atol = 1e-2 rtol as for CVODE); the
+    compilation is done before the clock starts (a warm-up solve)."""
+    params = dict(case)
+    y0 = start_state(case)
+    t_eval = load(case).output_times()
+    peer.solve(params, y0, t_eval[:2], rtol=rtol, atol=rtol * 1e-2)        # compile, warm up
+    t0 = time.perf_counter()
+    y, ok, nfev = peer.solve(params, y0, t_eval, rtol=rtol, atol=rtol * 1e-2)
+    wall = time.perf_counter() - t0
+    if not ok:
+        raise SplineError(f"numbalsoda LSODA failed at rtol {rtol:g}")
+    return wall, t_eval, y, nfev
+
+
 def _errors(tm, F, ref_tm, ref_F):
     e_tm = np.abs(tm - ref_tm).max() / np.abs(ref_tm).max()
     e_f = np.abs(F - ref_F).max() / np.abs(ref_F).max()
@@ -124,6 +150,7 @@ def work_precision(out, quick=False, progress=True):
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     oracle = _oracle()
+    peer = _numba_peer()
     t_end = 0.05 if quick else 0.3
     rtols_cv = [1e-3, 1e-5, 1e-7] if quick else [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10]
     rtols_sp = [1e-3, 1e-5] if quick else [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8]
@@ -140,10 +167,12 @@ def work_precision(out, quick=False, progress=True):
                 for r in (False, True) for rt in rtols_cv]
         jobs += [("scipy", m, kind, rt) for m in SCIPY_METHODS for kind in ("fortran", "numpy")
                  for rt in rtols_sp if kind == "fortran" or oracle is not None]
+        if peer is not None:
+            jobs += [("numbalsoda", "LSODA", "numba", rt) for rt in rtols_cv]
         for solver, method, opt, rtol in tqdm(jobs, desc=f"work-precision {name}",
                                               disable=not progress):
             label = (f"CVODE {method}{' + roots' if opt else ''}" if solver == "cvode"
-                     else f"scipy {method} ({opt} RHS)")
+                     else f"{solver} {method} ({opt} RHS)")
             row = dict(case=name, method=label, rtol=rtol)
             try:
                 if solver == "cvode":
@@ -155,6 +184,9 @@ def work_precision(out, quick=False, progress=True):
                         times.append(time.perf_counter() - t0)
                     wall, tm, F, nfev = statistics.median(times), res.Tm, res.F, \
                         res.stats["rhs_evals"]
+                elif solver == "numbalsoda":
+                    wall, t, y, nfev = run_numbalsoda(case, rtol, peer)
+                    tm, F = _mesh_outputs(case, t, y)
                 else:
                     wall, t, y, nfev = run_scipy(case, method, rtol, opt, oracle, budget)
                     tm, F = _mesh_outputs(case, t, y)
@@ -185,8 +217,8 @@ def speed_ratios(rows, accuracy=1e-6):
             cand = [r for r in good if pred(r["method"])]
             return min(cand, key=lambda r: r["time_s"]) if cand else None
         cv = best(lambda m: m.startswith("CVODE"))
-        for kind in ("numpy", "fortran"):
-            peer = best(lambda m, k=kind: m.startswith("scipy") and f"({k} RHS)" in m)
+        for kind in ("numpy", "fortran", "numba"):
+            peer = best(lambda m, k=kind: f"({k} RHS)" in m)
             out.append(dict(case=name, accuracy=accuracy, peer_rhs=kind,
                             cvode=cv and cv["method"], cvode_rtol=cv and cv["rtol"],
                             cvode_s=cv and cv["time_s"], peer=peer and peer["method"],
