@@ -1,79 +1,203 @@
 !> spline-dyn: the standalone (HPC) driver. Reads a case namelist, runs it with the same core
 !> as the Python package, and writes a self-describing CSV (one header row naming every column
 !> with its unit, '#' lines with the case and the solver statistics).
-!>   usage: spline-dyn CASE.nml [-o OUT.csv]
+!>   usage: spline-dyn CASE.nml [-o OUT.csv] [--set FIELD=VALUE]... | --version | --help
+!> Errors and usage go to stderr, warnings as 'spline-dyn: warning: ...' lines; the exit status
+!> says what failed (spline_errors err_exit_code): 0 ok, 2 bad input or usage, 3 solver
+!> failure, 4 thermal interference, 130 interrupted (SIGINT). The output is checked before the
+!> run (writable, not the case file itself), written to a temporary name next to it and
+!> renamed when complete, so a failed or interrupted run leaves what was there untouched.
 program spline_dyn
+  use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
+  use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use spline_kinds, only: wp
-  use spline_errors, only: err_ok, err_exit_code, msglen
-  use spline_case, only: case_t, case_read_file, case_name_of
-  use spline_model, only: model_t, model_from_case, nstate, nkterms, kterm_names
-  use spline_run, only: nstats, stat_names, run_case, ntooth_q, tooth_q_names, tooth_q_units
+  use spline_errors, only: err_ok, err_case, err_interrupted, err_exit_code, msglen
+  use spline_case, only: case_t, case_read_file, case_parse, case_name_of
+  use spline_model, only: model_t, model_from_case, model_warnings, nstate, nkterms, kterm_names
+  use spline_run, only: nstats, stat_names, run_case, run_warnings, ntooth_q, tooth_q_names, &
+       tooth_q_units
   implicit none
-  character(len=1024) :: path, out, arg
+
+  type :: string_t
+    character(len=:), allocatable :: s
+  end type string_t
+
+  interface   ! fortran/fileinfo.c
+    integer(c_int) function c_same_file(a, b) bind(C, name='spline_same_file')
+      import :: c_char, c_int
+      character(kind=c_char), intent(in) :: a(*), b(*)
+    end function c_same_file
+    integer(c_int) function c_rename(from, to, errbuf, errlen) bind(C, name='spline_rename')
+      import :: c_char, c_int
+      character(kind=c_char), intent(in) :: from(*), to(*)
+      character(kind=c_char), intent(out) :: errbuf(*)
+      integer(c_int), value :: errlen
+    end function c_rename
+    subroutine c_unlink(path) bind(C, name='spline_unlink')
+      import :: c_char
+      character(kind=c_char), intent(in) :: path(*)
+    end subroutine c_unlink
+    integer(c_int) function c_getpid() bind(C, name='spline_getpid')
+      import :: c_int
+    end function c_getpid
+    subroutine c_version(buf, buflen) bind(C, name='spline_version')
+      import :: c_char, c_int
+      character(kind=c_char), intent(out) :: buf(*)
+      integer(c_int), value :: buflen
+    end subroutine c_version
+    integer(c_int) function c_sigint_watch() bind(C, name='spline_sigint_watch')   ! interrupt.c
+      import :: c_int
+    end function c_sigint_watch
+    integer(c_int) function c_sigint_count() bind(C, name='spline_sigint_count')
+      import :: c_int
+    end function c_sigint_count
+  end interface
+
+  character(len=:), allocatable :: path, out, arg, tmp
+  type(string_t), allocatable :: sets(:)
   character(len=msglen) :: errmsg
+  character(len=256) :: iomsg
   type(case_t) :: c
   type(model_t) :: m
   real(wp), allocatable :: t(:), y(:, :), tooth(:, :, :), tm(:)
   real(wp) :: stats(nstats)
-  integer :: ierr, i, j, k, q, u, nargs
+  integer :: ierr, i, j, k, q, u, nargs, nsets, ios
+  integer(c_int) :: sigint0
+  logical :: have_out, options_done
   character(len=8), parameter :: state_names(nstate) = [character(len=8) :: 'x1', 'y1', 'x2', &
        'y2', 'D1', 'D2', 'D3', 'vx1', 'vy1', 'vx2', 'vy2', 'vD1', 'vD2', 'vD3']
 
+  ! arguments (any length: allocated from get_command_argument's length)
   nargs = command_argument_count()
-  path = ''; out = ''
+  allocate(sets(nargs))
+  nsets = 0
+  have_out = .false.
+  options_done = .false.
   i = 1
   do while (i <= nargs)
-    call get_command_argument(i, arg)
-    if (arg == '-o') then
-      i = i + 1
-      call get_command_argument(i, out)
-    else if (arg == '-h' .or. arg == '--help') then
-      call usage(0)
+    arg = argument(i)
+    if (.not. options_done .and. len(arg) > 1 .and. arg(1:1) == '-') then
+      select case (arg)
+      case ('-h', '--help')
+        call usage(output_unit)
+        stop 0, quiet=.true.
+      case ('--version')
+        write(*, '(a)') 'spline-dyn (pyspline) '//version()
+        stop 0, quiet=.true.
+      case ('-o', '--output')
+        if (i == nargs) call usage_error(arg//' needs a file name')
+        i = i + 1
+        out = argument(i)
+        have_out = .true.
+      case ('--set')
+        if (i == nargs) call usage_error('--set needs FIELD=VALUE')
+        i = i + 1
+        nsets = nsets + 1
+        sets(nsets)%s = argument(i)
+      case ('--')
+        options_done = .true.
+      case default
+        if (len(arg) > 6 .and. arg(1:min(6, len(arg))) == '--set=') then
+          nsets = nsets + 1
+          sets(nsets)%s = arg(7:)
+        else if (len(arg) > 9 .and. arg(1:min(9, len(arg))) == '--output=') then
+          out = arg(10:)
+          have_out = .true.
+        else
+          call usage_error('unknown option '//arg)
+        end if
+      end select
+    else if (allocated(path)) then
+      call usage_error('unexpected argument '''//arg//''' after the case file '''//path// &
+           ''' (one case per run)')
     else
       path = arg
     end if
     i = i + 1
   end do
-  if (len_trim(path) == 0) call usage(2)
-  if (len_trim(out) == 0) out = trim(case_name_of(path))//'.csv'
+  if (.not. allocated(path)) call usage_error('no case file given')
+  if (have_out) then
+    if (len(out) == 0) call usage_error('-o needs a file name')
+  else
+    out = trim(case_name_of(path))//'.csv'
+  end if
 
-  call case_read_file(trim(path), c, ierr, errmsg)
+  ! the case: the file, then the --set overrides, then validation and the model
+  call case_read_file(path, c, ierr, errmsg)
+  do j = 1, nsets
+    if (ierr /= err_ok) exit
+    call case_parse('&spline_case '//sets(j)%s//' /', c, ierr, errmsg, '--set '//sets(j)%s, &
+         show_lines=.false.)
+  end do
   if (ierr == err_ok) call model_from_case(c, m, ierr, errmsg)
   if (ierr /= err_ok) call die(errmsg, ierr)
-  allocate(t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q), tm(m%n_out))
-  call run_case(m, t, y, tooth, tm, stats, ierr, errmsg)
-  if (ierr /= err_ok) call die(errmsg, ierr)
 
-  open(newunit=u, file=trim(out), status='replace', action='write', iostat=ierr)
-  if (ierr /= 0) call die('cannot write '//trim(out), 1)
-  write(u, '(a)') '# spline-dyn output (pyspline): SI units, per-tooth columns Q_j for teeth j = 1..Z'
-  write(u, '(a)') '# case: '//trim(m%name)//' ('//trim(path)//')'
-  write(u, '(a,es24.16e3,a)') '# k_m: ', m%k_m, merge(' N/m (computed, Eq. 18)', ' N/m (case)            ', &
-       m%k_m_computed)
-  write(u, '(a)', advance='no') '# stats:'
+  ! the output, before the run: never the case file, and writable (a temporary name next to
+  ! it, renamed when the CSV is complete)
+  if (c_same_file(path//c_null_char, out//c_null_char) /= 0) &
+       call die('the output '//out//' is the case file '//path//': not overwritten '// &
+       '(give another -o)', err_case)
+  tmp = temp_name(out)
+  open(newunit=u, file=tmp, status='replace', action='write', iostat=ios, iomsg=iomsg)
+  if (ios /= 0) call die('cannot write the output '//out//': '//trim(iomsg), err_case)
+  ! From here a SIGINT is counted, not fatal (fortran/interrupt.c): the run stops at its next
+  ! right-hand side, the temporary file is removed, and the exit status is 130.
+  sigint0 = c_sigint_watch()
+
+  call print_warnings(model_warnings(m))
+  allocate(t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q), tm(m%n_out))
+  call run_case(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible=.true.)
+  if (ierr /= err_ok) then
+    close(u, status='delete', iostat=ios)
+    call die(errmsg, ierr)
+  end if
+  call check_interrupt()
+  call print_warnings(run_warnings(m, stats))
+
+  write(u, '(a)', iostat=ios) '# spline-dyn output (pyspline): SI units, per-tooth columns Q_j '// &
+       'for teeth j = 1..Z'
+  write(u, '(a)', iostat=ios) '# case: '//trim(m%name)//' ('//path//')'
+  write(u, '(a,es24.16e3,a)', iostat=ios) '# k_m: ', m%k_m, &
+       merge(' N/m (computed, Eq. 18)', ' N/m (case)            ', m%k_m_computed)
+  write(u, '(a)', advance='no', iostat=ios) '# stats:'
   do i = 1, nstats
-    write(u, '(1x,a,"=",g0)', advance='no') trim(stat_names(i)), stats(i)
+    write(u, '(1x,a,"=",g0)', advance='no', iostat=ios) trim(stat_names(i)), stats(i)
   end do
-  write(u, '(a)') ''
-  write(u, '(a)', advance='no') 't [s]'
+  write(u, '(a)', iostat=ios) ''
+  write(u, '(a)', advance='no', iostat=ios) 't [s]'
   do i = 1, nstate
-    write(u, '(a)', advance='no') ','//trim(state_names(i))//merge(' [m]  ', ' [m/s]', i <= 7)
+    write(u, '(a)', advance='no', iostat=ios) ','//trim(state_names(i))// &
+         merge(' [m]  ', ' [m/s]', i <= 7)
   end do
-  write(u, '(a)', advance='no') ',Tm [N m],kv [-]'
+  write(u, '(a)', advance='no', iostat=ios) ',Tm [N m],kv [-]'
   do q = 1, ntooth_q
     do j = 1, m%z
-      write(u, '(",",a,"_",i0," [",a,"]")', advance='no') trim(tooth_q_names(q)), j, &
+      write(u, '(",",a,"_",i0," [",a,"]")', advance='no', iostat=ios) trim(tooth_q_names(q)), j, &
            trim(tooth_q_units(q))
     end do
   end do
-  write(u, '(a)') ''
+  write(u, '(a)', iostat=ios) ''
   do k = 1, m%n_out
-    write(u, '(es24.16e3,*(:,",",es24.16e3))') t(k), y(:, k), tm(k), abs(tm(k))/m%t_d, &
-         ((tooth(k, j, q), j = 1, m%z), q = 1, ntooth_q)
+    if (ios /= 0) exit
+    write(u, '(es24.16e3,*(:,",",es24.16e3))', iostat=ios, iomsg=iomsg) t(k), y(:, k), tm(k), &
+         abs(tm(k))/m%t_d, ((tooth(k, j, q), j = 1, m%z), q = 1, ntooth_q)
   end do
-  close(u)
+  if (ios /= 0) then
+    close(u, status='delete', iostat=i)
+    call die('cannot write the output '//out//': '//trim(iomsg), err_case)
+  end if
+  close(u, iostat=ios, iomsg=iomsg)
+  if (ios /= 0) then
+    call c_unlink(tmp//c_null_char)
+    call die('cannot write the output '//out//': '//trim(iomsg), err_case)
+  end if
+  if (c_sigint_count() /= sigint0) then
+    call c_unlink(tmp//c_null_char)
+    call check_interrupt()
+  end if
+  call rename_into(tmp, out)
 
-  write(*, '(a)') 'case '//trim(m%name)//': '//trim(out)
+  write(*, '(a)') 'case '//trim(m%name)//': '//out
   write(*, '(a)', advance='no') '  mesh stiffness, potential energy method (Eq. 18) [N/m]:'
   do i = 1, nkterms
     write(*, '(1x,a,"=",es11.4)', advance='no') trim(kterm_names(i)), m%k_terms(i)
@@ -91,19 +215,108 @@ program spline_dyn
 
 contains
 
-  subroutine usage(code)
-    integer, intent(in) :: code
-    write(*, '(a)') 'usage: spline-dyn CASE.nml [-o OUT.csv]'
-    write(*, '(a)') '  runs one pyspline case (namelist &spline_case) and writes a CSV'
-    stop code
+  !> Command argument i, whatever its length.
+  function argument(i) result(s)
+    integer, intent(in) :: i
+    character(len=:), allocatable :: s
+    integer :: n
+    call get_command_argument(i, length=n)
+    allocate(character(len=n) :: s)
+    if (n > 0) call get_command_argument(i, s)
+  end function argument
+
+  function version() result(s)
+    character(len=:), allocatable :: s
+    character(kind=c_char) :: buf(64)
+    integer :: i
+    buf = c_null_char
+    call c_version(buf, int(size(buf), c_int))
+    s = ''
+    do i = 1, size(buf)
+      if (buf(i) == c_null_char) exit
+      s = s//buf(i)
+    end do
+  end function version
+
+  !> A temporary name in the output's directory: .NAME.tmp-PID (hidden, this process's own).
+  function temp_name(file) result(s)
+    character(len=*), intent(in) :: file
+    character(len=:), allocatable :: s
+    character(len=16) :: pid
+    integer :: slash
+    write(pid, '(i0)') c_getpid()
+    slash = index(file, '/', back=.true.)
+    s = file(1:slash)//'.'//file(slash+1:)//'.tmp-'//trim(pid)
+  end function temp_name
+
+  subroutine rename_into(from, to)
+    character(len=*), intent(in) :: from, to
+    character(kind=c_char) :: buf(256)
+    character(len=256) :: why
+    integer :: i
+    buf = c_null_char
+    if (c_rename(from//c_null_char, to//c_null_char, buf, int(size(buf), c_int)) == 0) return
+    why = ''
+    do i = 1, size(buf)
+      if (buf(i) == c_null_char) exit
+      why(i:i) = buf(i)
+    end do
+    call c_unlink(from//c_null_char)
+    call die('cannot write the output '//to//': '//trim(why), err_case)
+  end subroutine rename_into
+
+  !> A SIGINT since the watch began: remove the temporary file, exit 130.
+  subroutine check_interrupt()
+    integer :: ios2
+    if (c_sigint_count() == sigint0) return
+    close(u, status='delete', iostat=ios2)
+    call die('case '//trim(m%name)//': interrupted (SIGINT)', err_interrupted)
+  end subroutine check_interrupt
+
+  subroutine print_warnings(text)
+    character(len=*), intent(in) :: text
+    integer :: a, b
+    a = 1
+    do while (a <= len(text))
+      b = index(text(a:), new_line('a'))
+      if (b == 0) then
+        b = len(text) + 1
+      else
+        b = a + b - 1
+      end if
+      if (b > a) write(error_unit, '(a)') 'spline-dyn: warning: '//text(a:b-1)
+      a = b + 1
+    end do
+  end subroutine print_warnings
+
+  subroutine usage(unit)
+    integer, intent(in) :: unit
+    write(unit, '(a)') 'usage: spline-dyn CASE.nml [-o OUT.csv] [--set FIELD=VALUE]...'
+    write(unit, '(a)') '       spline-dyn --version | --help'
+    write(unit, '(a)') '  runs one pyspline case (namelist &spline_case) and writes a CSV (default: '// &
+         'the case file''s stem .csv)'
+    write(unit, '(a)') '  --set FIELD=VALUE  replaces a field of the case file (repeatable; '// &
+         'strings in quotes)'
+    write(unit, '(a)') '  exit status: 0 ok, 2 bad input or usage, 3 solver failure, '// &
+         '4 thermal interference, 130 interrupted'
   end subroutine usage
+
+  !> A usage error: the reason and the usage on stderr, exit status 2.
+  subroutine usage_error(why)
+    character(len=*), intent(in) :: why
+    write(error_unit, '(a)') 'spline-dyn: error: '//why
+    call usage(error_unit)
+    stop 2, quiet=.true.
+  end subroutine usage_error
 
   !> Print the message to stderr and exit with the status of the error code (spline_errors).
   subroutine die(msg, ierr)
     character(len=*), intent(in) :: msg
     integer, intent(in) :: ierr
-    write(0, '(a)') 'spline-dyn: error: '//trim(msg)
-    error stop err_exit_code(ierr), quiet=.true.
+    integer :: code
+    write(error_unit, '(a)') 'spline-dyn: error: '//trim(msg)
+    code = err_exit_code(ierr)
+    stop code, quiet=.true.
   end subroutine die
 
 end program spline_dyn

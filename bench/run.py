@@ -2,7 +2,8 @@
     python bench/run.py wp|stability|ladder|anatomy|parallel [--out DIR] [--quick]
 wp: work-precision chart against scipy and numbalsoda peers; stability: where methods fail;
 ladder: model levels and fidelity = auto; anatomy: where a run's time goes; parallel: scenes
-serially, on threads and on processes, fixed cost per call, RHS call cost.
+serially, on threads and on processes, fixed cost per call, RHS call cost; bifurcation: a
+1000-point sweep serially, on threads, processes and Dask.
 Each writes a PNG and/or CSV into --out (default out/bench) and prints a table."""
 from __future__ import annotations
 
@@ -68,13 +69,19 @@ def cmd_bench(args) -> int:
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="bench/run.py", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("what", choices=["wp", "stability", "ladder", "anatomy", "parallel"])
+    p.add_argument("what", choices=["wp", "stability", "ladder", "anatomy", "parallel",
+                                    "bifurcation"])
+    p.add_argument("--points", type=int, help="bifurcation: number of points (default 1000)")
+    p.add_argument("--rtol", type=float, help="bifurcation: tolerance (default: the case's)")
     p.add_argument("--out", default="out/bench", help="output directory (default out/bench)")
     p.add_argument("--quick", action="store_true", help="small sizes (for CI)")
     args = p.parse_args(argv)
     if args.what == "parallel":
         import parallel
         return parallel.main(args)
+    if args.what == "bifurcation":
+        import bifurcation
+        return bifurcation.main(args)
     return cmd_bench(args)
 
 

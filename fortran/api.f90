@@ -13,23 +13,83 @@ module spline_api
   use, intrinsic :: iso_c_binding, only: c_double, c_int
   use spline_kinds, only: wp
   use spline_errors, only: err_ok, err_case, nerr, err_names, msglen
-  use spline_case, only: case_t, case_read_text, case_write_text
+  use spline_case, only: case_t, case_read_text, case_write_text, case_parse, case_name_of, &
+       case_suggest, case_field
   use spline_model, only: model_t, model_from_case, model_magic, nstate, ndof, nkterms, &
-       kterm_names, thermal_coupled
+       kterm_names, thermal_coupled, model_warnings
   use spline_mesh, only: mesh_switch_functions
   use spline_stiffness, only: external_tooth_stiffness, internal_tooth_stiffness
   use spline_dynamics, only: accelerations, start_state, rhs_scaled, to_scaled
   use spline_run, only: nstats, stat_names, run_case, tooth_quantities, ntooth_q, tooth_q_names, &
-       tooth_q_units, output_times, section_count, lyapunov_count
+       tooth_q_units, output_times, section_count, lyapunov_count, run_warnings
   implicit none
   private
   public :: api_load, api_model_size, api_simulate, api_rhs, api_rhs_mesh, api_start_state
   public :: api_output_times, api_model_info, api_defaults, api_names, api_tooth_stiffness
-  public :: api_time_rhs, api_counts
+  public :: api_time_rhs, api_counts, api_parse, api_field_hint, api_warnings
 
   integer, parameter :: ninfo = 10   !< entries of api_model_info
 
 contains
+
+  !> Parse the text of a case file (its bytes, read by the caller after checking it is a
+  !> regular file) with the reader spline-dyn uses (case_parse: the same diagnosis, naming
+  !> path and line), and return the case as namelist text with every field (canon; the name
+  !> defaults to the file's stem). Ranges are not checked here (api_load does).
+  !> The text comes as its n byte values (0..255) in 4-byte integers: a character argument
+  !> would end at the first NUL byte (f2py passes a C string), and a NUL must reach the reader.
+  subroutine api_parse(text, n, path, canon, ierr, errmsg)
+    integer(c_int), intent(in) :: n
+    integer(c_int), intent(in) :: text(n)
+    character(len=*), intent(in) :: path
+    character(len=8192), intent(out) :: canon
+    integer(c_int), intent(out) :: ierr
+    character(len=msglen), intent(out) :: errmsg
+    type(case_t) :: c
+    character(len=:), allocatable :: full, t
+    integer :: ie, i
+    canon = ''
+    allocate(character(len=n) :: t)
+    do i = 1, n
+      t(i:i) = achar(iand(text(i), 255))
+    end do
+    c = case_t()
+    c%name = case_name_of(path)
+    call case_parse(t, c, ie, errmsg, path)
+    if (ie == err_ok) then
+      call case_write_text(c, full)
+      canon = full
+    end if
+    ierr = ie
+  end subroutine api_parse
+
+  !> The case field nearest to a misspelt name (blank if none is near): the suggestion of the
+  !> reader's 'did you mean', for the fields Python is given as a dict.
+  subroutine api_field_hint(word, hint)
+    character(len=*), intent(in) :: word
+    character(len=32), intent(out) :: hint
+    hint = case_suggest(word)
+  end subroutine api_field_hint
+
+  !> Warnings about a loaded model (stage 0: model_warnings) or about a run of it (stage 1:
+  !> run_warnings, from the run's statistics), one per line; blank if none.
+  subroutine api_warnings(model, nb, stats, ns, stage, text)
+    integer(c_int), intent(in) :: nb, ns, stage
+    integer(c_int), intent(in) :: model(nb)
+    real(c_double), intent(in) :: stats(ns)
+    character(len=2048), intent(out) :: text
+    type(model_t) :: m
+    character(len=msglen) :: errmsg
+    integer :: ie
+    text = ''
+    call unpack(model, m, ie, errmsg)
+    if (ie /= err_ok) return
+    if (stage == 0) then
+      text = model_warnings(m)
+    else if (ns == nstats) then
+      text = run_warnings(m, stats)
+    end if
+  end subroutine api_warnings
 
   !> 4-byte words in a loaded model (the size of the array api_load fills).
   integer(c_int) function api_model_size() result(nb)
@@ -236,7 +296,8 @@ contains
   end subroutine api_defaults
 
   !> Name (and unit) number i of a list: 'tooth' (per-tooth quantities), 'stats', 'info'
-  !> (api_model_info), 'kterms' (Eq. 18 terms) or 'errors' (error codes 0..nerr, i = code + 1).
+  !> (api_model_info), 'kterms' (Eq. 18 terms), 'errors' (error codes 0..nerr, i = code + 1) or
+  !> 'fields' (the case fields; unit: type i, r, l or c and the size, e.g. 'r7', 'c16').
   subroutine api_names(kind, i, name, unit)
     character(len=*), intent(in) :: kind
     integer(c_int), intent(in) :: i
@@ -245,6 +306,7 @@ contains
          'omega', 'l_ref', 'w_ref', 'c_bulk', 'kappa', 'k_m', 'k_m_computed', 'thermal_level']
     character(len=8), parameter :: info_units(ninfo) = [character(len=8) :: 'm', 'm', 'rad/s', &
          'm', 'rad/s', 'm', 'm/degC', 'N/m', '', '']
+    integer :: n
     name = ''; unit = ''
     select case (kind)
     case ('tooth')
@@ -263,6 +325,9 @@ contains
       end if
     case ('errors')
       if (i >= 1 .and. i <= nerr + 1) name = err_names(i - 1)
+    case ('fields')
+      call case_field(i, name, unit, n)
+      if (len_trim(name) > 0 .and. (n > 1 .or. unit == 'c')) write(unit, '(a,i0)') trim(unit), n
     end select
   end subroutine api_names
 

@@ -3,11 +3,14 @@
 module spline_dynamics
   use spline_kinds, only: wp
   use spline_model, only: model_t, ndof, nstate
-  use spline_mesh, only: mesh_eval, coupling_stats_t
+  use spline_mesh, only: mesh_eval, mesh_switch_functions, coupling_stats_t
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
   public :: accelerations, rhs_scaled, to_scaled, from_scaled, static_equilibrium, start_state, &
        integrated_states
+
+  integer, parameter :: max_newton = 100    !< Newton steps of the static equilibrium
 
 contains
 
@@ -19,7 +22,7 @@ contains
   !>   D1'' = r_b ((T_m - S1)/J_1 - (T_d + S1)/J_M)
   !>   D2'' = r_b ((-T_m - S3)/J_2 - (T_m - S1)/J_1)
   !>   D3'' = r_b ((-T_m - S3)/J_2 - (S3 - T_L)/J_L)
-  pure subroutine accelerations(m, t, q, v, a, ierr, errmsg, mode, branch, cstats)
+  subroutine accelerations(m, t, q, v, a, ierr, errmsg, mode, branch, cstats)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(ndof), v(ndof)
     real(wp), intent(out) :: a(ndof)
@@ -60,7 +63,7 @@ contains
   end subroutine from_scaled
 
   !> Eq. 25: d(ys)/d(tau) for the scaled state, ys' = (vs, a / (l w^2)).
-  pure subroutine rhs_scaled(m, tau, ys, dys, ierr, errmsg, mode, branch, cstats)
+  subroutine rhs_scaled(m, tau, ys, dys, ierr, errmsg, mode, branch, cstats)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: tau, ys(nstate)
     real(wp), intent(out) :: dys(nstate)
@@ -103,13 +106,22 @@ contains
     if (ierr /= 0) return
     y(1:ndof) = y(1:ndof) + m%dq0
     y(ndof+1:) = m%dv0
+    if (.not. all(ieee_is_finite(y))) then
+      ierr = 2
+      errmsg = 'case '//trim(m%name)//': the start state is not finite (NaN or Inf): use '// &
+           'start = ''rest'''
+    end if
   end subroutine start_state
 
   !> Static equilibrium at time t: the displacements q with zero velocities for which all
-  !> accelerations of Eq. 23 vanish (under T_d, T_L, gravity and misalignment). Newton's method
-  !> on the piecewise-linear residual, Jacobian by forward differences, backtracking line search;
-  !> the closed-form guess: shafts twisted by the torques, every tooth loaded equally, supports
-  !> sagging under gravity. Converged when the scaled step is below 1e-12.
+  !> accelerations of Eq. 23 vanish (under T_d, T_L, gravity and misalignment). Semi-smooth
+  !> Newton on the piecewise-linear residual: the Jacobian (forward differences) is taken with
+  !> the contact states of Eq. 16 frozen at the current iterate, so it is the exact Jacobian of
+  !> the piece the iterate lies on, never a difference across a tooth's contact switch (with a
+  !> misalignment and many teeth, Z >= ~150, the teeth near their switch made the plain
+  !> difference Jacobian point uphill and the line search stall); backtracking line search on
+  !> the residual. The closed-form guess: shafts twisted by the torques, every tooth loaded
+  !> equally, supports sagging under gravity. Converged when the scaled step is below 1e-12.
   subroutine static_equilibrium(m, t, q, ierr, errmsg)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t
@@ -117,7 +129,8 @@ contains
     integer, intent(out) :: ierr
     character(len=*), intent(inout) :: errmsg
     real(wp) :: r(ndof), rn(ndof), jac(ndof, ndof), dq(ndof), qn(ndof), h, lam
-    integer :: it, k, ls
+    real(wp) :: g(2*m%z), dqbar(ndof), q_prev(ndof), dq_prev(ndof), lam_prev
+    integer :: it, k, ls, j, modes(m%z)
     q = 0.0_wp
     q(2) = -m%m_1*m%grav/max(m%k_p1, tiny(1.0_wp))
     q(4) = -m%m_2*m%grav/max(m%k_p2, tiny(1.0_wp))
@@ -126,63 +139,114 @@ contains
     q(5) = -m%r_b*m%t_d/max(m%k_t1, tiny(1.0_wp))
     q(7) = m%r_b*m%t_l/max(m%k_t2, tiny(1.0_wp))
     q(6) = -sign(m%c_bulk, m%t_d) - m%t_d/(m%z*m%k_m*m%r_b)
+    lam_prev = 0.0_wp; q_prev = 0.0_wp; dq_prev = 0.0_wp
     call residual(q, r)
     if (ierr /= 0) return
-    do it = 1, 100
+    do it = 1, max_newton
+      ! contact states at q (Eq. 16, as the right-hand side decides them)
+      call mesh_switch_functions(m, t, q, g)
+      do j = 1, m%z
+        modes(j) = 0
+        if (g(2*j - 1) > 0.0_wp) modes(j) = 1
+        if (g(2*j) < 0.0_wp) modes(j) = -1
+      end do
       do k = 1, ndof
         h = 1.0e-7_wp*max(abs(q(k)), m%l_ref)
         qn = q
         qn(k) = q(k) + h
-        call residual(qn, rn)
+        call residual(qn, rn, modes)
         if (ierr /= 0) return
         jac(:, k) = (rn - r)/h
       end do
       call solve_dense(jac, -r, dq, ierr)
+      if (ierr /= 0 .and. lam_prev > 1.0e-6_wp) then
+        ! singular here (e.g. the step left every tooth out of contact): back to half the step
+        lam_prev = 0.5_wp*lam_prev
+        q = q_prev + lam_prev*dq_prev
+        call residual(q, r)
+        if (ierr /= 0) return
+        cycle
+      end if
       if (ierr /= 0) then
         ierr = 2
         errmsg = 'case '//trim(m%name)//': no unique static equilibrium (a free body, e.g. '// &
              'the mesh out of contact under zero torque): use start = ''rest'''
         return
       end if
+      ! converged: the step is below 1e-12 l_ref, or at round-off of the displacement itself
+      ! (the shaft twists r_b T / k_t reach metres at Z = 1000)
+      if (all(abs(dq) < 1.0e-12_wp*m%l_ref + 1.0e-14_wp*abs(q))) then
+        q = q + dq
+        return
+      end if
+      ! damping by the natural monotonicity test (affine invariant: the simplified Newton
+      ! correction at the trial point must shrink; the residual norm itself mixes rows of
+      ! stiffnesses decades apart and stalled the search)
       lam = 1.0_wp
       do ls = 1, 30
         qn = q + lam*dq
         call residual(qn, rn)
         if (ierr /= 0) return
-        if (norm2(rn) < norm2(r) .or. norm2(r) == 0.0_wp) exit
+        call solve_dense(jac, -rn, dqbar, ierr)
+        if (ierr /= 0) exit
+        if (norm2(dqbar) < (1.0_wp - 0.25_wp*lam)*norm2(dq)) exit
         lam = 0.5_wp*lam
       end do
+      if (ls > 30) then          ! no damped step passed the test: take the full one
+        lam = 1.0_wp
+        qn = q + dq
+        call residual(qn, rn)
+        if (ierr /= 0) return
+      end if
+      ierr = 0
+      q_prev = q; dq_prev = dq; lam_prev = lam
       q = qn
       r = rn
-      if (maxval(abs(lam*dq))/m%l_ref < 1.0e-12_wp) return
     end do
     ierr = 2
-    errmsg = 'case '//trim(m%name)//': static equilibrium did not converge in 100 Newton steps'
+    write(errmsg, '(a,i0,a)') 'case '//trim(m%name)//': static equilibrium did not converge in ', &
+         max_newton, ' Newton steps: use start = ''rest'''
   contains
-    subroutine residual(qq, rr)
+    subroutine residual(qq, rr, mode)
       real(wp), intent(in) :: qq(ndof)
       real(wp), intent(out) :: rr(ndof)
+      integer, intent(in), optional :: mode(m%z)
       real(wp), parameter :: zero(ndof) = 0.0_wp
-      call accelerations(m, t, qq, zero, rr, ierr, errmsg)
+      call accelerations(m, t, qq, zero, rr, ierr, errmsg, mode)
       rr = rr/(m%l_ref*m%w_ref**2)
     end subroutine residual
   end subroutine static_equilibrium
 
-  !> Gaussian elimination with partial pivoting for the small Newton systems. ierr = 1: singular.
+  !> Gaussian elimination with partial pivoting for the small Newton systems, on the matrix
+  !> equilibrated by rows and then columns (the stiffnesses of a case span many decades: mesh
+  !> k_m Z against shafts k_t, so a pivot is judged against its own row and column, not the
+  !> largest entry). ierr = 1: singular (a zero row or column, or a pivot below 1e-13).
   subroutine solve_dense(a_in, b, x, ierr)
     real(wp), intent(in) :: a_in(:, :), b(:)
     real(wp), intent(out) :: x(:)
     integer, intent(out) :: ierr
-    real(wp) :: a(size(b), size(b)), rhs(size(b)), rowtmp(size(b)), tmp, scale
+    real(wp) :: a(size(b), size(b)), rhs(size(b)), rowtmp(size(b)), tmp, rs(size(b)), cs(size(b))
     integer :: n, i, p
     n = size(b)
     a = a_in
     rhs = b
+    x = 0.0_wp
+    ierr = 1
+    do i = 1, n
+      rs(i) = maxval(abs(a(i, :)))
+      if (.not. rs(i) > 0.0_wp) return
+      a(i, :) = a(i, :)/rs(i)
+    end do
+    rhs = rhs/rs
+    do i = 1, n
+      cs(i) = maxval(abs(a(:, i)))
+      if (.not. cs(i) > 0.0_wp) return
+      a(:, i) = a(:, i)/cs(i)
+    end do
     ierr = 0
-    scale = maxval(abs(a))
     do i = 1, n
       p = maxloc(abs(a(i:, i)), dim=1) + i - 1
-      if (abs(a(p, i)) <= 1.0e-13_wp*scale) then
+      if (.not. abs(a(p, i)) > 1.0e-13_wp) then
         ierr = 1; return
       end if
       if (p /= i) then
@@ -195,6 +259,7 @@ contains
     do i = n, 1, -1
       x(i) = (rhs(i) - dot_product(a(i, i+1:), x(i+1:)))/a(i, i)
     end do
+    x = x/cs
   end subroutine solve_dense
 
 end module spline_dynamics

@@ -20,8 +20,11 @@ module spline_errors
 
 contains
 
-  !> Exit status of spline-dyn for an error code: 0 ok, 2 bad input (also usage), 3 solver
-  !> failure, 4 thermal interference, 130 interrupted (128 + SIGINT, the shell convention).
+  !> Exit status of spline-dyn for an error code: 0 ok, 2 bad input (a case file that is no
+  !> file, bad syntax, a field out of range, too much memory; also a usage error and an output
+  !> that cannot be written or is the case file), 3 solver failure (CVODE, no static
+  !> equilibrium, a work bound max_steps / max_total_steps, a non-finite output), 4 thermal
+  !> interference, 130 interrupted (128 + SIGINT, the shell convention).
   pure integer function err_exit_code(ierr) result(code)
     integer, intent(in) :: ierr
     select case (ierr)

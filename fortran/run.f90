@@ -3,24 +3,29 @@
 !> (Eqs. 11, 15-22 and, for the thermal levels that have it, Eqs. 1-7) at every output time.
 module spline_run
   use spline_kinds, only: wp, pi
-  use spline_errors, only: err_ok
+  use spline_errors, only: err_ok, err_solver
   use spline_model, only: model_t, nstate, ndof, thermal_none, thermal_bulk, thermal_oneway, &
        thermal_coupled, set_thermal_level
   use spline_dynamics, only: start_state, to_scaled, integrated_states
   use spline_mesh, only: mesh_eval
   use spline_solver, only: integrate, nsolver_stats => nstats, solver_stat_names => stat_names
   use spline_fidelity, only: lateral_estimate, backlash_estimate
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
   public :: run_case, output_times, tooth_outputs, tooth_quantities, ntooth_q, tooth_q_names, tooth_q_units
-  public :: nstats, stat_names, section_count, section_times, lyapunov_count
+  public :: nstats, stat_names, section_count, section_times, lyapunov_count, run_warnings
 
   !> Statistics of a run: the solver's, then the core's elapsed time, the model level that ran
-  !> (dof, thermal 0 none .. 3 coupled) and the fidelity estimates of spline_fidelity.
+  !> (dof, thermal 0 none .. 3 coupled), the fidelity estimates of spline_fidelity, and the
+  !> one-way check of Eq. 2 (result_checks): the number of (output time, tooth) samples whose
+  !> flash temperature would have closed the backlash, and the first time of one [s].
   real(wp), parameter :: fidelity_margin = 0.5_wp   !< auto reduces when estimate <= margin * tol
-  integer, parameter :: nstats = nsolver_stats + 5
+  integer, parameter :: nstats = nsolver_stats + 7
+  integer, parameter :: ist_closed = nsolver_stats + 6, ist_closed_t = nsolver_stats + 7
   character(len=24), parameter :: stat_names(nstats) = [solver_stat_names, [character(len=24) :: &
-       'core_wall_s', 'dof', 'thermal_level', 'fidelity_eps_lateral', 'fidelity_eps_thermal']]
+       'core_wall_s', 'dof', 'thermal_level', 'fidelity_eps_lateral', 'fidelity_eps_thermal', &
+       'backlash_closed', 'backlash_closed_t_s']]
 
   integer, parameter :: ntooth_q = 8
   integer, parameter :: iq_tf = 6                  !< position of T_f in tooth_q_names
@@ -70,7 +75,7 @@ contains
     logical, intent(in), optional :: interruptible
     real(wp), intent(out), optional :: sec_t(:), sec_y(:, :), lyap_t(:), lyap_g(:)
     type(model_t) :: run
-    real(wp) :: eps_lat, eps_th, tol
+    real(wp) :: eps_lat, eps_th, tol, closed, t_closed
     integer(8) :: c0, c1, rate
     call system_clock(c0, rate)
     run = m
@@ -98,10 +103,115 @@ contains
       if (ierr == err_ok .and. m%lyapunov) &
            call lyapunov_benettin(run, t(1), y(:, 1), lyap_t, lyap_g, ierr, errmsg, interruptible)
     end if
+    closed = 0.0_wp; t_closed = 0.0_wp
+    if (ierr == err_ok) call result_checks(run, t, y, tooth, tm, closed, t_closed, ierr, errmsg, &
+         sec_t, sec_y, lyap_t, lyap_g)
     call system_clock(c1)
     stats(nsolver_stats+1:) = [real(c1 - c0, wp)/rate, real(run%dof, wp), real(run%thermal, wp), &
-         eps_lat, eps_th]
+         eps_lat, eps_th, closed, t_closed]
   end subroutine run_case
+
+  !> The checks of a finished run: no output may be NaN or infinite (ierr = err_solver with a
+  !> message naming the quantity, the tooth or state, and the time: the model left its range,
+  !> e.g. a contact point below the base circle makes the Hertz width 0 and T_f infinite);
+  !> and at the one-way thermal level, the samples where Eq. 2 with the flash temperature,
+  !> c0 - kappa (T_M + T_f), is not positive: the coupled level would have stopped there with
+  !> thermal interference (closed: their number, t_closed: the first time; a warning, see
+  !> run_warnings).
+  subroutine result_checks(m, t, y, tooth, tm, closed, t_closed, ierr, errmsg, sec_t, sec_y, &
+       lyap_t, lyap_g)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t(:), y(:, :), tooth(:, :, :), tm(:)
+    real(wp), intent(out) :: closed, t_closed
+    integer, intent(inout) :: ierr
+    character(len=*), intent(inout) :: errmsg
+    real(wp), intent(in), optional :: sec_t(:), sec_y(:, :), lyap_t(:), lyap_g(:)
+    character(len=4), parameter :: state_names(nstate) = [character(len=4) :: 'x1', 'y1', 'x2', &
+         'y2', 'D1', 'D2', 'D3', 'vx1', 'vy1', 'vx2', 'vy2', 'vD1', 'vD2', 'vD3']
+    integer :: k, j, q, i
+    closed = 0.0_wp; t_closed = 0.0_wp
+    do k = 1, size(t)
+      if (.not. ieee_is_finite(t(k))) call bad('the output time', '', k)
+      do i = 1, nstate
+        if (.not. ieee_is_finite(y(i, k))) call bad('the state '//trim(state_names(i)), '', k)
+      end do
+      if (.not. ieee_is_finite(tm(k))) call bad('the meshing torque T_m', '', k)
+      do q = 1, ntooth_q
+        do j = 1, size(tooth, 2)
+          if (.not. ieee_is_finite(tooth(k, j, q))) call bad(trim(tooth_q_names(q))//' of tooth', &
+               ' '//itoa(j), k)
+        end do
+      end do
+      if (ierr /= err_ok) return
+    end do
+    if (present(sec_t)) then
+      do k = 1, size(sec_t)
+        if (.not. ieee_is_finite(sec_t(k)) .or. .not. all(ieee_is_finite(sec_y(:, k)))) then
+          call bad('a Poincare section point', '', 0, sec_t(k)); return
+        end if
+      end do
+    end if
+    if (present(lyap_t)) then
+      do k = 1, size(lyap_t)
+        if (.not. ieee_is_finite(lyap_t(k)) .or. .not. ieee_is_finite(lyap_g(k))) then
+          call bad('the Lyapunov growth', '', 0, lyap_t(k)); return
+        end if
+      end do
+    end if
+    if (m%thermal == thermal_oneway) then
+      do k = 1, size(t)
+        do j = 1, size(tooth, 2)
+          if (m%c_bulk - m%kappa*tooth(k, j, iq_tf) <= 0.0_wp) then
+            if (closed == 0.0_wp) t_closed = t(k)
+            closed = closed + 1.0_wp
+          end if
+        end do
+      end do
+    end if
+  contains
+    subroutine bad(what, which, k, tk)
+      character(len=*), intent(in) :: what, which
+      integer, intent(in) :: k
+      real(wp), intent(in), optional :: tk
+      character(len=40) :: buf
+      real(wp) :: tt
+      if (ierr /= err_ok) return
+      tt = 0.0_wp
+      if (k > 0) tt = t(k)
+      if (present(tk)) tt = tk
+      write(buf, '(es12.5)') tt
+      ierr = err_solver
+      errmsg = 'case '//trim(m%name)//': the run produced a non-finite value (NaN or Inf): '// &
+           what//which//' at t = '//trim(adjustl(buf))//' s; the model left its range there '// &
+           '(e.g. a contact point below the base circle, or a runaway state)'
+    end subroutine bad
+  end subroutine result_checks
+
+  !> Warnings about a finished run, one per line ('' if none), from its statistics: the
+  !> one-way flash temperature that would have closed the backlash (result_checks). The
+  !> executable prints them to stderr, Python raises pyspline.SplineWarning (api_warnings).
+  function run_warnings(m, stats) result(text)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: stats(nstats)
+    character(len=:), allocatable :: text
+    character(len=32) :: buf
+    text = ''
+    if (stats(ist_closed) > 0.0_wp) then
+      write(buf, '(es12.5)') stats(ist_closed_t)
+      text = text//'case '//trim(m%name)//': the one-way flash temperature closes the backlash '// &
+           '(Eq. 2: c0 - kappa (T_M + T_f) <= 0) in '//itoa(nint(stats(ist_closed)))//' tooth '// &
+           'samples, first at t = '//trim(adjustl(buf))//' s: the one-way result is not '// &
+           'physical there (thermal = ''coupled'' stops at the interference)'//new_line('a')
+    end if
+  end function run_warnings
+
+  pure function itoa(i) result(s)
+    integer, intent(in) :: i
+    character(len=:), allocatable :: s
+    character(len=12) :: buf
+    write(buf, '(i0)') i
+    s = trim(buf)
+  end function itoa
 
   !> One run of the model at the level m sets.
   subroutine run_level(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y)

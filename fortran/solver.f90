@@ -94,6 +94,8 @@ contains
     integer(c_int) :: flag, nroot
     integer(c_int), allocatable :: rootsfound(:)
     integer :: k, k0, nroots, nresync, ks, nsec
+    integer(8) :: done, done_k, allow
+    logical :: total_bound
     character(len=40) :: stage
 
     ierr = err_ok
@@ -197,8 +199,24 @@ contains
     else
       outputs: do k = 1, nt
         tau_out = tout(k)*m%w_ref
+        done_k = steps_done()
         do while (tau < tau_out)
-          flag = FCVode(mem, tau_out, sv, tret, CV_NORMAL)
+          ! The work bounds hold across the restarts at contact switches and section times
+          ! (each restart is a new CVode call, whose own count starts at 0): max_steps per
+          ! output interval, max_total_steps over the run.
+          done = steps_done()
+          allow = min(m%max_steps - (done - done_k), m%max_total_steps - done)
+          total_bound = m%max_total_steps - done <= m%max_steps - (done - done_k)
+          if (allow <= 0) then
+            call fail_work(tau)
+            exit outputs
+          end if
+          flag = FCVodeSetMaxNumSteps(mem, int(allow, c_long))
+          if (flag == 0) flag = FCVode(mem, tau_out, sv, tret, CV_NORMAL)
+          if (flag == CV_TOO_MUCH_WORK) then
+            call fail_work(tret(1))
+            exit outputs
+          end if
           if (flag < 0) then
             call fail(flag, tret(1), 'integrating')
             exit outputs
@@ -274,6 +292,30 @@ contains
     flag = FSUNContext_Free(sunctx)
 
   contains
+
+    !> CVODE steps taken so far in this run (over all restarts).
+    integer(8) function steps_done() result(n)
+      integer(c_long) :: cnt(1)
+      n = nint(stats(1), 8)
+      if (FCVodeGetNumSteps(mem, cnt) == 0) n = n + cnt(1)
+    end function steps_done
+
+    !> The run hit a work bound: name the field that sets it.
+    subroutine fail_work(tau)
+      real(c_double), intent(in) :: tau
+      if (ierr /= err_ok) return
+      call fail(CV_TOO_MUCH_WORK, tau, 'integrating')
+      if (ctx%cb_ierr /= err_ok .or. ierr /= err_solver) return
+      if (total_bound) then
+        write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': the run took max_total_steps = ', &
+             m%max_total_steps, ' CVODE steps in all by t = ', tau/m%w_ref, ' s (flag '// &
+             'CV_TOO_MUCH_WORK): raise max_total_steps, or find why the steps are so small'
+      else
+        write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': CVODE took max_steps = ', &
+             m%max_steps, ' steps between two output times without reaching the next, at t = ', &
+             tau/m%w_ref, ' s (flag CV_TOO_MUCH_WORK): raise max_steps or n_out'
+      end if
+    end subroutine fail_work
 
     !> Stop the integrator at the next section time (CVODE never steps past it), if any.
     integer(c_int) function next_section() result(fl)

@@ -249,7 +249,7 @@ def tooth_pass_hz(speed_rpm, z):
 
 class LyapunovFit(NamedTuple):
     """Result of `largest_lyapunov_fit` (all exponents in 1/s when times are in s)."""
-    lambda_t: np.ndarray   #: running estimate cumulative / elapsed time at each renormalisation [1/s]
+    lambda_t: np.ndarray   #: running estimate cumulative / elapsed time, per renormalisation [1/s]
     lam: float             #: final running estimate lambda_t[-1] [1/s]
     spread: float          #: max - min of lambda_t over the last third of the elapsed time [1/s]
     rel_spread: float      #: spread / |lam| (inf if lam == 0); small means converged

@@ -1,18 +1,24 @@
-"""Case input: the fields of a case (namelist group ``&spline_case``), read from files with
-f90nml or given as a dict, and handed to the core in memory as namelist text.
+"""Case input: the fields of a case (namelist group ``&spline_case``), read from files or given
+as a dict, and handed to the core in memory as namelist text.
 
 The defaults live in the Fortran core only (``case_t`` in fortran/case.f90): Python reads them
 from the core once, so a field that Python knows is a field the executable knows, with the same
-default. Ranges are checked by the core (the same check for Python and the executable).
+default. A case file is read by the core's reader (api_parse, the one spline-dyn uses), so a
+bad file gets the same message from both; ranges are checked by the core too. What Python
+checks itself: that the path is a regular file (the same words as fortran/case.f90
+case_check_file) and the Python types of a dict's values.
 """
 from __future__ import annotations
 
+import errno
 import functools
-import math
+import os
+import stat
 from collections.abc import Mapping
 from pathlib import Path
 
 import f90nml
+import numpy as np
 
 try:
     from . import _core
@@ -22,10 +28,11 @@ except ImportError as exc:  # the source tree shadows the installed package
         "not the installed package. Run `bash scripts/setup.sh` (pip install .) and import "
         "pyspline from outside the repository root (or use the `pyspline` command).") from exc
 
-from .errors import CaseError
+from .errors import CaseError, decode
 
 GROUP = "spline_case"
 NAME_BYTES = 128   #: longest case name (UTF-8 bytes; fortran/case.f90 namelen)
+MAX_CASE_BYTES = 1048576   #: largest case file (fortran/case.f90 max_case_bytes)
 
 
 @functools.cache
@@ -38,6 +45,47 @@ def defaults() -> dict:
 
 def _clean(v):
     return v.strip() if isinstance(v, str) else v
+
+
+def _shown(path: str) -> str:
+    """A path as messages show it (fortran/case.f90 shown): the last 237 characters of a long one."""
+    return path if len(path) <= 240 else "..." + path[-237:]
+
+
+def _check_file(path: str) -> None:
+    """Refuse, before opening, a path that is not a regular file of at most MAX_CASE_BYTES (a
+    FIFO blocks the open, a device never ends): fortran/case.f90 case_check_file, same words."""
+    shown = _shown(path)
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        if os.path.islink(path):
+            raise CaseError(f"case file {shown} does not exist (a dangling symbolic link)") from None
+        raise CaseError(f"case file {shown} does not exist") from None
+    except OSError as exc:
+        why = os.strerror(exc.errno) if exc.errno else str(exc)
+        if exc.errno == errno.ELOOP:
+            raise CaseError(f"case file {shown}: {why} (a symbolic-link loop)") from None
+        raise CaseError(f"case file {shown}: {why}") from None
+    except ValueError as exc:          # an embedded NUL character
+        raise CaseError(f"case file {shown!r}: {exc}") from None
+    mode = st.st_mode
+    kinds = [(stat.S_ISDIR, "is a directory, not a case file"),
+             (stat.S_ISFIFO, "is a FIFO (named pipe), not a case file"),
+             (stat.S_ISCHR, "is a character device, not a case file"),
+             (stat.S_ISBLK, "is a block device, not a case file"),
+             (stat.S_ISSOCK, "is a socket, not a case file")]
+    if not stat.S_ISREG(mode):
+        why = next((w for test, w in kinds if test(mode)), "is not a regular file")
+        raise CaseError(f"case file {shown} {why}")
+    if st.st_size > MAX_CASE_BYTES:
+        raise CaseError(f"case file {shown} is {st.st_size} bytes: a case file holds at most "
+                        f"{MAX_CASE_BYTES} bytes")
+
+
+def field_hint(word: str) -> str:
+    """The case field nearest to a misspelt name ('' if none is near): the core's suggestion."""
+    return _core.spline_api.api_field_hint(str(word).encode("utf-8", "replace")[:64]).decode().strip()
 
 
 def _fortran(v) -> str:
@@ -59,11 +107,17 @@ class Case(Mapping):
         base = defaults()
         merged = dict(base)
         label = name or fields.get("name") or "unnamed"
+        if not isinstance(label, str):
+            label = repr(label)[:40]
         for key, value in fields.items():
+            if not isinstance(key, str):
+                raise CaseError(f"case {label}: a field name must be a string, not {key!r:.40}")
             k = key.lower()
             if k not in base:
-                raise CaseError(f"case {label}: unknown field '{key}' (see cases/template.nml or "
-                                f"pyspline.defaults() for the fields)")
+                hint = field_hint(k)
+                raise CaseError(f"case {label}: unknown field '{key}'"
+                                + (f": did you mean {hint}?" if hint else
+                                   " (see cases/template.nml or pyspline.defaults() for the fields)"))
             merged[k] = _coerce(label, k, value, base[k])
         if name is not None and "name" not in {k.lower() for k in fields}:
             merged["name"] = name
@@ -124,13 +178,17 @@ class Case(Mapping):
 
 
 def _coerce(label, key, value, default):
-    """Check a field's type against its default's (the core validates ranges). numpy scalars
-    and arrays count as the Python numbers and lists they hold."""
+    """Check a field's type against its default's (the core checks sizes and ranges, with the
+    same messages as for a file: a whole number beyond 32 bits, NaN, a string longer than its
+    field). numpy scalars and arrays count as the Python numbers and lists they hold."""
     def bad(why):
-        return CaseError(f"case {label}: field {key} = {value!r} {why}")
+        return CaseError(f"case {label}: field {key} = {value!r:.60} {why}")
 
     if hasattr(value, "tolist") and not isinstance(value, (str, bytes)):
-        value = value.tolist()          # numpy scalar -> int/float/bool, array -> list
+        try:
+            value = value.tolist()      # numpy scalar -> int/float/bool/str, array -> list
+        except Exception:               # a foreign object with a tolist of its own
+            raise bad("is not a value a case field takes") from None
     if isinstance(default, bool):
         if not isinstance(value, bool):
             raise bad("must be .true. or .false.")
@@ -138,6 +196,8 @@ def _coerce(label, key, value, default):
     if isinstance(default, str):
         if not isinstance(value, str):
             raise bad("must be a string")
+        if any(ord(ch) < 32 or ord(ch) == 127 for ch in value):
+            raise bad("holds a control character (e.g. a newline)")
         return value.strip()
     if isinstance(default, list):
         if not isinstance(value, (list, tuple)) or len(value) != len(default):
@@ -150,29 +210,38 @@ def _coerce(label, key, value, default):
         return int(value)
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise bad("must be a number")
-    value = float(value)
-    if not math.isfinite(value):
-        raise bad("is not a finite number")
-    return value
+    try:
+        return float(value)
+    except OverflowError:               # a Python int beyond the largest double
+        raise CaseError(f"case {label}: field {key} = {str(value)[:20]}... is beyond the largest "
+                        "number (1.8e308)") from None
 
 
 def load_case(source, **overrides) -> Case:
     """Read a case: a namelist file path (group &spline_case), a dict of fields, or a Case.
-    Keyword overrides replace fields. Unknown fields raise CaseError."""
+    Keyword overrides replace fields. Any bad input raises CaseError naming the case (for a
+    file: the path, line and field, in the words spline-dyn uses)."""
     if isinstance(source, Case):
         return source.replace(**overrides) if overrides else source
     if isinstance(source, Mapping):
         return Case({**source, **overrides})
-    path = Path(source)
-    if not path.is_file():
-        raise CaseError(f"case file {path} does not exist")
+    if not isinstance(source, (str, os.PathLike)):
+        raise CaseError(f"a case is a namelist file path, a dict of fields or a Case, not "
+                        f"{type(source).__name__}")
+    path = os.fspath(source)
+    if isinstance(path, bytes):
+        path = os.fsdecode(path)
+    _check_file(path)
     try:
-        nml = f90nml.read(str(path))
-    except Exception as exc:  # f90nml raises several types for bad syntax
-        raise CaseError(f"case file {path}: cannot read namelist: {exc}") from exc
-    groups = [g.lower() for g in nml.keys()]
-    if groups != [GROUP]:
-        raise CaseError(f"case file {path}: expected one namelist group &{GROUP}, found "
-                        f"{', '.join('&' + g for g in groups) or 'none'}")
-    fields = {k: _clean(v) for k, v in nml[GROUP].items()}
-    return Case({**fields, **overrides}, name=path.stem, source=str(path))
+        with open(path, "rb") as f:
+            data = f.read(MAX_CASE_BYTES + 1)
+    except OSError as exc:
+        raise CaseError(f"case file {_shown(path)}: cannot read it: "
+                        f"{os.strerror(exc.errno) if exc.errno else exc}") from None
+    # the byte values as an array: a NUL byte must reach the reader (bytes would end there)
+    codes = np.frombuffer(data, dtype=np.uint8).astype(np.int32)
+    canon, ierr, msg = _core.spline_api.api_parse(codes, os.fsencode(path))
+    if ierr:
+        raise CaseError(decode(msg))
+    fields = {k.lower(): _clean(v) for k, v in f90nml.reads(canon.decode("utf-8", "replace"))[GROUP].items()}
+    return Case({**fields, **overrides}, source=path)

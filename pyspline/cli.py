@@ -19,30 +19,132 @@ def _summary(res) -> str:
             f"steps {s['steps']}  {s['wall_s']*1e3:.0f} ms")
 
 
+def _one_line(exc: BaseException) -> str:
+    """An exception as one line: its class and its message, newlines folded."""
+    return f"{type(exc).__name__}: {' '.join(str(exc).split())}"
+
+
+_RESULT_KEY = "pyspline_case"     #: the member that marks an .npz written by `pyspline run`
+
+
+def _safe_stem(name: str) -> str:
+    """A case name as a file name: characters other than letters, digits, '.', '_', '-' become '_'."""
+    stem = "".join(ch if ch.isascii() and (ch.isalnum() or ch in "._-") else "_" for ch in name)
+    stem = stem.strip(".") or "case"
+    return stem[:120]
+
+
+def _is_our_result(path: Path) -> bool:
+    """An .npz that `pyspline run --out` wrote (it holds the case text as _RESULT_KEY)."""
+    try:
+        with np.load(path, allow_pickle=False) as f:
+            return _RESULT_KEY in f.files
+    except Exception:
+        return False
+
+
+def _save_result(res, out: Path, taken: set) -> tuple[Path, str]:
+    """Write a result into out as NAME.npz, atomically (a temporary file renamed). A name
+    another case of this run already took gets -2, -3, ...; a file of the same name that
+    pyspline did not write is never replaced (the result goes to the next free name); an
+    earlier pyspline result is replaced. Returns the path and a note for the user ('' if none)."""
+    import os
+    import tempfile
+    stem = _safe_stem(res.case.name)
+    note = ""
+    k = 1
+    while True:
+        path = out / (f"{stem}.npz" if k == 1 else f"{stem}-{k}.npz")
+        if path in taken:
+            note = f"another case of this run is named {res.case.name!r}"
+        elif path.exists() and not (path.is_file() and _is_our_result(path)):
+            note = f"{path} exists and was not written by pyspline run: not overwritten"
+        else:
+            break
+        k += 1
+    if path.exists():
+        note = (note + "; " if note else "") + f"replaced the earlier result {path.name}"
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=out)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            np.savez_compressed(f, t=res.t, y=res.y, Tm=res.Tm, **res.tooth,
+                                **{_RESULT_KEY: np.array(res.case.text())})
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    taken.add(path)
+    return path, note
+
+
 def cmd_run(args) -> int:
+    """Run each case; a failure of any kind in one prints one line and the next case runs."""
     from .core import simulate
-    from .case import SplineError
     status = 0
+    taken: set = set()
+    out = Path(args.out) if args.out else None
     for path in args.cases:
         try:
             res = simulate(path)
-        except SplineError as exc:
-            print(f"error: {exc}", file=sys.stderr)
+            print(_summary(res))
+            if out is not None:
+                out.mkdir(parents=True, exist_ok=True)
+                saved, note = _save_result(res, out, taken)
+                if note:
+                    print(f"note: case {res.case.name}: result in {saved} ({note})", file=sys.stderr)
+        except KeyboardInterrupt:
+            print(f"interrupted: {path}", file=sys.stderr)
+            return 130
+        except Exception as exc:      # any failure: one line, then the next case
+            print(f"error: {path}: {_one_line(exc)}", file=sys.stderr)
             status = 1
-            continue
-        print(_summary(res))
-        if args.out:
-            out = Path(args.out)
-            out.mkdir(parents=True, exist_ok=True)
-            np.savez_compressed(out / f"{res.case.name}.npz", t=res.t, y=res.y, Tm=res.Tm,
-                                **res.tooth)
     return status
+
+
+#: what `pyspline reproduce` writes into --out, besides the figures (named in summary.json)
+_REPRODUCE_MARK = ".pyspline-reproduce"
+
+
+def _reproduce_files() -> list[str]:
+    from .paper import FIGURES, PHYSICAL
+    return ([f"{k}.png" for k in FIGURES] + [f"{c}.png" for c in PHYSICAL]
+            + ["verification.csv", "verification.md", "summary.json"])
+
+
+def _foreign_files(out: Path) -> list[str]:
+    """The files reproduce would write into out that an earlier reproduce did not write."""
+    import json
+    if not out.exists():
+        return []
+    ours: set = set()
+    mark = out / _REPRODUCE_MARK
+    if mark.is_file():
+        ours = set(mark.read_text(encoding="utf-8", errors="replace").split())
+    else:
+        try:           # a directory an earlier reproduce (before the mark existed) wrote
+            s = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+            if {"rows", "figures", "executable_check"} <= set(s):
+                ours = set(_reproduce_files()) | set(s["figures"])
+        except Exception:
+            pass
+    return [n for n in _reproduce_files() if (out / n).exists() and n not in ours]
 
 
 def cmd_reproduce(args) -> int:
     from .paper import reproduce
-    s = reproduce(args.out, quick=args.quick, directory=args.cases)
     out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        print(f"error: reproduce --out {out}: not a directory", file=sys.stderr)
+        return 2
+    foreign = _foreign_files(out)
+    if foreign:
+        print(f"error: reproduce --out {out}: {', '.join(foreign)} exist(s) and were not written "
+              "by pyspline reproduce: not overwritten (choose another --out or remove them)",
+              file=sys.stderr)
+        return 2
+    s = reproduce(args.out, quick=args.quick, directory=args.cases)
+    (out / _REPRODUCE_MARK).write_text("\n".join(sorted(set(_reproduce_files()) | set(s["figures"])))
+                                       + "\n", encoding="utf-8")
     print((out / "verification.md").read_text())
     print(f"figures: {', '.join(s['figures'])} in {out}/")
     print(f"executable check (spline-dyn vs Python): {s['executable_check']}")
@@ -90,11 +192,13 @@ def main(argv=None) -> int:
     sub = p.add_subparsers(dest="cmd", required=True)
     r = sub.add_parser("run", help="run case files and print a summary")
     r.add_argument("cases", nargs="+")
-    r.add_argument("--out", help="directory for .npz results")
+    r.add_argument("--out", help="directory for .npz results (NAME.npz per case; never replaces "
+                   "a file pyspline did not write; cases of the same name get NAME-2.npz, ...)")
     r.set_defaults(func=cmd_run)
     r = sub.add_parser("reproduce", help="run the paper's scenarios: figures, verification "
                        "table, summary.json")
-    r.add_argument("--out", default="out", help="output directory (default: out)")
+    r.add_argument("--out", default="out", help="output directory (default: out); refused if it "
+                   "holds files of the same names that reproduce did not write")
     r.add_argument("--quick", action="store_true", help="0.3 s per case (for CI)")
     r.add_argument("--cases", help="case directory (default: ./cases or the installed copies)")
     r.set_defaults(func=cmd_reproduce)
@@ -108,5 +212,7 @@ def main(argv=None) -> int:
     r.add_argument("--full", action="store_true", help="full length (default: 0.3 s)")
     r.add_argument("--cases")
     r.set_defaults(func=cmd_check_exe)
+    from .sweep import add_parsers      # pyspline sweep, pyspline plot (logic in sweep.py)
+    add_parsers(sub)
     args = p.parse_args(argv)
     return args.func(args)

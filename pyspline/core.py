@@ -10,13 +10,14 @@ from __future__ import annotations
 
 import functools
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from . import _core
 from .case import Case, load_case
-from .errors import BY_NAME, SplineError, decode
+from .errors import BY_NAME, SplineError, SplineWarning, decode
 
 _api = _core.spline_api
 STATE_NAMES = ("x1", "y1", "x2", "y2", "D1", "D2", "D3")
@@ -39,6 +40,13 @@ def _names(kind: str) -> tuple:
 def _errors() -> dict:
     """Error code of the core -> exception class (codes and names from fortran/errors.f90)."""
     return {i: BY_NAME.get(name, SplineError) for i, (name, _) in enumerate(_names("errors"))}
+
+
+def _warn(text) -> None:
+    """The core's warnings (one per line, the words spline-dyn prints) as SplineWarning."""
+    for line in decode(text).splitlines():
+        if line.strip():
+            warnings.warn(line.strip(), SplineWarning, stacklevel=3)
 
 
 def raise_for(ierr: int, errmsg) -> None:
@@ -69,6 +77,7 @@ class Model:
         raise_for(ierr, msg)
         self.case, self.bytes, self.z, self.n_out = case, data, int(z), int(nt)
         self.n_section, self.n_lyapunov = int(nsec), int(nlyap)
+        _warn(_api.api_warnings(data, np.zeros(1), 0))   # the core's model warnings (k_m)
 
     def __getstate__(self):
         return {k: getattr(self, k) for k in self.__slots__ if k != "__weakref__"}
@@ -130,9 +139,56 @@ def load(case) -> Model:
     return case if isinstance(case, Model) else load_case(case).model
 
 
+#: Result quantities: name -> (long name, units); per tooth (time, tooth) and states (time).
+TOOTH_QUANTITIES = {
+    "F": ("tooth load F_j (Eqs. 15-17)", "N"),
+    "Fx": ("x component of the tooth load", "N"),
+    "Fy": ("y component of the tooth load", "N"),
+    "dn": ("relative displacement along the line of action dn_j (Eq. 11)", "m"),
+    "c": ("backlash c_j (Eq. 2)", "m"),
+    "Tf": ("flash temperature T_f (Eqs. 3-7)", "degC"),
+    "rc1": ("contact-point radius on the external spline (Eqs. 13-14)", "m"),
+    "rc2": ("contact-point radius on the internal spline (Eqs. 13-14)", "m"),
+}
+STATE_QUANTITIES = {
+    "x1": ("x displacement of spline 1", "m"), "y1": ("y displacement of spline 1", "m"),
+    "x2": ("x displacement of spline 2", "m"), "y2": ("y displacement of spline 2", "m"),
+    "D1": ("torsional displacement D_1 (motor - spline 1, on the base circle)", "m"),
+    "D2": ("relative displacement D_2 (spline 1 - spline 2, on the base circle)", "m"),
+    "D3": ("torsional displacement D_3 (spline 2 - load, on the base circle)", "m"),
+}
+
+
+def _tooth_quantity(name: str) -> property:
+    def get(self):
+        try:
+            return self.tooth[name]
+        except KeyError:
+            raise AttributeError(f"this Result has no per-tooth quantity {name!r}") from None
+    get.__name__ = name
+    long, unit = TOOTH_QUANTITIES[name]
+    return property(get, doc=f"{long} [{unit}], shape (nt, Z)")
+
+
+def _state(name: str) -> property:
+    velocity = name not in STATE_NAMES
+    i = STATE_NAMES.index(name[1:] if velocity else name) + (7 if velocity else 0)
+
+    def get(self):
+        return self.y[:, i]
+    get.__name__ = name
+    long, unit = STATE_QUANTITIES[name[1:] if velocity else name]
+    doc = f"velocity of {name[1:]} [{unit}/s]" if velocity else f"{long} [{unit}]"
+    return property(get, doc=doc + ", shape (nt,)")
+
+
 @dataclass
 class Result:
-    """A simulation in SI units. Per-tooth arrays have shape (nt, Z)."""
+    """A simulation in SI units. Per-tooth arrays have shape (nt, Z).
+
+    Every quantity is an attribute: the states ``x1 y1 x2 y2 D1 D2 D3`` [m] and their
+    velocities ``vx1 ... vD3`` [m/s] (nt,), the per-tooth ``F Fx Fy dn c Tf rc1 rc2`` (nt, Z),
+    ``Tm`` and ``kv`` (nt,). ``to_xarray()`` gives all of it as an xarray.Dataset."""
     case: Case
     t: np.ndarray            #: output times [s]
     y: np.ndarray            #: states (nt, 14): x1, y1, x2, y2, D1, D2, D3 [m], then their velocities [m/s]
@@ -143,6 +199,19 @@ class Result:
     section_y: np.ndarray = None   #: states at the section times (n, 14), SI, like y
     lyapunov: dict = None    #: Benettin record (case field lyapunov): t [s], log_growth, exponent [1/s]
 
+    F = _tooth_quantity("F")
+    Fx = _tooth_quantity("Fx")
+    Fy = _tooth_quantity("Fy")
+    dn = _tooth_quantity("dn")
+    c = _tooth_quantity("c")
+    Tf = _tooth_quantity("Tf")
+    rc1 = _tooth_quantity("rc1")
+    rc2 = _tooth_quantity("rc2")
+    x1, y1, x2, y2 = _state("x1"), _state("y1"), _state("x2"), _state("y2")
+    D1, D2, D3 = _state("D1"), _state("D2"), _state("D3")
+    vx1, vy1, vx2, vy2 = _state("vx1"), _state("vy1"), _state("vx2"), _state("vy2")
+    vD1, vD2, vD3 = _state("vD1"), _state("vD2"), _state("vD3")
+
     @property
     def level(self) -> str:
         """The model level that ran (differs from the case's under fidelity = 'auto')."""
@@ -150,18 +219,76 @@ class Result:
 
     @property
     def kv(self) -> np.ndarray:
-        """Dynamic load coefficient k_v = |T_m| / T_d."""
+        """Dynamic load coefficient k_v = |T_m| / T_d, shape (nt,)."""
         return np.abs(self.Tm) / self.case["t_d"]
 
     def __getattr__(self, name):
+        # per-tooth quantities that the core has and this class does not name yet
         tooth = self.__dict__.get("tooth", {})
         if name in tooth:
             return tooth[name]
-        if name in STATE_NAMES:
-            return self.y[:, STATE_NAMES.index(name)]
-        if name.startswith("v") and name[1:] in STATE_NAMES:
-            return self.y[:, 7 + STATE_NAMES.index(name[1:])]
-        raise AttributeError(name)
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+    def __dir__(self):
+        return sorted(set(super().__dir__()) | set(self.__dict__.get("tooth", {})))
+
+    def to_xarray(self):
+        """The run as an xarray.Dataset (SI units in each variable's attrs['units']).
+
+        dims: time (the output times t [s]), tooth (1..Z), section_point (the Poincare section,
+        if the case asked for one), renormalisation (the Benettin record, if lyapunov).
+        Variables: the states x1 .. D3 and velocities vx1 .. vD3 (time); Tm, kv (time); the
+        per-tooth F, Fx, Fy, dn, c, Tf, rc1, rc2 (time, tooth); section_t and the states on the
+        section section_x1 .. section_vD3 (section_point); lyapunov_log_growth
+        (renormalisation, with coordinate lyapunov_t [s]). attrs: case (namelist text), name, level, pyspline_version, the
+        exponent as lyapunov_exponent [1/s], and the run statistics as stat_<name>."""
+        import xarray as xr
+        from . import __version__
+        z = next(iter(self.tooth.values())).shape[1] if self.tooth else 0
+        tooth_no = np.arange(1, z + 1)
+        coords = {"time": ("time", np.asarray(self.t), {"long_name": "time", "units": "s"}),
+                  "tooth": ("tooth", tooth_no, {"long_name": "tooth number j"})}
+        data = {}
+        for i, n in enumerate(STATE_NAMES):
+            long, unit = STATE_QUANTITIES[n]
+            data[n] = ("time", self.y[:, i], {"long_name": long, "units": unit})
+        for i, n in enumerate(STATE_NAMES):
+            data["v" + n] = ("time", self.y[:, 7 + i],
+                             {"long_name": f"velocity of {n}",
+                              "units": STATE_QUANTITIES[n][1] + "/s"})
+        data["Tm"] = ("time", self.Tm, {"long_name": "meshing torque T_m (Eq. 22)",
+                                        "units": "N m"})
+        data["kv"] = ("time", self.kv, {"long_name": "dynamic load coefficient k_v = |T_m|/T_d",
+                                        "units": "1"})
+        units = dict(_names("tooth"))
+        for n, arr in self.tooth.items():
+            long, unit = TOOTH_QUANTITIES.get(n, (n, units.get(n, "")))
+            data[n] = (("time", "tooth"), arr, {"long_name": long, "units": unit})
+        if self.section_t is not None and len(self.section_t):
+            sec = np.asarray(self.section_y).reshape(-1, 14)
+            data["section_t"] = ("section_point", self.section_t,
+                                 {"long_name": "time of the Poincare section point "
+                                  f"({self.case['section']})", "units": "s"})
+            for i, n in enumerate(STATE_NAMES + tuple("v" + n for n in STATE_NAMES)):
+                unit = STATE_QUANTITIES[n.removeprefix("v") if i >= 7 else n][1]
+                data["section_" + n] = ("section_point", sec[:, i],
+                                        {"long_name": f"{n} on the Poincare section",
+                                         "units": unit + ("/s" if i >= 7 else "")})
+        attrs = {"case": self.case.text(), "name": self.case.name,
+                 "pyspline_version": __version__}
+        if self.stats:
+            attrs["level"] = self.level
+        if self.lyapunov is not None:
+            coords["lyapunov_t"] = ("renormalisation", self.lyapunov["t"],
+                                    {"long_name": "time of the Benettin renormalisation",
+                                     "units": "s"})
+            data["lyapunov_log_growth"] = ("renormalisation", self.lyapunov["log_growth"],
+                                           {"long_name": "cumulative log stretch of the "
+                                            "separation (Benettin)", "units": "1"})
+            attrs["lyapunov_exponent"] = float(self.lyapunov["exponent"])
+        for k, v in self.stats.items():
+            attrs[f"stat_{k}"] = v
+        return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
 _FLOAT_STATS = ("_s", "_degC")
@@ -181,6 +308,7 @@ def simulate(case) -> Result:
     st = {n: (float(v) if n.endswith(_FLOAT_STATS) or n.startswith("fidelity_eps") else int(v))
           for (n, _), v in zip(s, stats)}
     st["wall_s"] = wall
+    _warn(_api.api_warnings(model.bytes, stats, 1))      # the run's (one-way backlash, Eq. 2)
     lyap = None
     if model.n_lyapunov:
         span = lyap_t - (t[0] if len(t) else 0.0)

@@ -28,7 +28,8 @@ BY_NAME = {"case": CaseError, "solver": SolverError, "thermal": ThermalInterfere
 
 
 def decode(msg) -> str:
-    """A message from the core (bytes, possibly cut inside a UTF-8 character) as text."""
+    """A message from the core (bytes, possibly cut inside a UTF-8 character) as text, without
+    the blank padding of its Fortran buffer (what spline-dyn prints: trim(msg))."""
     if isinstance(msg, bytes):
         msg = msg.decode("utf-8", errors="replace")
-    return str(msg).strip()
+    return str(msg).rstrip(" \0").lstrip(" ")

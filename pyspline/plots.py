@@ -12,16 +12,18 @@ pyspline.analysis and passed in as arrays.
 """
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
-from matplotlib.colors import LogNorm
+from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm, TwoSlopeNorm
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 from matplotlib.ticker import MaxNLocator
 
-__all__ = ["bifurcation", "lyapunov_vs_param", "scene", "waterfall"]
+__all__ = ["bifurcation", "bifurcation_grid", "lyapunov_vs_param", "param_map", "scene",
+           "waterfall"]
 
 # Colours of periods 1, 2, 3, 4 (Okabe-Ito, colour-blind safe) and > 4; not periodic is grey.
 PERIOD_COLOURS = {1: "#0072B2", 2: "#D55E00", 3: "#009E73", 4: "#CC79A7", 5: "#000000"}
@@ -110,7 +112,9 @@ def _peak_hold(f, a, f_max, columns=500):
     f = np.pad(f, ((0, 0), (0, pad)), constant_values=np.nan)
     a = np.pad(a, ((0, 0), (0, pad)), constant_values=np.nan)
     shape = (f.shape[0], f.shape[1] // g, g)
-    return np.nanmean(f.reshape(shape), axis=2), np.nanmax(a.reshape(shape), axis=2)
+    with warnings.catch_warnings():       # all-NaN groups (beyond a run's Nyquist) stay NaN
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return np.nanmean(f.reshape(shape), axis=2), np.nanmax(a.reshape(shape), axis=2)
 
 
 # --------------------------------------------------------------------------- bifurcation
@@ -134,29 +138,156 @@ def bifurcation(ds, param: str, coord: str = "section_D2", period: str = "period
     factor, unit = _prefix(y, _units(ds, coord, "m", units))
     px, ux = _prefix(p, _units(ds, param, "", units))
     long = _long_name(ds, coord)
-    cls = np.where(np.isfinite(per) & (per > 0), np.minimum(np.nan_to_num(per), 5), 0).astype(int)
     fig = Figure(figsize=(9, 5.5), layout="constrained")
     ax = fig.add_subplot()
+    handles = _bifurcation_points(ax, p / px, y / factor, per)
+    ax.set_xlabel(_label(ds, param, factor_unit=ux))
+    ax.set_ylabel(_label(ds, coord, factor_unit=unit))
+    ax.legend(handles=handles, fontsize=8, loc="best", title="runs by period",
+              title_fontsize=8, framealpha=0.9)
+    ax.set_title(title or f"bifurcation diagram: {long} vs {_long_name(ds, param)}")
+    return _finish(fig, path)
+
+
+def _period_class(per) -> np.ndarray:
+    """0: not periodic (0, negative, NaN); 1..4: the period; 5: period > 4."""
+    per = np.asarray(per, dtype=float)
+    return np.where(np.isfinite(per) & (per > 0), np.minimum(np.nan_to_num(per), 5), 0).astype(int)
+
+
+def _period_name(c: int) -> str:
+    return "not periodic" if c == 0 else ("period > 4" if c == 5 else f"period {c}")
+
+
+def _bifurcation_points(ax, x, y, per, counts=True, ms=9) -> list:
+    """Scatter y (n, n_points) against x (n,) on ax, coloured by period class; legend handles."""
+    cls = _period_class(per)
     handles = []
     for c in (0, 1, 2, 3, 4, 5):
         rows = cls == c
         if not rows.any():
             continue
-        xs = np.repeat(p[rows] / px, y.shape[1])
-        ys = y[rows].ravel() / factor
+        xs = np.repeat(x[rows], y.shape[1])
+        ys = y[rows].ravel()
         ok = np.isfinite(ys)
         colour = NOT_PERIODIC if c == 0 else PERIOD_COLOURS[c]
-        ax.scatter(xs[ok], ys[ok], s=3 if c == 0 else 9, c=colour, lw=0,
+        ax.scatter(xs[ok], ys[ok], s=ms / 3 if c == 0 else ms, c=colour, lw=0,
                    alpha=0.6 if c == 0 else 1.0, zorder=1 if c == 0 else 2, rasterized=True)
-        name = "not periodic" if c == 0 else ("period > 4" if c == 5 else f"period {c}")
-        handles.append(Line2D([], [], ls="", marker="o", ms=6, color=colour,
-                              label=f"{name} ({rows.sum()})"))
-    ax.set_xlabel(_label(ds, param, factor_unit=ux))
-    ax.set_ylabel(_label(ds, coord, factor_unit=unit))
-    ax.legend(handles=handles, fontsize=8, loc="best", title="runs by period",
-              title_fontsize=8, framealpha=0.9)
+        label = f"{_period_name(c)} ({rows.sum()})" if counts else _period_name(c)
+        handles.append(Line2D([], [], ls="", marker="o", ms=6, color=colour, label=label))
     ax.grid(alpha=0.3, lw=0.5)
-    ax.set_title(title or f"bifurcation diagram: {long} vs {_long_name(ds, param)}")
+    return handles
+
+
+def _axis_values(ds, name, units=None):
+    """(numeric positions, tick labels or None, factor, unit) of a coordinate; text values
+    (e.g. thermal = 'none', 'bulk') are placed at 0, 1, 2 ... and labelled."""
+    raw = np.asarray(ds[name])
+    if raw.dtype.kind in "biuf":
+        v = raw.astype(float)
+        factor, unit = _prefix(v, _units(ds, name, "", units))
+        return v / factor, None, factor, unit
+    return (np.arange(len(raw), dtype=float), [str(r) for r in raw], 1.0,
+            _units(ds, name, "", units))
+
+
+def bifurcation_grid(ds, param: str, by: str, coord: str = "section_D2",
+                     period: str = "period", max_panels: int = 12, path=None,
+                     title: str | None = None, units: dict | None = None) -> Figure:
+    """Bifurcation diagrams of a two-field sweep: one panel per value of ``ds[by]`` (at most
+    `max_panels`, evenly chosen, first and last included), each showing ``ds[coord]`` (dims
+    (param, by, 'section_point')) against ``ds[param]``, coloured by ``ds[period]`` (dims
+    (param, by)) as in `bifurcation`. Panels share both axes; one legend for all."""
+    p = _array(ds, param)
+    b = np.asarray(ds[by])
+    y = _array(ds, coord, dims=(param, by, "section_point") if hasattr(ds, "dims") else None)
+    per = _array(ds, period, dims=(param, by) if hasattr(ds, "dims") else None)
+    if y.ndim == 2:
+        y = y[:, :, None]
+    if y.shape[:2] != (len(p), len(b)) or per.shape != (len(p), len(b)):
+        raise ValueError(f"{coord} must have shape ({len(p)}, {len(b)}, n_points) and {period} "
+                         f"({len(p)}, {len(b)}), got {y.shape} and {per.shape}")
+    pick = np.unique(np.linspace(0, len(b) - 1, min(len(b), max(1, max_panels)))
+                     .round().astype(int))
+    factor, unit = _prefix(y, _units(ds, coord, "m", units))
+    px, ux = _prefix(p, _units(ds, param, "", units))
+    bv, blabels, bf, bu = _axis_values(ds, by, units)
+    n = len(pick)
+    ncols = min(4, int(np.ceil(np.sqrt(n))))
+    nrows = int(np.ceil(n / ncols))
+    fig = Figure(figsize=(3.6 * ncols + 1.0, 2.9 * nrows + 1.2), layout="constrained")
+    axes = fig.subplots(nrows, ncols, sharex=True, sharey=True, squeeze=False)
+    seen = {}
+    for k, j in enumerate(pick):
+        ax = axes.flat[k]
+        for h in _bifurcation_points(ax, p / px, y[:, j, :] / factor, per[:, j], counts=False,
+                                     ms=6):
+            seen.setdefault(h.get_label(), h)
+        value = blabels[j] if blabels else f"{bv[j]:.4g}" + (f" {bu}" if bu else "")
+        ax.set_title(f"{by} = {value}", fontsize=9)
+    for ax in axes.flat[n:]:
+        ax.set_axis_off()
+    for k in range(max(0, n - ncols), n):     # the lowest panel of each column
+        axes.flat[k].tick_params(labelbottom=True)
+        axes.flat[k].set_xlabel(_label(ds, param, factor_unit=ux), fontsize=9)
+    for ax in axes[:, 0]:
+        ax.set_ylabel(_label(ds, coord, factor_unit=unit), fontsize=9)
+    order = [_period_name(c) for c in (1, 2, 3, 4, 5, 0)]
+    handles = [seen[name] for name in order if name in seen]
+    fig.legend(handles=handles, fontsize=8, loc="outside lower center", ncols=len(handles),
+               frameon=False)
+    shown = "" if n == len(b) else f" ({n} of {len(b)} values of {by})"
+    fig.suptitle((title or f"bifurcation diagrams: {_long_name(ds, coord)} vs "
+                  f"{_long_name(ds, param)}") + shown)
+    return _finish(fig, path)
+
+
+def param_map(ds, var: str, x: str, y: str, path=None, title: str | None = None,
+              units: dict | None = None) -> Figure:
+    """A quantity of a two-field sweep as a map over the grid: ``ds[var]`` (dims (x, y))
+    with ``ds[x]`` across and ``ds[y]`` up, one cell per run. A period (`var` named
+    'period...') is drawn in the period colours of `bifurcation` (not periodic grey, no result
+    white); a quantity of both signs (e.g. a Lyapunov exponent) on a blue-red scale centred on
+    zero; anything else on viridis. Cells without a value (NaN: failed runs) stay white."""
+    v = _array(ds, var, dims=(x, y) if hasattr(ds, "dims") else None)
+    xv, xlab, _, xu = _axis_values(ds, x, units)
+    yv, ylab, _, yu = _axis_values(ds, y, units)
+    if v.shape != (len(xv), len(yv)):
+        raise ValueError(f"{var} must have shape ({len(xv)}, {len(yv)}), got {v.shape}")
+    fig = Figure(figsize=(9, 6.5), layout="constrained")
+    ax = fig.add_subplot()
+    ax.set_facecolor("white")
+    X, Y = np.meshgrid(xv, yv, indexing="ij")
+    if var.startswith("period"):
+        cls = np.where(np.isfinite(v), _period_class(v), -1).astype(float)
+        cls[cls < 0] = np.nan
+        colours = [NOT_PERIODIC] + [PERIOD_COLOURS[c] for c in (1, 2, 3, 4, 5)]
+        mesh = ax.pcolormesh(X, Y, np.ma.masked_invalid(cls), shading="nearest",
+                             cmap=ListedColormap(colours),
+                             norm=BoundaryNorm(np.arange(-0.5, 6.5), 6), edgecolors="w",
+                             linewidth=0.3 if max(v.shape) <= 30 else 0, rasterized=True)
+        cb = fig.colorbar(mesh, ax=ax, pad=0.01, ticks=np.arange(6))
+        cb.ax.set_yticklabels(["not periodic", "1", "2", "3", "4", "> 4"])
+        cb.set_label("period of the section sequence (white: no result)")
+    else:
+        finite = v[np.isfinite(v)]
+        lo, hi = (finite.min(), finite.max()) if finite.size else (0.0, 1.0)
+        if lo < 0 < hi:
+            norm, cmap = TwoSlopeNorm(0.0, lo, hi), "RdBu_r"
+        else:
+            norm, cmap = None, "viridis"
+        mesh = ax.pcolormesh(X, Y, np.ma.masked_invalid(v), shading="nearest", cmap=cmap,
+                             norm=norm, rasterized=True)
+        cb = fig.colorbar(mesh, ax=ax, pad=0.01)
+        cb.set_label(_label(ds, var, units=units))
+    for lab, set_ticks, set_labels, pos in ((xlab, ax.set_xticks, ax.set_xticklabels, xv),
+                                            (ylab, ax.set_yticks, ax.set_yticklabels, yv)):
+        if lab:
+            set_ticks(pos)
+            set_labels(lab)
+    ax.set_xlabel(_label(ds, x, factor_unit=xu))
+    ax.set_ylabel(_label(ds, y, factor_unit=yu))
+    ax.set_title(title or f"{_long_name(ds, var)} over {x} and {y}")
     return _finish(fig, path)
 
 

@@ -23,7 +23,8 @@ if [ ${#need[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${need[@]}"
 fi
 python3 -m pip install -q --disable-pip-version-check \
-  "numpy>=2.0" meson meson-python ninja pytest matplotlib scipy f90nml tqdm
+  "numpy>=2.0" meson meson-python ninja pytest hypothesis matplotlib scipy f90nml tqdm \
+  xarray "h5netcdf[h5py]" distributed
 
 # Test-only cross-checks and benchmark peers (never imported by the package): ROSS (an
 # independent potential-energy stiffness; 2.3 needs plotly < 6), numba + numbalsoda (the

@@ -1,6 +1,9 @@
 """Bad input: a clear error naming the field (or the CVODE flag, the time and the case)."""
+import json
 import math
+import os
 import subprocess
+from pathlib import Path
 
 import f90nml
 import pytest
@@ -82,3 +85,237 @@ def test_template_lists_every_field_with_the_core_defaults():
     assert set(tpl) == set(defaults)
     for k, v in defaults.items():
         assert tpl[k] == v, k
+
+
+# ------------------------------------------------------------------ one reader, one diagnosis
+
+CORPUS = Path(__file__).resolve().parent / "corpus"
+_MANIFEST = json.loads((CORPUS / "manifest.json").read_text(encoding="utf-8"))
+BAD_FILES = sorted({e["file"] for e in _MANIFEST if e["kind"] == "file" and e["expect"] == "CaseError"})
+
+
+def _exe_error(exe, args, tmp_path):
+    run = subprocess.run([exe, *args, "-o", str(tmp_path / "out.csv")], capture_output=True,
+                         text=True, timeout=60, stdin=subprocess.DEVNULL)
+    lines = run.stderr.splitlines()
+    assert lines and lines[0].startswith("spline-dyn: error: "), run.stderr
+    assert not (tmp_path / "out.csv").exists()
+    return run.returncode, lines[0].removeprefix("spline-dyn: error: ")
+
+
+@pytest.mark.parametrize("name", BAD_FILES)
+def test_python_and_executable_say_the_same(name, exe, tmp_path):
+    """A bad case file gets the same message, word for word, from pyspline and spline-dyn:
+    the file is parsed by one reader (fortran/case.f90 case_parse) and validated by one check."""
+    path = str(CORPUS / name)
+    with pytest.raises(pyspline.CaseError) as exc:
+        pyspline.simulate(pyspline.load_case(path))
+    code, msg = _exe_error(exe, [path], tmp_path)
+    assert code == 2
+    assert msg == str(exc.value)
+
+
+def _not_a_file(kind, tmp_path):
+    if kind == "directory":
+        (tmp_path / "d.nml").mkdir()
+        return tmp_path / "d.nml"
+    if kind == "missing":
+        return tmp_path / "missing.nml"
+    if kind == "dangling":
+        (tmp_path / "dangling.nml").symlink_to(tmp_path / "gone.nml")
+        return tmp_path / "dangling.nml"
+    if kind == "loop":
+        (tmp_path / "a.nml").symlink_to(tmp_path / "b.nml")
+        (tmp_path / "b.nml").symlink_to(tmp_path / "a.nml")
+        return tmp_path / "a.nml"
+    if kind == "fifo":
+        os.mkfifo(tmp_path / "f.nml")
+        return tmp_path / "f.nml"
+    if kind == "too_big":
+        with open(tmp_path / "big.nml", "wb") as f:
+            f.truncate(2 * 1024 * 1024)
+        return tmp_path / "big.nml"
+    if kind == "nul_inside":
+        (tmp_path / "nul.nml").write_bytes(b"&spline_case\n  t_end = 1e-3\x00\n/\n")
+        return tmp_path / "nul.nml"
+    if kind == "not_a_dir":
+        (tmp_path / "plain").write_text("x")
+        return tmp_path / "plain" / "case.nml"
+    raise ValueError(kind)
+
+
+@pytest.mark.parametrize("kind", ["directory", "missing", "dangling", "loop", "fifo", "too_big",
+                                  "nul_inside", "not_a_dir"])
+def test_not_a_case_file_same_words(kind, exe, tmp_path):
+    """Paths that are no case file: refused before any open (a FIFO would block), in the same
+    words by Python (os.stat) and the executable (stat(2) in fortran/fileinfo.c)."""
+    path = str(_not_a_file(kind, tmp_path))
+    with pytest.raises(pyspline.CaseError) as exc:
+        pyspline.load_case(path)
+    code, msg = _exe_error(exe, [path], tmp_path)
+    assert code == 2
+    assert msg == str(exc.value)
+
+
+def test_field_table_matches_the_defaults():
+    """The reader's table of fields (type and size) agrees with case_t's defaults."""
+    from pyspline.core import _names
+    table = {name: unit for name, unit in _names("fields")}
+    defaults = pyspline.defaults()
+    assert set(table) == set(defaults)
+    for name, v in defaults.items():
+        kind = table[name]
+        if isinstance(v, bool):
+            assert kind == "l", name
+        elif isinstance(v, int):
+            assert kind == "i", name
+        elif isinstance(v, float):
+            assert kind == "r", name
+        elif isinstance(v, list):
+            assert kind == f"r{len(v)}", name
+        else:
+            assert kind.startswith("c"), name
+
+
+@pytest.mark.parametrize("body,expected", [
+    ("dq0(6) = 1e-6", {"dq0": [0, 0, 0, 0, 0, 1e-6, 0]}),
+    ("dq0(2:3) = 1e-6, 2e-6", {"dq0": [0, 1e-6, 2e-6, 0, 0, 0, 0]}),
+    ("dv0 = 3*0.0, 4*1e-6", {"dv0": [0, 0, 0, 1e-6, 1e-6, 1e-6, 1e-6]}),
+    ("dq0 = , 1e-6", {"dq0": [0, 1e-6, 0, 0, 0, 0, 0]}),
+    ("roots = T, stald = .False.", {"roots": True, "stald": False}),
+    ("ROOTS = .t", {"roots": True}),
+    ("c0 = 2.0d-4, module_m = 2.0D-3", {"c0": 2e-4, "module_m": 2e-3}),
+    ("method = 'adams'   , t_end = 1e-3", {"method": "adams", "t_end": 1e-3}),
+    ("name = 'it''s \"q\" / ! & z = 2'", {"name": "it's \"q\" / ! & z = 2", "z": 16}),
+    ("thermal = 'none                         '", {"thermal": "none"}),
+    ("t_end =", {"t_end": 0.1}),
+    ("n_out = +0003", {"n_out": 3}),
+])
+def test_reader_accepts_fortran_forms(tmp_path, body, expected):
+    path = tmp_path / "forms.nml"
+    path.write_text(f"&spline_case\n  {body}\n/\n")
+    case = pyspline.load_case(path)
+    for k, v in expected.items():
+        assert case[k] == (pytest.approx(v) if not isinstance(v, (str, bool)) else v), k
+
+
+@pytest.mark.parametrize("body,words", [
+    ("t_end = 1e-3\n  t_end = 2e-3", ["field t_end is given twice", "lines 2 and 3"]),
+    ("z = 16.0", ["field z = 16.0", "whole number"]),
+    ("t_end = 1e400", ["t_end = 1e400", "largest number"]),
+    ("dq0(0) = 1.0", ["dq0(0)", "outside 1 to 7"]),
+    ("t_end(2) = 1.0", ["t_end is not an array"]),
+    ("z = 3*16", ["field z: more than one value"]),
+    ("roots = yes", ["roots = yes", ".true. or .false."]),
+    ("name = '" + "x" * 129 + "'", ["field name", "longer than 128 characters"]),
+    ("lyapunov_int = 2.0", ["unknown field 'lyapunov_int'", "did you mean lyapunov_interval?"]),
+    ("k_mesh = 1.0", ["unknown field 'k_mesh'", "template.nml"]),
+    ("= 3", ["'=' without a field name"]),
+    ("t_end = 1e-3;", ["unexpected ';'"]),
+])
+def test_reader_refuses_with_line_and_field(tmp_path, body, words):
+    path = tmp_path / "bad.nml"
+    path.write_text(f"&spline_case\n  {body}\n/\n")
+    with pytest.raises(pyspline.CaseError) as exc:
+        pyspline.load_case(path)
+    msg = str(exc.value)
+    assert msg.startswith(f"case bad ({path}, line "), msg
+    for w in words:
+        assert w in msg, msg
+
+
+def test_dict_fields_get_the_core_suggestion():
+    with pytest.raises(pyspline.CaseError, match="unknown field 'l_xx': did you mean l_x?"):
+        pyspline.load_case({"l_xx": 1e-4})
+    with pytest.raises(pyspline.CaseError, match="field l_x = 1000.* beyond the largest number"):
+        pyspline.load_case({"l_x": 10 ** 400})
+
+
+def test_numpy_values_in_dicts():
+    import numpy as np
+    case = pyspline.load_case(dict(z=np.int64(20), module_m=np.float32(2e-3), roots=np.bool_(True),
+                                   dq0=np.zeros(7), method=np.str_("adams")))
+    assert case["z"] == 20 and case["roots"] is True and case["method"] == "adams"
+    assert case["module_m"] == pytest.approx(2e-3)
+
+
+def test_memory_is_checked_before_allocating():
+    with pytest.raises(pyspline.CaseError, match=r"field n_out = 100000000 with z = 1000 teeth needs "
+                       r"13\.2 TB of memory"):
+        pyspline.load(dict(z=1000, n_out=10 ** 8, t_end=1e-3))
+
+
+def test_static_equilibrium_of_large_misaligned_splines():
+    """Z = 200 .. 1000 with the computed k_m and a misalignment: the frozen-contact Newton
+    (fortran/dynamics.f90 static_equilibrium) converges where a plain difference Jacobian stalled."""
+    import numpy as np
+    for z in (200, 400, 1000):
+        y = pyspline.start_state(dict(z=z, l_x=1e-4, l_y=-3e-5, k_m=0.0, t_end=1e-3, n_out=3))
+        model = pyspline.load(dict(z=z, l_x=1e-4, l_y=-3e-5, k_m=0.0, t_end=1e-3, n_out=3))
+        acc = model.rhs(0.0, y)[7:]
+        assert np.all(np.isfinite(y))
+        assert np.abs(acc).max() < 1e-6 * model.info()["k_m"] * 1e-4, (z, acc)
+
+
+def test_total_work_bound_names_the_field():
+    with pytest.raises(pyspline.SolverError, match="max_total_steps = 200 CVODE steps in all"):
+        pyspline.simulate(dict(PAPER, name="bounded", l_x=1e-4, roots=True, start="rest",
+                               max_total_steps=200, t_end=0.05, n_out=3))
+
+
+# --------------------------------------------------------------------------- the executable
+
+def test_executable_sigint_exits_130_and_leaves_no_file(exe, tmp_path):
+    """SIGINT during a run: exit status 130, the partial output never appears (the CSV is
+    written to a temporary name and renamed only when complete)."""
+    import signal
+    import time
+    out = tmp_path / "out.csv"
+    proc = subprocess.Popen([exe, str(CASES / "paper_T100.nml"), "--set", "t_end=30.0", "-o", str(out)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(1.0)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "interrupted" in err
+    assert os.listdir(tmp_path) == []
+
+
+def test_executable_version_matches_the_package(exe):
+    run = subprocess.run([exe, "--version"], capture_output=True, text=True)
+    assert run.returncode == 0 and run.stdout.split()[-1] == pyspline.__version__
+
+
+# ------------------------------------------------------------------------------------ the CLI
+
+def test_cli_run_goes_on_after_a_failure_and_keeps_every_result(tmp_path, capsys):
+    from pyspline.cli import main
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "ok_minimal.npz").write_text("not ours")
+    a = tmp_path / "a.nml"
+    b = tmp_path / "b.nml"
+    for p in (a, b):
+        p.write_text((CORPUS / "ok_minimal.nml").read_text())
+    status = main(["run", str(a), str(CORPUS / "syntax_misspelt_lx.nml"), "/dev/zero", str(b),
+                   "--out", str(out)])
+    err = capsys.readouterr().err
+    assert status == 1
+    assert sum(line.startswith("error: ") for line in err.splitlines()) == 2
+    assert (out / "ok_minimal.npz").read_text() == "not ours"          # never replaced
+    assert sorted(p.name for p in out.iterdir()) == ["ok_minimal-2.npz", "ok_minimal-3.npz",
+                                                    "ok_minimal.npz"]
+    # a second run replaces its own earlier results, still not the foreign file
+    assert main(["run", str(a), "--out", str(out)]) == 0
+    assert (out / "ok_minimal.npz").read_text() == "not ours"
+    assert len(list(out.iterdir())) == 3
+
+
+def test_cli_reproduce_refuses_files_it_did_not_write(tmp_path, capsys):
+    from pyspline.cli import main
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "summary.json").write_text("{}")
+    assert main(["reproduce", "--out", str(out), "--quick"]) == 2
+    assert "summary.json" in capsys.readouterr().err
+    assert (out / "summary.json").read_text() == "{}"

@@ -1,0 +1,341 @@
+"""pyspline.sweep: one- and two-field sweeps on every kind of executor (same numbers bit for
+bit), failed points, resume, interrupts, Dask, the command line (sweep, plot) and
+Result.to_xarray. Short runs: paper_lx1e-4 over 0.25 s (20 shaft revolutions in the window)."""
+import concurrent.futures as cf
+import multiprocessing as mp
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import pyspline
+from pyspline import analysis
+from pyspline.core import _names
+
+xr = pytest.importorskip("xarray")
+sw = sys.modules["pyspline.sweep"]      # pyspline.sweep is the function; this is its module
+
+from conftest import CASES  # noqa: E402
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+TIMING = ["wall_s", "core_wall_s"]      # the only numbers that differ between two runs
+LX = np.linspace(0.0, 3e-4, 4)
+
+
+@pytest.fixture(scope="module")
+def case():
+    return pyspline.load_case(CASES / "paper_lx1e-4.nml", t_end=0.25, t_transient=0.05,
+                              n_out=201)
+
+
+def _same(a, b):
+    """Equal data bit for bit (NaN == NaN), coordinates included; timings excluded."""
+    xr.testing.assert_equal(a.drop_vars(TIMING), b.drop_vars(TIMING))
+
+
+def _png(path):
+    data = path.read_bytes()
+    assert data[:8] == PNG_MAGIC and len(data) > 5000, path
+
+
+# --------------------------------------------------------------------------- executors
+
+def test_1d_serial_threads_processes_identical(case):
+    serial = pyspline.sweep(case, progress=False, lyapunov=True, l_x=LX)
+    assert serial["section_D2"].dims == ("l_x", "section_point")
+    assert serial.sizes["l_x"] == 4 and serial.sizes["section_point"] == 21
+    np.testing.assert_array_equal(serial["l_x"], LX)
+    assert serial["l_x"].attrs["units"] == "m"
+    assert serial["section_D2"].attrs["units"] == "m"
+    assert (serial["error"] == "").all() and serial.attrs["n_ok"] == 4
+    assert serial.attrs["case"] == case.replace(section="shaft", lyapunov=True).text()
+    assert serial.attrs["pyspline_version"] == pyspline.__version__
+    assert np.isfinite(serial["period"]).all() and np.isfinite(serial["lyapunov"]).all()
+    np.testing.assert_array_equal(serial["predictability_horizon"],
+                                  analysis.predictability_horizon(serial["lyapunov"].values))
+    assert (serial["steps"] > 0).all() and (serial["rhs_evals"] > 0).all()
+    assert "Tm_spectrum" not in serial                       # only for speed sweeps
+    with cf.ThreadPoolExecutor(2) as ex:
+        threads = pyspline.sweep(case, executor=ex, progress=False, lyapunov=True, l_x=LX)
+    with cf.ProcessPoolExecutor(2, mp_context=mp.get_context("spawn")) as ex:
+        procs = pyspline.sweep(case, executor=ex, progress=False, lyapunov=True, l_x=LX)
+    _same(serial, threads)
+    _same(serial, procs)
+
+
+def test_points_equal_direct_runs(case):
+    """A grid has both dims in keyword order, and each point is the run of its own case."""
+    ds = pyspline.sweep(case, progress=False, l_x=[0.0, 1e-4, 2e-4], t_d=[20.0, 40.0])
+    assert ds["section_D2"].dims == ("l_x", "t_d", "section_point")
+    assert ds["period"].shape == (3, 2) and ds["Tm_max"].shape == (3, 2)
+    assert ds["t_d"].attrs["units"] == "N m"
+    assert ds.attrs["swept"] == "l_x t_d" and ds.attrs["n_points"] == 6
+    res = pyspline.simulate(case.replace(l_x=2e-4, t_d=20.0, section="shaft"))
+    p = ds.sel(l_x=2e-4, t_d=20.0)
+    np.testing.assert_array_equal(p["section_D2"], res.section_y[:, 5])
+    np.testing.assert_array_equal(p["section_vD2"], res.section_y[:, 12])
+    np.testing.assert_array_equal(p["section_t"], res.section_t)
+    assert float(p["Tm_max"]) == res.Tm.max() and float(p["Tm_min"]) == res.Tm.min()
+    assert float(p["F_max"]) == res.F.max() and float(p["kv_max"]) == res.kv.max()
+    assert float(p["Tm_rms"]) == pytest.approx(np.sqrt(np.mean(res.Tm**2)), rel=1e-12)
+    assert float(p["steps"]) == res.stats["steps"]
+
+
+def test_failing_point_is_recorded(case, tmp_path):
+    """t_bulk = 3100 degC closes the backlash (ThermalInterferenceError): that point has its
+    error and NaN values, the others ran, and the failure is saved like any result."""
+    hot = case.replace(thermal="bulk")
+    ds = pyspline.sweep(hot, progress=False, out=tmp_path, t_bulk=[0.0, 3100.0, 50.0])
+    assert list(ds["error_class"].values) == ["", "ThermalInterferenceError", ""]
+    msg = str(ds["error"].sel(t_bulk=3100.0).values)
+    assert case.name in msg
+    bad = ds.sel(t_bulk=3100.0)
+    assert np.isnan(bad["Tm_max"]) and np.isnan(bad["period"]) and np.isnan(bad["steps"])
+    assert np.isnan(bad["section_D2"]).all()
+    ok = ds.sel(t_bulk=[0.0, 50.0])
+    assert np.isfinite(ok["Tm_max"]).all() and np.isfinite(ok["period"]).all()
+    assert ds.attrs["n_failed"] == 1 and ds.attrs["n_ok"] == 2 and ds.attrs["n_missing"] == 0
+    assert len(list((tmp_path / "points").glob("*.npz"))) == 3
+    back = pyspline.open_sweep(tmp_path)
+    assert str(back["error_class"].sel(t_bulk=3100.0).values) == "ThermalInterferenceError"
+
+
+def test_bad_field_fails_at_once(case):
+    with pytest.raises(pyspline.CaseError, match="unknown field 'lx'"):
+        pyspline.sweep(case, progress=False, lx=[0.0, 1e-4])
+    with pytest.raises(TypeError):
+        pyspline.sweep(case, progress=False, l_x=1e-4)           # not a sequence
+
+
+# --------------------------------------------------------------------------- files
+
+def _counting(monkeypatch, fail_on=None):
+    """Replace the task by a counting one (in-process executors look it up at call time);
+    on call number `fail_on` it raises KeyboardInterrupt, as a Ctrl-C during a run does."""
+    calls = []
+    real = sw.run_point
+
+    def task(point_case, options):
+        calls.append(point_case["l_x"])
+        if fail_on is not None and len(calls) == fail_on:
+            raise KeyboardInterrupt
+        return real(point_case, options)
+
+    monkeypatch.setattr(sw, "run_point", task)
+    return calls
+
+
+def test_resume_computes_only_missing_points(case, tmp_path, monkeypatch):
+    first = pyspline.sweep(case, progress=False, out=tmp_path, l_x=LX)
+    files = sorted((tmp_path / "points").glob("*.npz"))
+    assert len(files) == 4 and (tmp_path / "sweep.nc").is_file()
+    _same(first, pyspline.open_sweep(tmp_path / "sweep.nc"))
+    files[2].unlink()
+    calls = _counting(monkeypatch)
+    again = pyspline.sweep(case, progress=False, out=tmp_path, l_x=LX)
+    assert calls == [LX[2]]
+    assert again.attrs["n_computed"] == 1 and again.attrs["n_reused"] == 3
+    _same(first, again)
+    np.testing.assert_array_equal(first["wall_s"][[0, 1, 3]], again["wall_s"][[0, 1, 3]])
+    # a changed case is never served from the old files
+    calls.clear()
+    changed = pyspline.sweep(case.replace(t_d=25.0), progress=False, out=tmp_path, l_x=LX)
+    assert len(calls) == 4 and changed.attrs["n_reused"] == 0
+    assert not np.array_equal(changed["Tm_max"], first["Tm_max"])
+
+
+@pytest.mark.parametrize("kind", ["serial", "threads"])
+def test_interrupt_keeps_finished_points(case, tmp_path, monkeypatch, kind):
+    values = np.linspace(0.0, 4e-4, 5)
+    _counting(monkeypatch, fail_on=3)
+    ex = cf.ThreadPoolExecutor(1) if kind == "threads" else None
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            pyspline.sweep(case, executor=ex, progress=False, out=tmp_path, l_x=values)
+    finally:
+        if ex is not None:
+            ex.shutdown(wait=True, cancel_futures=True)
+    saved = sorted(p.name[:5] for p in (tmp_path / "points").glob("*.npz"))
+    assert saved[:2] == ["00000", "00001"] and "00002" not in saved
+    if kind == "serial":
+        assert saved == ["00000", "00001"]
+    merged = pyspline.open_sweep(tmp_path)
+    assert merged.attrs["n_ok"] == len(saved)
+    assert merged.attrs["n_missing"] == 5 - len(saved)
+    assert merged["error_class"].values[2] == "NotComputed"
+    assert np.isfinite(merged["Tm_max"].values[:2]).all()
+    monkeypatch.undo()
+    rest = pyspline.sweep(case, progress=False, out=tmp_path, l_x=values)
+    assert rest.attrs["n_computed"] == 5 - len(saved) and rest.attrs["n_ok"] == 5
+
+
+def test_ctrl_c_in_a_real_sweep(case, tmp_path):
+    """SIGINT to `pyspline sweep` (serial) during a run: exit 130, finished points kept and
+    merged, a rerun completes the sweep."""
+    path = tmp_path / "long.nml"
+    case.replace(t_end=30.0, n_out=1001, name="long").to_namelist(path)   # ~0.5 s a point
+    out = tmp_path / "out"
+    cmd = [sys.executable, "-m", "pyspline", "sweep", str(path), "--set", "l_x=0:3e-4:40",
+           "--out", str(out), "--quiet"]
+    # SIGINT as in a terminal, also when this process was started with SIGINT ignored (a
+    # background job of a non-interactive shell)
+    # (cwd: not the checkout, whose source tree would shadow the installed package)
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            cwd=tmp_path,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and len(list(out.glob("points/*.npz"))) < 2:
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGINT)
+    stdout, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 130, stderr
+    assert "interrupted" in stderr
+    n = len(list(out.glob("points/*.npz")))
+    assert 2 <= n < 40
+    merged = pyspline.open_sweep(out)
+    assert merged.attrs["n_ok"] == n and merged.attrs["n_missing"] == 40 - n
+
+
+# --------------------------------------------------------------------------- Dask
+
+def test_dask_executor(case):
+    """A local Dask cluster of two worker processes gives the serial numbers (needs
+    `distributed`, which scripts/setup.sh installs: in CI this test runs, never skips)."""
+    if os.environ.get("CI"):
+        import distributed
+    else:
+        distributed = pytest.importorskip("distributed")
+    serial = pyspline.sweep(case, progress=False, l_x=LX)
+    box = {}
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster, timeout="60s") as client:
+
+        def run():
+            box["ds"] = pyspline.sweep(case, executor=client.get_executor(), progress=False,
+                                       l_x=LX)
+
+        worker = threading.Thread(target=run, daemon=True)
+        worker.start()
+        worker.join(timeout=180)
+        assert not worker.is_alive(), "the Dask sweep did not finish in 180 s"
+    assert box["ds"].attrs["n_ok"] == 4
+    _same(serial, box["ds"])
+
+
+# --------------------------------------------------------------------------- spectrum
+
+def test_binned_spectrum_keeps_tone_heights():
+    rpm, z = 6000.0, 16
+    t = np.arange(2000) / 10000.0                    # 0.2 s: 20 revolutions
+    f1 = rpm / 60
+    x = 3.0 + 1.5 * np.sin(2 * np.pi * f1 * t) + 0.25 * np.sin(2 * np.pi * z * f1 * t)
+    axis = sw._default_orders([pyspline.load_case({})])
+    assert axis[0] == 0 and axis[-1] == pytest.approx(2 * z + 2)
+    a = sw._binned_spectrum(t, x, rpm, axis)
+    assert a[np.argmin(abs(axis - 1))] == pytest.approx(1.5, rel=1e-9)
+    assert a[np.argmin(abs(axis - z))] == pytest.approx(0.25, rel=1e-9)
+    assert np.nanmax(a[(axis > 1.5) & (axis < 15)]) < 1e-3
+
+
+def test_speed_sweep_has_order_spectrum(case):
+    ds = pyspline.sweep(case, progress=False, speed_rpm=[3000.0, 6000.0])
+    assert ds["Tm_spectrum"].dims == ("speed_rpm", "order")
+    assert ds["order"][-1] == pytest.approx(2 * case["z"] + 2)
+    dt = (case["t_end"] - case["t_transient"]) / (case["n_out"] - 1)
+    f_top = np.fft.rfftfreq(case["n_out"], dt)[-1]          # highest FFT line (~ Nyquist)
+    for rpm in (3000.0, 6000.0):
+        a = ds["Tm_spectrum"].sel(speed_rpm=rpm)
+        below = ds["order"] <= f_top / (rpm / 60) + 0.025       # up to its bin
+        assert np.isfinite(a[below]).all() and np.isnan(a[~below]).all()
+
+
+def test_parse_values():
+    np.testing.assert_array_equal(sw.parse_values("l_x", "0:3e-4:61"), np.linspace(0, 3e-4, 61))
+    np.testing.assert_array_equal(sw.parse_values("t_d", "10,20,30"), [10.0, 20.0, 30.0])
+    assert sw.parse_values("n_out", "101:201:3").dtype.kind == "i"
+    assert list(sw.parse_values("thermal", "none,bulk")) == ["none", "bulk"]
+    assert list(sw.parse_values("roots", ".true.,false")) == [True, False]
+    with pytest.raises(pyspline.CaseError, match="unknown field"):
+        sw.parse_values("nope", "1,2")
+    with pytest.raises(pyspline.CaseError, match="not a number"):
+        sw.parse_values("t_d", "ten")
+
+
+# --------------------------------------------------------------------------- command line
+
+def test_cli_sweep_and_plot(case, tmp_path, capsys):
+    from pyspline.cli import main
+    path = tmp_path / "short.nml"
+    case.replace(name="short").to_namelist(path)
+    out = tmp_path / "lx"
+    assert main(["sweep", str(path), "--set", "l_x=0:2e-4:3", "--lyapunov", "--out", str(out),
+                 "--quiet"]) == 0
+    printed = capsys.readouterr().out
+    for name in ("sweep.nc", "bifurcation.png", "lyapunov.png"):
+        assert (out / name).is_file() and str(out / name) in printed
+    _png(out / "bifurcation.png")
+    _png(out / "lyapunov.png")
+    ds = pyspline.open_sweep(out)
+    assert ds.sizes["l_x"] == 3 and ds.attrs["command"].startswith("pyspline sweep ")
+    assert not (out / "waterfall.png").exists()
+
+    out = tmp_path / "speed"
+    assert main(["sweep", str(path), "--set", "speed_rpm=3000,6000,9000", "--workers", "2",
+                 "--threads", "--out", str(out), "--quiet"]) == 0
+    _png(out / "waterfall.png")
+    _png(out / "bifurcation.png")
+
+    out = tmp_path / "grid"
+    assert main(["sweep", str(path), "--set", "l_x=0,2e-4", "--set", "t_d=20,40",
+                 "--out", str(out), "--quiet"]) == 0
+    _png(out / "bifurcation.png")
+    _png(out / "period_map.png")
+
+    assert main(["plot", str(path), "--out", str(tmp_path / "scene")]) == 0
+    _png(tmp_path / "scene" / "short.png")
+    assert str(tmp_path / "scene" / "short.png") in capsys.readouterr().out
+
+    assert main(["sweep", str(path), "--set", "lx=0,1", "--out", str(out)]) == 2
+    assert "unknown field" in capsys.readouterr().err
+
+
+def test_cli_help_says_what_it_writes(capsys):
+    from pyspline.cli import main
+    with pytest.raises(SystemExit) as e:
+        main(["sweep", "--help"])
+    assert e.value.code == 0
+    text = capsys.readouterr().out
+    for word in ("sweep.nc", "bifurcation.png", "lyapunov.png", "waterfall.png", "points/",
+                 "start:stop:num"):
+        assert word in text
+
+
+# --------------------------------------------------------------------------- Result
+
+def test_result_to_xarray_roundtrip(case, tmp_path):
+    res = pyspline.simulate(case.replace(section="shaft", lyapunov=True))
+    names = dir(res)
+    for n in ["F", "D2", "vD2", "Tm", "kv", "x1", "vD3"] + [n for n, _ in _names("tooth")]:
+        assert n in names
+    assert res.F is res.tooth["F"]
+    np.testing.assert_array_equal(res.vD2, res.y[:, 12])
+    ds = res.to_xarray()
+    z = case["z"]
+    assert ds["F"].dims == ("time", "tooth") and ds["F"].shape == (201, z)
+    assert ds["D2"].dims == ("time",) and ds["section_D2"].dims == ("section_point",)
+    assert ds["F"].attrs["units"] == "N" and ds["vD2"].attrs["units"] == "m/s"
+    assert ds["Tf"].attrs["units"] == "degC" and ds["time"].attrs["units"] == "s"
+    assert ds.attrs["case"] == res.case.text()
+    assert ds.attrs["stat_steps"] == res.stats["steps"]
+    assert ds.attrs["lyapunov_exponent"] == res.lyapunov["exponent"]
+    np.testing.assert_array_equal(ds["section_D2"], res.section_y[:, 5])
+    path = tmp_path / "run.nc"
+    ds.to_netcdf(path, engine="h5netcdf")
+    with xr.open_dataset(path, engine="h5netcdf") as back:
+        xr.testing.assert_identical(back.load(), ds)
