@@ -139,17 +139,19 @@ contains
 
   !> Sizes of a loaded model's extras: Poincare section points nsec and Benettin
   !> renormalisations nlyap (0 when the case asks for none).
-  subroutine api_counts(model, nb, nsec, nlyap, ierr, errmsg)
+  !> nslice: face-width slices of the face-load output (0 for an unsliced face).
+  subroutine api_counts(model, nb, nsec, nlyap, nslice, ierr, errmsg)
     integer(c_int), intent(in) :: nb
     integer(c_int), intent(in) :: model(nb)
-    integer(c_int), intent(out) :: nsec, nlyap, ierr
+    integer(c_int), intent(out) :: nsec, nlyap, nslice, ierr
     character(len=msglen), intent(out) :: errmsg
     type(model_t) :: m
     integer :: ie
-    nsec = 0; nlyap = 0
+    nsec = 0; nlyap = 0; nslice = 0
     call unpack(model, m, ie, errmsg)
     if (ie == err_ok) then
       nsec = section_count(m); nlyap = lyapunov_count(m)
+      if (m%n_slices > 1) nslice = m%n_slices
     end if
     ierr = ie
   end subroutine api_counts
@@ -157,30 +159,40 @@ contains
   !> Simulate a loaded model: output times t, SI states y (nt x 14), per-tooth quantities tooth
   !> (nt x z x nq, order of api_names('tooth')), meshing torque tm and run statistics; the
   !> Poincare section (times sec_t, SI states sec_y: nsec x 14) and the Benettin record (times
-  !> lyap_t, cumulative log growth lyap_g), sized by api_counts.
+  !> lyap_t, cumulative log growth lyap_g), sized by api_counts; for a sliced face (nslice > 0,
+  !> nft = nt, else both 0) the load of every slice face(nt, z, nslice) and the tilting moment
+  !> tilt(nt, 2) (M_x, M_y) on spline 1 [N m].
   !> A SIGINT during the run stops it (ierr 4). Called without the GIL.
-  subroutine api_simulate(model, nb, z, nt, nq, ns, nsec, nlyap, t, y, tooth, tm, stats, &
-       sec_t, sec_y, lyap_t, lyap_g, ierr, errmsg)
-    integer(c_int), intent(in) :: nb, z, nt, nq, ns, nsec, nlyap
+  subroutine api_simulate(model, nb, z, nt, nq, ns, nsec, nlyap, nft, nslice, t, y, tooth, tm, &
+       stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, ierr, errmsg)
+    integer(c_int), intent(in) :: nb, z, nt, nq, ns, nsec, nlyap, nft, nslice
     integer(c_int), intent(in) :: model(nb)
     real(c_double), intent(out) :: t(nt), y(nt, 14), tooth(nt, z, nq), tm(nt), stats(ns)
     real(c_double), intent(out) :: sec_t(nsec), sec_y(nsec, 14), lyap_t(nlyap), lyap_g(nlyap)
+    real(c_double), intent(out) :: face(nft, z, nslice), tilt(nft, 2)
     integer(c_int), intent(out) :: ierr
     character(len=msglen), intent(out) :: errmsg
     type(model_t) :: m
     real(wp), allocatable :: ycol(:, :), scol(:, :)
     integer :: ie
     t = 0; y = 0; tooth = 0; tm = 0; stats = 0; sec_t = 0; sec_y = 0; lyap_t = 0; lyap_g = 0
+    face = 0; tilt = 0
     call unpack(model, m, ie, errmsg)
     if (ie == err_ok .and. (m%z /= z .or. m%n_out /= nt .or. nq /= ntooth_q .or. ns /= nstats &
-         .or. nsec /= section_count(m) .or. nlyap /= lyapunov_count(m))) then
+         .or. nsec /= section_count(m) .or. nlyap /= lyapunov_count(m) .or. &
+         nslice /= merge(m%n_slices, 0, m%n_slices > 1) .or. nft /= merge(nt, 0, nslice > 0))) then
       ie = err_case
       errmsg = 'api_simulate: array sizes do not match the loaded case'
     end if
     if (ie == err_ok) then
       allocate(ycol(nstate, nt), scol(nstate, nsec))
-      call run_case(m, t, ycol, tooth, tm, stats, ie, errmsg, interruptible=.true., &
-           sec_t=sec_t, sec_y=scol, lyap_t=lyap_t, lyap_g=lyap_g)
+      if (nslice > 0) then
+        call run_case(m, t, ycol, tooth, tm, stats, ie, errmsg, interruptible=.true., &
+             sec_t=sec_t, sec_y=scol, lyap_t=lyap_t, lyap_g=lyap_g, face=face, tilt=tilt)
+      else
+        call run_case(m, t, ycol, tooth, tm, stats, ie, errmsg, interruptible=.true., &
+             sec_t=sec_t, sec_y=scol, lyap_t=lyap_t, lyap_g=lyap_g)
+      end if
       y = transpose(ycol)
       sec_y = transpose(scol)
     end if

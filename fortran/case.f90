@@ -19,10 +19,11 @@ module spline_case
   private
   public :: case_t, case_read_file, case_read_text, case_parse, case_write_text, case_validate
   public :: case_name_of, case_suggest, case_field, case_check_file, case_output_bytes
-  public :: namelen, ndof_case, thermal_values, method_values, nonlinear_values, start_values, &
+  public :: namelen, nripple, ndof_case, thermal_values, method_values, nonlinear_values, start_values, &
        fidelity_values, section_values, option_index, nfields, max_case_bytes, max_output_bytes
 
   integer, parameter :: namelen = 128
+  integer, parameter :: nripple = 4         !< torque-ripple orders a case can give
   integer, parameter :: ndof_case = 7        !< entries of dq0, dv0: x1, y1, x2, y2, D1, D2, D3
   integer, parameter :: optlen = 16
   !> Largest case file read [bytes]: a case with every field and comments is ~5 kB.
@@ -94,17 +95,30 @@ module spline_case
     logical  :: lyapunov = .false.          !< largest Lyapunov exponent (Benettin) over the output window
     real(wp) :: lyapunov_interval = 1.0_wp  !< renormalisation interval [shaft revolutions]
     real(wp) :: lyapunov_d0 = 1.0e-8_wp     !< initial separation, in the scaled states of Eq. 25 [-]
+    ! beyond the paper (docs/model.md "Beyond the paper")
+    logical  :: fillet = .true.             !< fillet-foundation term in a computed k_m (Eq. 18 + k_f)
+    real(wp) :: fillet_radius = 0.0_wp      !< root fillet radius [m]; 0 = 0.2 m (ISO 4156 flat root)
+    real(wp) :: r_bore = 0.0_wp             !< bore radius of the external spline [m]; 0 = half its root radius
+    real(wp) :: r_rim = 0.0_wp              !< outer radius of the internal spline's rim [m]; 0 = twice its root radius
+    real(wp) :: zeta_m = 0.0_wp             !< mesh damping ratio [-]; > 0: c_m = 2 zeta_m sqrt(k_m m_e)
+    real(wp) :: ripple_order(nripple) = 0.0_wp      !< torque ripple: engine orders n_k [-]
+    real(wp) :: ripple_amp(nripple) = 0.0_wp        !< amplitudes a_k, relative to T_d [-]
+    real(wp) :: ripple_phase_deg(nripple) = 0.0_wp  !< phases psi_k [deg]
+    real(wp) :: unbalance(2) = 0.0_wp       !< mass unbalance m_u e of splines 1, 2 [kg m]
+    real(wp) :: unbalance_phase_deg(2) = 0.0_wp     !< its phase beta_i [deg]
+    real(wp) :: gamma_x = 0.0_wp, gamma_y = 0.0_wp  !< angular misalignment of spline 1 about x, y [rad]
+    integer  :: n_slices = 1                !< face-width slices (angular misalignment) [-]
   end type case_t
 
   !> A field of the namelist: its name, type (i integer, r real, l logical, c character) and
   !> size (elements of an array, or the length of a character field). Same order as case_t
   !> and the namelist in nml_io (tests/test_input.py checks the table against the defaults).
   type :: field_t
-    character(len=17) :: name
+    character(len=20) :: name
     character(len=1) :: kind
     integer :: n
   end type field_t
-  integer, parameter :: nfields = 65
+  integer, parameter :: nfields = 78
   type(field_t), parameter :: fields(nfields) = [ &
        field_t('name', 'c', namelen), field_t('z', 'i', 1), field_t('module_m', 'r', 1), &
        field_t('alpha_deg', 'r', 1), field_t('b', 'r', 1), field_t('s', 'r', 1), &
@@ -128,7 +142,12 @@ module spline_case
        field_t('dv0', 'r', ndof_case), field_t('l_ref', 'r', 1), field_t('w_ref', 'r', 1), &
        field_t('fidelity', 'c', optlen), field_t('fidelity_tol', 'r', 1), &
        field_t('section', 'c', optlen), field_t('lyapunov', 'l', 1), &
-       field_t('lyapunov_interval', 'r', 1), field_t('lyapunov_d0', 'r', 1)]
+       field_t('lyapunov_interval', 'r', 1), field_t('lyapunov_d0', 'r', 1), &
+       field_t('fillet', 'l', 1), field_t('fillet_radius', 'r', 1), field_t('r_bore', 'r', 1), &
+       field_t('r_rim', 'r', 1), field_t('zeta_m', 'r', 1), field_t('ripple_order', 'r', nripple), &
+       field_t('ripple_amp', 'r', nripple), field_t('ripple_phase_deg', 'r', nripple), &
+       field_t('unbalance', 'r', 2), field_t('unbalance_phase_deg', 'r', 2), &
+       field_t('gamma_x', 'r', 1), field_t('gamma_y', 'r', 1), field_t('n_slices', 'i', 1)]
 
   ! tokens of the case text
   integer, parameter :: tk_word = 1, tk_string = 2, tk_equals = 3, tk_comma = 4, tk_slash = 5, &
@@ -876,7 +895,7 @@ contains
   function hint(word) result(s)
     character(len=*), intent(in) :: word
     character(len=:), allocatable :: s
-    character(len=17) :: best
+    character(len=20) :: best
     best = case_suggest(word)
     if (len_trim(best) > 0) then
       s = ': did you mean '//trim(best)//'?'
@@ -889,7 +908,7 @@ contains
   !> the word's length; or the one field the word begins), else blank.
   function case_suggest(word) result(best)
     character(len=*), intent(in) :: word
-    character(len=17) :: best
+    character(len=20) :: best
     character(len=:), allocatable :: w
     integer :: i, d, dbest, nprefix, iprefix
     w = lower(trim(adjustl(word)))
@@ -1143,12 +1162,18 @@ contains
     character(len=optlen) :: thermal, method, jacobian, nonlinear, start, fidelity, section
     logical :: roots, stald, lyapunov
     real(wp) :: lyapunov_interval, lyapunov_d0
+    logical :: fillet
+    real(wp) :: fillet_radius, r_bore, r_rim, zeta_m, ripple_order(nripple), ripple_amp(nripple), &
+         ripple_phase_deg(nripple), unbalance(2), unbalance_phase_deg(2), gamma_x, gamma_y
+    integer :: n_slices
     namelist /spline_case/ name, z, module_m, alpha_deg, b, s, c0, e_mod, nu, lambda_th, k_cond, rho, c_heat, j_m, &
          j_l, j_1, j_2, m_1, m_2, k_p1, k_p2, c_p1, c_p2, k_t1, k_t2, c_t1, c_t2, k_m, c_m, t_d, &
          t_l, speed_rpm, grav, l_x, l_y, dof, thermal, t_bulk, f_m, u_flash, eta_hertz, method, &
          jacobian, nonlinear, roots, stald, rtol, atol, max_steps, max_total_steps, t0, t_end, &
          t_transient, n_out, start, dq0, dv0, l_ref, w_ref, fidelity, fidelity_tol, section, &
-         lyapunov, lyapunov_interval, lyapunov_d0
+         lyapunov, lyapunov_interval, lyapunov_d0, fillet, fillet_radius, r_bore, r_rim, zeta_m, &
+         ripple_order, ripple_amp, ripple_phase_deg, unbalance, unbalance_phase_deg, gamma_x, &
+         gamma_y, n_slices
     name = c%name; z = c%z; module_m = c%module_m; alpha_deg = c%alpha_deg; b = c%b; s = c%s
     c0 = c%c0; e_mod = c%e_mod; nu = c%nu; lambda_th = c%lambda_th; k_cond = c%k_cond
     rho = c%rho; c_heat = c%c_heat; j_m = c%j_m; j_l = c%j_l; j_1 = c%j_1; j_2 = c%j_2
@@ -1163,6 +1188,11 @@ contains
     dq0 = c%dq0; dv0 = c%dv0; l_ref = c%l_ref; w_ref = c%w_ref; fidelity = c%fidelity
     fidelity_tol = c%fidelity_tol; section = c%section; lyapunov = c%lyapunov
     lyapunov_interval = c%lyapunov_interval; lyapunov_d0 = c%lyapunov_d0
+    fillet = c%fillet; fillet_radius = c%fillet_radius; r_bore = c%r_bore; r_rim = c%r_rim
+    zeta_m = c%zeta_m; ripple_order = c%ripple_order; ripple_amp = c%ripple_amp
+    ripple_phase_deg = c%ripple_phase_deg; unbalance = c%unbalance
+    unbalance_phase_deg = c%unbalance_phase_deg; gamma_x = c%gamma_x; gamma_y = c%gamma_y
+    n_slices = c%n_slices
     iomsg = ''
     if (present(out)) then
       write(out, nml=spline_case, iostat=ierr, iomsg=iomsg)
@@ -1189,6 +1219,11 @@ contains
     c%w_ref = w_ref; c%fidelity = fidelity; c%fidelity_tol = fidelity_tol
     c%section = section; c%lyapunov = lyapunov; c%lyapunov_interval = lyapunov_interval
     c%lyapunov_d0 = lyapunov_d0
+    c%fillet = fillet; c%fillet_radius = fillet_radius; c%r_bore = r_bore; c%r_rim = r_rim
+    c%zeta_m = zeta_m; c%ripple_order = ripple_order; c%ripple_amp = ripple_amp
+    c%ripple_phase_deg = ripple_phase_deg; c%unbalance = unbalance
+    c%unbalance_phase_deg = unbalance_phase_deg; c%gamma_x = gamma_x; c%gamma_y = gamma_y
+    c%n_slices = n_slices
   end subroutine nml_io
 
   !> The file name without directory and extension: the case name unless the file sets one.
@@ -1230,6 +1265,7 @@ contains
          nlyap = window*omega/(2.0_wp*pi*c%lyapunov_interval) + 2.0_wp
     bytes = nt*(2.0_wp*8.0_wp*(16.0_wp + 8.0_wp*c%z) + 4.0_wp*c%z) + 2.0_wp*8.0_wp*15.0_wp*nsec &
          + 2.0_wp*8.0_wp*2.0_wp*nlyap
+    if (c%n_slices > 1) bytes = bytes + nt*2.0_wp*8.0_wp*(c%z*c%n_slices + 2.0_wp)
   end function case_output_bytes
 
   !> Check every field against its physical range (in its unit, with the reason), the
@@ -1250,6 +1286,7 @@ contains
          't_transient', 'l_ref', 'w_ref', 'dq0', 'dv0', 'fidelity_tol', 'lyapunov_int', &
          'lyapunov_d0', 'lyapunov_d0']
     real(wp) :: r_pitch, depth, involute, e, ta, dt_out, bytes
+    type(case_t) :: dflt          ! the defaults (component defaults of case_t)
     integer :: i
 
     ierr = err_case
@@ -1422,6 +1459,46 @@ contains
            '(both are timed by the shaft revolution)'); return
     end if
 
+    ! beyond the paper
+    if (.not. all_finite([c%fillet_radius, c%r_bore, c%r_rim, c%zeta_m, c%ripple_order, &
+         c%ripple_amp, c%ripple_phase_deg, c%unbalance, c%unbalance_phase_deg, c%gamma_x, &
+         c%gamma_y])) then
+      call fail('fillet_radius', '.. gamma_y (the fields beyond the paper) must be finite numbers')
+      return
+    end if
+    if (.not. in_range(c%fillet_radius, 0.0_wp, c%module_m, 'fillet_radius', &
+         'metres, at most one module; 0 = 0.2 m')) return
+    if (.not. in_range(c%r_bore, 0.0_wp, 0.5_wp*c%module_m*(c%z - 1.5_wp), 'r_bore', &
+         'metres, inside the external root circle; 0 = half its radius')) return
+    if (c%r_rim /= 0.0_wp .and. .not. in_range(c%r_rim, 0.5_wp*c%module_m*(c%z + 1.5_wp), &
+         100.0_wp*c%module_m*c%z, 'r_rim', 'metres, outside the internal root circle; 0 = twice '// &
+         'its radius')) return
+    if (.not. in_range(c%zeta_m, 0.0_wp, 1.0_wp, 'zeta_m', 'a damping ratio')) return
+    if (c%zeta_m > 0.0_wp .and. c%c_m /= dflt%c_m) then
+      call fail('zeta_m', 'and c_m are both given: give the mesh damping one way'); return
+    end if
+    do i = 1, nripple
+      if (.not. in_range(c%ripple_order(i), 0.0_wp, 1000.0_wp, 'ripple_order', &
+           'engine orders (multiples of the shaft speed)')) return
+      if (.not. in_range(c%ripple_amp(i), -10.0_wp, 10.0_wp, 'ripple_amp', &
+           'a fraction of T_d')) return
+    end do
+    if (.not. in_range(minval(c%unbalance), 0.0_wp, 1.0_wp, 'unbalance', 'kg m (m_u e)')) return
+    if (.not. in_range(maxval(c%unbalance), 0.0_wp, 1.0_wp, 'unbalance', 'kg m (m_u e)')) return
+    if (.not. in_range(hypot(c%gamma_x, c%gamma_y), 0.0_wp, c%module_m/c%b, 'gamma_x', &
+         'radians: |(gamma_x, gamma_y)| b / 2 must stay within half a module at the face ends')) return
+    if (c%n_slices < 1 .or. c%n_slices > 256) then
+      call fail('n_slices', '= '//itoa(c%n_slices)//' is outside 1 .. 256'); return
+    end if
+    if ((c%gamma_x /= 0.0_wp .or. c%gamma_y /= 0.0_wp) .and. c%n_slices < 2) then
+      call fail('n_slices', 'must be at least 2 for an angular misalignment (gamma_x, gamma_y): '// &
+           'the face is cut into slices'); return
+    end if
+    if (c%n_slices > 1 .and. option_index(thermal_values, c%thermal) > 2) then
+      call fail('n_slices', '> 1 needs thermal = none or bulk: the flash temperature (oneway, '// &
+           'coupled) is modelled for a whole tooth'); return
+    end if
+
     ! memory, before anything is allocated
     bytes = case_output_bytes(c)
     if (bytes > max_output_bytes) then
@@ -1438,6 +1515,11 @@ contains
     ierr = err_ok
 
   contains
+
+    pure logical function all_finite(x)
+      real(wp), intent(in) :: x(:)
+      all_finite = all(ieee_is_finite(x))
+    end function all_finite
 
     subroutine fail(field, why)
       character(len=*), intent(in) :: field, why

@@ -7,7 +7,7 @@ module spline_dynamics
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
-  public :: accelerations, rhs_scaled, to_scaled, from_scaled, static_equilibrium, start_state, &
+  public :: accelerations, driving_torque, unbalance_forces, rhs_scaled, to_scaled, from_scaled, static_equilibrium, start_state, &
        integrated_states
 
   integer, parameter :: max_newton = 100    !< Newton steps of the static equilibrium
@@ -22,28 +22,61 @@ contains
   !>   D1'' = r_b ((T_m - S1)/J_1 - (T_d + S1)/J_M)
   !>   D2'' = r_b ((-T_m - S3)/J_2 - (T_m - S1)/J_1)
   !>   D3'' = r_b ((-T_m - S3)/J_2 - (S3 - T_L)/J_L)
+  !> Beyond the paper (MODEL.md Section 10): T_d is driving_torque(t) (torque ripple), and the
+  !> unbalance forces (unbalance_forces) act on the x, y equations of splines 1 and 2.
+  !> mode: the frozen contact state of every contact (tooth, or slice of a tooth: mesh_eval).
   subroutine accelerations(m, t, q, v, a, ierr, errmsg, mode, branch, cstats)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(ndof), v(ndof)
     real(wp), intent(out) :: a(ndof)
     integer, intent(out) :: ierr
     character(len=*), intent(inout) :: errmsg
-    integer, intent(in), optional :: mode(m%z), branch(2, m%z)
+    integer, intent(in), optional :: mode(m%z*m%n_slices), branch(2, m%z)
     type(coupling_stats_t), intent(inout), optional :: cstats
-    real(wp) :: fx1, fy1, tm, s1, s3, th1dd
+    real(wp) :: fx1, fy1, tm, s1, s3, th1dd, fu(4)
     call mesh_eval(m, t, q, v, fx1, fy1, tm, ierr, errmsg, mode=mode, branch=branch, cstats=cstats)
     if (ierr /= 0) return
     a(1) = (fx1 - m%c_p1*v(1) - m%k_p1*q(1))/m%m_1
     a(2) = (fy1 - m%c_p1*v(2) - m%k_p1*q(2))/m%m_1 - m%grav
     a(3) = (-fx1 - m%c_p2*v(3) - m%k_p2*q(3))/m%m_2
     a(4) = (-fy1 - m%c_p2*v(4) - m%k_p2*q(4))/m%m_2 - m%grav
+    if (any(m%unbalance /= 0.0_wp)) then
+      call unbalance_forces(m, t, fu)
+      a(1:2) = a(1:2) + fu(1:2)/m%m_1
+      a(3:4) = a(3:4) + fu(3:4)/m%m_2
+    end if
     s1 = (m%k_t1*q(5) + m%c_t1*v(5))/m%r_b
     s3 = (m%k_t2*q(7) + m%c_t2*v(7))/m%r_b
     th1dd = (tm - s1)/m%j_1
-    a(5) = m%r_b*(th1dd - (m%t_d + s1)/m%j_m)
+    a(5) = m%r_b*(th1dd - (driving_torque(m, t) + s1)/m%j_m)
     a(6) = m%r_b*((-tm - s3)/m%j_2 - th1dd)
     a(7) = m%r_b*((-tm - s3)/m%j_2 - (s3 - m%t_l)/m%j_l)
   end subroutine accelerations
+
+  !> Driving torque with ripple (MODEL.md Section 10): T_d(t) = T_d [1 + sum_k a_k sin(n_k omega t
+  !> + psi_k)], the engine orders n_k; exactly T_d without ripple.
+  pure real(wp) function driving_torque(m, t) result(td)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t
+    integer :: k
+    td = m%t_d
+    do k = 1, m%n_ripple
+      td = td + m%t_d*m%ripple_amp(k)*sin(m%ripple_order(k)*m%omega*t + m%ripple_phase(k))
+    end do
+  end function driving_torque
+
+  !> Mass unbalance (MODEL.md Section 10): the rotating force m_ui e_i omega^2 (cos(omega t +
+  !> beta_i), sin(omega t + beta_i)) on spline i: f = (f_x1, f_y1, f_x2, f_y2) [N].
+  pure subroutine unbalance_forces(m, t, f)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t
+    real(wp), intent(out) :: f(4)
+    integer :: i
+    do i = 1, 2
+      f(2*i - 1) = m%unbalance(i)*m%omega**2*cos(m%omega*t + m%unbalance_phase(i))
+      f(2*i) = m%unbalance(i)*m%omega**2*sin(m%omega*t + m%unbalance_phase(i))
+    end do
+  end subroutine unbalance_forces
 
   !> Eq. 25: scaled state ys = (q / l, v / (l w)) in scaled time tau = w t.
   pure subroutine to_scaled(m, y, ys)
@@ -69,7 +102,7 @@ contains
     real(wp), intent(out) :: dys(nstate)
     integer, intent(out) :: ierr
     character(len=*), intent(inout) :: errmsg
-    integer, intent(in), optional :: mode(m%z), branch(2, m%z)
+    integer, intent(in), optional :: mode(m%z*m%n_slices), branch(2, m%z)
     type(coupling_stats_t), intent(inout), optional :: cstats
     real(wp) :: y(nstate), a(ndof)
     call from_scaled(m, ys, y)
@@ -129,8 +162,8 @@ contains
     integer, intent(out) :: ierr
     character(len=*), intent(inout) :: errmsg
     real(wp) :: r(ndof), rn(ndof), jac(ndof, ndof), dq(ndof), qn(ndof), h, lam
-    real(wp) :: g(2*m%z), dqbar(ndof), q_prev(ndof), dq_prev(ndof), lam_prev
-    integer :: it, k, ls, j, modes(m%z)
+    real(wp) :: g(2*m%z*m%n_slices), dqbar(ndof), q_prev(ndof), dq_prev(ndof), lam_prev
+    integer :: it, k, ls, j, modes(m%z*m%n_slices)
     q = 0.0_wp
     q(2) = -m%m_1*m%grav/max(m%k_p1, tiny(1.0_wp))
     q(4) = -m%m_2*m%grav/max(m%k_p2, tiny(1.0_wp))
@@ -145,7 +178,7 @@ contains
     do it = 1, max_newton
       ! contact states at q (Eq. 16, as the right-hand side decides them)
       call mesh_switch_functions(m, t, q, g)
-      do j = 1, m%z
+      do j = 1, m%z*m%n_slices
         modes(j) = 0
         if (g(2*j - 1) > 0.0_wp) modes(j) = 1
         if (g(2*j) < 0.0_wp) modes(j) = -1
@@ -210,7 +243,7 @@ contains
     subroutine residual(qq, rr, mode)
       real(wp), intent(in) :: qq(ndof)
       real(wp), intent(out) :: rr(ndof)
-      integer, intent(in), optional :: mode(m%z)
+      integer, intent(in), optional :: mode(m%z*m%n_slices)
       real(wp), parameter :: zero(ndof) = 0.0_wp
       call accelerations(m, t, qq, zero, rr, ierr, errmsg, mode)
       rr = rr/(m%l_ref*m%w_ref**2)

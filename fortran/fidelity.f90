@@ -5,8 +5,9 @@
 !> tooth equal) and bound the change of a tooth force as k_m times a displacement the cheaper
 !> level leaves out (Eqs. 15-17):
 !>  - torsional only (dof 3) leaves out the lateral motion. Its drivers are the misalignment
-!>    (l_x, l_y), the difference of the gravity sags g |m_1/k_p1 - m_2/k_p2| and a lateral start
-!>    offset. Without them every tooth sees the same dn_j, sum_j F_j sin(phi_j) = 0 (Z >= 3) and
+!>    (l_x, l_y), the difference of the gravity sags g |m_1/k_p1 - m_2/k_p2|, a lateral start
+!>    offset, the unbalance (its static deflection m_u e omega^2 / k_p) and the angular
+!>    misalignment (gamma b / 2 at the face ends). Without them every tooth sees the same dn_j, sum_j F_j sin(phi_j) = 0 (Z >= 3) and
 !>    the lateral states never move: dof 3 is then exact.
 !>  - a temperature dT left out of Eq. 2 moves the backlash by kappa dT, kappa = 2 lambda s cos(alpha).
 module spline_fidelity
@@ -34,7 +35,9 @@ contains
     eps = huge(1.0_wp)
     if (f0 == 0.0_wp .or. m%k_p1 == 0.0_wp .or. m%k_p2 == 0.0_wp) return
     if (any(m%dv0(1:4) /= 0.0_wp)) return
-    e = hypot(m%l_x, m%l_y) + m%grav*abs(m%m_1/m%k_p1 - m%m_2/m%k_p2) + norm2(m%dq0(1:4))
+    e = hypot(m%l_x, m%l_y) + m%grav*abs(m%m_1/m%k_p1 - m%m_2/m%k_p2) + norm2(m%dq0(1:4)) &
+         + m%omega**2*(m%unbalance(1)/m%k_p1 + m%unbalance(2)/m%k_p2) &
+         + 0.5_wp*m%b*hypot(m%gamma_x, m%gamma_y)
     eps = m%k_m*e/f0
   end function lateral_estimate
 

@@ -32,21 +32,29 @@ contains
   !> branch (optional): frozen root (-1) / tip (+1) branch of Eqs. 13-14 for spline 1 (row 1) and
   !> 2 (row 2) of every tooth, used between located branch switches; else the sign of dDelta/dt.
   !> cstats (optional): updated with the work of the flash-temperature coupling.
+  !> Angular misalignment (MODEL.md Section 10): with n_slices > 1 the face is cut into slices
+  !> at z_s; slice s of tooth j has its own dn_js (Eq. 11 with spline 1's centre at
+  !> (x1 + l_x + gamma_y z_s, y1 + l_y - gamma_x z_s)), dead zone and force F_js (Eqs. 15-17
+  !> with k_m / n_s, c_m / n_s); F_j is their sum; mode then holds the state of every slice
+  !> (index (j - 1) n_s + s). fslice(s, j): F_js; mtilt: the tilting moment (M_x, M_y) on spline 1
+  !> about the face mid-plane, M_x = -sum z_s F_js cos(phi_j), M_y = -sum z_s F_js sin(phi_j).
   pure subroutine mesh_eval(m, t, q, v, fx1, fy1, tm, ierr, errmsg, mode, flash, dn, c, f, tf, &
-       rc1, rc2, sphi_out, cphi_out, branch, cstats)
+       rc1, rc2, sphi_out, cphi_out, branch, cstats, fslice, mtilt)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(7), v(7)
     real(wp), intent(out) :: fx1, fy1, tm
     integer, intent(out) :: ierr
     character(len=*), intent(inout) :: errmsg
-    integer, intent(in), optional :: mode(m%z)
+    integer, intent(in), optional :: mode(m%z*m%n_slices)
     logical, intent(in), optional :: flash
     integer, intent(in), optional :: branch(2, m%z)
     real(wp), intent(out), optional, dimension(m%z) :: dn, c, f, tf, rc1, rc2, sphi_out, cphi_out
     type(coupling_stats_t), intent(inout), optional :: cstats
+    real(wp), intent(out), optional :: fslice(m%n_slices, m%z), mtilt(2)
     real(wp) :: sp(m%z), cp(m%z)
-    real(wp) :: ex, ey, evx, evy, dnj, ddnj, cj, fj, tfj, r1, r2, sumf, resid
-    integer :: j, mj, iters
+    real(wp) :: ex, ey, evx, evy, dnj, ddnj, cj, fj, tfj, r1, r2, sumf, resid, zs, dns, ddns, fs
+    real(wp) :: mx, my
+    integer :: j, mj, iters, is, ns
     logical :: want_flash, coupled
 
     ierr = 0
@@ -60,10 +68,42 @@ contains
     want_flash = coupled
     if (present(flash)) want_flash = want_flash .or. (flash .and. m%thermal >= thermal_oneway)
     fx1 = 0.0_wp; fy1 = 0.0_wp; sumf = 0.0_wp
+    mx = 0.0_wp; my = 0.0_wp
+    ns = m%n_slices
     do j = 1, m%z
-      ! Eq. 11 and its total time derivative (phi_j' = omega)
+      ! Eq. 11 and its total time derivative (phi_j' = omega), at the face centre
       dnj = ex*sp(j) - ey*cp(j) + q(6)
       ddnj = evx*sp(j) - evy*cp(j) + v(6) + m%omega*(ex*cp(j) + ey*sp(j))
+      if (ns > 1) then
+        ! slices of the face (angular misalignment; thermal none or bulk: c_j = c_bulk)
+        fj = 0.0_wp
+        do is = 1, ns
+          zs = m%b*((is - 0.5_wp)/ns - 0.5_wp)
+          dns = dnj + zs*(m%gamma_y*sp(j) + m%gamma_x*cp(j))
+          ddns = ddnj + m%omega*zs*(m%gamma_y*cp(j) - m%gamma_x*sp(j))
+          if (present(mode)) then
+            mj = mode((j - 1)*ns + is)
+          else
+            mj = contact_state(dns, m%c_bulk)
+          end if
+          fs = 0.0_wp
+          if (mj /= 0) fs = contact_force(m, dns, ddns, mj, m%c_bulk)/ns
+          fj = fj + fs
+          mx = mx - zs*fs*cp(j)
+          my = my - zs*fs*sp(j)
+          if (present(fslice)) fslice(is, j) = fs
+        end do
+        fx1 = fx1 - fj*sp(j)
+        fy1 = fy1 + fj*cp(j)
+        sumf = sumf + fj
+        if (present(dn)) dn(j) = dnj
+        if (present(c)) c(j) = m%c_bulk
+        if (present(f)) f(j) = fj
+        if (present(tf)) tf(j) = 0.0_wp
+        if (present(rc1)) rc1(j) = m%r_pitch
+        if (present(rc2)) rc2(j) = m%r_pitch
+        cycle
+      end if
       if (present(mode)) then
         mj = mode(j)
       else
@@ -113,10 +153,12 @@ contains
       if (present(tf)) tf(j) = tfj
       if (present(rc1)) rc1(j) = r1
       if (present(rc2)) rc2(j) = r2
+      if (present(fslice)) fslice(1, j) = fj
     end do
     tm = m%r_b*sumf
     if (present(sphi_out)) sphi_out = sp
     if (present(cphi_out)) cphi_out = cp
+    if (present(mtilt)) mtilt = [mx, my]
   end subroutine mesh_eval
 
   !> Eq. 16: contact state of a tooth pair, +1 drive flank (dn > c), -1 back flank (dn < -c), 0 free.
@@ -227,25 +269,35 @@ contains
     end function tf_at
   end subroutine solve_coupled
 
-  !> Root functions for the contact switches of Eq. 16: g_{2j-1} = dn_j - c_j, g_{2j} = dn_j + c_j
-  !> (with the backlash at the bulk temperature, which decides the contact state), and, if gb is
-  !> present, for the root/tip branch switches of Eqs. 13-14: gb_{2j-1} = dDelta_1j/dt,
-  !> gb_{2j} = dDelta_2j/dt (needs the velocities v).
+  !> Root functions for the contact switches of Eq. 16: g_{2k-1} = dn_k - c_k, g_{2k} = dn_k + c_k
+  !> for every contact k (a tooth, or slice s of tooth j: k = (j - 1) n_s + s), with the backlash
+  !> at the bulk temperature, which decides the contact state; and, if gb is present, for the
+  !> root/tip branch switches of Eqs. 13-14: gb_{2j-1} = dDelta_1j/dt, gb_{2j} = dDelta_2j/dt
+  !> (needs the velocities v).
   pure subroutine mesh_switch_functions(m, t, q, g, v, gb)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(7)
-    real(wp), intent(out) :: g(2*m%z)
+    real(wp), intent(out) :: g(2*m%z*m%n_slices)
     real(wp), intent(in), optional :: v(7)
     real(wp), intent(out), optional :: gb(2*m%z)
-    real(wp) :: sp(m%z), cp(m%z), ex, ey, dnj, d
-    integer :: j
+    real(wp) :: sp(m%z), cp(m%z), ex, ey, dnj, d, dns, zs
+    integer :: j, is, k, ns
     call tooth_angles(m%z, m%omega, t, m%theta0, m%alpha, sp, cp)
     ex = q(1) + m%l_x - q(3)
     ey = q(2) + m%l_y - q(4)
+    ns = m%n_slices
     do j = 1, m%z
       dnj = ex*sp(j) - ey*cp(j) + q(6)
-      g(2*j - 1) = dnj - m%c_bulk
-      g(2*j) = dnj + m%c_bulk
+      do is = 1, ns
+        dns = dnj
+        if (ns > 1) then
+          zs = m%b*((is - 0.5_wp)/ns - 0.5_wp)
+          dns = dnj + zs*(m%gamma_y*sp(j) + m%gamma_x*cp(j))
+        end if
+        k = (j - 1)*ns + is
+        g(2*k - 1) = dns - m%c_bulk
+        g(2*k) = dns + m%c_bulk
+      end do
       if (present(gb)) then
         call profile_shift(q(1) + m%l_x, q(2) + m%l_y, v(1), v(2), m%omega, sp(j), cp(j), d, &
              gb(2*j - 1))

@@ -6,27 +6,28 @@ module spline_model
   use spline_kinds, only: wp, pi
   use spline_errors, only: err_ok, err_case, err_thermal
   use spline_case, only: case_t, case_validate, namelen, option_index, thermal_values, &
-       method_values, nonlinear_values, start_values, fidelity_values, section_values
+       method_values, nonlinear_values, start_values, fidelity_values, section_values, nripple
   use spline_geometry, only: iso4156_radii
-  use spline_stiffness, only: spline_mesh_stiffness
+  use spline_stiffness, only: spline_mesh_stiffness_fillet
   use spline_thermal, only: backlash_coefficient, thermal_backlash
   implicit none
   private
   public :: model_t, model_from_case, set_thermal_level, model_magic, model_warnings
   public :: nstate, ndof, thermal_none, thermal_bulk, thermal_oneway, thermal_coupled
-  public :: nkterms, kterm_names
+  public :: nkterms, kterm_names, ik_m, nripple
 
   integer, parameter :: ndof = 7            !< x1, y1, x2, y2, D1, D2, D3 (Eq. 24)
   integer, parameter :: nstate = 2*ndof     !< displacements then velocities
   !> thermal levels, in the order of spline_case's thermal_values
   integer, parameter :: thermal_none = 0, thermal_bulk = 1, thermal_oneway = 2, thermal_coupled = 3
-  integer, parameter :: nkterms = 8         !< terms of Eq. 18 reported with every case
+  integer, parameter :: nkterms = 10        !< terms of Eq. 18 reported with every case
   character(len=4), parameter :: kterm_names(nkterms) = [character(len=4) :: &
-       'k_h', 'k_b1', 'k_s1', 'k_a1', 'k_b2', 'k_s2', 'k_a2', 'k_m']
+       'k_h', 'k_b1', 'k_s1', 'k_a1', 'k_f1', 'k_b2', 'k_s2', 'k_a2', 'k_f2', 'k_m']
+  integer, parameter :: ik_m = nkterms      !< position of the total k_m in k_terms
   integer, parameter :: stiffness_nquad = 32   !< Gauss points: converged to 1e-15 from 16 on
   !> Marks a model_t built by this build's constructor (layout version in the last digits):
   !> a copy handed back from outside is checked against it.
-  integer, parameter :: model_magic = 517730003
+  integer, parameter :: model_magic = 517730004
   !> A given k_m this many times below Eq. 18 draws a warning (model_warnings): the paper's
   !> calibrated 2.54e5 N/m is ~7600 times below for its spline, a deliberate fit; N/mm read
   !> as N/m is 1000 times, on top of such a fit 1e4 is passed.
@@ -67,6 +68,17 @@ module spline_model
     real(wp) :: c_bulk                      !< backlash with the bulk rise only [m]
     logical  :: k_m_computed = .false.      !< k_m from Eq. 18 (the case left k_m = 0)
     real(wp) :: k_terms(nkterms) = 0.0_wp   !< Eq. 18 terms k_h, k_b1, ..., k_m (0: not computable)
+    real(wp) :: k_m_nofillet = 0.0_wp       !< Eq. 18 without the fillet foundation (warnings)
+    ! beyond the paper (MODEL.md Section 10; docs/model.md)
+    real(wp) :: zeta_m = 0.0_wp             !< mesh damping ratio (c_m from it when > 0)
+    real(wp) :: m_e = 0.0_wp                !< effective torsional mass of a tooth pair [kg]
+    integer  :: n_ripple = 0                !< torque-ripple terms in use
+    real(wp) :: ripple_order(nripple) = 0.0_wp, ripple_amp(nripple) = 0.0_wp
+    real(wp) :: ripple_phase(nripple) = 0.0_wp     !< [rad]
+    real(wp) :: unbalance(2) = 0.0_wp       !< m_u e of splines 1, 2 [kg m]
+    real(wp) :: unbalance_phase(2) = 0.0_wp !< [rad]
+    real(wp) :: gamma_x = 0.0_wp, gamma_y = 0.0_wp  !< angular misalignment of spline 1 [rad]
+    integer  :: n_slices = 1                !< face-width slices
   end type model_t
 
 contains
@@ -80,7 +92,7 @@ contains
     type(model_t), intent(out) :: m
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
-    real(wp) :: rf1, rf2, ra2
+    real(wp) :: rf1, rf2, ra2, rho_f, r_bore, r_rim
 
     call case_validate(c, ierr, errmsg)
     if (ierr /= err_ok) return
@@ -116,22 +128,57 @@ contains
     m%r_b = m%r_pitch*m%cos_alpha
     m%theta0 = pi/(2.0_wp*m%z)
 
-    ! Eq. 18 at the pitch point: always reported; used if the case leaves k_m = 0
-    call spline_mesh_stiffness(real(m%z, wp), m%m_n, m%alpha, m%b, m%e_mod, m%nu, rf1, rf2, ra2, &
-         stiffness_nquad, m%k_terms(1), m%k_terms(2), m%k_terms(3), m%k_terms(4), m%k_terms(5), &
-         m%k_terms(6), m%k_terms(7), m%k_terms(8), ierr, errmsg)
+    ! Eq. 18 at the pitch point, with the fillet-foundation terms k_f1, k_f2 (Sainsot 2004)
+    ! when the case counts them: always reported; used if the case leaves k_m = 0. The fillet
+    ! geometry: root fillet radius 0.2 m (ISO 4156 flat root), the external spline's bore at
+    ! half its root radius, the internal spline's rim at twice its root radius, unless given.
+    rho_f = c%fillet_radius
+    if (rho_f == 0.0_wp) rho_f = 0.2_wp*m%m_n
+    r_bore = c%r_bore
+    if (r_bore == 0.0_wp) r_bore = 0.5_wp*rf1
+    r_rim = c%r_rim
+    if (r_rim == 0.0_wp) r_rim = 2.0_wp*rf2
+    call spline_mesh_stiffness_fillet(real(m%z, wp), m%m_n, m%alpha, m%b, m%e_mod, m%nu, rf1, rf2, &
+         ra2, rho_f, rho_f, r_bore, r_rim, .false., stiffness_nquad, m%k_terms(1), m%k_terms(2), &
+         m%k_terms(3), m%k_terms(4), m%k_terms(5), m%k_terms(6), m%k_terms(7), m%k_terms(8), &
+         m%k_terms(9), m%k_terms(10), ierr, errmsg)
+    if (ierr == 0) then
+      m%k_m_nofillet = m%k_terms(ik_m)
+      if (c%fillet) call spline_mesh_stiffness_fillet(real(m%z, wp), m%m_n, m%alpha, m%b, &
+           m%e_mod, m%nu, rf1, rf2, ra2, rho_f, rho_f, r_bore, r_rim, .true., stiffness_nquad, &
+           m%k_terms(1), m%k_terms(2), m%k_terms(3), m%k_terms(4), m%k_terms(5), m%k_terms(6), &
+           m%k_terms(7), m%k_terms(8), m%k_terms(9), m%k_terms(10), ierr, errmsg)
+    end if
     if (ierr /= 0) then
       m%k_terms = 0.0_wp
       if (c%k_m == 0.0_wp) then
         errmsg = 'case '//trim(m%name)//': field k_m = 0 asks for the potential-energy stiffness '// &
-             '(Eq. 18), which fails for this geometry: '//trim(errmsg)//'; set k_m in N/m'
+             '(Eq. 18), which fails for this geometry: '//trim(errmsg)//'; set k_m in N/m '// &
+             '(or fillet = .false., fillet_radius, r_bore, r_rim)'
         ierr = err_case; return
       end if
+      ierr = 0
     end if
     if (c%k_m == 0.0_wp) then
-      m%k_m = m%k_terms(8)
+      m%k_m = m%k_terms(ik_m)
       m%k_m_computed = .true.
     end if
+
+    ! mesh damping as a ratio: c_m = 2 zeta_m sqrt(k_m m_e), with the tooth pair's effective
+    ! torsional mass m_e = 1 / (r_b^2 / J_1 + r_b^2 / J_2) (MODEL.md Section 10)
+    m%m_e = 1.0_wp/(m%r_b**2/m%j_1 + m%r_b**2/m%j_2)
+    m%zeta_m = c%zeta_m
+    if (c%zeta_m > 0.0_wp) m%c_m = 2.0_wp*c%zeta_m*sqrt(m%k_m*m%m_e)
+
+    ! torque ripple, unbalance, angular misalignment (MODEL.md Section 10)
+    m%n_ripple = count(c%ripple_amp /= 0.0_wp)
+    m%ripple_order(1:m%n_ripple) = pack(c%ripple_order, c%ripple_amp /= 0.0_wp)
+    m%ripple_amp(1:m%n_ripple) = pack(c%ripple_amp, c%ripple_amp /= 0.0_wp)
+    m%ripple_phase(1:m%n_ripple) = pack(c%ripple_phase_deg, c%ripple_amp /= 0.0_wp)*pi/180.0_wp
+    m%unbalance = c%unbalance
+    m%unbalance_phase = c%unbalance_phase_deg*pi/180.0_wp
+    m%gamma_x = c%gamma_x; m%gamma_y = c%gamma_y
+    m%n_slices = c%n_slices
 
     ! thermal (Eq. 2)
     m%kappa = backlash_coefficient(m%lambda_th, m%s, m%cos_alpha)
@@ -161,11 +208,11 @@ contains
     type(model_t), intent(in) :: m
     character(len=:), allocatable :: text
     text = ''
-    if (.not. m%k_m_computed .and. m%k_terms(8) > 0.0_wp) then
-      if (m%k_m*k_m_warn_ratio < m%k_terms(8)) then
+    if (.not. m%k_m_computed .and. m%k_m_nofillet > 0.0_wp) then
+      if (m%k_m*k_m_warn_ratio < m%k_m_nofillet) then
         text = text//'case '//trim(m%name)//': field k_m = '//fmt(m%k_m, '(es10.3)')//' N/m is '// &
-             fmt(m%k_terms(8)/m%k_m, '(es8.1)')//' times below the potential-energy mesh '// &
-             'stiffness of this geometry (Eq. 18: '//fmt(m%k_terms(8), '(es10.3)')//' N/m): a '// &
+             fmt(m%k_m_nofillet/m%k_m, '(es8.1)')//' times below the potential-energy mesh '// &
+             'stiffness of this geometry (Eq. 18: '//fmt(m%k_m_nofillet, '(es10.3)')//' N/m): a '// &
              'unit slip (N/mm for N/m)? Run as given'//new_line('a')
       end if
     end if

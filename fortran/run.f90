@@ -64,9 +64,11 @@ contains
   !> interruptible: a SIGINT stops the run with err_interrupted (callers that can raise it).
   !> Optional extras, sized by the caller: sec_t(section_count(m)), sec_y(nstate, ...) get the
   !> Poincare section (times, SI states); lyap_t(lyapunov_count(m)), lyap_g(...) the Benettin
-  !> renormalisation times and the cumulative log growth of the separation (lyapunov_benettin).
+  !> renormalisation times and the cumulative log growth of the separation (lyapunov_benettin);
+  !> face(n_out, z, n_slices), tilt(n_out, 2) the load along the face and the tilting moment
+  !> (sliced faces: angular misalignment, tooth_outputs).
   subroutine run_case(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-       lyap_t, lyap_g)
+       lyap_t, lyap_g, face, tilt)
     type(model_t), intent(in) :: m
     real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
     real(wp), intent(out) :: tm(m%n_out), stats(nstats)
@@ -74,6 +76,7 @@ contains
     character(len=*), intent(out) :: errmsg
     logical, intent(in), optional :: interruptible
     real(wp), intent(out), optional :: sec_t(:), sec_y(:, :), lyap_t(:), lyap_g(:)
+    real(wp), intent(out), optional :: face(:, :, :), tilt(:, :)
     type(model_t) :: run
     real(wp) :: eps_lat, eps_th, tol, closed, t_closed
     integer(8) :: c0, c1, rate
@@ -90,12 +93,14 @@ contains
       end if
       if (m%thermal == thermal_coupled) call set_thermal_level(run, thermal_oneway)
     end if
-    call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y)
+    call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
+         face, tilt)
     if (ierr == err_ok .and. m%auto .and. m%thermal == thermal_coupled) then
       eps_th = backlash_estimate(m, maxval(abs(tooth(:, :, iq_tf))))
       if (eps_th > tol) then
         call set_thermal_level(run, thermal_coupled)
-        call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y)
+        call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
+             face, tilt)
       end if
     end if
     if (present(lyap_t)) then
@@ -214,21 +219,22 @@ contains
   end function itoa
 
   !> One run of the model at the level m sets.
-  subroutine run_level(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y)
+  subroutine run_level(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
+       face, tilt)
     type(model_t), intent(in) :: m
     real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
     real(wp), intent(out) :: tm(m%n_out), stats(nstats)
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
     logical, intent(in), optional :: interruptible
-    real(wp), intent(out), optional :: sec_t(:), sec_y(:, :)
+    real(wp), intent(out), optional :: sec_t(:), sec_y(:, :), face(:, :, :), tilt(:, :)
     real(wp) :: y0(nstate)
     real(wp), allocatable :: ts(:), ysec(:, :)
     integer, allocatable :: modes(:, :)
     errmsg = ''
     stats = 0.0_wp
     t = 0.0_wp; y = 0.0_wp; tooth = 0.0_wp; tm = 0.0_wp
-    allocate(modes(m%z, m%n_out))
+    allocate(modes(m%z*m%n_slices, m%n_out))
     call output_times(m, t)
     call start_state(m, y0, ierr, errmsg)
     if (ierr /= 0) return
@@ -245,7 +251,7 @@ contains
            interruptible, ts, ysec)
     end if
     if (ierr /= 0) return
-    call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg)
+    call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt)
   end subroutine run_level
 
   !> Period of the Poincare section [s]: the shaft revolution 2 pi / omega (section 1) or the
@@ -317,7 +323,7 @@ contains
     type(model_t) :: mm
     real(wp) :: y(nstate), yp(nstate), t0, t1, ys(nstate), yps(nstate), dv(nstate), d, g
     real(wp) :: tout(1), y1(nstate, 1), yp1(nstate, 1), st(nsolver_stats)
-    integer :: idx(nstate), n, k, i, modes(m%z, 1)
+    integer :: idx(nstate), n, k, i, modes(m%z*m%n_slices, 1)
     call integrated_states(m, idx, n)
     mm = m
     y = y_start
@@ -368,40 +374,46 @@ contains
 
   !> Per-tooth quantities at the output times, with the contact states the integration used
   !> (2: decided by the state).
-  subroutine tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg)
+  !> face(k, j, s), tilt(k, :) (optional): the load of slice s of tooth j along the face and the
+  !> tilting moment (M_x, M_y) on spline 1 (mesh_eval), for sliced faces.
+  subroutine tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t(:), y(:, :)
     integer, intent(in) :: modes(:, :)
     real(wp), intent(out) :: tooth(:, :, :), tm(:)
     integer, intent(out) :: ierr
     character(len=*), intent(inout) :: errmsg
-    real(wp) :: row(m%z, ntooth_q)
+    real(wp), intent(out), optional :: face(:, :, :), tilt(:, :)
+    real(wp) :: row(m%z, ntooth_q), fs(m%n_slices, m%z), mt(2)
     integer :: k
     ierr = 0
     do k = 1, size(t)
       if (modes(1, k) == 2) then
-        call tooth_quantities(m, t(k), y(:, k), row, tm(k), ierr, errmsg)
+        call tooth_quantities(m, t(k), y(:, k), row, tm(k), ierr, errmsg, fslice=fs, mtilt=mt)
       else
-        call tooth_quantities(m, t(k), y(:, k), row, tm(k), ierr, errmsg, modes(:, k))
+        call tooth_quantities(m, t(k), y(:, k), row, tm(k), ierr, errmsg, modes(:, k), fs, mt)
       end if
       if (ierr /= 0) return
       tooth(k, :, :) = row
+      if (present(face)) face(k, :, :) = transpose(fs)
+      if (present(tilt)) tilt(k, :) = mt
     end do
   end subroutine tooth_outputs
 
   !> Every per-tooth quantity (order of tooth_q_names) and the meshing torque at one state y (SI):
   !> Eqs. 11, 15-17, 19-22 and, where the thermal level has them, Eqs. 1-7 and 12-14.
-  subroutine tooth_quantities(m, t, y, row, tm, ierr, errmsg, mode)
+  subroutine tooth_quantities(m, t, y, row, tm, ierr, errmsg, mode, fslice, mtilt)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, y(nstate)
     real(wp), intent(out) :: row(m%z, ntooth_q), tm
     integer, intent(out) :: ierr
     character(len=*), intent(inout) :: errmsg
-    integer, intent(in), optional :: mode(m%z)
+    integer, intent(in), optional :: mode(m%z*m%n_slices)
+    real(wp), intent(out), optional :: fslice(m%n_slices, m%z), mtilt(2)
     real(wp) :: fx1, fy1, sp(m%z), cp(m%z)
     call mesh_eval(m, t, y(1:ndof), y(ndof+1:), fx1, fy1, tm, ierr, errmsg, mode=mode, &
          flash=.true., f=row(:, 1), dn=row(:, 4), c=row(:, 5), tf=row(:, 6), rc1=row(:, 7), &
-         rc2=row(:, 8), sphi_out=sp, cphi_out=cp)
+         rc2=row(:, 8), sphi_out=sp, cphi_out=cp, fslice=fslice, mtilt=mtilt)
     row(:, 2) = row(:, 1)*sp     ! F_jx (Eq. 19 with phi_j)
     row(:, 3) = row(:, 1)*cp     ! F_jy
   end subroutine tooth_quantities

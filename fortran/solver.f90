@@ -75,7 +75,7 @@ contains
     integer, intent(in) :: nt
     real(wp), intent(in) :: tout(nt)
     real(wp), intent(out) :: yout(nstate, nt)
-    integer, intent(out) :: modes_out(m%z, nt)
+    integer, intent(out) :: modes_out(m%z*m%n_slices, nt)
     real(wp), intent(out) :: stats(nstats)
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
@@ -108,8 +108,8 @@ contains
     ctx%frozen = m%roots
     nroot = 0
     if (ctx%frozen) then
-      allocate(ctx%modes(m%z))
-      nroot = 2*m%z
+      allocate(ctx%modes(m%z*m%n_slices))
+      nroot = 2*m%z*m%n_slices
       if (m%thermal == thermal_coupled) then
         allocate(ctx%branches(2, m%z))
         nroot = 4*m%z
@@ -392,13 +392,13 @@ contains
     type(solver_ctx_t), intent(inout) :: ctx
     real(c_double), intent(in) :: tau, ys(nstate)
     integer, intent(inout) :: nchanged
-    real(wp) :: y(nstate), g(2*ctx%m%z), gb(2*ctx%m%z), eps, epsv
+    real(wp) :: y(nstate), g(2*ctx%m%z*ctx%m%n_slices), gb(2*ctx%m%z), eps, epsv
     integer :: j, i, want
     call from_scaled(ctx%m, ys, y)
     call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), g, y(ndof+1:), gb)
     eps = 1.0e-9_wp*ctx%m%c_bulk
     epsv = eps*ctx%m%w_ref
-    do j = 1, ctx%m%z
+    do j = 1, ctx%m%z*ctx%m%n_slices         ! every contact: a tooth, or a slice of a tooth
       want = 0
       if (g(2*j - 1) > 0.0_wp) want = 1
       if (g(2*j) < 0.0_wp) want = -1
@@ -406,7 +406,9 @@ contains
         if (abs(g(2*j - 1)) > eps .and. abs(g(2*j)) > eps) nchanged = nchanged + 1
         ctx%modes(j) = want
       end if
-      if (.not. allocated(ctx%branches)) cycle
+    end do
+    if (.not. allocated(ctx%branches)) return
+    do j = 1, ctx%m%z
       do i = 1, 2
         want = merge(-1, 1, gb(2*j - 2 + i) < 0.0_wp)
         if (want /= ctx%branches(i, j)) then
@@ -424,18 +426,22 @@ contains
     type(solver_ctx_t), intent(inout) :: ctx
     integer(c_int), intent(in) :: rootsfound(:)
     integer, intent(inout) :: nroots
-    integer :: j, i, z
+    integer :: j, i, z, nc
     z = ctx%m%z
-    do j = 1, z
+    nc = z*ctx%m%n_slices                      ! contacts: teeth, or slices of teeth
+    do j = 1, nc
       if (rootsfound(2*j - 1) == 1) ctx%modes(j) = 1
       if (rootsfound(2*j - 1) == -1) ctx%modes(j) = 0
       if (rootsfound(2*j) == -1) ctx%modes(j) = -1
       if (rootsfound(2*j) == 1) ctx%modes(j) = 0
-      if (.not. allocated(ctx%branches)) cycle
-      do i = 1, 2
-        if (rootsfound(2*z + 2*j - 2 + i) /= 0) ctx%branches(i, j) = rootsfound(2*z + 2*j - 2 + i)
-      end do
     end do
+    if (allocated(ctx%branches)) then          ! coupled level: a whole tooth per contact
+      do j = 1, z
+        do i = 1, 2
+          if (rootsfound(2*nc + 2*j - 2 + i) /= 0) ctx%branches(i, j) = rootsfound(2*nc + 2*j - 2 + i)
+        end do
+      end do
+    end if
     nroots = nroots + count(rootsfound /= 0)
   end subroutine apply_roots
 
@@ -478,18 +484,19 @@ contains
     real(c_double), pointer :: ys(:)
     real(c_double) :: yf(nstate)
     real(wp) :: y(nstate)
-    integer :: z
+    integer :: z, nc
     call c_f_pointer(udata, ctx)
     ys => FN_VGetArrayPointer(sv_y)
     yf = ctx%ys_full
     yf(ctx%idx(1:ctx%n)) = ys
     call from_scaled(ctx%m, yf, y)
     z = ctx%m%z
+    nc = z*ctx%m%n_slices
     if (allocated(ctx%branches)) then
-      call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), gout(1:2*z), y(ndof+1:), &
-           gout(2*z+1:4*z))
+      call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), gout(1:2*nc), y(ndof+1:), &
+           gout(2*nc+1:2*nc+2*z))
     else
-      call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), gout(1:2*z))
+      call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), gout(1:2*nc))
     end if
     ret = 0
   end function roots_cb

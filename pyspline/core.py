@@ -66,17 +66,18 @@ class Model:
     that the caller owns: it can be copied, pickled to another process and used from many
     threads at once. ``Case.model`` keeps one per case."""
 
-    __slots__ = ("case", "bytes", "z", "n_out", "n_section", "n_lyapunov", "__weakref__")
+    __slots__ = ("case", "bytes", "z", "n_out", "n_section", "n_lyapunov", "n_slices",
+                 "__weakref__")
 
     def __init__(self, case):
         case = load_case(case)
         data, z, nt, ierr, msg = _api.api_load(case.text().encode("utf-8"), _MODEL_BYTES)
         raise_for(ierr, msg)
         data.flags.writeable = False
-        nsec, nlyap, ierr, msg = _api.api_counts(data)
+        nsec, nlyap, nslice, ierr, msg = _api.api_counts(data)
         raise_for(ierr, msg)
         self.case, self.bytes, self.z, self.n_out = case, data, int(z), int(nt)
-        self.n_section, self.n_lyapunov = int(nsec), int(nlyap)
+        self.n_section, self.n_lyapunov, self.n_slices = int(nsec), int(nlyap), int(nslice)
         _warn(_api.api_warnings(data, np.zeros(1), 0))   # the core's model warnings (k_m)
 
     def __getstate__(self):
@@ -198,6 +199,8 @@ class Result:
     section_t: np.ndarray = None   #: Poincare section times [s] (case field section)
     section_y: np.ndarray = None   #: states at the section times (n, 14), SI, like y
     lyapunov: dict = None    #: Benettin record (case field lyapunov): t [s], log_growth, exponent [1/s]
+    face: np.ndarray = None  #: sliced face (n_slices > 1): load of slice s of tooth j, (nt, Z, n_slices) [N]
+    tilt: np.ndarray = None  #: sliced face: tilting moment (M_x, M_y) on spline 1, (nt, 2) [N m]
 
     F = _tooth_quantity("F")
     Fx = _tooth_quantity("Fx")
@@ -301,8 +304,10 @@ def simulate(case) -> Result:
     model = load(case)
     q, s = _names("tooth"), _names("stats")
     t0 = time.perf_counter()
-    t, y, tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, ierr, msg = _api.api_simulate(
-        model.bytes, model.z, model.n_out, len(q), len(s), model.n_section, model.n_lyapunov)
+    nft = model.n_out if model.n_slices else 0
+    t, y, tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, ierr, msg = \
+        _api.api_simulate(model.bytes, model.z, model.n_out, len(q), len(s), model.n_section,
+                          model.n_lyapunov, nft, model.n_slices)
     wall = time.perf_counter() - t0
     raise_for(ierr, msg)
     st = {n: (float(v) if n.endswith(_FLOAT_STATS) or n.startswith("fidelity_eps") else int(v))
@@ -314,7 +319,8 @@ def simulate(case) -> Result:
         span = lyap_t - (t[0] if len(t) else 0.0)
         lyap = dict(t=lyap_t, log_growth=lyap_g, exponent=float(lyap_g[-1] / span[-1]))
     return Result(case=model.case, t=t, y=y, tooth={n: tooth[:, :, i] for i, (n, _) in enumerate(q)},
-                  Tm=tm, stats=st, section_t=sec_t, section_y=sec_y, lyapunov=lyap)
+                  Tm=tm, stats=st, section_t=sec_t, section_y=sec_y, lyapunov=lyap,
+                  face=face if model.n_slices else None, tilt=tilt if model.n_slices else None)
 
 
 def rhs(case, t: float, y) -> tuple[np.ndarray, dict, float]:

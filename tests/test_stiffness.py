@@ -17,14 +17,30 @@ def test_hertz_closed_form():
 
 
 def test_combination_is_eq18():
+    """Eq. 18: the pair's compliance is the sum of its terms; the fillet-foundation terms count
+    when fillet is on (the default), and are reported as 0 and left out when it is off."""
+    base = ("k_h", "k_b1", "k_s1", "k_a1", "k_b2", "k_s2", "k_a2")
     k = spline_terms()
-    inv = sum(1 / k[n] for n in ("k_h", "k_b1", "k_s1", "k_a1", "k_b2", "k_s2", "k_a2"))
+    inv = sum(1 / k[n] for n in base + ("k_f1", "k_f2"))
     np.testing.assert_allclose(k["k_m"], 1 / inv, rtol=1e-14)
+    k0 = spline_terms(fillet=False)
+    assert k0["k_f1"] == k0["k_f2"] == 0.0
+    np.testing.assert_allclose(k0["k_m"], 1 / sum(1 / k0[n] for n in base), rtol=1e-14)
+    for n in base:                                  # the other terms do not depend on it
+        assert k0[n] == k[n], n
+    assert 2 < k0["k_m"] / k["k_m"] < 3             # the foundation is the softest part
+
+
+def test_computed_k_m_counts_the_fillet_by_default():
+    used = pyspline.mesh_stiffness(dict(name="c", k_m=0.0))
+    assert used["computed"] and used["k_m_used"] == used["k_m"] and used["k_f1"] > 0
+    off = pyspline.mesh_stiffness(dict(name="c", k_m=0.0, fillet=False))
+    assert off["k_m_used"] == off["k_m"] > used["k_m_used"]
 
 
 def test_linear_in_face_width():
     k1, k2 = spline_terms(b=0.03), spline_terms(b=0.045)
-    for n in ("k_h", "k_b1", "k_s1", "k_a1", "k_b2", "k_s2", "k_a2", "k_m"):
+    for n in ("k_h", "k_b1", "k_s1", "k_a1", "k_f1", "k_b2", "k_s2", "k_a2", "k_f2", "k_m"):
         np.testing.assert_allclose(k2[n] / k1[n], 1.5, rtol=1e-13, err_msg=n)
 
 
