@@ -28,7 +28,7 @@ module spline_api
   public :: api_output_times, api_model_info, api_defaults, api_names, api_tooth_stiffness
   public :: api_time_rhs, api_counts, api_parse, api_field_hint, api_warnings
 
-  integer, parameter :: ninfo = 10   !< entries of api_model_info
+  integer, parameter :: ninfo = 12   !< entries of api_model_info
 
 contains
 
@@ -293,7 +293,7 @@ contains
     call unpack(model, m, ie, errmsg)
     if (ie == err_ok) then
       info = [m%r_b, m%r_pitch, m%omega, m%l_ref, m%w_ref, m%c_bulk, m%kappa, m%k_m, &
-           merge(1.0_wp, 0.0_wp, m%k_m_computed), real(m%thermal, wp)]
+           merge(1.0_wp, 0.0_wp, m%k_m_computed), real(m%thermal, wp), m%c_m, m%m_e]
       terms = m%k_terms
     end if
     ierr = ie
@@ -315,9 +315,10 @@ contains
     integer(c_int), intent(in) :: i
     character(len=32), intent(out) :: name, unit
     character(len=16), parameter :: info_names(ninfo) = [character(len=16) :: 'r_b', 'r_pitch', &
-         'omega', 'l_ref', 'w_ref', 'c_bulk', 'kappa', 'k_m', 'k_m_computed', 'thermal_level']
+         'omega', 'l_ref', 'w_ref', 'c_bulk', 'kappa', 'k_m', 'k_m_computed', 'thermal_level', &
+         'c_m', 'm_e']
     character(len=8), parameter :: info_units(ninfo) = [character(len=8) :: 'm', 'm', 'rad/s', &
-         'm', 'rad/s', 'm', 'm/degC', 'N/m', '', '']
+         'm', 'rad/s', 'm', 'm/degC', 'N/m', '', '', 'N s/m', 'kg']
     integer :: n
     name = ''; unit = ''
     select case (kind)

@@ -124,8 +124,9 @@ class Model:
 
     def info(self) -> dict:
         """Derived quantities (SI): r_b, r_pitch, omega, the Eq. 25 scales l_ref and w_ref,
-        c_bulk, kappa, the k_m used, k_m_computed, thermal_level, and the Eq. 18 terms as a
-        dict 'k_terms' (k_h, k_b1, ..., k_m of the geometry)."""
+        c_bulk, kappa, the k_m used, k_m_computed, thermal_level, the c_m used, the tooth
+        pair's effective mass m_e, and the Eq. 18 terms as a dict 'k_terms' (k_h, k_b1, ..., k_m
+        of the geometry)."""
         info, terms, ierr, msg = _api.api_model_info(self.bytes)
         raise_for(ierr, msg)
         out = {n: float(v) for (n, _), v in zip(_names("info"), info)}
