@@ -1,12 +1,12 @@
 """The strongest "peer" a Python user could assemble: compiled LSODA (numbalsoda, ODEPACK's
-LSODA in C) driving a numba-compiled right-hand side written from /work/shared/spec/MODEL.md.
+LSODA in C) driving a numba-compiled right-hand side written from the model specification (docs/model.md restates it).
 
 Independent of the Fortran core and of the pyspline package (it imports neither). The case
 parameters come from tests/oracle.py's `prepare` (the same dict of case fields the oracle takes),
 so this RHS and the numpy oracle read one parameter set; the numbers are then packed into one
 float64 array `data` that numbalsoda hands to the compiled RHS at every call.
 
-Model (MODEL.md; equation numbers are the paper's):
+Model (docs/model.md; equation numbers are the paper's):
   phi_j = 2 pi j/Z + omega t + theta_0 - alpha, theta_0 = pi/(2Z)            Eqs. 8-9
   dn_j  = (X1 - x2) sin phi_j - (Y1 - y2) cos phi_j + D2,  X1 = x1+l_x ...    Eq. 11
           (r_b (th2 - th1) = D2, Eq. 24)
@@ -59,7 +59,7 @@ __all__ = ["make_rhs", "solve", "rhs_eval", "load_case", "DEFAULTS", "lsoda_sig"
 lsoda_sig = types.void(types.double, types.CPointer(types.double),
                        types.CPointer(types.double), types.CPointer(types.double))
 
-# Defaults of every model field (fortran/case.f90 `case_defaults`, values only; MODEL.md s.8).
+# Defaults of every model field (fortran/case.f90 `case_defaults`, values only; docs/model.md s.8).
 DEFAULTS = dict(
     z=16, module_m=2.0e-3, alpha_deg=30.0, b=0.03, s=3.14e-3, c0=2.0e-4, e_mod=2.1e11, nu=0.3,
     lambda_th=1.2e-5, k_cond=46.47, rho=7800.0, c_heat=481.48,
@@ -167,7 +167,7 @@ def _h(f, A, Req, dn, ddn, sigma, k_m, c_m, b, eta, hertz, c0, th, tb):
 
 @nb.njit(cache=False)
 def _coupled_force(d, dn, ddn, sp, cp, X1, Y1, x2, y2, vx1, vy1, vx2, vy2):
-    """Thermally coupled tooth force of one tooth in contact (MODEL.md s.6; Eqs. 1-7, 12-17).
+    """Thermally coupled tooth force of one tooth in contact (docs/model.md s.6; Eqs. 1-7, 12-17).
 
     F = k_m (dn - sigma c(F)) + c_m ddn, c = c0 - th_coef (T_M + T_f(|F|)). Fixed-point
     iteration from the T_f = 0 force F0 until |F_{n+1} - F_n| <= 4.5e-16 |F_{n+1}| (2 ulp; the

@@ -44,7 +44,7 @@ module spline_case
   character(len=optlen), parameter :: section_values(3) = [character(len=optlen) :: &
        'none', 'shaft', 'tooth']
 
-  !> The fields of a case with their defaults: the paper's spline and drive (MODEL.md Section 8).
+  !> The fields of a case with their defaults: the paper's spline and drive (docs/model.md section 12).
   type :: case_t
     character(len=namelen) :: name = 'unnamed'   !< case name, used in messages
     integer  :: z = 16                      !< number of teeth Z [-]

@@ -22,7 +22,7 @@ contains
   !>   D1'' = r_b ((T_m - S1)/J_1 - (T_d + S1)/J_M)
   !>   D2'' = r_b ((-T_m - S3)/J_2 - (T_m - S1)/J_1)
   !>   D3'' = r_b ((-T_m - S3)/J_2 - (S3 - T_L)/J_L)
-  !> Beyond the paper (MODEL.md Section 10): T_d is driving_torque(t) (torque ripple), and the
+  !> Beyond the paper (docs/model.md section 11): T_d is driving_torque(t) (torque ripple), and the
   !> unbalance forces (unbalance_forces) act on the x, y equations of splines 1 and 2.
   !> mode: the frozen contact state of every contact (tooth, or slice of a tooth: mesh_eval).
   subroutine accelerations(m, t, q, v, a, ierr, errmsg, mode, branch, cstats)
@@ -53,7 +53,7 @@ contains
     a(7) = m%r_b*((-tm - s3)/m%j_2 - (s3 - m%t_l)/m%j_l)
   end subroutine accelerations
 
-  !> Driving torque with ripple (MODEL.md Section 10): T_d(t) = T_d [1 + sum_k a_k sin(n_k omega t
+  !> Driving torque with ripple (docs/model.md section 11): T_d(t) = T_d [1 + sum_k a_k sin(n_k omega t
   !> + psi_k)], the engine orders n_k; exactly T_d without ripple.
   pure real(wp) function driving_torque(m, t) result(td)
     type(model_t), intent(in) :: m
@@ -65,7 +65,7 @@ contains
     end do
   end function driving_torque
 
-  !> Mass unbalance (MODEL.md Section 10): the rotating force m_ui e_i omega^2 (cos(omega t +
+  !> Mass unbalance (docs/model.md section 11): the rotating force m_ui e_i omega^2 (cos(omega t +
   !> beta_i), sin(omega t + beta_i)) on spline i: f = (f_x1, f_y1, f_x2, f_y2) [N].
   pure subroutine unbalance_forces(m, t, f)
     type(model_t), intent(in) :: m

@@ -7,7 +7,7 @@ module spline_geometry
 
 contains
 
-  !> ISO 4156 flat-root (30 deg) spline radii for module m and Z teeth (MODEL.md Section 8):
+  !> ISO 4156 flat-root (30 deg) spline radii for module m and Z teeth (docs/model.md section 12):
   !> pitch R = m Z / 2, external minor (root) m (Z - 1.5) / 2, internal major (root)
   !> m (Z + 1.5) / 2 and internal minor (tip) m (Z - 1) / 2.
   pure subroutine iso4156_radii(z, m, r_pitch, rf_ext, rf_int, ra_int)

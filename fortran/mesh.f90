@@ -32,7 +32,7 @@ contains
   !> branch (optional): frozen root (-1) / tip (+1) branch of Eqs. 13-14 for spline 1 (row 1) and
   !> 2 (row 2) of every tooth, used between located branch switches; else the sign of dDelta/dt.
   !> cstats (optional): updated with the work of the flash-temperature coupling.
-  !> Angular misalignment (MODEL.md Section 10): with n_slices > 1 the face is cut into slices
+  !> Angular misalignment (docs/model.md section 11): with n_slices > 1 the face is cut into slices
   !> at z_s; slice s of tooth j has its own dn_js (Eq. 11 with spline 1's centre at
   !> (x1 + l_x + gamma_y z_s, y1 + l_y - gamma_x z_s)), dead zone and force F_js (Eqs. 15-17
   !> with k_m / n_s, c_m / n_s); F_j is their sum; mode then holds the state of every slice
@@ -143,7 +143,7 @@ contains
       else
         fj = 0.0_wp
       end if
-      ! Eqs. 19-22 with the tooth's own line-of-action angle (MODEL.md Section 4)
+      ! Eqs. 19-22 with the tooth's own line-of-action angle (docs/model.md section 4)
       fx1 = fx1 - fj*sp(j)
       fy1 = fy1 + fj*cp(j)
       sumf = sumf + fj

@@ -69,7 +69,7 @@ module spline_model
     logical  :: k_m_computed = .false.      !< k_m from Eq. 18 (the case left k_m = 0)
     real(wp) :: k_terms(nkterms) = 0.0_wp   !< Eq. 18 terms k_h, k_b1, ..., k_m (0: not computable)
     real(wp) :: k_m_nofillet = 0.0_wp       !< Eq. 18 without the fillet foundation (warnings)
-    ! beyond the paper (MODEL.md Section 10; docs/model.md)
+    ! beyond the paper (docs/model.md section 11; docs/model.md)
     real(wp) :: zeta_m = 0.0_wp             !< mesh damping ratio (c_m from it when > 0)
     real(wp) :: m_e = 0.0_wp                !< effective torsional mass of a tooth pair [kg]
     integer  :: n_ripple = 0                !< torque-ripple terms in use
@@ -83,7 +83,7 @@ module spline_model
 
 contains
 
-  !> Build the model of a case: validate it, derive the geometry (MODEL.md Section 2, Eq. 9),
+  !> Build the model of a case: validate it, derive the geometry (docs/model.md section 2, Eq. 9),
   !> the mesh stiffness (Eq. 18; used when the case leaves k_m = 0), the thermal constants
   !> (Eq. 2) and the scales of Eq. 25. ierr: err_case (bad field) or err_thermal (the bulk
   !> temperature alone closes the backlash).
@@ -121,7 +121,7 @@ contains
     m%lyap_d0 = c%lyapunov_d0
     if (m%omega > 0.0_wp) m%lyap_dt = c%lyapunov_interval*2.0_wp*pi/m%omega
 
-    ! geometry (MODEL.md Sections 2 and 8, Eq. 9)
+    ! geometry (docs/model.md sections 2 and 12, Eq. 9)
     call iso4156_radii(m%z, m%m_n, m%r_pitch, rf1, rf2, ra2)
     m%cos_alpha = cos(m%alpha)
     m%sin_alpha = sin(m%alpha)
@@ -165,12 +165,12 @@ contains
     end if
 
     ! mesh damping as a ratio: c_m = 2 zeta_m sqrt(k_m m_e), with the tooth pair's effective
-    ! torsional mass m_e = 1 / (r_b^2 / J_1 + r_b^2 / J_2) (MODEL.md Section 10)
+    ! torsional mass m_e = 1 / (r_b^2 / J_1 + r_b^2 / J_2) (docs/model.md section 11)
     m%m_e = 1.0_wp/(m%r_b**2/m%j_1 + m%r_b**2/m%j_2)
     m%zeta_m = c%zeta_m
     if (c%zeta_m > 0.0_wp) m%c_m = 2.0_wp*c%zeta_m*sqrt(m%k_m*m%m_e)
 
-    ! torque ripple, unbalance, angular misalignment (MODEL.md Section 10)
+    ! torque ripple, unbalance, angular misalignment (docs/model.md section 11)
     m%n_ripple = count(c%ripple_amp /= 0.0_wp)
     m%ripple_order(1:m%n_ripple) = pack(c%ripple_order, c%ripple_amp /= 0.0_wp)
     m%ripple_amp(1:m%n_ripple) = pack(c%ripple_amp, c%ripple_amp /= 0.0_wp)

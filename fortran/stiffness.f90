@@ -1,7 +1,7 @@
-!> Mesh stiffness of the spline tooth pair by the potential energy method (MODEL.md Section 7,
+!> Mesh stiffness of the spline tooth pair by the potential energy method (docs/model.md section 7,
 !> the paper's Eq. 18):
 !>   1/k_m = 1/k_h + sum over the external AND the internal tooth of (1/k_b + 1/k_s + 1/k_a),
-!> optionally (MODEL.md Section 10) + 1/k_f per tooth, the fillet-foundation compliance of Sainsot,
+!> optionally (docs/model.md section 11) + 1/k_f per tooth, the fillet-foundation compliance of Sainsot,
 !> Velex & Duverger (2004): fillet_foundation_stiffness[_internal], spline_mesh_stiffness_fillet.
 !>
 !> Every tooth is a variable-section cantilever ("slice beam") clamped at its root circle and
@@ -47,7 +47,7 @@ module spline_stiffness
 
 contains
 
-  !> Hertz contact stiffness of a line contact of face width b, Yang & Lin (1987), MODEL.md
+  !> Hertz contact stiffness of a line contact of face width b, Yang & Lin (1987), docs/model.md
   !> Eq. 18: k_h = pi E b / (4 (1 - nu^2)) (independent of the contact position).
   pure function hertz_stiffness(e, nu, b) result(kh)
     real(wp), intent(in) :: e, nu, b
@@ -184,7 +184,7 @@ contains
     kb = 1.0_wp/cb; ks = 1.0_wp/cs; ka = 1.0_wp/ca
   end subroutine internal_tooth_stiffness
 
-  !> MODEL.md Eq. 18 at the pitch point (r_contact = m z / 2 on both teeth):
+  !> docs/model.md Eq. 18 at the pitch point (r_contact = m z / 2 on both teeth):
   !>   1/k_m = 1/k_h + 1/k_b1 + 1/k_s1 + 1/k_a1 + 1/k_b2 + 1/k_s2 + 1/k_a2,
   !> tooth 1 = external spline (root radius rf1), tooth 2 = internal spline (root rf2, tip ra2).
   pure subroutine spline_mesh_stiffness(z, m, alpha, b, e, nu, rf1, rf2, ra2, nquad, kh, &
@@ -371,7 +371,7 @@ contains
     if (present(detail)) detail = [thf, hf, uf, sf, am, coef]
   end subroutine fillet_foundation_stiffness_internal
 
-  !> spline_mesh_stiffness plus the fillet-foundation terms (MODEL.md Section 10), at the pitch point:
+  !> spline_mesh_stiffness plus the fillet-foundation terms (docs/model.md section 11), at the pitch point:
   !>   fillet = .true.:  1/k_m = 1/k_h + sum_{i=1,2} (1/k_bi + 1/k_si + 1/k_ai + 1/k_fi)
   !>   fillet = .false.: k_m exactly (bit for bit) that of spline_mesh_stiffness; kf1 = kf2 = 0 and
   !>                     rho_f1, rho_f2, rint1, rout2 are then neither used nor checked.

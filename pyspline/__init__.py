@@ -9,4 +9,9 @@ from .sweep import open_sweep, sweep   # binds pyspline.sweep to the function (m
 __all__ = ["Case", "CaseError", "Model", "Result", "SolverError", "SplineError", "SplineWarning",
            "ThermalInterferenceError", "defaults", "load", "load_case", "mesh_stiffness",
            "open_sweep", "rhs", "simulate", "start_state", "sweep", "tooth_stiffness"]
-__version__ = "0.1.0"
+from importlib.metadata import PackageNotFoundError, version as _version
+
+try:
+    __version__ = _version("pyspline")      #: from meson.build's project version
+except PackageNotFoundError:                # pragma: no cover - not installed
+    __version__ = "unknown"

@@ -1,4 +1,13 @@
-"""Command line: ``pyspline run CASE...`` (and ``python -m pyspline``)."""
+"""pyspline: simulate involute spline couplings (Xue, Shen & Xue 2025, and beyond).
+
+commands (each --help says what it writes and where):
+  cases list | copy NAME [DEST]   the shipped cases; copy one to start your own (template)
+  run CASE...                     run cases, print a summary line each (--out DIR: NAME.npz)
+  plot CASE... [--out DIR]        one scene as a figure: DIR/NAME.png
+  sweep CASE --set F=a:b:n ...    sweep one or two fields: DIR/sweep.nc and figures
+  reproduce [--out DIR]           the paper's scenarios: figures, verification table, summary
+  calibrate, check-exe            fit the paper's unknowns; executable against Python
+Also `python -m pyspline`. The standalone executable is spline-dyn (spline-dyn --help)."""
 from __future__ import annotations
 
 import argparse
@@ -187,28 +196,71 @@ def cmd_check_exe(args) -> int:
     return 0 if all(v == "identical" for v in rep.values()) else 1
 
 
+def _installed_cases() -> Path:
+    from .paper import cases_dir
+    return cases_dir()
+
+
+def cmd_cases(args) -> int:
+    """List the shipped cases, or copy one (with its comments) to a file or directory."""
+    src = _installed_cases()
+    names = sorted(p.stem for p in src.glob("*.nml"))
+    if args.action == "list":
+        for n in names:
+            first = next((ln[1:].strip() for ln in (src / f"{n}.nml").read_text().splitlines()
+                          if ln.startswith("!")), "")
+            print(f"{n:24s} {first[:90]}")
+        print(f"({len(names)} cases in {src}; `pyspline cases copy NAME DEST` copies one)")
+        return 0
+    if args.name not in names:
+        print(f"pyspline: error: no case {args.name!r}: the cases are {', '.join(names)}",
+              file=sys.stderr)
+        return 2
+    dest = Path(args.dest or f"{args.name}.nml")
+    if dest.is_dir():
+        dest = dest / f"{args.name}.nml"
+    if dest.exists() and not args.force:
+        print(f"pyspline: error: {dest} exists (--force replaces it)", file=sys.stderr)
+        return 2
+    dest.write_text((src / f"{args.name}.nml").read_text())
+    print(f"wrote {dest}")
+    return 0
+
+
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(prog="pyspline", description=__doc__)
+    from . import __version__
+    p = argparse.ArgumentParser(prog="pyspline", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--version", action="version", version=f"pyspline {__version__}")
     sub = p.add_subparsers(dest="cmd", required=True)
-    r = sub.add_parser("run", help="run case files and print a summary")
+    r = sub.add_parser("cases", help="list the shipped cases, or copy one to start your own "
+                       "(template: every field with its default and unit)")
+    r.add_argument("action", choices=["list", "copy"])
+    r.add_argument("name", nargs="?", default="template", help="case to copy (default: template)")
+    r.add_argument("dest", nargs="?", help="file or directory to write (default: ./NAME.nml)")
+    r.add_argument("--force", action="store_true", help="replace an existing file")
+    r.set_defaults(func=cmd_cases)
+    r = sub.add_parser("run", help="run case files and print a summary line each; with --out, "
+                       "the results as DIR/NAME.npz (t, y, Tm and the per-tooth arrays, SI)")
     r.add_argument("cases", nargs="+")
     r.add_argument("--out", help="directory for .npz results (NAME.npz per case; never replaces "
                    "a file pyspline did not write; cases of the same name get NAME-2.npz, ...)")
     r.set_defaults(func=cmd_run)
-    r = sub.add_parser("reproduce", help="run the paper's scenarios: figures, verification "
-                       "table, summary.json")
+    r = sub.add_parser("reproduce", help="run the paper's scenarios and write into --out (default "
+                       "out/) the figures (fig*.png), verification.md/.csv and summary.json")
     r.add_argument("--out", default="out", help="output directory (default: out); refused if it "
                    "holds files of the same names that reproduce did not write")
     r.add_argument("--quick", action="store_true", help="0.3 s per case (for CI)")
     r.add_argument("--cases", help="case directory (default: ./cases or the installed copies)")
     r.set_defaults(func=cmd_reproduce)
-    r = sub.add_parser("calibrate", help="fit k_m and f_m to the paper's values")
+    r = sub.add_parser("calibrate", help="fit k_m and f_m to the paper's values and print them "
+                       "with the sensitivities; --write puts them into the paper's case files")
     r.add_argument("--quick", action="store_true")
     r.add_argument("--write", action="store_true", help="write the fitted values into the cases")
     r.add_argument("--cases")
     r.set_defaults(func=cmd_calibrate)
-    r = sub.add_parser("check-exe", help="run the paper cases through spline-dyn and compare "
-                       "with Python, number for number")
+    r = sub.add_parser("check-exe", help="run the paper cases through spline-dyn (in a temporary "
+                       "directory) and compare with Python, number for number; prints the result")
     r.add_argument("--full", action="store_true", help="full length (default: 0.3 s)")
     r.add_argument("--cases")
     r.set_defaults(func=cmd_check_exe)

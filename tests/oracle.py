@@ -1,7 +1,7 @@
 """Independent numpy reference implementation ("oracle") of the spline-coupling model.
 
-Written from /work/shared/spec/MODEL.md only (equation numbers "Eq. N" are the paper's,
-"MODEL.md s.N" are sections of the spec page).  It does not import anything from the
+Written from the model specification only (docs/model.md restates it; equation numbers "Eq. N" are the paper's,
+"docs/model.md s.N" are sections of the spec page).  It does not import anything from the
 pyspline package; it exists so the Fortran/CVODE implementation can be checked against an
 independent implementation to ~1e-12 relative, and as a plain-scipy benchmark baseline:
 
@@ -30,7 +30,7 @@ __all__ = ["Prepared", "prepare", "mesh", "rhs", "energy", "static_torsion",
 
 THERMAL_MODES = ("none", "bulk", "oneway", "coupled")
 
-# Fixed-point iteration of the thermally coupled tooth force (MODEL.md s.6, Eq. 2):
+# Fixed-point iteration of the thermally coupled tooth force (docs/model.md s.6, Eq. 2):
 # stop when successive iterates differ by <= _FP_RTOL*|F| (~2 ulp); the map contracts
 # with factor ~ 0.75 * k_m * 2 lambda s cos(alpha) * T_f / |F|  (~1e-3 for the paper's
 # values), so the remaining error is ~1e-3 of the last step, i.e. at rounding level.
@@ -81,7 +81,7 @@ class Prepared:
         self.u_flash = g("u_flash")          # u = 0.83   (Eq. 3)
         self.eta_hertz = g("eta_hertz")      # eta = 1.127 (Eq. 4)
 
-        # Derived (convention 1 of the brief / MODEL.md s.2, s.8)
+        # Derived (convention 1 of the brief / docs/model.md s.2, s.8)
         self.omega = self.speed_rpm * 2.0 * math.pi / 60.0          # rad/s
         self.R = self.module_m * self.z / 2.0                        # pitch radius
         self.r_b = self.R * math.cos(self.alpha)                     # base radius
@@ -119,7 +119,7 @@ def flash_geometry(t, y, case):
     Returns dict with arrays rc1, rc2 (contact-point radii), Rc1, Rc2 (curvature radii
     R_i = r_ci sin(alpha_mi), Eqs. 5-6), v1, v2 (surface velocities, Eq. 7).
     Delta_1j = X1 cos phi + Y1 sin phi, Delta_2j = x2 cos phi + y2 sin phi (Eq. 12, as
-    simplified in MODEL.md s.6); the branch is chosen from the TOTAL time derivative
+    simplified in docs/model.md s.6); the branch is chosen from the TOTAL time derivative
     dDelta/dt (including d phi/dt = omega): < 0 -> root (Eq. 13), >= 0 -> tip (Eq. 14).
     """
     p = prepare(case)
@@ -189,7 +189,7 @@ def _check_backlash(c):
 
 
 def _solve_coupled(dn, ddn, geo, p):
-    """Thermally coupled tooth force (MODEL.md s.6, Eqs. 1-2, 15-17, 3-4).
+    """Thermally coupled tooth force (docs/model.md s.6, Eqs. 1-2, 15-17, 3-4).
 
     Per tooth solve F = k_m delta(dn, c(T_f(|F|))) + c_m ddn with
     c = c0 - 2 lambda s (T_M + T_f) cos(alpha).  A tooth out of contact at c evaluated with
@@ -286,7 +286,7 @@ def mesh(t, y, case):
 
     Returns dict with arrays (length z): phi (Eqs. 8-9), dn (Eq. 11), ddn (its total time
     derivative), c (Eq. 2), F (Eqs. 15-17), Fx = F sin phi, Fy = F cos phi (Eq. 19 with
-    phi_j, MODEL.md s.4), Tf (Eq. 3), rc1, rc2 (Eqs. 12-14); and scalars Tm (Eq. 22),
+    phi_j, docs/model.md s.4), Tf (Eq. 3), rc1, rc2 (Eqs. 12-14); and scalars Tm (Eq. 22),
     kv = |Tm|/T_d, Fx1 = -sum F sin phi, Fy1 = +sum F cos phi (Eqs. 20-21 corrected).
     """
     p = prepare(case)
@@ -367,7 +367,7 @@ def rhs(t, y, case):
             _check_backlash(np.array([c]))
         F, _, _ = _tooth_force(dn, ddn, c, p)                             # Eqs. 15-17
     Tm = p.r_b * np.sum(F)                                                # Eq. 22
-    Fx1 = -np.dot(F, sp)                                                  # MODEL.md s.4
+    Fx1 = -np.dot(F, sp)                                                  # docs/model.md s.4
     Fy1 = np.dot(F, cp)
 
     x1, y1, x2, y2, D1, D2, D3 = y[0:7]
@@ -402,7 +402,7 @@ def energy(y, case):
     momentum J_M thM' + J_1 th1' + J_2 th2' + J_L thL' = 0:
         th1' = thM' + D1'/r_b, th2' = th1' + D2'/r_b, thL' = th2' - D3'/r_b.
     E = sum m v^2/2 (x1,y1,x2,y2) + sum J th'^2/2 + k_p (x^2+y^2)/2 (both supports)
-        + k_T1 (D1/r_b)^2/2 + k_T2 (D3/r_b)^2/2 + sum_j k_m delta_j^2/2 (MODEL.md s.4, V).
+        + k_T1 (D1/r_b)^2/2 + k_T2 (D3/r_b)^2/2 + sum_j k_m delta_j^2/2 (docs/model.md s.4, V).
     """
     p = prepare(case)
     y = np.asarray(y, dtype=float)

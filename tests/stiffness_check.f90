@@ -1,11 +1,11 @@
-!> Standalone check of module spline_stiffness (MODEL.md Section 7, Eq. 18). Build and run:
+!> Standalone check of module spline_stiffness (docs/model.md section 7, Eq. 18). Build and run:
 !>   gfortran -O2 fortran/kinds.f90 fortran/stiffness.f90 tests/stiffness_check.f90 -o /tmp/stiff && /tmp/stiff
 !> (add -J /tmp to keep the .mod files out of the source tree)
-!> Prints: the spline's terms (MODEL.md Section 8), a convergence table in nquad, the spur gear
+!> Prints: the spline's terms (docs/model.md section 12), a convergence table in nquad, the spur gear
 !> of Tian (2004) / Chen & Shao (2011) at its pitch point, two independent cross-checks
 !> (Tian's closed-form integrands in his angle variable, and the rack / trapezoid closed form
 !> that both tooth routines must approach for z -> infinity), the fillet-foundation terms of
-!> Sainsot et al. (2004) (MODEL.md Section 10) with their checks, the numbers that
+!> Sainsot et al. (2004) (docs/model.md section 11) with their checks, the numbers that
 !> tests/test_ross.py compares with ROSS (lines starting with '@', key=value), the ISO 6336-1
 !> comparison of docs/stiffness.md, and the error paths.
 !> Exit status 1 if a cross-check fails (tolerances printed with each check).
@@ -25,7 +25,7 @@ program stiffness_check
 
   nfail = 0
 
-  ! ---------------- 1. the spline (MODEL.md Section 8) -----------------------------------------
+  ! ---------------- 1. the spline (docs/model.md section 12) -----------------------------------------
   z = 16; m = 2e-3_wp; alpha = 30*deg; b = 0.03_wp; e = 2.1e11_wp; nu = 0.3_wp
   call spline_mesh_stiffness(z, m, alpha, b, e, nu, 14.5e-3_wp, 17.5e-3_wp, 15e-3_wp, nref, &
        kh, kb1, ks1, ka1, kb2, ks2, ka2, km, ierr, msg)
@@ -269,7 +269,7 @@ contains
          all(abs(dev_int(:, 2)/dev_int(:, 3) - 10) < 2), 'rack limit not approached as 1/z')
   end subroutine rack_limit
 
-  !> The spline's fillet-foundation terms (MODEL.md Section 10; docs/stiffness.md): ISO 4156 flat
+  !> The spline's fillet-foundation terms (docs/model.md section 11; docs/stiffness.md): ISO 4156 flat
   !> root, fillet radius 0.2 m on both splines, bore r_int = r_root/2 (external), body outer radius
   !> r_out = 2 r_root (internal), pitch point. Checks: fillet = .false. reproduces
   !> spline_mesh_stiffness bit for bit; u_f equals the independent construction x_c - h_c tan(alpha_m)

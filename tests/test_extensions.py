@@ -1,4 +1,4 @@
-"""Beyond the paper (issue 12, MODEL.md Section 10 as docs/model.md states it): torque ripple,
+"""Beyond the paper (issue 12, docs/model.md section 11 as docs/model.md states it): torque ripple,
 mass unbalance, angular misalignment with face slices, mesh damping as a ratio. Each term is
 held against a closed form, a limit it must reproduce, or a convergence check."""
 import numpy as np
@@ -127,7 +127,7 @@ def test_face_load_is_linear_in_z_in_full_contact():
     slope = k * (gy * sphi + gx * cphi) + c * w * (gy * cphi - gx * sphi)
     expect = F[:, None] / ns + zs[None, :] * slope[:, None]
     np.testing.assert_allclose(face, expect, rtol=1e-9, atol=1e-9 * np.abs(F).max())
-    # the tilting moment is the first moment of the face loads (MODEL.md Section 10)
+    # the tilting moment is the first moment of the face loads (docs/model.md section 11)
     np.testing.assert_allclose(res.tilt[0], [-(zs * face * cphi[:, None]).sum(),
                                              -(zs * face * sphi[:, None]).sum()], rtol=1e-9)
 

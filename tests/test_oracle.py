@@ -1,5 +1,5 @@
 """The Fortran right-hand side against the independent numpy oracle (tests/oracle.py), written
-from MODEL.md by someone who did not read the Fortran."""
+from docs/model.md by someone who did not read the Fortran."""
 import zlib
 
 import numpy as np

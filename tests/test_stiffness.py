@@ -85,7 +85,7 @@ def test_rack_limit(internal):
 
 
 def test_spline_order_of_magnitude():
-    """A short (1.25 m deep), wide (30 mm) steel tooth pair: between 1e8 and 3e9 N/m (MODEL.md
+    """A short (1.25 m deep), wide (30 mm) steel tooth pair: between 1e8 and 3e9 N/m (docs/model.md
     Section 7); the paper's forces imply about 2.3e5 N/m (a unit slip, see the README)."""
     k = spline_terms()
     assert 1e8 < k["k_m"] < 3e9

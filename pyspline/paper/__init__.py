@@ -1,4 +1,4 @@
-"""The paper's scenarios (MODEL.md Section 9): run them, compare with the paper's values, and
+"""The paper's scenarios (docs/model.md section 9): run them, compare with the paper's values, and
 calibrate the unknowns the paper does not give (k_m, f_m).
 
 Calibration fits the fewest unknowns to the fewest paper values:
@@ -177,7 +177,11 @@ def cases_dir(path=None) -> Path:
     here = Path.cwd() / "cases"
     if (here / "paper_ideal.nml").is_file():
         return here
-    return Path(__file__).resolve().parent.parent / "cases"   # installed with the package
+    pkg = Path(__file__).resolve().parent.parent
+    for d in (pkg / "cases", pkg.parent / "cases"):   # installed with the package; a source tree
+        if (d / "paper_ideal.nml").is_file():
+            return d
+    return pkg / "cases"
 
 
 def load_paper_case(name, directory, quick: bool):
