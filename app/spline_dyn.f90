@@ -167,7 +167,7 @@ program spline_dyn
   write(u, '(a)', advance='no', iostat=ios) 't [s]'
   do i = 1, nstate
     write(u, '(a)', advance='no', iostat=ios) ','//trim(state_names(i))// &
-         merge(' [m]  ', ' [m/s]', i <= 7)
+         trim(merge(" [m]  ", " [m/s]", i <= 7))
   end do
   write(u, '(a)', advance='no', iostat=ios) ',Tm [N m],kv [-]'
   do q = 1, ntooth_q

@@ -139,15 +139,12 @@ contains
     r_rim = c%r_rim
     if (r_rim == 0.0_wp) r_rim = 2.0_wp*rf2
     call spline_mesh_stiffness_fillet(real(m%z, wp), m%m_n, m%alpha, m%b, m%e_mod, m%nu, rf1, rf2, &
-         ra2, rho_f, rho_f, r_bore, r_rim, .false., stiffness_nquad, m%k_terms(1), m%k_terms(2), &
+         ra2, rho_f, rho_f, r_bore, r_rim, c%fillet, stiffness_nquad, m%k_terms(1), m%k_terms(2), &
          m%k_terms(3), m%k_terms(4), m%k_terms(5), m%k_terms(6), m%k_terms(7), m%k_terms(8), &
          m%k_terms(9), m%k_terms(10), ierr, errmsg)
-    if (ierr == 0) then
-      m%k_m_nofillet = m%k_terms(ik_m)
-      if (c%fillet) call spline_mesh_stiffness_fillet(real(m%z, wp), m%m_n, m%alpha, m%b, &
-           m%e_mod, m%nu, rf1, rf2, ra2, rho_f, rho_f, r_bore, r_rim, .true., stiffness_nquad, &
-           m%k_terms(1), m%k_terms(2), m%k_terms(3), m%k_terms(4), m%k_terms(5), m%k_terms(6), &
-           m%k_terms(7), m%k_terms(8), m%k_terms(9), m%k_terms(10), ierr, errmsg)
+    if (ierr == 0) then        ! Eq. 18 without the fillet terms (k_f1 = k_f2 = 0 when off)
+      m%k_m_nofillet = 1.0_wp/(1.0_wp/m%k_terms(1) + 1.0_wp/m%k_terms(2) + 1.0_wp/m%k_terms(3) &
+           + 1.0_wp/m%k_terms(4) + 1.0_wp/m%k_terms(6) + 1.0_wp/m%k_terms(7) + 1.0_wp/m%k_terms(8))
     end if
     if (ierr /= 0) then
       m%k_terms = 0.0_wp

@@ -292,6 +292,21 @@ def run_point(case: Case, options: dict) -> dict:
         return s
 
 
+def run_points(cases: list, options: dict) -> list:
+    """A chunk of sweep points as one task (fewer round trips through a process pool or a
+    Dask scheduler): run_point for each."""
+    return [run_point(case, options) for case in cases]
+
+
+def _chunk_size(executor, n: int) -> int:
+    """Points per task: 1 in this process or on threads (no transfer to amortise); on
+    processes and Dask, about 64 tasks per sweep (at most 32 points each), so that the
+    per-task cost of the pool or the scheduler is paid rarely but the load still balances."""
+    if executor is None or isinstance(executor, cf.ThreadPoolExecutor):
+        return 1
+    return max(1, min(32, n // 64))
+
+
 # --------------------------------------------------------------------------- files
 
 def _save_point(path: Path, summary: dict) -> None:
@@ -462,7 +477,7 @@ def _version() -> str:
 
 
 def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapunov=False, *,
-          spectrum=None, orders=None, command=None, **fields):
+          spectrum=None, orders=None, command=None, chunk=None, **fields):
     """Run `case` (a Case, dict of fields or namelist path) over one or two swept fields and
     return an xarray.Dataset of the per-point summaries.
 
@@ -472,6 +487,8 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     executor : None (serial, in this process) or a concurrent.futures.Executor
         (ThreadPoolExecutor, ProcessPoolExecutor, ``distributed.Client(...).get_executor()``).
         The caller keeps ownership: it is not shut down here.
+    chunk : points per task (default: 1 serially or on threads; on processes and Dask about
+        64 tasks per sweep, at most 32 points each, to amortise the per-task cost).
     progress : bool, tqdm progress bar on stderr.
     out : directory or None. Each finished point is written to ``out/points/`` at once; the
         merge goes to ``out/sweep.nc`` (NetCDF-4, h5netcdf), also when the sweep is stopped by
@@ -571,8 +588,10 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     futures, bar = {}, None
     try:
         if executor is not None:       # before the bar's thread: a fork pool forks here
-            futures = {executor.submit(run_point, cases[index], options): index
-                       for index in todo}
+            size = chunk or _chunk_size(executor, len(todo))
+            chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
+            futures = {executor.submit(run_points, [cases[i] for i in ch], options): ch
+                       for ch in chunks}
         bar = tqdm(total=len(todo), desc=f"sweep {' x '.join(grid)}", unit="run",
                    disable=not progress, dynamic_ncols=True)
         if executor is None:
@@ -583,32 +602,34 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
                 bar.set_postfix(failed=failed, refresh=False)
         else:
             for fut in cf.as_completed(futures):
-                index = futures[fut]
+                chunk_indices = futures[fut]
                 try:
                     exc = fut.exception()
                 except cf.CancelledError as cancelled:    # cancelled by someone else
                     exc = cancelled
                 if isinstance(exc, KeyboardInterrupt):
                     raise exc
-                if exc is not None:          # the executor failed, not the case: not saved,
-                    s = _template(options, _stat_names())   # a rerun tries it again
-                    s.update(error=f"the executor failed: {type(exc).__name__}: {exc}",
-                             error_class=type(exc).__name__)
-                    summaries[index] = s
-                    executor_errors += 1
-                else:
-                    record(index, fut.result())
-                failed += bool(summaries[index]["error"])
-                bar.update(1)
+                for k, index in enumerate(chunk_indices):
+                    if exc is not None:      # the executor failed, not the case: not saved,
+                        s = _template(options, _stat_names())   # a rerun tries it again
+                        s.update(error=f"the executor failed: {type(exc).__name__}: {exc}",
+                                 error_class=type(exc).__name__)
+                        summaries[index] = s
+                        executor_errors += 1
+                    else:
+                        record(index, fut.result()[k])
+                    failed += bool(summaries[index]["error"])
+                bar.update(len(chunk_indices))
                 bar.set_postfix(failed=failed, refresh=False)
     except BaseException:
         for fut in futures:
             fut.cancel()
-        for fut, index in futures.items():    # finished but not yet taken: keep them too
+        for fut, chunk_indices in futures.items():   # finished but not yet taken: keep them
             try:
-                if index not in summaries and fut.done() and not fut.cancelled() \
-                        and fut.exception() is None:
-                    record(index, fut.result())
+                if fut.done() and not fut.cancelled() and fut.exception() is None:
+                    for k, index in enumerate(chunk_indices):
+                        if index not in summaries:
+                            record(index, fut.result()[k])
             except BaseException:              # noqa: BLE001 -- keep the original exception
                 pass
         if bar is not None:

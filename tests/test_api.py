@@ -2,6 +2,8 @@
 the same numbers as serially, the GIL is released during a run, SIGINT stops a long run, and
 case names may hold any characters."""
 import concurrent.futures as cf
+import re
+import subprocess
 import os
 import pickle
 import random
@@ -158,3 +160,15 @@ def test_any_case_name(name):
 def test_a_name_longer_than_the_core_holds_is_refused():
     with pytest.raises(pyspline.CaseError, match="field name is longer than 128 bytes"):
         pyspline.load_case(dict(PAPER, name="ü" * 65))
+
+
+def test_executable_csv_columns_are_unpadded(exe, tmp_path):
+    """Every column of spline-dyn's CSV is 'NAME [UNIT]', with no padding."""
+    out = tmp_path / "c.csv"
+    run = subprocess.run([exe, str(CASES / "paper_ideal.nml"), "--set", "t_end=0.001",
+                          "--set", "n_out=2", "-o", str(out)], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    header, data = pyspline.core.read_csv(out)
+    assert len(header) == data.shape[1] == 1 + 14 + 2 + 8 * 16
+    for name in header:
+        assert re.fullmatch(r"[A-Za-z0-9_]+ \[[^\]]*\]", name), repr(name)

@@ -190,3 +190,27 @@ def test_slices_refuse_the_flash_levels():
         pyspline.load(dict(name="s", n_slices=4, thermal="oneway"))
     with pytest.raises(pyspline.CaseError, match="n_slices"):
         pyspline.load(dict(name="s", gamma_x=1e-3))
+
+
+@pytest.mark.parametrize("order,period", [(2.0, 1), (1 / 3, 3), (2 ** -0.5, 0)])
+def test_sections_classify_constructed_scenes(order, period):
+    """Scenes built to a known motion: the linear full-contact drive driven by a torque ripple
+    of order n, started on its forced orbit. n = 2 repeats every revolution (period 1), n = 1/3
+    every third (period 3), n = 1/sqrt(2) never (quasi-periodic: 0). The exact shaft sections,
+    classified with the solver's tolerance, say so."""
+    from pyspline.analysis import classify_period
+    a = 0.02
+    case0 = BASE.replace(c_p1=500.0, c_p2=500.0)
+    y_eq = case0.model.start_state()
+    A = jacobian(case0.model, y_eq)
+    info = case0.model.info()
+    B = np.zeros(14, complex)
+    B[11] = -1j * (-info["r_b"] * BASE["t_d"] * a / BASE["j_m"])
+    yp = forced_response(A, B, order * info["omega"])
+    case = case0.replace(ripple_order=[order, 0, 0, 0], ripple_amp=[a, 0, 0, 0], t_end=0.6,
+                         n_out=3, section="shaft")
+    res, _, _ = run_on_the_orbit(case, y_eq, yp)
+    pts = res.section_y[:, [5, 12]]
+    scale = [case["c0"], case["c0"] * info["omega"]]
+    got, info_p = classify_period(pts, case["rtol"], scale=scale, max_period=12)
+    assert got == period, info_p["residual"]
