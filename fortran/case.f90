@@ -13,7 +13,7 @@
 module spline_case
   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long_long, c_null_char
   use spline_kinds, only: wp, pi
-  use spline_errors, only: err_ok, err_case, msglen
+  use spline_errors, only: err_ok, err_case, msglen, itoa
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
   implicit none
   private
@@ -1119,14 +1119,6 @@ contains
       c = s
     end if
   end function clip
-
-  pure function itoa(i) result(s)
-    integer, intent(in) :: i
-    character(len=:), allocatable :: s
-    character(len=12) :: buf
-    write(buf, '(i0)') i
-    s = trim(buf)
-  end function itoa
 
   !> A case as namelist text (every field, one per line): Python reads the defaults from it.
   subroutine case_write_text(c, text)

@@ -6,7 +6,7 @@ module spline_errors
   implicit none
   private
   public :: err_ok, err_case, err_solver, err_thermal, err_interrupted, nerr, err_names
-  public :: msglen, err_exit_code
+  public :: msglen, err_exit_code, itoa
 
   integer, parameter :: err_ok = 0           !< success
   integer, parameter :: err_case = 1         !< bad case: field missing, ill-typed, out of range
@@ -36,5 +36,14 @@ contains
     case default;           code = 1
     end select
   end function err_exit_code
+
+  !> An integer as text, for messages.
+  pure function itoa(i) result(s)
+    integer, intent(in) :: i
+    character(len=:), allocatable :: s
+    character(len=12) :: buf
+    write(buf, '(i0)') i
+    s = trim(buf)
+  end function itoa
 
 end module spline_errors

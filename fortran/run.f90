@@ -3,7 +3,7 @@
 !> (Eqs. 11, 15-22 and, for the thermal levels that have it, Eqs. 1-7) at every output time.
 module spline_run
   use spline_kinds, only: wp, pi
-  use spline_errors, only: err_ok, err_solver
+  use spline_errors, only: err_ok, err_solver, itoa
   use spline_model, only: model_t, nstate, ndof, thermal_none, thermal_bulk, thermal_oneway, &
        thermal_coupled, set_thermal_level
   use spline_dynamics, only: start_state, to_scaled, integrated_states
@@ -209,14 +209,6 @@ contains
            'physical there (thermal = ''coupled'' stops at the interference)'//new_line('a')
     end if
   end function run_warnings
-
-  pure function itoa(i) result(s)
-    integer, intent(in) :: i
-    character(len=:), allocatable :: s
-    character(len=12) :: buf
-    write(buf, '(i0)') i
-    s = trim(buf)
-  end function itoa
 
   !> One run of the model at the level m sets.
   subroutine run_level(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &

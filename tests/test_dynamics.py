@@ -5,7 +5,7 @@ import pytest
 
 import pyspline
 from pyspline.analysis import classify_period
-from conftest import CASES
+from conftest import CASES, jacobian
 
 LX = pyspline.load_case(CASES / "paper_lx1e-4.nml")
 
@@ -51,14 +51,7 @@ def test_settled_scene_is_period_one():
 
 def linearised_rates(model):
     """Eigenvalues of the Jacobian of the SI right-hand side at the start state."""
-    y0 = model.start_state()
-    h = 1e-6 * np.r_[np.full(7, 2e-4), np.full(7, 2e-4 * 628.3)]
-    J = np.empty((14, 14))
-    for k in range(14):
-        e = np.zeros(14)
-        e[k] = h[k]
-        J[:, k] = (model.rhs(0.0, y0 + e) - model.rhs(0.0, y0 - e)) / (2 * h[k])
-    return np.linalg.eigvals(J)
+    return np.linalg.eigvals(jacobian(model, model.start_state()))
 
 
 @pytest.mark.parametrize("l_x", [0.0, 5e-5])

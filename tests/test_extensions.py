@@ -5,24 +5,12 @@ import numpy as np
 import pytest
 
 import pyspline
-from conftest import CASES
+from conftest import CASES, jacobian
 
 # the paper's aligned drive in full contact: its mesh is a linear isotropic spring, so the
 # whole system is linear and time invariant about its static equilibrium
 BASE = pyspline.load_case(CASES / "paper_ideal.nml", start="equilibrium", method="bdf",
                           rtol=1e-11, atol=1e-13, t_end=0.2, n_out=201, roots=False)
-
-
-def jacobian(model, y0):
-    """The linearised system dy/dt = A (y - y0) + forcing, by central differences (the
-    right-hand side is linear here, so they are exact to round-off)."""
-    h = 1e-6 * np.r_[np.full(7, 2e-4), np.full(7, 2e-4 * 628.3)]
-    A = np.empty((14, 14))
-    for k in range(14):
-        e = np.zeros(14)
-        e[k] = h[k]
-        A[:, k] = (model.rhs(0.0, y0 + e) - model.rhs(0.0, y0 - e)) / (2 * h[k])
-    return A
 
 
 def forced_response(A, B, omega):
