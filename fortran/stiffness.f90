@@ -273,7 +273,7 @@ contains
     character(len=*), intent(out) :: errmsg
     real(wp), intent(out), optional :: detail(9)
     character(len=*), parameter :: who = 'fillet_foundation_stiffness'
-    real(wp) :: rb, rp, psi0, tc, psic, am, thf, uf, sf, hf, c, coef(4)
+    real(wp) :: rb, rp, psi0, tc, psic, am, thf, uf
 
     kf = 0.0_wp
     if (present(detail)) detail = 0.0_wp
@@ -298,17 +298,8 @@ contains
     ierr = 0; errmsg = ''
     am = atan(tc) - psic                    ! load angle (Tian's alpha_1)
     uf = rb/cos(am) - r_root                ! line of action crosses the centre line at r_b/cos(alpha_m)
-    sf = 2.0_wp*r_root*thf
-    hf = r_root/r_int
-    call sainsot_fillet_compliance(thf, hf, uf, sf, am, e, b, c, coef)
-    if (.not. (c > 0.0_wp)) then      ! the fit's quadratic form left its positive range
-      ierr = 1
-      errmsg = who//': Sainsot''s fit gives no positive compliance at h_f = '//num(hf)// &
-           ', theta_f = '//num(thf)//' (r_int/r_out, rho_f, r_root out of range)'
-      return
-    end if
-    kf = 1.0_wp/c
-    if (present(detail)) detail = [thf, hf, uf, sf, am, coef]
+    call fillet_stiffness_of(who, thf, r_root/r_int, uf, 2.0_wp*r_root*thf, am, e, b, kf, ierr, &
+         errmsg, detail)
   end subroutine fillet_foundation_stiffness
 
   !> Fillet-foundation stiffness k_f [N/m] of ONE internal (ring) tooth at radius r_contact.
@@ -332,7 +323,7 @@ contains
     character(len=*), intent(out) :: errmsg
     real(wp), intent(out), optional :: detail(9)
     character(len=*), parameter :: who = 'fillet_foundation_stiffness_internal'
-    real(wp) :: rb, rp, psi0, tc, psic, am, thf, uf, sf, hf, c, coef(4)
+    real(wp) :: rb, rp, psi0, tc, psic, am, thf, uf
 
     kf = 0.0_wp
     if (present(detail)) detail = 0.0_wp
@@ -358,8 +349,21 @@ contains
     ierr = 0; errmsg = ''
     am = atan(tc) + psic
     uf = r_root - rb/cos(am)
-    sf = 2.0_wp*r_root*thf
-    hf = r_out/r_root
+    call fillet_stiffness_of(who, thf, r_out/r_root, uf, 2.0_wp*r_root*thf, am, e, b, kf, ierr, &
+         errmsg, detail)
+  end subroutine fillet_foundation_stiffness_internal
+
+  !> The last step of both fillet routines: Sainsot's compliance at the fillet geometry found
+  !> (theta_f, h_f, u_f, S_f, alpha_m), checked positive (the fit's quadratic form can leave its
+  !> range), as k_f [N/m] and the optional detail (theta_f, h_f, u_f, S_f, alpha_m, L, M, P, Q).
+  pure subroutine fillet_stiffness_of(who, thf, hf, uf, sf, am, e, b, kf, ierr, errmsg, detail)
+    character(len=*), intent(in) :: who
+    real(wp), intent(in) :: thf, hf, uf, sf, am, e, b
+    real(wp), intent(out) :: kf
+    integer, intent(out) :: ierr
+    character(len=*), intent(out) :: errmsg
+    real(wp), intent(out), optional :: detail(9)
+    real(wp) :: c, coef(4)
     call sainsot_fillet_compliance(thf, hf, uf, sf, am, e, b, c, coef)
     if (.not. (c > 0.0_wp)) then      ! the fit's quadratic form left its positive range
       ierr = 1
@@ -369,7 +373,7 @@ contains
     end if
     kf = 1.0_wp/c
     if (present(detail)) detail = [thf, hf, uf, sf, am, coef]
-  end subroutine fillet_foundation_stiffness_internal
+  end subroutine fillet_stiffness_of
 
   !> spline_mesh_stiffness plus the fillet-foundation terms (docs/model.md section 11), at the pitch point:
   !>   fillet = .true.:  1/k_m = 1/k_h + sum_{i=1,2} (1/k_bi + 1/k_si + 1/k_ai + 1/k_fi)
