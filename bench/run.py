@@ -24,7 +24,7 @@ def cmd_bench(args) -> int:
         print("note: Debian's SUNDIALS is compiled without optimisation; runs take up to 2.4x "
               "longer than on the -O2 build that scripts/setup.sh makes")
     if args.what == "wp":
-        rows, notes = bench.work_precision(out, quick=args.quick)
+        rows, notes = bench.work_precision(out, quick=args.quick, cases=args.cases)
         for n in notes:
             print(n)
         print(f"{'case':14s} {'method':28s} {'rtol':>7s} {'time [s]':>9s} {'RHS':>8s} "
@@ -72,6 +72,8 @@ def main(argv=None) -> int:
     p.add_argument("what", choices=["wp", "stability", "ladder", "anatomy", "parallel",
                                     "bifurcation"])
     p.add_argument("--points", type=int, help="bifurcation: number of points (default 1000)")
+    p.add_argument("--cases", nargs="+", help="wp: the scenes (default: paper_lx1e-4 paper_T100 "
+                   "rattle_z24; --quick: the two paper scenes)")
     p.add_argument("--rtol", type=float, help="bifurcation: tolerance (default: the case's)")
     p.add_argument("--out", default="out/bench", help="output directory (default out/bench)")
     p.add_argument("--quick", action="store_true", help="small sizes (for CI)")
