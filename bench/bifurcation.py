@@ -22,6 +22,15 @@ from pyspline.paper import cases_dir
 from speed import _write_csv
 
 
+def _warm_up_n(_):
+    _warm_up()
+
+
+def _warm_up():
+    """Import pyspline and load a case in a fresh worker process (start-up, not the sweep)."""
+    pyspline.sweep(bench_case(), progress=False, l_x=[0.0])
+
+
 def bench_case(rtol=None):
     case = pyspline.load_case(cases_dir() / "paper_lx1e-4.nml")
     T = 60.0 / case["speed_rpm"]
@@ -58,11 +67,12 @@ def main(args) -> int:
     with cf.ThreadPoolExecutor(2) as ex:
         timed("2 threads", ex)
     with cf.ProcessPoolExecutor(2) as ex:
-        list(ex.map(abs, range(2)))                              # start the workers
+        list(ex.map(_warm_up_n, range(2)))                       # start the workers
         timed("2 processes", ex)
     from distributed import Client, LocalCluster
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                       dashboard_address=None) as cluster, Client(cluster) as client:
+        client.run(_warm_up)              # import pyspline in the workers (as the pools above)
         timed("Dask LocalCluster, 2 workers", client.get_executor())
     _write_csv(out / "bifurcation.csv", rows)
     from pyspline import plots
