@@ -13,7 +13,6 @@ from __future__ import annotations
 import statistics
 from pathlib import Path
 
-import numpy as np
 
 from pyspline import SplineError, load_case, simulate
 from pyspline.core import THERMAL_LEVELS as THERMAL, level_name

@@ -388,7 +388,7 @@ contains
     end if
     ierr = ie
     if (ie /= err_ok .or. n < 1) return
-    allocate(g(2*m%z), gb(2*m%z))
+    allocate(g(2*m%z*m%n_slices), gb(2*m%z))   ! a switch pair per contact (tooth or slice)
     call to_scaled(m, y, ys)
     dt = 1.0e-3_wp/n
     acc = 0

@@ -14,7 +14,7 @@ module spline_model
   private
   public :: model_t, model_from_case, set_thermal_level, model_magic, model_warnings
   public :: nstate, ndof, thermal_none, thermal_bulk, thermal_oneway, thermal_coupled
-  public :: nkterms, kterm_names, ik_m, nripple
+  public :: nkterms, kterm_names, ik_m
 
   integer, parameter :: ndof = 7            !< x1, y1, x2, y2, D1, D2, D3 (Eq. 24)
   integer, parameter :: nstate = 2*ndof     !< displacements then velocities

@@ -6,7 +6,7 @@ module spline_run
   use spline_errors, only: err_ok, err_solver, itoa
   use spline_model, only: model_t, nstate, ndof, thermal_none, thermal_bulk, thermal_oneway, &
        thermal_coupled, set_thermal_level
-  use spline_dynamics, only: start_state, to_scaled, integrated_states
+  use spline_dynamics, only: start_state, to_scaled, from_scaled, integrated_states
   use spline_mesh, only: mesh_eval
   use spline_solver, only: integrate, nsolver_stats => nstats, solver_stat_names => stat_names
   use spline_fidelity, only: lateral_estimate, backlash_estimate
@@ -323,7 +323,7 @@ contains
     dv(idx(1:n)) = 1.0_wp/sqrt(real(n, wp))         ! unit direction in the scaled states
     call to_scaled(m, y, ys)
     yps = ys + m%lyap_d0*dv
-    call from_scaled_local(yps, yp)
+    call from_scaled(m, yps, yp)
     t0 = t_start
     g = 0.0_wp
     do k = 1, size(lt)
@@ -352,16 +352,9 @@ contains
         yps(idx(i)) = ys(idx(i)) + dv(idx(i))*(m%lyap_d0/d)
       end do
       y = y1(:, 1)
-      call from_scaled_local(yps, yp)
+      call from_scaled(m, yps, yp)
       t0 = t1
     end do
-  contains
-    subroutine from_scaled_local(a, b)     ! Eq. 25 back to SI
-      real(wp), intent(in) :: a(nstate)
-      real(wp), intent(out) :: b(nstate)
-      b(1:ndof) = a(1:ndof)*m%l_ref
-      b(ndof+1:) = a(ndof+1:)*(m%l_ref*m%w_ref)
-    end subroutine from_scaled_local
   end subroutine lyapunov_benettin
 
   !> Per-tooth quantities at the output times, with the contact states the integration used
