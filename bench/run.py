@@ -22,7 +22,7 @@ def cmd_bench(args) -> int:
     print(f"CVODE library: {lib}")
     if lib.endswith("(debian)"):
         print("note: Debian's SUNDIALS is compiled without optimisation; runs take up to 2.4x "
-              "longer than on the -O2 build that scripts/setup.sh makes")
+              "longer than on the optimised build that scripts/setup.sh makes")
     if args.what == "wp":
         rows, notes = bench.work_precision(out, quick=args.quick, cases=args.cases)
         for n in notes:
