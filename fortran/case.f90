@@ -35,8 +35,8 @@ module spline_case
   character(len=optlen), parameter :: thermal_values(4) = [character(len=optlen) :: &
        'none', 'bulk', 'oneway', 'coupled']
   character(len=optlen), parameter :: method_values(2) = [character(len=optlen) :: 'bdf', 'adams']
-  character(len=optlen), parameter :: nonlinear_values(2) = [character(len=optlen) :: &
-       'newton', 'fixedpoint']
+  character(len=optlen), parameter :: nonlinear_values(3) = [character(len=optlen) :: &
+       'newton', 'fixedpoint', 'auto']
   character(len=optlen), parameter :: start_values(2) = [character(len=optlen) :: &
        'equilibrium', 'rest']
   character(len=optlen), parameter :: fidelity_values(2) = [character(len=optlen) :: 'given', 'auto']
@@ -75,9 +75,12 @@ module spline_case
     character(len=optlen) :: thermal = 'none'      !< none | bulk | oneway | coupled
     real(wp) :: t_bulk = 0.0_wp             !< bulk temperature rise T_M [degC]
     real(wp) :: f_m = 0.1_wp, u_flash = 0.83_wp, eta_hertz = 1.127_wp  !< friction, Blok u, Hertz eta [-]
-    character(len=optlen) :: method = 'bdf'        !< bdf | adams
+    !> The defaults are what won where it was measured (docs/performance.md, "Choosing the
+    !> solver"): Adams with fixed-point iteration, on every scene of the stability sweep and on
+    !> the impacting Z = 24 scene.
+    character(len=optlen) :: method = 'adams'      !< adams | bdf
     character(len=optlen) :: jacobian = 'dq'       !< dq (difference quotients)
-    character(len=optlen) :: nonlinear = 'newton'  !< newton | fixedpoint
+    character(len=optlen) :: nonlinear = 'auto'    !< auto (adams: fixedpoint, bdf: newton) | newton | fixedpoint
     logical  :: roots = .false.             !< locate the contact switches by root finding
     logical  :: stald = .false.             !< BDF stability-limit detection
     real(wp) :: rtol = 1.0e-8_wp, atol = 1.0e-10_wp   !< tolerances on the scaled states [-]

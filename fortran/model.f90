@@ -114,7 +114,14 @@ contains
     m%dof = c%dof; m%fidelity_tol = c%fidelity_tol
     m%auto = option_index(fidelity_values, c%fidelity) == 2
     m%method_bdf = merge(1, 0, option_index(method_values, c%method) == 1)
-    m%newton = option_index(nonlinear_values, c%nonlinear) == 1
+    select case (option_index(nonlinear_values, c%nonlinear))
+    case (1)
+      m%newton = .true.
+    case (2)
+      m%newton = .false.
+    case default                  ! auto: Newton for BDF (stiff), fixed-point for Adams
+      m%newton = m%method_bdf == 1
+    end select
     m%start_equilibrium = option_index(start_values, c%start) == 1
     m%section = option_index(section_values, c%section) - 1
     m%lyapunov = c%lyapunov

@@ -38,14 +38,20 @@ def test_energy_without_root_finding():
 
 
 def test_aligned_uniform_forces_and_fx_sum_zero():
+    """Aligned and weightless, the drive is symmetric: every tooth carries the same load and
+    the lateral forces cancel, so the splines stay centred. Numerically, the lateral states
+    are zero up to the solver's absolute tolerance (atol on states scaled by l_ref, Eq. 25),
+    which the support spring k_p1 turns into a force: the bound below."""
+    atol = 1e-12
     res = pyspline.simulate(dict(PAPER, name="aligned", grav=0.0, start="rest", t_end=0.05,
-                                 n_out=401))
+                                 n_out=401, rtol=1e-10, atol=atol))
     F = res.tooth["F"]
     scale = np.abs(F).max()
     assert scale > 100.0                                    # it did transmit load
     np.testing.assert_allclose(F, F[:, :1].repeat(F.shape[1], 1), atol=1e-9 * scale)
-    np.testing.assert_allclose(res.tooth["Fx"].sum(axis=1), 0.0, atol=1e-9 * scale)
-    np.testing.assert_allclose(res.tooth["Fy"].sum(axis=1), 0.0, atol=1e-9 * scale)
+    bound = 10 * res.case["k_p1"] * atol * res.case.model.info()["l_ref"]   # 1e-8 N
+    np.testing.assert_allclose(res.tooth["Fx"].sum(axis=1), 0.0, atol=bound)
+    np.testing.assert_allclose(res.tooth["Fy"].sum(axis=1), 0.0, atol=bound)
 
 
 def test_misaligned_fx_sum_equals_lateral_mesh_force():
