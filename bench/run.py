@@ -73,7 +73,7 @@ def main(argv=None) -> int:
                                     "bifurcation"])
     p.add_argument("--points", type=int, help="bifurcation: number of points (default 1000)")
     p.add_argument("--cases", nargs="+", help="wp: the scenes (default: paper_lx1e-4 paper_T100 "
-                   "rattle_z24; --quick: the two paper scenes)")
+                   "rattle_z24 physical_z24; --quick: the two paper scenes)")
     p.add_argument("--rtol", type=float, help="bifurcation: tolerance (default: the case's)")
     p.add_argument("--out", default="out/bench", help="output directory (default out/bench)")
     p.add_argument("--quick", action="store_true", help="small sizes (for CI)")
