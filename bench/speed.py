@@ -152,8 +152,9 @@ def reference(case):
 
 
 #: the work-precision scenes and their simulated time [s]: the paper's mechanical and coupled
-#: scenes, and the physical rattling scene over its engagement and first impacts (it is chaotic:
-#: far beyond its predictability horizon of about 20 ms no two runs agree pointwise)
+#: scenes, the rattling scene over its engagement and first impacts (it is chaotic: far beyond
+#: its predictability horizon of about 20 ms no two runs agree pointwise), and the physically
+#: damped Z = 24 scene over its engagement (its impacts, before it settles)
 WP_CASES = {"paper_lx1e-4": 0.3, "paper_T100": 0.3, "rattle_z24": 0.05, "physical_z24": 0.1}
 
 

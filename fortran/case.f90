@@ -75,9 +75,9 @@ module spline_case
     character(len=optlen) :: thermal = 'none'      !< none | bulk | oneway | coupled
     real(wp) :: t_bulk = 0.0_wp             !< bulk temperature rise T_M [degC]
     real(wp) :: f_m = 0.1_wp, u_flash = 0.83_wp, eta_hertz = 1.127_wp  !< friction, Blok u, Hertz eta [-]
-    !> The defaults are what won where it was measured (docs/performance.md, "Choosing the
-    !> solver"): Adams with fixed-point iteration, on every scene of the stability sweep and on
-    !> the impacting Z = 24 scene.
+    !> The defaults are what won where it was measured (docs/performance.md, "Impacting scenes,
+    !> and how the defaults were chosen"): Adams with fixed-point iteration, on every scene of
+    !> the stability sweep and on the impacting Z = 24 scene.
     character(len=optlen) :: method = 'adams'      !< adams | bdf
     character(len=optlen) :: jacobian = 'dq'       !< dq (difference quotients)
     character(len=optlen) :: nonlinear = 'auto'    !< auto (adams: fixedpoint, bdf: newton) | newton | fixedpoint
