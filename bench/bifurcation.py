@@ -3,8 +3,9 @@ in one run: `python bench/run.py bifurcation [--points N] [--rtol R] [--quick]`.
 
 Each point: 20 shaft revolutions of transient, then 100 revolutions sampled (exact shaft
 sections, 8 outputs per revolution for the load statistics). The same sweep runs serially, on 2
-threads, on 2 processes and on a Dask LocalCluster with 2 worker processes; the wall time of each
-and its speed-up over serial are printed and written to bifurcation.csv, with the figure of the
+threads, on 2 processes and on a Dask LocalCluster of 2 workers (pyspline.local_dask_client:
+threads in one process, its default, then processes); the wall time of each and its speed-up
+over serial are printed and written to bifurcation.csv, with the figure of the
 last run. The case's own tolerance (rtol 1e-9, Adams) unless --rtol is given.
 """
 from __future__ import annotations
@@ -69,11 +70,13 @@ def main(args) -> int:
     with cf.ProcessPoolExecutor(2) as ex:
         list(ex.map(_warm_up_n, range(2)))                       # start the workers
         timed("2 processes", ex)
-    from distributed import Client, LocalCluster
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                      dashboard_address=None) as cluster, Client(cluster) as client:
-        client.run(_warm_up)              # import pyspline in the workers (as the pools above)
-        timed("Dask LocalCluster, 2 workers", client.get_executor())
+    # Dask: pyspline.local_dask_client, a LocalCluster set up for sweeps (DASK_SWEEP_CONFIG);
+    # its default layout, 2 worker threads in this process, then 2 worker processes
+    for processes, label in ((False, "Dask LocalCluster, 2 workers"),
+                             (True, "Dask LocalCluster, 2 worker procs")):
+        with pyspline.local_dask_client(2, processes=processes) as client:
+            client.run(_warm_up)          # import pyspline in the workers (as the pools above)
+            timed(label, client.get_executor())
     _write_csv(out / "bifurcation.csv", rows)
     from pyspline import plots
     plots.bifurcation(ds, "l_x", path=out / "bifurcation.png")

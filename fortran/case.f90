@@ -12,7 +12,7 @@
 !> (nml_io), so reading a case changes no module variable (reentrant).
 module spline_case
   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long_long, c_null_char
-  use spline_kinds, only: wp, pi
+  use spline_kinds, only: wp, pi, max_teeth
   use spline_errors, only: err_ok, err_case, msglen, itoa
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
   implicit none
@@ -1305,7 +1305,7 @@ contains
 
     ! geometry (ISO 4156 and beyond it, with margin)
     if (c%z < 3) then; call fail('z', 'must be at least 3 teeth'); return; end if
-    if (c%z > 1000) then
+    if (c%z > max_teeth) then
       call fail('z', 'is more than 1000 teeth (the largest spline the tooth-angle recurrence is '// &
            'checked for)'); return
     end if

@@ -3,7 +3,7 @@ module spline_geometry
   use spline_kinds, only: wp, pi
   implicit none
   private
-  public :: tooth_angles, contact_radius, profile_shift, iso4156_radii
+  public :: tooth_angles, pitch_rotation, contact_radius, profile_shift, iso4156_radii
 
 contains
 
@@ -24,15 +24,14 @@ contains
   !> returned as sin and cos (what the mesh needs). Two sin/cos pairs per call instead of Z: the
   !> teeth are equally spaced, so phi_{j+1} = phi_j + 2 pi / Z is a rotation (round-off grows
   !> like j eps: 1e-15 at Z = 16, 1.4e-14 at Z = 1000, the most a case allows).
-  pure subroutine tooth_angles(z, omega, t, theta0, alpha, sphi, cphi)
+  !> sd, cd: sin and cos of the pitch angle 2 pi / Z (pitch_rotation, once per case).
+  pure subroutine tooth_angles(z, omega, t, theta0, alpha, sd, cd, sphi, cphi)
     integer, intent(in) :: z
-    real(wp), intent(in) :: omega, t, theta0, alpha
+    real(wp), intent(in) :: omega, t, theta0, alpha, sd, cd
     real(wp), intent(out) :: sphi(z), cphi(z)
     integer :: j
-    real(wp) :: phi, sd, cd
+    real(wp) :: phi
     phi = 2.0_wp*pi/z + omega*t + theta0 - alpha
-    sd = sin(2.0_wp*pi/z)
-    cd = cos(2.0_wp*pi/z)
     sphi(1) = sin(phi)
     cphi(1) = cos(phi)
     do j = 2, z
@@ -40,6 +39,14 @@ contains
       cphi(j) = cphi(j-1)*cd - sphi(j-1)*sd
     end do
   end subroutine tooth_angles
+
+  !> The rotation between neighbouring teeth of Eqs. 8-9: sd = sin(2 pi / Z), cd = cos(2 pi / Z).
+  pure subroutine pitch_rotation(z, sd, cd)
+    integer, intent(in) :: z
+    real(wp), intent(out) :: sd, cd
+    sd = sin(2.0_wp*pi/z)
+    cd = cos(2.0_wp*pi/z)
+  end subroutine pitch_rotation
 
   !> Eq. 12 in its exact simplified form: displacement of spline i in the tooth-profile direction,
   !> Delta = x cos(phi) + y sin(phi), and its total time derivative (phi' = omega).

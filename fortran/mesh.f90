@@ -2,7 +2,7 @@
 !> dead-zone contact with time-varying backlash (Eqs. 2, 15-17), flash-temperature coupling
 !> (Eqs. 1, 3-7, 12-14) and the energy-consistent mesh forces on the bodies (Eqs. 19-22, corrected).
 module spline_mesh
-  use spline_kinds, only: wp
+  use spline_kinds, only: wp, max_teeth
   use spline_errors, only: err_thermal
   use spline_model, only: model_t, thermal_oneway, thermal_coupled
   use spline_geometry, only: tooth_angles, profile_shift, contact_radius
@@ -51,14 +51,14 @@ contains
     real(wp), intent(out), optional, dimension(m%z) :: dn, c, f, tf, rc1, rc2, sphi_out, cphi_out
     type(coupling_stats_t), intent(inout), optional :: cstats
     real(wp), intent(out), optional :: fslice(m%n_slices, m%z), mtilt(2)
-    real(wp) :: sp(m%z), cp(m%z)
+    real(wp) :: sp(max_teeth), cp(max_teeth)   ! fixed size: no allocation per call
     real(wp) :: ex, ey, evx, evy, dnj, ddnj, cj, fj, tfj, r1, r2, sumf, resid, zs, dns, ddns, fs
     real(wp) :: mx, my
     integer :: j, mj, iters, is, ns
     logical :: want_flash, coupled
 
     ierr = 0
-    call tooth_angles(m%z, m%omega, t, m%theta0, m%alpha, sp, cp)
+    call tooth_angles(m%z, m%omega, t, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
     ! relative centre offset of spline 1 (misaligned, Section 1) against spline 2
     ex = q(1) + m%l_x - q(3)
     ey = q(2) + m%l_y - q(4)
@@ -156,8 +156,8 @@ contains
       if (present(fslice)) fslice(1, j) = fj
     end do
     tm = m%r_b*sumf
-    if (present(sphi_out)) sphi_out = sp
-    if (present(cphi_out)) cphi_out = cp
+    if (present(sphi_out)) sphi_out = sp(1:m%z)
+    if (present(cphi_out)) cphi_out = cp(1:m%z)
     if (present(mtilt)) mtilt = [mx, my]
   end subroutine mesh_eval
 
@@ -280,9 +280,9 @@ contains
     real(wp), intent(out) :: g(2*m%z*m%n_slices)
     real(wp), intent(in), optional :: v(7)
     real(wp), intent(out), optional :: gb(2*m%z)
-    real(wp) :: sp(m%z), cp(m%z), ex, ey, dnj, d, dns, zs
+    real(wp) :: sp(max_teeth), cp(max_teeth), ex, ey, dnj, d, dns, zs
     integer :: j, is, k, ns
-    call tooth_angles(m%z, m%omega, t, m%theta0, m%alpha, sp, cp)
+    call tooth_angles(m%z, m%omega, t, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
     ex = q(1) + m%l_x - q(3)
     ey = q(2) + m%l_y - q(4)
     ns = m%n_slices

@@ -7,7 +7,7 @@ module spline_model
   use spline_errors, only: err_ok, err_case, err_thermal
   use spline_case, only: case_t, case_validate, namelen, option_index, thermal_values, &
        method_values, nonlinear_values, start_values, fidelity_values, section_values, nripple
-  use spline_geometry, only: iso4156_radii
+  use spline_geometry, only: iso4156_radii, pitch_rotation
   use spline_stiffness, only: spline_mesh_stiffness_fillet
   use spline_thermal, only: backlash_coefficient, thermal_backlash
   implicit none
@@ -64,6 +64,7 @@ module spline_model
     real(wp) :: cos_alpha, sin_alpha        !< of the pressure angle (once per case, not per tooth)
     real(wp) :: r_b                         !< base radius R cos(alpha)
     real(wp) :: theta0                      !< pi / (2 Z)  (Eq. 9)
+    real(wp) :: sin_pitch, cos_pitch        !< of the pitch angle 2 pi / Z (Eqs. 8-9, once per case)
     real(wp) :: kappa                       !< 2 lambda s cos(alpha): backlash loss per degC (Eq. 2)
     real(wp) :: c_bulk                      !< backlash with the bulk rise only [m]
     logical  :: k_m_computed = .false.      !< k_m from Eq. 18 (the case left k_m = 0)
@@ -134,6 +135,7 @@ contains
     m%sin_alpha = sin(m%alpha)
     m%r_b = m%r_pitch*m%cos_alpha
     m%theta0 = pi/(2.0_wp*m%z)
+    call pitch_rotation(m%z, m%sin_pitch, m%cos_pitch)
 
     ! Eq. 18 at the pitch point, with the fillet-foundation terms k_f1, k_f2 (Sainsot 2004)
     ! when the case counts them: always reported; used if the case leaves k_m = 0. The fillet

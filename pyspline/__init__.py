@@ -4,11 +4,11 @@ this package reads cases, runs them and plots them."""
 from .case import Case, defaults, load_case
 from .core import Model, Result, load, mesh_stiffness, rhs, simulate, start_state, tooth_stiffness
 from .errors import CaseError, SolverError, SplineError, SplineWarning, ThermalInterferenceError
-from .sweep import open_sweep, sweep   # binds pyspline.sweep to the function (module: sys.modules)
+from .sweep import local_dask_client, open_sweep, sweep  # pyspline.sweep: the function
 
 __all__ = ["Case", "CaseError", "Model", "Result", "SolverError", "SplineError", "SplineWarning",
-           "ThermalInterferenceError", "defaults", "load", "load_case", "mesh_stiffness",
-           "open_sweep", "rhs", "simulate", "start_state", "sweep", "tooth_stiffness"]
+           "ThermalInterferenceError", "defaults", "load", "load_case", "local_dask_client",
+           "mesh_stiffness", "open_sweep", "rhs", "simulate", "start_state", "sweep", "tooth_stiffness"]
 from importlib.metadata import PackageNotFoundError, version as _version
 
 try:

@@ -329,15 +329,17 @@ def predictability_horizon(lam):
 
 # --------------------------------------------------------------------------- statistics
 
-def stats(x) -> dict:
+def stats(x, quantiles: bool = True) -> dict:
     """Summary of a signal, NaN ignored, in the units of `x`: ``max``, ``min``, ``mean``,
     ``rms`` (root mean square about zero, ``sqrt(mean(x**2))``), and the quantiles ``q05``,
-    ``q50`` (median) and ``q95``."""
+    ``q50`` (median) and ``q95`` (unless quantiles=False: they cost a sort)."""
     a = np.asarray(x, dtype=float).ravel()
     a = a[~np.isnan(a)]
     if a.size == 0:
         raise ValueError("stats of an empty (or all-NaN) array")
-    q05, q50, q95 = np.quantile(a, [0.05, 0.5, 0.95])
-    return dict(max=float(a.max()), min=float(a.min()), mean=float(a.mean()),
-                rms=float(np.sqrt(np.mean(a**2))), q05=float(q05), q50=float(q50),
-                q95=float(q95))
+    out = dict(max=float(a.max()), min=float(a.min()), mean=float(a.mean()),
+               rms=float(np.sqrt(np.mean(a**2))))
+    if quantiles:
+        q05, q50, q95 = np.quantile(a, [0.05, 0.5, 0.95])
+        out.update(q05=float(q05), q50=float(q50), q95=float(q95))
+    return out

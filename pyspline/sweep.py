@@ -33,8 +33,8 @@ from .case import Case, defaults, load_case
 from .core import STATE_NAMES
 from .errors import CaseError, SplineError
 
-__all__ = ["open_sweep", "parse_values", "point_cases", "run_point", "summarise", "sweep",
-           "sweep_figures", "write_netcdf"]
+__all__ = ["DASK_SWEEP_CONFIG", "local_dask_client", "open_sweep", "parse_values", "point_cases",
+           "run_point", "summarise", "sweep", "sweep_figures", "write_netcdf"]
 
 #: Bump when the content of a point summary changes: older point files are then recomputed.
 SUMMARY_VERSION = 1
@@ -266,7 +266,7 @@ def summarise(res, options: dict) -> dict:
             s.update(lyapunov_spread=fit.spread, lyapunov_rel_spread=fit.rel_spread,
                      lyapunov_slope=fit.slope)
     for q, arr in (("Tm", res.Tm), ("kv", res.kv), ("F", res.tooth["F"])):
-        st = analysis.stats(arr)
+        st = analysis.stats(arr, quantiles=False)
         s.update({f"{q}_max": st["max"], f"{q}_min": st["min"], f"{q}_rms": st["rms"]})
     s["Tf_max"] = float(np.max(res.tooth["Tf"]))
     s.update(D2_max=float(res.D2.max()), D2_min=float(res.D2.min()))
@@ -296,6 +296,41 @@ def run_points(cases: list, options: dict) -> list:
     """A chunk of sweep points as one task (fewer round trips through a process pool or a
     Dask scheduler): run_point for each."""
     return [run_point(case, options) for case in cases]
+
+
+#: Dask settings for a cluster that runs long CPU-bound sweep tasks on a few cores, where every
+#: cycle Dask spends on itself is taken from a run (docs/performance.md measures them). Each
+#: turns off or slows a service such sweeps do not use: the statistical profiler (a sample of
+#: every worker thread each 10 ms), work stealing (a rebalance each 100 ms; a sweep's tasks are
+#: equal chunks handed out as workers free up), and the system and memory monitors (each 500 and
+#: 100 ms; a point holds a few MB).
+DASK_SWEEP_CONFIG = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.scheduler.work-stealing": False,
+    "distributed.admin.system-monitor.interval": "2s",
+    "distributed.worker.memory.monitor-interval": "1s",
+}
+
+
+def local_dask_client(n_workers: int = 2, processes: bool = False, **kwargs):
+    """A ``distributed.Client`` on a new LocalCluster of `n_workers` single-threaded workers,
+    set up for sweeps (DASK_SWEEP_CONFIG, no dashboard); closing the client closes the cluster:
+
+        with pyspline.local_dask_client(2) as client:
+            ds = pyspline.sweep(case, executor=client.get_executor(), l_x=values)
+
+    processes : False (default): the workers are threads of this process. The core releases
+        the GIL, so they run in parallel, with no pickling and no worker processes to feed;
+        Dask's advice for code that releases the GIL. True: one process per worker (a nanny
+        each), the layout of a multi-node cluster.
+    kwargs : passed to LocalCluster (e.g. dashboard_address=':8787' to watch the sweep)."""
+    import dask
+    from distributed import Client
+    options = dict(n_workers=n_workers, threads_per_worker=1, processes=processes,
+                   dashboard_address=None)
+    options.update(kwargs)
+    with dask.config.set(DASK_SWEEP_CONFIG):
+        return Client(**options)
 
 
 def _chunk_size(executor, n: int) -> int:

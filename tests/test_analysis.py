@@ -237,6 +237,8 @@ def test_stats():
     assert s["max"] == 100 and s["min"] == 1 and s["q50"] == pytest.approx(50.5)
     assert s["q05"] == pytest.approx(5.95) and s["q95"] == pytest.approx(95.05)
     assert s["rms"] == pytest.approx(np.sqrt(np.mean(np.arange(1.0, 101.0) ** 2)))
+    light = an.stats(x, quantiles=False)
+    assert "q50" not in light and all(light[k] == s[k] for k in ("max", "min", "mean", "rms"))
     with pytest.raises(ValueError):
         an.stats([np.nan])
 
