@@ -203,18 +203,25 @@ def test_ctrl_c_in_a_real_sweep(case, tmp_path):
 
 # --------------------------------------------------------------------------- Dask
 
-def test_dask_executor(case):
-    """A local Dask cluster of two worker processes gives the serial numbers (needs
-    `distributed`, which scripts/setup.sh installs: in CI this test runs, never skips)."""
+@pytest.mark.parametrize("processes", [True, False], ids=["worker-processes", "worker-threads"])
+def test_dask_executor(case, processes):
+    """A local Dask cluster of two workers (pyspline.local_dask_client: worker processes, where
+    cases and summaries are pickled, and worker threads in this process) gives the serial
+    numbers (needs `distributed`, which scripts/setup.sh installs: in CI this test runs, never
+    skips)."""
     if os.environ.get("CI"):
         import distributed
     else:
         distributed = pytest.importorskip("distributed")
     serial = pyspline.sweep(case, progress=False, l_x=LX)
     box = {}
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster, \
-            distributed.Client(cluster, timeout="60s") as client:
+    with pyspline.local_dask_client(2, processes=processes) as client:
+        assert len(client.scheduler_info()["workers"]) == 2
+        # the sweep settings hold in the workers: no statistical profiler, no work stealing
+        assert all(client.run(lambda dask_worker: "profile" not in dask_worker.periodic_callbacks)
+                   .values())
+        assert "stealing" not in client.run_on_scheduler(
+            lambda dask_scheduler: list(dask_scheduler.extensions))
 
         def run():
             box["ds"] = pyspline.sweep(case, executor=client.get_executor(), progress=False,
