@@ -97,7 +97,7 @@ module spline_case
     character(len=optlen) :: section = 'none'      !< Poincare section: none | shaft | tooth (pass)
     logical  :: lyapunov = .false.          !< largest Lyapunov exponent (Benettin) over the output window
     real(wp) :: lyapunov_interval = 1.0_wp  !< renormalisation interval [shaft revolutions]
-    real(wp) :: lyapunov_d0 = 1.0e-8_wp     !< initial separation, in the scaled states of Eq. 25 [-]
+    real(wp) :: lyapunov_d0 = 0.0_wp        !< initial separation, scaled states of Eq. 25 [-]; 0: auto
     ! beyond the paper (docs/model.md "Beyond the paper")
     logical  :: fillet = .true.             !< fillet-foundation term in a computed k_m (Eq. 18 + k_f)
     real(wp) :: fillet_radius = 0.0_wp      !< root fillet radius [m]; 0 = 0.2 m (ISO 4156 flat root)
@@ -1447,8 +1447,10 @@ contains
     if (.not. one_of(section_values, c%section, 'section')) return
     if (.not. in_range(c%lyapunov_interval, 1.0e-3_wp, 1.0e3_wp, 'lyapunov_interval', &
          'shaft revolutions')) return
-    if (.not. in_range(c%lyapunov_d0, 1.0e-12_wp, 1.0e-3_wp, 'lyapunov_d0', &
-         'a separation of the scaled states')) return
+    if (c%lyapunov_d0 /= 0.0_wp) then      ! 0: chosen from rtol (model: lyapunov_separation)
+      if (.not. in_range(c%lyapunov_d0, 1.0e-12_wp, 1.0e-3_wp, 'lyapunov_d0', &
+           'a separation of the scaled states (0: chosen from rtol)')) return
+    end if
     if ((c%lyapunov .or. option_index(section_values, c%section) > 1) .and. c%speed_rpm <= 0.0_wp) then
       call fail('speed_rpm', 'must be positive for a Poincare section or a Lyapunov exponent '// &
            '(both are timed by the shaft revolution)'); return

@@ -14,7 +14,7 @@ module spline_model
   private
   public :: model_t, model_from_case, set_thermal_level, model_magic, model_warnings
   public :: nstate, ndof, thermal_none, thermal_bulk, thermal_oneway, thermal_coupled
-  public :: nkterms, kterm_names, ik_m
+  public :: nkterms, kterm_names, ik_m, lyapunov_separation
 
   integer, parameter :: ndof = 7            !< x1, y1, x2, y2, D1, D2, D3 (Eq. 24)
   integer, parameter :: nstate = 2*ndof     !< displacements then velocities
@@ -126,7 +126,7 @@ contains
     m%start_equilibrium = option_index(start_values, c%start) == 1
     m%section = option_index(section_values, c%section) - 1
     m%lyapunov = c%lyapunov
-    m%lyap_d0 = c%lyapunov_d0
+    m%lyap_d0 = lyapunov_separation(c%lyapunov_d0, c%rtol)
     if (m%omega > 0.0_wp) m%lyap_dt = c%lyapunov_interval*2.0_wp*pi/m%omega
 
     ! geometry (docs/model.md sections 2 and 12, Eq. 9)
@@ -242,5 +242,17 @@ contains
     m%c_bulk = m%c0
     if (level /= thermal_none) m%c_bulk = thermal_backlash(m%c0, m%kappa, m%t_bulk)
   end subroutine set_thermal_level
+
+  !> Benettin's initial separation d0 in the scaled states of Eq. 25: the case's lyapunov_d0, or,
+  !> if it is 0, 1e4 rtol within [1e-8, 1e-3]. The reference and the perturbed copy are
+  !> integrated separately, so their difference carries the solver's own error, measured at up to
+  !> about 100 rtol in the scaled states per interval; d0 must lie well above that floor, or
+  !> ln(d/d0) measures integration noise and a quiet drive shows a positive exponent
+  !> (tests/test_chaos.py shows both). The cap keeps d0 e^(lambda T) small against the motion.
+  pure real(wp) function lyapunov_separation(d0, rtol) result(d)
+    real(wp), intent(in) :: d0, rtol
+    d = d0
+    if (d == 0.0_wp) d = min(1.0e-3_wp, max(1.0e-8_wp, 1.0e4_wp*rtol))
+  end function lyapunov_separation
 
 end module spline_model

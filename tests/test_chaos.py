@@ -1,10 +1,13 @@
 """Chaos-aware verification (issue 11): in a chaotic scene, pointwise trajectories part whatever
-the tolerance, but statistics, the section's location and the Lyapunov exponent converge as
-rtol tightens. The scene is cases/rattle_z24.nml (computed stiffness, the paper's tiny mesh
-damping), over 50 revolutions after the engagement; each run takes about half a minute.
-Tolerances: the statistics of a 50-revolution window of a chaotic signal carry a sampling error
-of a few per cent (5 % here); the exponent's own estimate varies by 15-20 % over the last third
-of the window (analysis.largest_lyapunov_fit's rel_spread), so two runs must agree to 25 %."""
+the tolerance, but statistics, the section's extent and the Lyapunov exponent converge as rtol
+tightens. The scene is cases/chaos_z24.nml: physical mesh damping (zeta_m = 0.01), light load,
+misalignment of twice the backlash; 200 revolutions after the engagement, with the tooth-pass
+section (4800 points), about 4 s a run. Tolerances: over 200 revolutions the statistics of this
+chaotic signal carry a sampling error of a few per cent (T_m RMS and k_v's 95 % quantile within
+1 %, its median within 3 % at rtol 1e-6, 1e-7 and 1e-8; thirds of a 150-revolution window differ
+by up to 4 %); the section's extent (5-95 % of D_2) within 7 %; the exponent's estimate by up to
+15 % between settings. And Benettin's separation must sit above the solver's
+own noise: with d0 = 1e-8 a quiet drive shows a positive exponent (the last test)."""
 import numpy as np
 import pytest
 
@@ -16,31 +19,51 @@ RTOLS = (1e-6, 1e-7)
 
 @pytest.fixture(scope="module")
 def runs():
-    case = pyspline.load_case(CASES / "rattle_z24.nml", t_end=1.3, t_transient=0.3,
-                              n_out=8001, lyapunov=True)
+    case = pyspline.load_case(CASES / "chaos_z24.nml", t_end=2.3, n_out=32001, section="tooth")
     return [pyspline.simulate(case.replace(rtol=r, atol=r * 1e-2)) for r in RTOLS]
 
 
 def stats(res):
+    d2 = np.asarray(res.section_y)[:, pyspline.core.STATE_NAMES.index("D2")]
     return dict(kv_q50=np.quantile(res.kv, 0.5), kv_q95=np.quantile(res.kv, 0.95),
-                Tm_rms=np.sqrt(np.mean(res.Tm ** 2)), exponent=res.lyapunov["exponent"])
+                Tm_rms=np.sqrt(np.mean(res.Tm ** 2)),
+                section_extent=np.quantile(d2, 0.95) - np.quantile(d2, 0.05),
+                exponent=res.lyapunov["exponent"])
 
 
 def test_trajectories_part(runs):
     a, b = runs
     extent = np.ptp(a.D2)
-    assert np.abs(a.D2 - b.D2).max() > 0.1 * extent        # pointwise: no agreement
+    assert np.abs(a.D2 - b.D2).max() > 0.3 * extent        # pointwise: no agreement
 
 
-def test_exponent_positive_and_horizon_short(runs):
+def test_exponent_positive_converged_and_horizon_short(runs):
     for r in runs:
         lam = r.lyapunov["exponent"]
-        assert lam > 10, lam                                   # chaotic
-        assert 1 / lam < 0.1                                    # horizon: hundredths of a second
+        fit = pyspline.analysis.largest_lyapunov_fit(r.lyapunov["t"], r.lyapunov["log_growth"],
+                                                     t0=float(r.t[0]))
+        assert lam > 300, lam                                  # chaotic
+        assert fit.rel_spread < 0.1, fit                       # the running estimate settled
+        assert 1 / lam < 0.01                                   # horizon: milliseconds
+    assert (np.asarray(runs[0].kv) < 1e-9).mean() > 0.05       # teeth all free at times: impacts
 
 
 def test_statistics_converge(runs):
     sa, sb = (stats(r) for r in runs)
-    tol = dict(kv_q50=0.05, kv_q95=0.10, Tm_rms=0.05, exponent=0.25)
+    tol = dict(kv_q50=0.07, kv_q95=0.05, Tm_rms=0.05, section_extent=0.15, exponent=0.2)
     for k, t in tol.items():
         assert abs(sa[k] / sb[k] - 1) < t, (k, sa[k], sb[k])
+
+
+def test_benettin_separation_above_the_solver_noise():
+    """A drive that settles (physical_z24 at 4000 r/min, 5 N m: k_v within 1 +- 2 %) has no
+    positive exponent. With d0 = 1e-8 the copy's separation sits below the solver's own error at
+    rtol 1e-8, and Benettin's sum measures that noise: a spurious exponent of tens of 1/s. The
+    default d0 (0: 1e4 rtol) sits above it."""
+    case = pyspline.load_case(CASES / "physical_z24.nml", speed_rpm=4000.0, t_d=5.0, t_l=5.0,
+                              t_transient=0.3, t_end=0.8, n_out=2001, lyapunov=True)
+    res = pyspline.simulate(case)
+    assert np.ptp(res.kv) < 0.05
+    assert abs(res.lyapunov["exponent"]) < 5, res.lyapunov["exponent"]
+    noisy = pyspline.simulate(case.replace(lyapunov_d0=1e-8))
+    assert noisy.lyapunov["exponent"] > 20, noisy.lyapunov["exponent"]
