@@ -37,7 +37,8 @@ __all__ = ["DASK_SWEEP_CONFIG", "local_dask_client", "open_sweep", "parse_values
            "run_point", "summarise", "sweep", "sweep_figures", "write_netcdf"]
 
 #: Bump when the content of a point summary changes: older point files are then recomputed.
-SUMMARY_VERSION = 1
+#: 2: the default Benettin separation (lyapunov_d0 = 0: 1e4 rtol, was 1e-8) changed exponents.
+SUMMARY_VERSION = 2
 #: Step of the common shaft-order axis of the T_m spectra [shaft orders].
 ORDER_STEP = 0.05
 SECTIONS = ("shaft", "tooth", "none")
