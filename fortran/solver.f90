@@ -35,12 +35,14 @@ module spline_solver
   !> Everything a run changes, owned by `integrate` and given to CVODE as user data.
   type :: solver_ctx_t
     type(model_t) :: m                      !< the model integrated
-    integer :: n = nstate                   !< integrated states: ys_full(idx(1:n))
+    integer :: n = nstate                   !< integrated states of a copy: ys_full(idx(1:n), c)
     integer :: idx(nstate)
-    real(c_double) :: ys_full(nstate)       !< scaled full state; the frozen entries stay here
+    integer :: ncopy = 1                    !< 1, or 2: a perturbed copy beside the reference
+    real(c_double) :: ys_full(nstate, 2)    !< scaled full state per copy; frozen entries stay here
     logical :: frozen = .false.             !< root finding: contact states frozen between switches
-    integer, allocatable :: modes(:)        !< contact state per tooth (+1, 0, -1), if frozen
-    integer, allocatable :: branches(:, :)  !< root (-1) / tip (+1) branch, coupled level only
+    integer :: nrc = 0                      !< root functions per copy
+    integer, allocatable :: modes(:, :)     !< contact state (+1, 0, -1) per contact and copy
+    integer, allocatable :: branches(:, :, :)  !< root (-1) / tip (+1) branch per copy, coupled only
     type(coupling_stats_t) :: cstats        !< work of the flash-temperature coupling
     logical :: watch = .false.              !< stop on SIGINT (callers that can raise it)
     integer(c_int) :: sigint0 = 0           !< SIGINT count when the run began
@@ -73,8 +75,13 @@ contains
   !> closed form, no root function is needed, and unlike a stop time (CVodeSetStopTime) it
   !> leaves CVODE's step sequence alone (stopping at every revolution cost 20 % more work on
   !> paper_lx1e-4, docs/performance.md).
+  !> y0b, youtb (optional, together): a second copy of the system started at y0b, integrated
+  !> beside the first as one CVODE system, with the same steps, order and corrector iterations,
+  !> so that the difference of the two carries no independent solver noise (Benettin's method,
+  !> spline_run::lyapunov_benettin); youtb(:, k) its state at tout(k). Contact switches of either
+  !> copy are located (root finding) and restart both.
   subroutine integrate(m, y0, nt, tout, yout, modes_out, stats, ierr, errmsg, interruptible, &
-       tsec, ysec)
+       tsec, ysec, y0b, youtb)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: y0(nstate)
     integer, intent(in) :: nt
@@ -87,8 +94,10 @@ contains
     logical, intent(in), optional :: interruptible
     real(wp), intent(in), optional :: tsec(:)
     real(wp), intent(out), optional :: ysec(:, :)
+    real(wp), intent(in), optional :: y0b(nstate)
+    real(wp), intent(out), optional :: youtb(nstate, nt)
     type(solver_ctx_t), target :: ctx
-    real(c_double) :: ys(nstate)
+    real(c_double) :: ys(nstate), ysb(nstate)
     real(c_double), allocatable, target :: yr(:)
     real(c_double) :: tau, tau_out, tau_to, tret(1), hlast(1)
     type(c_ptr) :: sunctx, mem
@@ -98,7 +107,7 @@ contains
     type(SUNNonlinearSolver), pointer :: nls
     integer(c_int) :: flag, nroot
     integer(c_int), allocatable :: rootsfound(:)
-    integer :: k, k0, nroots, nresync, ks, nsec
+    integer :: k, k0, nroots, nresync, ks, nsec, nn
     integer(8) :: done, done_k, allow
     logical :: total_bound
     character(len=40) :: stage
@@ -111,15 +120,19 @@ contains
     ctx%m = m
     nroots = 0; nresync = 0
     ctx%frozen = m%roots
+    if (present(y0b)) ctx%ncopy = 2
+    if (present(youtb)) youtb = 0.0_wp
     nroot = 0
     if (ctx%frozen) then
-      allocate(ctx%modes(m%z*m%n_slices))
+      allocate(ctx%modes(m%z*m%n_slices, ctx%ncopy))
       nroot = 2*m%z*m%n_slices
       if (m%thermal == thermal_coupled) then
-        allocate(ctx%branches(2, m%z))
+        allocate(ctx%branches(2, m%z, ctx%ncopy))
         nroot = 4*m%z
       end if
     end if
+    ctx%nrc = nroot
+    nroot = nroot*ctx%ncopy
     allocate(rootsfound(nroot))
     nsec = 0
     if (present(tsec)) nsec = size(tsec)
@@ -127,12 +140,24 @@ contains
     ks = 1
     call to_scaled(m, y0, ys)
     call integrated_states(m, ctx%idx, ctx%n)
-    if (ctx%n < nstate) ys(ndof+1:ndof+4) = 0.0_wp   ! lateral states frozen at the start displacement
-    ctx%ys_full = ys
-    yr = ys(ctx%idx(1:ctx%n))
+    nn = ctx%n
+    if (nn < nstate) ys(ndof+1:ndof+4) = 0.0_wp   ! lateral states frozen at the start displacement
+    ysb = ys
+    if (ctx%ncopy == 2) then
+      call to_scaled(m, y0b, ysb)
+      if (nn < nstate) ysb(ndof+1:ndof+4) = 0.0_wp
+    end if
+    ctx%ys_full(:, 1) = ys
+    ctx%ys_full(:, 2) = ysb
+    allocate(yr(nn*ctx%ncopy))
+    yr(1:nn) = ys(ctx%idx(1:nn))
+    if (ctx%ncopy == 2) yr(nn+1:) = ysb(ctx%idx(1:nn))
     tau = m%t0*m%w_ref
     k = 0
-    if (ctx%frozen) call sync_modes(ctx, tau, ys, k)
+    if (ctx%frozen) then
+      call sync_modes(ctx, 1, tau, ys, k)
+      if (ctx%ncopy == 2) call sync_modes(ctx, 2, tau, ysb, k)
+    end if
     if (present(interruptible)) ctx%watch = interruptible
     if (ctx%watch) ctx%sigint0 = sigint_watch()
 
@@ -143,7 +168,7 @@ contains
     flag = sundials_context_new(sunctx)
     if (flag == 0) then
       stage = 'creating the state vector'
-      sv => FN_VMake_Serial(int(ctx%n, c_long), yr, sunctx)
+      sv => FN_VMake_Serial(int(size(yr), c_long), yr, sunctx)
       if (.not. associated(sv)) flag = -1
     end if
     if (flag == 0) flag = FN_VEnableFusedOps_Serial(sv, 1)   ! fused kernels: less work per step
@@ -169,7 +194,7 @@ contains
     if (flag == 0) then
       stage = 'attaching the (non)linear solver'
       if (m%newton) then
-        amat => FSUNDenseMatrix(int(ctx%n, c_long), int(ctx%n, c_long), sunctx)
+        amat => FSUNDenseMatrix(int(size(yr), c_long), int(size(yr), c_long), sunctx)
         if (associated(amat)) ls => FSUNLinSol_Dense(sv, amat, sunctx)
         if (associated(ls)) then
           flag = FCVodeSetLinearSolver(mem, ls, amat)
@@ -227,7 +252,7 @@ contains
           tau = tret(1)
           if (ks <= nsec) then
             if (tau >= tsec(ks)*m%w_ref) then     ! returned at the section instant
-              ys(ctx%idx(1:ctx%n)) = yr
+              ys(ctx%idx(1:nn)) = yr(1:nn)
               call from_scaled(m, ys, ysec(:, ks))
               ks = ks + 1
             end if
@@ -253,10 +278,12 @@ contains
           exit outputs
         end if
         ! Safety net: a grazing contact can touch a switch without a sign change over a step.
-        ys(ctx%idx(1:ctx%n)) = yr
+        ys(ctx%idx(1:nn)) = yr(1:nn)
+        if (ctx%ncopy == 2) ysb(ctx%idx(1:nn)) = yr(nn+1:)
         if (ctx%frozen) then
           k0 = nresync
-          call sync_modes(ctx, tau, ys, nresync)
+          call sync_modes(ctx, 1, tau, ys, nresync)
+          if (ctx%ncopy == 2) call sync_modes(ctx, 2, tau, ysb, nresync)
           if (nresync > k0 .and. k < nt) then
             call add_counters(ctx, mem, stats)
             flag = FCVodeReInit(mem, tau, sv)
@@ -267,7 +294,8 @@ contains
           end if
         end if
         call from_scaled(m, ys, yout(:, k))
-        if (ctx%frozen) modes_out(:, k) = ctx%modes
+        if (present(youtb)) call from_scaled(m, ysb, youtb(:, k))
+        if (ctx%frozen) modes_out(:, k) = ctx%modes(:, 1)
       end do outputs
     end if
 
@@ -379,8 +407,9 @@ contains
 
   !> Contact states (and branches) from the sign of the switch functions. Counts the switches
   !> whose stored state disagreed clearly (beyond round-off) with the state: a missed switch.
-  subroutine sync_modes(ctx, tau, ys, nchanged)
+  subroutine sync_modes(ctx, c, tau, ys, nchanged)
     type(solver_ctx_t), intent(inout) :: ctx
+    integer, intent(in) :: c                   !< the copy
     real(c_double), intent(in) :: tau, ys(nstate)
     integer, intent(inout) :: nchanged
     real(wp) :: y(nstate), g(2*ctx%m%z*ctx%m%n_slices), gb(2*ctx%m%z), eps, epsv
@@ -393,18 +422,18 @@ contains
       want = 0
       if (g(2*j - 1) > 0.0_wp) want = 1
       if (g(2*j) < 0.0_wp) want = -1
-      if (want /= ctx%modes(j)) then
+      if (want /= ctx%modes(j, c)) then
         if (abs(g(2*j - 1)) > eps .and. abs(g(2*j)) > eps) nchanged = nchanged + 1
-        ctx%modes(j) = want
+        ctx%modes(j, c) = want
       end if
     end do
     if (.not. allocated(ctx%branches)) return
     do j = 1, ctx%m%z
       do i = 1, 2
         want = merge(-1, 1, gb(2*j - 2 + i) < 0.0_wp)
-        if (want /= ctx%branches(i, j)) then
+        if (want /= ctx%branches(i, j, c)) then
           if (abs(gb(2*j - 2 + i)) > epsv) nchanged = nchanged + 1
-          ctx%branches(i, j) = want
+          ctx%branches(i, j, c) = want
         end if
       end do
     end do
@@ -413,26 +442,31 @@ contains
   !> A located root of g_{2j-1} = dn_j - c_j (rising: drive flank engages, falling: it opens)
   !> or of g_{2j} = dn_j + c_j (falling: back flank engages, rising: it opens); then, in coupled
   !> mode, of dDelta_ij/dt (rising: the contact point moves to the tip, falling: to the root).
+  !> The root functions of copy c are rootsfound((c - 1) nrc + 1 : c nrc).
   subroutine apply_roots(ctx, rootsfound, nroots)
     type(solver_ctx_t), intent(inout) :: ctx
     integer(c_int), intent(in) :: rootsfound(:)
     integer, intent(inout) :: nroots
-    integer :: j, i, z, nc
+    integer :: j, i, z, nc, c, o
     z = ctx%m%z
     nc = z*ctx%m%n_slices                      ! contacts: teeth, or slices of teeth
-    do j = 1, nc
-      if (rootsfound(2*j - 1) == 1) ctx%modes(j) = 1
-      if (rootsfound(2*j - 1) == -1) ctx%modes(j) = 0
-      if (rootsfound(2*j) == -1) ctx%modes(j) = -1
-      if (rootsfound(2*j) == 1) ctx%modes(j) = 0
-    end do
-    if (allocated(ctx%branches)) then          ! coupled level: a whole tooth per contact
-      do j = 1, z
-        do i = 1, 2
-          if (rootsfound(2*nc + 2*j - 2 + i) /= 0) ctx%branches(i, j) = rootsfound(2*nc + 2*j - 2 + i)
-        end do
+    do c = 1, ctx%ncopy
+      o = (c - 1)*ctx%nrc
+      do j = 1, nc
+        if (rootsfound(o + 2*j - 1) == 1) ctx%modes(j, c) = 1
+        if (rootsfound(o + 2*j - 1) == -1) ctx%modes(j, c) = 0
+        if (rootsfound(o + 2*j) == -1) ctx%modes(j, c) = -1
+        if (rootsfound(o + 2*j) == 1) ctx%modes(j, c) = 0
       end do
-    end if
+      if (allocated(ctx%branches)) then        ! coupled level: a whole tooth per contact
+        do j = 1, z
+          do i = 1, 2
+            if (rootsfound(o + 2*nc + 2*j - 2 + i) /= 0) &
+                 ctx%branches(i, j, c) = rootsfound(o + 2*nc + 2*j - 2 + i)
+          end do
+        end do
+      end if
+    end do
     nroots = nroots + count(rootsfound /= 0)
   end subroutine apply_roots
 
@@ -445,18 +479,26 @@ contains
     type(solver_ctx_t), pointer :: ctx
     real(c_double), pointer :: ys(:), fs(:)
     real(c_double) :: yf(nstate), ff(nstate)
-    integer :: ierr
+    integer :: ierr, c, o, n
     call c_f_pointer(udata, ctx)
     ys => FN_VGetArrayPointer(sv_y)
     fs => FN_VGetArrayPointer(sv_f)
-    yf = ctx%ys_full
-    yf(ctx%idx(1:ctx%n)) = ys
-    if (ctx%frozen) then
-      call rhs_scaled(ctx%m, tau, yf, ff, ierr, ctx%cb_msg, ctx%modes, ctx%branches, ctx%cstats)
-    else
-      call rhs_scaled(ctx%m, tau, yf, ff, ierr, ctx%cb_msg, cstats=ctx%cstats)
-    end if
-    fs = ff(ctx%idx(1:ctx%n))
+    n = ctx%n
+    do c = 1, ctx%ncopy
+      o = (c - 1)*n
+      yf = ctx%ys_full(:, c)
+      yf(ctx%idx(1:n)) = ys(o+1:o+n)
+      if (.not. ctx%frozen) then
+        call rhs_scaled(ctx%m, tau, yf, ff, ierr, ctx%cb_msg, cstats=ctx%cstats)
+      else if (allocated(ctx%branches)) then
+        call rhs_scaled(ctx%m, tau, yf, ff, ierr, ctx%cb_msg, ctx%modes(:, c), &
+             ctx%branches(:, :, c), ctx%cstats)
+      else
+        call rhs_scaled(ctx%m, tau, yf, ff, ierr, ctx%cb_msg, ctx%modes(:, c), cstats=ctx%cstats)
+      end if
+      fs(o+1:o+n) = ff(ctx%idx(1:n))
+      if (ierr /= 0) exit
+    end do
     ret = 0
     if (ierr /= 0) then
       ctx%cb_ierr = ierr
@@ -475,20 +517,24 @@ contains
     real(c_double), pointer :: ys(:)
     real(c_double) :: yf(nstate)
     real(wp) :: y(nstate)
-    integer :: z, nc
+    integer :: z, nc, c, n, og
     call c_f_pointer(udata, ctx)
     ys => FN_VGetArrayPointer(sv_y)
-    yf = ctx%ys_full
-    yf(ctx%idx(1:ctx%n)) = ys
-    call from_scaled(ctx%m, yf, y)
     z = ctx%m%z
     nc = z*ctx%m%n_slices
-    if (allocated(ctx%branches)) then
-      call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), gout(1:2*nc), y(ndof+1:), &
-           gout(2*nc+1:2*nc+2*z))
-    else
-      call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), gout(1:2*nc))
-    end if
+    n = ctx%n
+    do c = 1, ctx%ncopy
+      og = (c - 1)*ctx%nrc
+      yf = ctx%ys_full(:, c)
+      yf(ctx%idx(1:n)) = ys((c-1)*n+1:c*n)
+      call from_scaled(ctx%m, yf, y)
+      if (allocated(ctx%branches)) then
+        call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), gout(og+1:og+2*nc), &
+             y(ndof+1:), gout(og+2*nc+1:og+2*nc+2*z))
+      else
+        call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), gout(og+1:og+2*nc))
+      end if
+    end do
     ret = 0
   end function roots_cb
 
