@@ -6,7 +6,8 @@ section (4800 points), about 4 s a run. Tolerances: over 200 revolutions the sta
 chaotic signal carry a sampling error of a few per cent (T_m RMS and k_v's 95 % quantile within
 1 %, its median within 3 % at rtol 1e-6, 1e-7 and 1e-8; thirds of a 150-revolution window differ
 by up to 4 %); the section's extent (5-95 % of D_2) within 7 %; the exponent's estimate by up to
-15 % between solver settings (2.5 % between these two tolerances, measured). And Benettin's
+15 % between solver settings with separate copies; with the copy beside the reference, 926
+against 921 1/s at these two tolerances, each estimate settled to 1.2 %. And Benettin's
 copy must carry no solver noise, and its separation must suit the contact switches (the last
 two tests)."""
 import numpy as np
@@ -51,7 +52,7 @@ def test_exponent_positive_converged_and_horizon_short(runs):
 
 def test_statistics_converge(runs):
     sa, sb = (stats(r) for r in runs)
-    tol = dict(kv_q50=0.07, kv_q95=0.05, Tm_rms=0.05, section_extent=0.15, exponent=0.2)
+    tol = dict(kv_q50=0.07, kv_q95=0.05, Tm_rms=0.05, section_extent=0.15, exponent=0.05)
     for k, t in tol.items():
         assert abs(sa[k] / sb[k] - 1) < t, (k, sa[k], sb[k])
 
