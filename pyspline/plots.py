@@ -299,7 +299,10 @@ def lyapunov_vs_param(ds, param: str, var: str = "lyapunov", path=None,
     line (above it, shaded: chaos) and, on the right axis (log scale), the predictability
     horizon 1/lambda [s] of the runs with lambda > 0 (lambda <= 0: no horizon, infinite).
     Error bars of half the spread ``ds[var + '_spread']`` when the dataset has it (e.g. the
-    spread of `largest_lyapunov_fit`). `units` as in `bifurcation`."""
+    spread of `largest_lyapunov_fit`); a run then counts as chaotic (gets a horizon) only if its
+    exponent exceeds its whole spread, so an estimate of +2 1/s with a spread of 20 is not
+    called chaos.
+    `units` as in `bifurcation`."""
     p = _array(ds, param)
     lam = _array(ds, var)
     unit = _units(ds, var, "1/s", units)
@@ -312,6 +315,8 @@ def lyapunov_vs_param(ds, param: str, var: str = "lyapunov", path=None,
     ax.errorbar(x, lam, yerr=err, fmt="o-", ms=4, lw=1, color="tab:blue", ecolor="0.5",
                 capsize=2)
     pos = np.isfinite(lam) & (lam > 0)
+    if err is not None:
+        pos &= ~(lam - 2 * np.nan_to_num(err, nan=0.0) <= 0)
     lo, hi = ax.get_ylim()
     if hi > 0:
         ax.axhspan(0, hi, color="tab:red", alpha=0.06, lw=0)
@@ -329,7 +334,8 @@ def lyapunov_vs_param(ds, param: str, var: str = "lyapunov", path=None,
         ax2.set_ylabel(f"predictability horizon 1/lambda [{h_unit}]", color="tab:orange")
         ax2.tick_params(axis="y", colors="tab:orange", which="both")
         handles.append(Line2D([], [], ls="", marker="s", mfc="none", mec="tab:orange",
-                              label="horizon 1/lambda where lambda > 0 (right axis)"))
+                              label="horizon 1/lambda where lambda > its spread "
+                                    "(right axis)"))
     fig.legend(handles=handles, fontsize=8, loc="outside lower center", ncols=3, frameon=False)
     ax.set_title(title or f"largest Lyapunov exponent vs {_long_name(ds, param)}")
     return _finish(fig, path)

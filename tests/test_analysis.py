@@ -293,6 +293,12 @@ def test_plot_lyapunov(tmp_path):
     fig = pl.lyapunov_vs_param(ds, "torque", path=tmp_path / "lyap.png")
     _png_ok(tmp_path / "lyap.png", fig)
     assert len(fig.axes) == 2                                 # the horizon axis
+    n_horizon = len(fig.axes[1].lines[0].get_xdata())
+    assert n_horizon == int((lam > 3.0).sum())
+    # a small positive estimate whose error bar reaches zero is not called chaos
+    ds_noise = dict(torque=p[:3] * 100, lyapunov=np.array([2.0, -1.0, 1.0]),
+                    lyapunov_spread=np.array([20.0, 20.0, 20.0]))
+    assert len(pl.lyapunov_vs_param(ds_noise, "torque").axes) == 1
 
 
 def _spectra(z=12):
