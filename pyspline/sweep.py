@@ -200,7 +200,7 @@ def _template(options: dict, stat_names: Sequence[str]) -> dict:
                  period_residual=nan)
     if options["lyapunov"]:
         s.update(lyapunov=nan, lyapunov_spread=nan, lyapunov_rel_spread=nan,
-                 lyapunov_slope=nan, predictability_horizon=nan)
+                 lyapunov_slope=nan, predictability_horizon=nan, chaotic=nan)
     for q in ("Tm", "kv", "F"):
         s.update({f"{q}_max": nan, f"{q}_min": nan, f"{q}_rms": nan})
     s.update(Tf_max=nan, D2_max=nan, D2_min=nan)
@@ -265,7 +265,7 @@ def summarise(res, options: dict) -> dict:
         if len(ly["t"]) >= 3 and np.isfinite(ly["log_growth"]).all():
             fit = analysis.largest_lyapunov_fit(ly["t"], ly["log_growth"], t0=float(res.t[0]))
             s.update(lyapunov_spread=fit.spread, lyapunov_rel_spread=fit.rel_spread,
-                     lyapunov_slope=fit.slope)
+                     lyapunov_slope=fit.slope, chaotic=float(lam > max(fit.spread, 0.0)))
     for q, arr in (("Tm", res.Tm), ("kv", res.kv), ("F", res.tooth["F"])):
         st = analysis.stats(arr, quantiles=False)
         s.update({f"{q}_max": st["max"], f"{q}_min": st["min"], f"{q}_rms": st["rms"]})
@@ -382,6 +382,8 @@ _VAR_ATTRS = {
     "lyapunov_rel_spread": ("lyapunov_spread / |lyapunov| (small: converged)", ""),
     "lyapunov_slope": ("slope of the log growth over the last two thirds of the window", "1/s"),
     "predictability_horizon": ("predictability horizon 1/lambda (inf: lambda <= 0)", "s"),
+    "chaotic": ("1: the exponent is positive beyond its own spread (chaos: read statistics, "
+                "not trajectories); 0: not; NaN: no converged estimate", ""),
     "Tm_max": ("max of the meshing torque T_m", "N m"),
     "Tm_min": ("min of the meshing torque T_m", "N m"),
     "Tm_rms": ("RMS of the meshing torque T_m", "N m"),
@@ -541,7 +543,7 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     Dataset: coordinates = the swept values (units from cases/template.nml); per point
     section_t/section_D2/section_vD2 (dim 'section_point', NaN-padded), period and
     period_residual; lyapunov, lyapunov_spread, lyapunov_rel_spread, lyapunov_slope,
-    predictability_horizon (if lyapunov); Tm_/kv_/F_ max, min, rms, Tf_max, D2_max, D2_min;
+    predictability_horizon, chaotic (1 if the exponent exceeds its spread; if lyapunov); Tm_/kv_/F_ max, min, rms, Tf_max, D2_max, D2_min;
     solver statistics (steps, rhs_evals, ..., core_wall_s, wall_s); Tm_spectrum (dim 'order');
     error, error_class ('' if ok), point_hash. A failed point has NaN values and its error.
     attrs: case (namelist text of the base case), pyspline_version, command, swept, section,
@@ -865,6 +867,10 @@ def cli_sweep(args) -> int:
     print(f"{a['n_points']} points: {a['n_ok']} ran, {a['n_failed']} failed, "
           f"{a['n_missing']} missing; {a['n_computed']} computed now, {a['n_reused']} reused "
           f"from {out / POINTS_DIR}/")
+    if "chaotic" in ds:
+        n_chaos = int((ds["chaotic"] == 1).sum())
+        print(f"{n_chaos} of {a['n_ok']} points chaotic (Lyapunov exponent positive beyond its "
+              "spread): read their statistics, sections and spectra, not their trajectories")
     if a["n_failed"] or a["n_missing"]:
         errors = [e for e in ds["error"].values.ravel() if e]
         print(f"first error: {errors[0]}", file=sys.stderr)

@@ -87,3 +87,12 @@ def test_benettin_separation_needs_located_switches_when_tiny():
     assert abs(located[0] - located[1]) < 0.5, located
     assert abs(pyspline.simulate(case).lyapunov["exponent"]) < 5          # default d0, no roots
     assert pyspline.simulate(case.replace(lyapunov_d0=1e-8)).lyapunov["exponent"] > 20
+
+
+def test_sweep_flags_chaos():
+    """A sweep says which points are chaotic: chaos_z24 is period 1 at 50 um of misalignment and
+    chaotic at 180 um (docs/sweeps.md)."""
+    case = pyspline.load_case(CASES / "chaos_z24.nml", t_end=0.6, n_out=2001)
+    ds = pyspline.sweep(case, progress=False, lyapunov=True, l_x=[5e-5, 1.8e-4])
+    np.testing.assert_array_equal(ds["chaotic"].values, [0.0, 1.0])
+    assert ds["period"].values[0] == 1 and ds["lyapunov"].values[1] > 300
