@@ -417,10 +417,7 @@ contains
       after_sep = .true.        ! just after '=' or a comma
       k = lo
       do while (p <= ntok)
-        if (tk(p) == tk_slash .or. tk(p) == tk_group) exit
-        if (tk(p) == tk_word) then
-          if (next_is_item(p)) exit
-        end if
+        if (ends_values(p)) exit
         select case (tk(p))
         case (tk_comma)
           if (after_sep) then           ! a null value: the element keeps its value
@@ -513,10 +510,7 @@ contains
       total = 0; digits_only = .true.; nn = 0
       q = p
       do while (q <= ntok)
-        if (tk(q) == tk_slash .or. tk(q) == tk_group) exit
-        if (tk(q) == tk_word) then
-          if (next_is_item(q)) exit
-        end if
+        if (ends_values(q)) exit
         if (tk(q) == tk_word .or. tk(q) == tk_string) then
           nn = nn + 1
           if (.not. is_digits(tok(q))) digits_only = .false.
@@ -784,6 +778,13 @@ contains
       call fail(line, 'byte 0x'//hex//' at column '//itoa(col)//' is a control character: '// &
            'this is not a text file')
     end subroutine control
+
+    !> Token q ends the values of an item: '/', the next group, or the next item's name.
+    logical function ends_values(q)
+      integer, intent(in) :: q
+      ends_values = tk(q) == tk_slash .or. tk(q) == tk_group
+      if (.not. ends_values .and. tk(q) == tk_word) ends_values = next_is_item(q)
+    end function ends_values
 
     !> A word at token q starts the next item: NAME = or NAME(...) =.
     logical function next_is_item(q)
