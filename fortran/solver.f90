@@ -97,7 +97,6 @@ contains
     real(wp), intent(in), optional :: y0b(nstate)
     real(wp), intent(out), optional :: youtb(nstate, nt)
     type(solver_ctx_t), target :: ctx
-    real(c_double) :: ys(nstate), ysb(nstate)
     real(c_double), allocatable, target :: yr(:)
     real(c_double) :: tau, tau_out, tau_to, tret(1), hlast(1)
     type(c_ptr) :: sunctx, mem
@@ -107,7 +106,7 @@ contains
     type(SUNNonlinearSolver), pointer :: nls
     integer(c_int) :: flag, nroot
     integer(c_int), allocatable :: rootsfound(:)
-    integer :: k, k0, nroots, nresync, ks, nsec, nn
+    integer :: k, k0, nroots, nresync, ks, nsec, nn, c
     integer(8) :: done, done_k, allow
     logical :: total_bound
     character(len=40) :: stage
@@ -138,25 +137,19 @@ contains
     if (present(tsec)) nsec = size(tsec)
     if (present(ysec)) ysec = 0.0_wp
     ks = 1
-    call to_scaled(m, y0, ys)
     call integrated_states(m, ctx%idx, ctx%n)
     nn = ctx%n
-    if (nn < nstate) ys(ndof+1:ndof+4) = 0.0_wp   ! lateral states frozen at the start displacement
-    ysb = ys
-    if (ctx%ncopy == 2) then
-      call to_scaled(m, y0b, ysb)
-      if (nn < nstate) ysb(ndof+1:ndof+4) = 0.0_wp
-    end if
-    ctx%ys_full(:, 1) = ys
-    ctx%ys_full(:, 2) = ysb
-    allocate(yr(nn*ctx%ncopy))
-    yr(1:nn) = ys(ctx%idx(1:nn))
-    if (ctx%ncopy == 2) yr(nn+1:) = ysb(ctx%idx(1:nn))
+    call to_scaled(m, y0, ctx%ys_full(:, 1))
+    if (ctx%ncopy == 2) call to_scaled(m, y0b, ctx%ys_full(:, 2))
+    ! dof 3: the lateral states are held at the start displacement, at rest
+    if (nn < nstate) ctx%ys_full(ndof+1:ndof+4, :) = 0.0_wp
+    yr = [(ctx%ys_full(ctx%idx(1:nn), c), c = 1, ctx%ncopy)]
     tau = m%t0*m%w_ref
     k = 0
     if (ctx%frozen) then
-      call sync_modes(ctx, 1, tau, ys, k)
-      if (ctx%ncopy == 2) call sync_modes(ctx, 2, tau, ysb, k)
+      do c = 1, ctx%ncopy
+        call sync_modes(ctx, c, tau, yr, k)
+      end do
     end if
     if (present(interruptible)) ctx%watch = interruptible
     if (ctx%watch) ctx%sigint0 = sigint_watch()
@@ -252,8 +245,7 @@ contains
           tau = tret(1)
           if (ks <= nsec) then
             if (tau >= tsec(ks)*m%w_ref) then     ! returned at the section instant
-              ys(ctx%idx(1:nn)) = yr(1:nn)
-              call from_scaled(m, ys, ysec(:, ks))
+              call from_scaled(m, copy_state(ctx, yr, 1), ysec(:, ks))
               ks = ks + 1
             end if
           end if
@@ -278,12 +270,11 @@ contains
           exit outputs
         end if
         ! Safety net: a grazing contact can touch a switch without a sign change over a step.
-        ys(ctx%idx(1:nn)) = yr(1:nn)
-        if (ctx%ncopy == 2) ysb(ctx%idx(1:nn)) = yr(nn+1:)
         if (ctx%frozen) then
           k0 = nresync
-          call sync_modes(ctx, 1, tau, ys, nresync)
-          if (ctx%ncopy == 2) call sync_modes(ctx, 2, tau, ysb, nresync)
+          do c = 1, ctx%ncopy
+            call sync_modes(ctx, c, tau, yr, nresync)
+          end do
           if (nresync > k0 .and. k < nt) then
             call add_counters(ctx, mem, stats)
             flag = FCVodeReInit(mem, tau, sv)
@@ -293,8 +284,8 @@ contains
             end if
           end if
         end if
-        call from_scaled(m, ys, yout(:, k))
-        if (present(youtb)) call from_scaled(m, ysb, youtb(:, k))
+        call from_scaled(m, copy_state(ctx, yr, 1), yout(:, k))
+        if (present(youtb)) call from_scaled(m, copy_state(ctx, yr, 2), youtb(:, k))
         if (ctx%frozen) modes_out(:, k) = ctx%modes(:, 1)
       end do outputs
     end if
@@ -407,14 +398,14 @@ contains
 
   !> Contact states (and branches) from the sign of the switch functions. Counts the switches
   !> whose stored state disagreed clearly (beyond round-off) with the state: a missed switch.
-  subroutine sync_modes(ctx, c, tau, ys, nchanged)
+  subroutine sync_modes(ctx, c, tau, v, nchanged)
     type(solver_ctx_t), intent(inout) :: ctx
     integer, intent(in) :: c                   !< the copy
-    real(c_double), intent(in) :: tau, ys(nstate)
+    real(c_double), intent(in) :: tau, v(:)    !< v: the integrated states (CVODE's vector)
     integer, intent(inout) :: nchanged
     real(wp) :: y(nstate), g(2*ctx%m%z*ctx%m%n_slices), gb(2*ctx%m%z), eps, epsv
     integer :: j, i, want
-    call from_scaled(ctx%m, ys, y)
+    call from_scaled(ctx%m, copy_state(ctx, v, c), y)
     call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), g, y(ndof+1:), gb)
     eps = 1.0e-9_wp*ctx%m%c_bulk
     epsv = eps*ctx%m%w_ref
@@ -486,8 +477,7 @@ contains
     n = ctx%n
     do c = 1, ctx%ncopy
       o = (c - 1)*n
-      yf = ctx%ys_full(:, c)
-      yf(ctx%idx(1:n)) = ys(o+1:o+n)
+      yf = copy_state(ctx, ys, c)
       if (.not. ctx%frozen) then
         call rhs_scaled(ctx%m, tau, yf, ff, ierr, ctx%cb_msg, cstats=ctx%cstats)
       else if (allocated(ctx%branches)) then
@@ -515,19 +505,15 @@ contains
     type(c_ptr), value :: udata
     type(solver_ctx_t), pointer :: ctx
     real(c_double), pointer :: ys(:)
-    real(c_double) :: yf(nstate)
     real(wp) :: y(nstate)
-    integer :: z, nc, c, n, og
+    integer :: z, nc, c, og
     call c_f_pointer(udata, ctx)
     ys => FN_VGetArrayPointer(sv_y)
     z = ctx%m%z
     nc = z*ctx%m%n_slices
-    n = ctx%n
     do c = 1, ctx%ncopy
       og = (c - 1)*ctx%nrc
-      yf = ctx%ys_full(:, c)
-      yf(ctx%idx(1:n)) = ys((c-1)*n+1:c*n)
-      call from_scaled(ctx%m, yf, y)
+      call from_scaled(ctx%m, copy_state(ctx, ys, c), y)
       if (allocated(ctx%branches)) then
         call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), gout(og+1:og+2*nc), &
              y(ndof+1:), gout(og+2*nc+1:og+2*nc+2*z))
@@ -537,6 +523,17 @@ contains
     end do
     ret = 0
   end function roots_cb
+
+  !> The scaled full state of copy c: the held (frozen) entries from ys_full, the integrated ones
+  !> from v, CVODE's vector (the copies one after the other, n states each).
+  pure function copy_state(ctx, v, c) result(yf)
+    type(solver_ctx_t), intent(in) :: ctx
+    real(c_double), intent(in) :: v(:)
+    integer, intent(in) :: c
+    real(c_double) :: yf(nstate)
+    yf = ctx%ys_full(:, c)
+    yf(ctx%idx(1:ctx%n)) = v((c - 1)*ctx%n + 1:c*ctx%n)
+  end function copy_state
 
   !> CVODE's own error text, kept for the exception instead of being printed to stderr.
   subroutine err_cb(error_code, module, function, msg, udata) bind(C)
