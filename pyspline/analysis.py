@@ -316,6 +316,16 @@ def largest_lyapunov_fit(times, log_growth, t0: float | None = None) -> Lyapunov
     return LyapunovFit(lam_t, lam, spread, float(rel), slope)
 
 
+def is_chaotic(lam, spread=0.0):
+    """Chaos by the largest Lyapunov exponent `lam` [1/s]: positive beyond the `spread` of its
+    own estimate (e.g. `largest_lyapunov_fit`'s; NaN spread counts as 0), lam > max(spread, 0).
+    NaN lam is not chaotic. Works on scalars (returns bool) and arrays."""
+    a = np.asarray(lam, dtype=float)
+    s = np.nan_to_num(np.asarray(spread, dtype=float), nan=0.0)
+    out = np.isfinite(a) & (a > np.maximum(s, 0.0))
+    return bool(out) if out.ndim == 0 else out
+
+
 def predictability_horizon(lam):
     """Predictability horizon ``1 / lam`` [s] for a largest Lyapunov exponent `lam` [1/s]: the
     time in which an error grows by the factor e. Infinite for lam <= 0 (no exponential error

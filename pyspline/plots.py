@@ -311,12 +311,12 @@ def lyapunov_vs_param(ds, param: str, var: str = "lyapunov", path=None,
     fig = Figure(figsize=(9, 5.5), layout="constrained")
     ax = fig.add_subplot()
     ax.axhline(0, color="k", lw=0.8)
-    err = _array(ds, var + "_spread") / 2 if var + "_spread" in ds else None
-    ax.errorbar(x, lam, yerr=err, fmt="o-", ms=4, lw=1, color="tab:blue", ecolor="0.5",
-                capsize=2)
-    pos = np.isfinite(lam) & (lam > 0)
-    if err is not None:
-        pos &= ~(lam - 2 * np.nan_to_num(err, nan=0.0) <= 0)
+    spread = _array(ds, var + "_spread") if var + "_spread" in ds else None
+    ax.errorbar(x, lam, yerr=None if spread is None else spread / 2, fmt="o-", ms=4, lw=1,
+                color="tab:blue", ecolor="0.5", capsize=2)
+    # chaotic: positive beyond its spread (analysis.is_chaotic, restated: this module stands alone)
+    pos = np.isfinite(lam) & (lam > (0.0 if spread is None else
+                                     np.maximum(np.nan_to_num(spread, nan=0.0), 0.0)))
     lo, hi = ax.get_ylim()
     if hi > 0:
         ax.axhspan(0, hi, color="tab:red", alpha=0.06, lw=0)

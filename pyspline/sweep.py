@@ -265,7 +265,8 @@ def summarise(res, options: dict) -> dict:
         if len(ly["t"]) >= 3 and np.isfinite(ly["log_growth"]).all():
             fit = analysis.largest_lyapunov_fit(ly["t"], ly["log_growth"], t0=float(res.t[0]))
             s.update(lyapunov_spread=fit.spread, lyapunov_rel_spread=fit.rel_spread,
-                     lyapunov_slope=fit.slope, chaotic=float(lam > max(fit.spread, 0.0)))
+                     lyapunov_slope=fit.slope,
+                     chaotic=float(analysis.is_chaotic(lam, fit.spread)))
     for q, arr in (("Tm", res.Tm), ("kv", res.kv), ("F", res.tooth["F"])):
         st = analysis.stats(arr, quantiles=False)
         s.update({f"{q}_max": st["max"], f"{q}_min": st["min"], f"{q}_rms": st["rms"]})

@@ -231,6 +231,13 @@ def test_predictability_horizon():
     assert h[0] == 0.5 and np.isinf(h[1]) and np.isnan(h[2])
 
 
+def test_is_chaotic():
+    assert an.is_chaotic(900.0, 30.0) and not an.is_chaotic(1.4, 2.7)
+    assert not an.is_chaotic(-0.5) and not an.is_chaotic(np.nan, 0.0)
+    np.testing.assert_array_equal(an.is_chaotic([5.0, 5.0, -1.0], [1.0, np.nan, 0.0]),
+                                  [True, True, False])
+
+
 def test_stats():
     x = np.r_[np.arange(1.0, 101.0), np.nan]
     s = an.stats(x)
