@@ -1,5 +1,6 @@
 """A bifurcation diagram of paper_lx1e-4 over l_x (issue 11's benchmark), measured side by side
-in one run: `python bench/run.py bifurcation [--points N] [--rtol R] [--blocks K] [--quick]`.
+in one run: `python bench/run.py bifurcation [--points N] [--rtol R] [--repeats R] [--blocks K]
+[--accuracy] [--quick]`.
 
 Each point: 20 shaft revolutions of transient, then 100 revolutions sampled (exact shaft
 sections, 8 outputs per revolution for the load statistics). The same sweep runs serially, on 2
@@ -8,11 +9,21 @@ threads in one process, its default, then processes); the wall time of each and 
 over serial are printed and written to bifurcation.csv, with the figure of the serial run. The
 case's own tolerance (rtol 1e-9, Adams) unless --rtol is given.
 
+With --repeats R every executor runs the whole sweep R times, in an order that rotates from
+repeat to repeat; the median wall time and the median of the speed-ups within each repeat are
+printed, with their ranges.
+
 With --blocks K the sweep is cut into K interleaved subsets (l_x[b::K]); every executor runs
 each subset, in an order that rotates from subset to subset, and its times are summed. On a
 machine whose speed drifts (a shared host: the same serial sweep took 35-42 s within an hour),
 the executors then share the drift, and the ratios mean something; the per-block speed-ups show
 the spread that remains.
+
+With --accuracy the question is what tolerance a diagram needs: every 10th point (100 points)
+is swept on 2 threads at rtol 1e-5 ... 1e-10 and compared with the same sweep at rtol 1e-11: the
+largest error of a section point (D2 at whole revolutions) as a fraction of the diagram's range
+of D2, the points whose period differs, the largest relative error of the RMS of T_m, and the
+wall time (bifurcation_accuracy.csv and .png).
 """
 from __future__ import annotations
 
@@ -66,62 +77,137 @@ def bench_case(rtol=None):
     return case.replace(**kw)
 
 
+ACCURACY_RTOLS = (1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
+REFERENCE_RTOL = 1e-11
+
+
+def accuracy(out: Path, n: int) -> list[dict]:
+    """Wall time against the diagram's error, per rtol (the docstring's --accuracy)."""
+    l_x = np.linspace(0.0, 3e-4, n)[::10]
+    rows, ref = [], None
+    with cf.ThreadPoolExecutor(2) as ex:
+        pyspline.sweep(bench_case(), executor=ex, progress=False, l_x=l_x[:2])
+        for rtol in (REFERENCE_RTOL,) + ACCURACY_RTOLS[::-1]:
+            t0 = time.perf_counter()
+            ds = pyspline.sweep(bench_case(rtol), executor=ex, progress=False, l_x=l_x)
+            wall = time.perf_counter() - t0
+            if int(ds.attrs.get("n_failed", 0)):
+                raise RuntimeError(f"rtol {rtol:g}: {ds.attrs['n_failed']} points failed")
+            if ref is None:
+                ref = ds
+                continue
+            d2, d2_ref = ds["section_D2"].values, ref["section_D2"].values
+            span = np.nanmax(d2_ref) - np.nanmin(d2_ref)
+            rows.append(dict(
+                rtol=rtol, points=len(l_x), wall_s=wall,
+                ms_per_point_2_threads=1e3 * wall / len(l_x),
+                section_error_of_range=float(np.nanmax(np.abs(d2 - d2_ref)) / span),
+                period_differs=int((ds["period"].values != ref["period"].values).sum()),
+                periods=" ".join(f"{int(k)}:{int(c)}" for k, c in zip(
+                    *np.unique(ds["period"].values, return_counts=True))),
+                tm_rms_rel_error=float(np.max(np.abs(ds["Tm_rms"].values / ref["Tm_rms"].values
+                                                     - 1))),
+                steps_per_point=float(ds["steps"].values.mean())))
+            print(f"rtol {rtol:7.0e}: {wall:6.2f} s for {len(l_x)} points on 2 threads, section "
+                  f"error {rows[-1]['section_error_of_range']:.1e} of the range, period differs "
+                  f"at {rows[-1]['period_differs']} points, T_m RMS error "
+                  f"{rows[-1]['tm_rms_rel_error']:.1e}", flush=True)
+    _write_csv(out / "bifurcation_accuracy.csv", rows)
+    _plot_accuracy(rows, out / "bifurcation_accuracy.png")
+    return rows
+
+
+def _plot_accuracy(rows, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6, 4), constrained_layout=True)
+    x = [r["ms_per_point_2_threads"] for r in rows]
+    y = [r["section_error_of_range"] for r in rows]
+    ax.loglog(x, y, "o-", label="every period as at the reference")
+    odd = [k for k, r in enumerate(rows) if r["period_differs"]]
+    ax.loglog([x[k] for k in odd], [y[k] for k in odd], "o", color="C3",
+              label="periods differ from the reference")
+    for r, xi, yi in zip(rows, x, y):
+        ax.annotate(f"{r['rtol']:g}", (xi, yi), textcoords="offset points", xytext=(5, -11),
+                    fontsize=8)
+    ax.axhline(1e-3, color="0.6", lw=0.8, ls="--", label="1/1000 of the range")
+    ax.set_ylim(top=1e-2)
+    ax.legend(fontsize=8, loc="upper right")
+    ax.set_xlabel("wall time per point on 2 threads [ms]")
+    ax.set_ylabel("largest section error / range of D2")
+    ax.set_title(f"paper_lx1e-4 bifurcation diagram ({rows[0]['points']} points) at rtol ...: "
+                 f"error against rtol {REFERENCE_RTOL:g}", fontsize=9)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
 def main(args) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.accuracy:
+        accuracy(out, args.points or 1000)
+        print(f"wrote {out}/bifurcation_accuracy.csv and bifurcation_accuracy.png")
+        return 0
     n = args.points or (40 if args.quick else 1000)
     blocks = max(1, args.blocks or 1)
+    repeats = max(1, args.repeats or 1)
     case = bench_case(args.rtol)
     l_x = np.linspace(0.0, 3e-4, n)
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
                             text=True, cwd=Path(__file__).parent).stdout.strip()
     print(f"commit {commit}, {os.cpu_count()} cores; {n} points of paper_lx1e-4 over l_x, "
           f"120 revolutions each (20 transient), rtol {case['rtol']:g}"
-          + (f"; {blocks} interleaved blocks" if blocks > 1 else ""))
+          + (f"; {blocks} interleaved blocks" if blocks > 1 else "")
+          + (f"; {repeats} repeats" if repeats > 1 else ""))
     pyspline.sweep(case, progress=False, l_x=l_x[:2])            # imports, first load
     labels = ["serial", "2 threads", "2 processes", "Dask LocalCluster, 2 workers",
               "Dask LocalCluster, 2 worker procs"]
-    wall = {label: [] for label in labels}
+    wall = {label: np.zeros(repeats) for label in labels}       # per repeat, summed over blocks
     failed = dict.fromkeys(labels, 0)
     ds = None
-    # blocks > 1: every executor runs the same interleaved subsets l_x[b::blocks], in an order
-    # that rotates from block to block, so that a machine whose speed drifts during the
-    # benchmark slows all of them alike (chunks as for the whole sweep); the executors then stay
-    # up together. blocks = 1: each executor exists only for its own run (an idle Dask cluster
-    # costs 0.05-0.07 s of CPU a second, measured).
-    with contextlib.ExitStack() as keep:
-        started = {}
-        if blocks > 1:
-            started = {label: _start(label, keep) for label in labels}
-        for b in range(blocks):
-            values = l_x[b::blocks]
-            for label in labels[b % len(labels):] + labels[:b % len(labels)]:
-                with contextlib.ExitStack() as this_run:
-                    ex = started[label] if blocks > 1 else _start(label, this_run)
-                    t0 = time.perf_counter()
-                    part = pyspline.sweep(case, executor=ex, progress=False, l_x=values,
-                                          chunk=_chunk_size(ex, n))
-                    wall[label].append(time.perf_counter() - t0)
-                failed[label] += int(part.attrs.get("n_failed", 0))
-                if blocks == 1:
-                    ds = part if label == "serial" else ds
-                    print(f"{label:34s} {wall[label][0]:8.2f} s  speed-up "
-                          f"{wall['serial'][0] / wall[label][0]:5.2f}x", flush=True)
+    # Every repeat and every block runs the executors in an order that rotates, so that a
+    # machine whose speed drifts during the benchmark slows all of them alike. blocks > 1: every
+    # executor runs the same interleaved subsets l_x[b::blocks] (chunks as for the whole sweep),
+    # and the executors stay up together. blocks = 1: each executor exists only for its own run
+    # (an idle Dask cluster costs 0.05-0.07 s of CPU a second, measured).
+    for rep in range(repeats):
+        with contextlib.ExitStack() as keep:
+            started = {}
+            if blocks > 1:
+                started = {label: _start(label, keep) for label in labels}
+            for b in range(blocks):
+                values = l_x[b::blocks]
+                turn = (rep * blocks + b) % len(labels)
+                for label in labels[turn:] + labels[:turn]:
+                    with contextlib.ExitStack() as this_run:
+                        ex = started[label] if blocks > 1 else _start(label, this_run)
+                        t0 = time.perf_counter()
+                        part = pyspline.sweep(case, executor=ex, progress=False, l_x=values,
+                                              chunk=_chunk_size(ex, n))
+                        wall[label][rep] += time.perf_counter() - t0
+                    failed[label] += int(part.attrs.get("n_failed", 0))
+                    if blocks == 1 and label == "serial" and ds is None:
+                        ds = part
+        print(f"repeat {rep + 1}: " + ", ".join(f"{label} {wall[label][rep]:.2f} s"
+                                                for label in labels), flush=True)
     rows = []
     for label in labels:
-        total = sum(wall[label])
-        ratio = [s_ / w for s_, w in zip(wall["serial"], wall[label])]
-        rows.append(dict(executor=label, points=n, blocks=blocks, wall_s=total,
-                         speed_up=sum(wall["serial"]) / total,
-                         block_speed_up_min=min(ratio), block_speed_up_median=float(
-                             np.median(ratio)), block_speed_up_max=max(ratio),
+        ratio = wall["serial"] / wall[label]                    # within each repeat
+        rows.append(dict(executor=label, points=n, blocks=blocks, repeats=repeats,
+                         rtol=case["rtol"], wall_median_s=float(np.median(wall[label])),
+                         wall_min_s=float(wall[label].min()),
+                         wall_max_s=float(wall[label].max()),
+                         speed_up_median=float(np.median(ratio)),
+                         speed_up_min=float(ratio.min()), speed_up_max=float(ratio.max()),
+                         walls_s=" ".join(f"{w:.2f}" for w in wall[label]),
                          failed=failed[label]))
-    if blocks > 1:
-        print(f"{'executor':34s} {'wall':>8s}   {'speed-up':>8s}   per block: min / median / max")
-        for r in rows:
-            print(f"{r['executor']:34s} {r['wall_s']:8.2f} s {r['speed_up']:8.2f}x   "
-                  f"{r['block_speed_up_min']:.2f} / {r['block_speed_up_median']:.2f} / "
-                  f"{r['block_speed_up_max']:.2f}", flush=True)
+    print(f"{'executor':34s} {'wall: median':>12s} {'(min-max)':>15s}   speed-up: median "
+          f"(min-max), within each repeat")
+    for r in rows:
+        print(f"{r['executor']:34s} {r['wall_median_s']:10.2f} s ({r['wall_min_s']:5.2f}-"
+              f"{r['wall_max_s']:5.2f})   {r['speed_up_median']:5.2f}x ({r['speed_up_min']:.2f}-"
+              f"{r['speed_up_max']:.2f})", flush=True)
     if any(failed.values()):
         print(f"failed points: {failed}")
     _write_csv(out / "bifurcation.csv", rows)

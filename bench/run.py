@@ -75,9 +75,13 @@ def main(argv=None) -> int:
     p.add_argument("--cases", nargs="+", help="wp: the scenes (default: paper_lx1e-4 paper_T100 "
                    "rattle_z24 physical_z24; --quick: the two paper scenes)")
     p.add_argument("--rtol", type=float, help="bifurcation: tolerance (default: the case's)")
+    p.add_argument("--repeats", type=int, help="bifurcation: run the whole sweep this many "
+                   "times per executor, in rotating order; medians and ranges (default 1)")
     p.add_argument("--blocks", type=int, help="bifurcation: run the sweep as this many "
                    "interleaved blocks, the executors in rotating order (default 1: each "
                    "executor runs the whole sweep once, one after the other)")
+    p.add_argument("--accuracy", action="store_true", help="bifurcation: wall time against the "
+                   "diagram's error over rtol (every 10th point)")
     p.add_argument("--out", default="out/bench", help="output directory (default out/bench)")
     p.add_argument("--quick", action="store_true", help="small sizes (for CI)")
     args = p.parse_args(argv)
