@@ -80,3 +80,32 @@ def test_anatomy_quick(tmp_path):
     case = pyspline.load_case(CASES / "paper_lx1e-4.nml")
     assert anatomy.rhs_cost(case.replace(z=32), n=10, repeat=1)[2] > \
         anatomy.rhs_cost(case, n=10, repeat=1)[2]
+
+
+def test_bifurcation_accuracy_quick(tmp_path):
+    """The diagram's accuracy chart: every rtol a row, the section error falls as rtol tightens,
+    and at the case's rtol every period is the reference's."""
+    import bifurcation
+    rows = bifurcation.accuracy(tmp_path, 30)                       # l_x[::10]: 3 points
+    assert [r["rtol"] for r in rows] == sorted(bifurcation.ACCURACY_RTOLS)     # tightest first
+    err = {r["rtol"]: r["section_error_of_range"] for r in rows}
+    assert err[1e-10] < err[1e-8] < err[1e-6] < 1e-3
+    assert next(r for r in rows if r["rtol"] == 1e-9)["period_differs"] == 0
+    assert (tmp_path / "bifurcation_accuracy.png").stat().st_size > 10_000
+    assert len(list(csv.DictReader(open(tmp_path / "bifurcation_accuracy.csv")))) == len(rows)
+
+
+def test_bifurcation_repeats_quick(tmp_path):
+    """--repeats: every executor's walls per repeat, medians and the same diagram."""
+    import argparse
+
+    import bifurcation
+    args = argparse.Namespace(out=str(tmp_path), accuracy=False, points=4, blocks=1, repeats=2,
+                              rtol=1e-6, quick=True)
+    assert bifurcation.main(args) == 0
+    table = list(csv.DictReader(open(tmp_path / "bifurcation.csv")))
+    assert len(table) == 5 and {r["failed"] for r in table} == {"0"}
+    for r in table:
+        walls = [float(w) for w in r["walls_s"].split()]
+        assert len(walls) == 2 and float(r["wall_min_s"]) == pytest.approx(min(walls), abs=0.01)
+    assert float(table[0]["speed_up_median"]) == 1.0                 # serial against itself
