@@ -257,12 +257,7 @@ contains
               exit outputs
             end if
             call apply_roots(ctx, rootsfound, nroots)
-            call add_counters(ctx, mem, stats)        ! CVodeReInit zeroes CVODE's counters
-            flag = FCVodeReInit(mem, tau, sv)
-            if (flag /= 0) then
-              call fail(flag, tau, 'restarting at a contact switch')
-              exit outputs
-            end if
+            if (.not. restarted('restarting at a contact switch')) exit outputs
           end if
         end do
         if (interrupted(ctx)) then
@@ -276,12 +271,7 @@ contains
             call sync_modes(ctx, c, tau, yr, nresync)
           end do
           if (nresync > k0 .and. k < nt) then
-            call add_counters(ctx, mem, stats)
-            flag = FCVodeReInit(mem, tau, sv)
-            if (flag /= 0) then
-              call fail(flag, tau, 'restarting after a missed switch')
-              exit outputs
-            end if
+            if (.not. restarted('restarting after a missed switch')) exit outputs
           end if
         end if
         call from_scaled(m, copy_state(ctx, yr, 1), yout(:, k))
@@ -315,6 +305,16 @@ contains
       n = nint(stats(1), 8)
       if (FCVodeGetNumSteps(mem, cnt) == 0) n = n + cnt(1)
     end function steps_done
+
+    !> CVODE restarted at tau (a contact switch: the right-hand side's branch changed), its
+    !> counters kept first (CVodeReInit zeroes them); .false. if it failed (ierr, errmsg set).
+    logical function restarted(what)
+      character(len=*), intent(in) :: what
+      call add_counters(ctx, mem, stats)
+      flag = FCVodeReInit(mem, tau, sv)
+      restarted = flag == 0
+      if (.not. restarted) call fail(flag, tau, what)
+    end function restarted
 
     !> The run hit a work bound: name the field that sets it.
     subroutine fail_work(tau)
@@ -475,6 +475,7 @@ contains
     ys => FN_VGetArrayPointer(sv_y)
     fs => FN_VGetArrayPointer(sv_f)
     n = ctx%n
+    ierr = 0
     do c = 1, ctx%ncopy
       o = (c - 1)*n
       yf = copy_state(ctx, ys, c)
