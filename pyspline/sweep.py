@@ -304,13 +304,16 @@ def run_points(cases: list, options: dict) -> list:
 #: cycle Dask spends on itself is taken from a run (docs/performance.md measures them). Each
 #: turns off or slows a service such sweeps do not use: the statistical profiler (a sample of
 #: every worker thread each 10 ms), work stealing (a rebalance each 100 ms; a sweep's tasks are
-#: equal chunks handed out as workers free up), and the system and memory monitors (each 500 and
-#: 100 ms; a point holds a few MB).
+#: equal chunks handed out as workers free up), the system and memory monitors (each 500 and
+#: 100 ms; a point holds a few MB), and the event-loop health check of the scheduler and of every
+#: worker (each 20 ms: most of an idle cluster's CPU, and a wake-up that preempts a run; a loop
+#: blocked for 3 s is still reported).
 DASK_SWEEP_CONFIG = {
     "distributed.worker.profile.enabled": False,
     "distributed.scheduler.work-stealing": False,
     "distributed.admin.system-monitor.interval": "2s",
     "distributed.worker.memory.monitor-interval": "1s",
+    "distributed.admin.tick.interval": "1s",
 }
 
 

@@ -217,11 +217,17 @@ def test_dask_executor(case, processes):
     box = {}
     with pyspline.local_dask_client(2, processes=processes) as client:
         assert len(client.scheduler_info()["workers"]) == 2
-        # the sweep settings hold in the workers: no statistical profiler, no work stealing
+        # the sweep settings hold in the workers: no statistical profiler, no work stealing,
+        # the event-loop health check each second (Dask's default: 20 ms)
         assert all(client.run(lambda dask_worker: "profile" not in dask_worker.periodic_callbacks)
                    .values())
         assert "stealing" not in client.run_on_scheduler(
             lambda dask_scheduler: list(dask_scheduler.extensions))
+        ticks = list(client.run(lambda dask_worker: dask_worker.periodic_callbacks["tick"]
+                                .callback_time).values())
+        ticks.append(client.run_on_scheduler(
+            lambda dask_scheduler: dask_scheduler.periodic_callbacks["tick"].callback_time))
+        assert ticks == [1000] * 3
 
         def run():
             box["ds"] = pyspline.sweep(case, executor=client.get_executor(), progress=False,
