@@ -83,7 +83,7 @@ REFERENCE_RTOL = 1e-11
 
 
 def accuracy(out: Path, n: int) -> list[dict]:
-    """Wall time against the diagram's error, per rtol (the docstring's --accuracy)."""
+    """The diagram's error, steps and wall time per rtol (the module docstring's --accuracy)."""
     l_x = np.linspace(0.0, 3e-4, n)[::10]
     rows, ref = [], None
     with cf.ThreadPoolExecutor(2) as ex:
@@ -101,7 +101,6 @@ def accuracy(out: Path, n: int) -> list[dict]:
             span = np.nanmax(d2_ref) - np.nanmin(d2_ref)
             rows.append(dict(
                 rtol=rtol, points=len(l_x), wall_s=wall,
-                ms_per_point_2_threads=1e3 * wall / len(l_x),
                 section_error_of_range=float(np.nanmax(np.abs(d2 - d2_ref)) / span),
                 period_differs=int((ds["period"].values != ref["period"].values).sum()),
                 periods=" ".join(f"{int(k)}:{int(c)}" for k, c in zip(
@@ -172,7 +171,7 @@ def main(args) -> int:
     # machine whose speed drifts during the benchmark slows all of them alike. blocks > 1: every
     # executor runs the same interleaved subsets l_x[b::blocks] (chunks as for the whole sweep),
     # and the executors stay up together. blocks = 1: each executor exists only for its own run
-    # (an idle Dask cluster costs 0.05-0.07 s of CPU a second, measured).
+    # (an idle Dask cluster takes CPU from the others: docs/performance.md).
     for rep in range(repeats):
         with contextlib.ExitStack() as keep:
             started = {}

@@ -13,7 +13,6 @@ from __future__ import annotations
 import statistics
 from pathlib import Path
 
-
 from pyspline import SplineError, load_case, simulate
 from pyspline.core import THERMAL_LEVELS as THERMAL, level_name
 from pyspline.paper import cases_dir

@@ -80,8 +80,8 @@ def main(argv=None) -> int:
     p.add_argument("--blocks", type=int, help="bifurcation: run the sweep as this many "
                    "interleaved blocks, the executors in rotating order (default 1: each "
                    "executor runs the whole sweep once, one after the other)")
-    p.add_argument("--accuracy", action="store_true", help="bifurcation: wall time against the "
-                   "diagram's error over rtol (every 10th point)")
+    p.add_argument("--accuracy", action="store_true", help="bifurcation: the diagram's section "
+                   "error, periods, steps and wall time over rtol (every 10th point)")
     p.add_argument("--out", default="out/bench", help="output directory (default out/bench)")
     p.add_argument("--quick", action="store_true", help="small sizes (for CI)")
     args = p.parse_args(argv)

@@ -1307,7 +1307,7 @@ contains
     ! geometry (ISO 4156 and beyond it, with margin)
     if (c%z < 3) then; call fail('z', 'must be at least 3 teeth'); return; end if
     if (c%z > max_teeth) then
-      call fail('z', 'is more than 1000 teeth (the largest spline the tooth-angle recurrence is '// &
+      call fail('z', 'is more than '//itoa(max_teeth)//' teeth (the largest spline the tooth-angle recurrence is '// &
            'checked for)'); return
     end if
     if (.not. in_range(c%module_m, 1.0e-4_wp, 0.1_wp, 'module_m', &

@@ -547,7 +547,8 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     Dataset: coordinates = the swept values (units from cases/template.nml); per point
     section_t/section_D2/section_vD2 (dim 'section_point', NaN-padded), period and
     period_residual; lyapunov, lyapunov_spread, lyapunov_rel_spread, lyapunov_slope,
-    predictability_horizon, chaotic (1 if the exponent exceeds its spread; if lyapunov); Tm_/kv_/F_ max, min, rms, Tf_max, D2_max, D2_min;
+    predictability_horizon, chaotic (1 if the exponent exceeds its spread; if lyapunov);
+    Tm_/kv_/F_ max, min, rms, Tf_max, D2_max, D2_min;
     solver statistics (steps, rhs_evals, ..., core_wall_s, wall_s); Tm_spectrum (dim 'order');
     error, error_class ('' if ok), point_hash. A failed point has NaN values and its error.
     attrs: case (namelist text of the base case), pyspline_version, command, swept, section,
