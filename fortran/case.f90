@@ -83,6 +83,7 @@ module spline_case
     character(len=optlen) :: nonlinear = 'auto'    !< auto (adams: fixedpoint, bdf: newton) | newton | fixedpoint
     logical  :: roots = .false.             !< locate the contact switches by root finding
     logical  :: stald = .false.             !< BDF stability-limit detection
+    logical  :: linear_tail = .true.        !< closed-form tail once full contact is proven to last
     real(wp) :: rtol = 1.0e-8_wp, atol = 1.0e-10_wp   !< tolerances on the scaled states [-]
     integer  :: max_steps = 100000          !< CVODE steps allowed between two output times
     integer  :: max_total_steps = 20000000  !< CVODE steps allowed over the whole run (all restarts)
@@ -121,7 +122,7 @@ module spline_case
     character(len=1) :: kind
     integer :: n
   end type field_t
-  integer, parameter :: nfields = 78
+  integer, parameter :: nfields = 79
   type(field_t), parameter :: fields(nfields) = [ &
        field_t('name', 'c', namelen), field_t('z', 'i', 1), field_t('module_m', 'r', 1), &
        field_t('alpha_deg', 'r', 1), field_t('b', 'r', 1), field_t('s', 'r', 1), &
@@ -138,7 +139,8 @@ module spline_case
        field_t('thermal', 'c', optlen), field_t('t_bulk', 'r', 1), field_t('f_m', 'r', 1), &
        field_t('u_flash', 'r', 1), field_t('eta_hertz', 'r', 1), field_t('method', 'c', optlen), &
        field_t('jacobian', 'c', optlen), field_t('nonlinear', 'c', optlen), &
-       field_t('roots', 'l', 1), field_t('stald', 'l', 1), field_t('rtol', 'r', 1), &
+       field_t('roots', 'l', 1), field_t('stald', 'l', 1), field_t('linear_tail', 'l', 1), &
+       field_t('rtol', 'r', 1), &
        field_t('atol', 'r', 1), field_t('max_steps', 'i', 1), field_t('max_total_steps', 'i', 1), &
        field_t('t0', 'r', 1), field_t('t_end', 'r', 1), field_t('t_transient', 'r', 1), &
        field_t('n_out', 'i', 1), field_t('start', 'c', optlen), field_t('dq0', 'r', ndof_case), &
@@ -1156,7 +1158,7 @@ contains
          speed_rpm, grav, l_x, l_y, t_bulk, f_m, u_flash, eta_hertz, rtol, atol, t0, t_end, &
          t_transient, dq0(ndof_case), dv0(ndof_case), l_ref, w_ref, fidelity_tol
     character(len=optlen) :: thermal, method, jacobian, nonlinear, start, fidelity, section
-    logical :: roots, stald, lyapunov
+    logical :: roots, stald, lyapunov, linear_tail
     real(wp) :: lyapunov_interval, lyapunov_d0
     logical :: fillet
     real(wp) :: fillet_radius, r_bore, r_rim, zeta_m, ripple_order(nripple), ripple_amp(nripple), &
@@ -1165,7 +1167,8 @@ contains
     namelist /spline_case/ name, z, module_m, alpha_deg, b, s, c0, e_mod, nu, lambda_th, k_cond, rho, c_heat, j_m, &
          j_l, j_1, j_2, m_1, m_2, k_p1, k_p2, c_p1, c_p2, k_t1, k_t2, c_t1, c_t2, k_m, c_m, t_d, &
          t_l, speed_rpm, grav, l_x, l_y, dof, thermal, t_bulk, f_m, u_flash, eta_hertz, method, &
-         jacobian, nonlinear, roots, stald, rtol, atol, max_steps, max_total_steps, t0, t_end, &
+         jacobian, nonlinear, roots, stald, linear_tail, rtol, atol, max_steps, max_total_steps, &
+         t0, t_end, &
          t_transient, n_out, start, dq0, dv0, l_ref, w_ref, fidelity, fidelity_tol, section, &
          lyapunov, lyapunov_interval, lyapunov_d0, fillet, fillet_radius, r_bore, r_rim, zeta_m, &
          ripple_order, ripple_amp, ripple_phase_deg, unbalance, unbalance_phase_deg, gamma_x, &
@@ -1178,7 +1181,8 @@ contains
     t_d = c%t_d; t_l = c%t_l; speed_rpm = c%speed_rpm; grav = c%grav; l_x = c%l_x; l_y = c%l_y
     dof = c%dof; thermal = c%thermal; t_bulk = c%t_bulk; f_m = c%f_m; u_flash = c%u_flash
     eta_hertz = c%eta_hertz; method = c%method; jacobian = c%jacobian; nonlinear = c%nonlinear
-    roots = c%roots; stald = c%stald; rtol = c%rtol; atol = c%atol; max_steps = c%max_steps
+    roots = c%roots; stald = c%stald; linear_tail = c%linear_tail; rtol = c%rtol; atol = c%atol
+    max_steps = c%max_steps
     max_total_steps = c%max_total_steps
     t0 = c%t0; t_end = c%t_end; t_transient = c%t_transient; n_out = c%n_out; start = c%start
     dq0 = c%dq0; dv0 = c%dv0; l_ref = c%l_ref; w_ref = c%w_ref; fidelity = c%fidelity
@@ -1208,7 +1212,8 @@ contains
     c%t_d = t_d; c%t_l = t_l; c%speed_rpm = speed_rpm; c%grav = grav; c%l_x = l_x
     c%l_y = l_y; c%dof = dof; c%thermal = thermal; c%t_bulk = t_bulk; c%f_m = f_m
     c%u_flash = u_flash; c%eta_hertz = eta_hertz; c%method = method; c%jacobian = jacobian
-    c%nonlinear = nonlinear; c%roots = roots; c%stald = stald; c%rtol = rtol; c%atol = atol
+    c%nonlinear = nonlinear; c%roots = roots; c%stald = stald; c%linear_tail = linear_tail
+    c%rtol = rtol; c%atol = atol
     c%max_steps = max_steps; c%max_total_steps = max_total_steps
     c%t0 = t0; c%t_end = t_end; c%t_transient = t_transient
     c%n_out = n_out; c%start = start; c%dq0 = dq0; c%dv0 = dv0; c%l_ref = l_ref

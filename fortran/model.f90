@@ -27,7 +27,7 @@ module spline_model
   integer, parameter :: stiffness_nquad = 32   !< Gauss points: converged to 1e-15 from 16 on
   !> Marks a model_t built by this build's constructor (layout version in the last digits):
   !> a copy handed back from outside is checked against it.
-  integer, parameter :: model_magic = 517730004
+  integer, parameter :: model_magic = 517730005
   !> A given k_m this many times below Eq. 18 draws a warning (model_warnings): the paper's
   !> calibrated 2.54e5 N/m is ~7600 times below for its spline, a deliberate fit; N/mm read
   !> as N/m is 1000 times, on top of such a fit 1e4 is passed.
@@ -49,6 +49,7 @@ module spline_model
     logical  :: newton = .true.             !< Newton + dense solver, else fixed-point iteration
     logical  :: roots = .false.
     logical  :: stald = .false.
+    logical  :: linear_tail = .true.        !< closed-form tail in proven full contact (spline_linear)
     real(wp) :: rtol, atol
     integer  :: max_steps, max_total_steps, n_out
     real(wp) :: t0, t_end, t_transient
@@ -111,7 +112,7 @@ contains
     m%rtol = c%rtol; m%atol = c%atol; m%max_steps = c%max_steps; m%n_out = c%n_out
     m%max_total_steps = c%max_total_steps
     m%t0 = c%t0; m%t_end = c%t_end; m%t_transient = c%t_transient
-    m%roots = c%roots; m%stald = c%stald; m%dq0 = c%dq0; m%dv0 = c%dv0
+    m%roots = c%roots; m%stald = c%stald; m%linear_tail = c%linear_tail; m%dq0 = c%dq0; m%dv0 = c%dv0
     m%dof = c%dof; m%fidelity_tol = c%fidelity_tol
     m%auto = option_index(fidelity_values, c%fidelity) == 2
     m%method_bdf = merge(1, 0, option_index(method_values, c%method) == 1)

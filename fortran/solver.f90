@@ -22,15 +22,16 @@ module spline_solver
   use spline_model, only: model_t, nstate, ndof, thermal_coupled
   use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, integrated_states
   use spline_mesh, only: mesh_switch_functions, coupling_stats_t
+  use spline_linear, only: tail_t, tail_possible, tail_try, tail_state
   implicit none
   private
   public :: integrate, nstats, stat_names
 
-  integer, parameter :: nstats = 12
+  integer, parameter :: nstats = 13
   character(len=24), parameter :: stat_names(nstats) = [character(len=24) :: &
        'steps', 'rhs_evals', 'jac_evals', 'lin_rhs_evals', 'err_test_fails', &
        'nonlin_conv_fails', 'roots_found', 'root_fn_evals', 'last_step_s', &
-       'mode_resyncs', 'coupling_residual_degC', 'coupling_iterations']
+       'mode_resyncs', 'coupling_residual_degC', 'coupling_iterations', 'linear_tail_t_s']
 
   !> Everything a run changes, owned by `integrate` and given to CVODE as user data.
   type :: solver_ctx_t
@@ -98,7 +99,7 @@ contains
     real(wp), intent(out), optional :: youtb(nstate, nt)
     type(solver_ctx_t), target :: ctx
     real(c_double), allocatable, target :: yr(:)
-    real(c_double) :: tau, tau_out, tau_to, tret(1), hlast(1)
+    real(c_double) :: tau, tau_out, tau_to, tret(1), hlast(1), tau_chk, dchk
     type(c_ptr) :: sunctx, mem
     type(N_Vector), pointer :: sv
     type(SUNMatrix), pointer :: amat
@@ -108,12 +109,14 @@ contains
     integer(c_int), allocatable :: rootsfound(:)
     integer :: k, k0, nroots, nresync, ks, nsec, nn, c
     integer(8) :: done, done_k, allow
-    logical :: total_bound
+    logical :: total_bound, use_tail
     character(len=40) :: stage
+    type(tail_t) :: tail
 
     ierr = err_ok
     errmsg = ''
     stats = 0.0_wp
+    stats(13) = -1.0_wp
     yout = 0.0_wp
     modes_out = 2
     ctx%m = m
@@ -213,9 +216,14 @@ contains
       flag = FCVodeRootInit(mem, nroot, c_funloc(roots_cb))
       if (flag == 0) flag = FCVodeSetNoInactiveRootWarn(mem)
     end if
+    use_tail = m%linear_tail .and. ctx%ncopy == 1 .and. tail_possible(m)
+    ! the tail is also tried between outputs (the transient): each quarter shaft revolution
+    dchk = huge(1.0_c_double)
+    if (m%omega > 0.0_wp) dchk = 0.5_wp*acos(-1.0_wp)*m%w_ref/m%omega
+    tau_chk = tau + dchk
     if (flag /= 0) then
       call fail(flag, tau, trim(stage))
-    else
+    else if (.not. tailed(0)) then
       outputs: do k = 1, nt
         tau_out = tout(k)*m%w_ref
         done_k = steps_done()
@@ -232,6 +240,7 @@ contains
           end if
           tau_to = tau_out
           if (ks <= nsec) tau_to = min(tau_out, real(tsec(ks)*m%w_ref, c_double))
+          if (use_tail) tau_to = min(tau_to, tau_chk)
           flag = FCVodeSetMaxNumSteps(mem, int(allow, c_long))
           if (flag == 0) flag = FCVode(mem, tau_to, sv, tret, CV_NORMAL)
           if (flag == CV_TOO_MUCH_WORK) then
@@ -248,6 +257,10 @@ contains
               call from_scaled(m, copy_state(ctx, yr, 1), ysec(:, ks))
               ks = ks + 1
             end if
+          end if
+          if (use_tail .and. tau >= tau_chk .and. flag /= CV_ROOT_RETURN) then
+            tau_chk = tau_chk + dchk
+            if (tailed(k - 1)) exit outputs
           end if
           if (flag == CV_ROOT_RETURN) then
             ! Step onto the switch, flip the states of the teeth that crossed, restart.
@@ -277,6 +290,7 @@ contains
         call from_scaled(m, copy_state(ctx, yr, 1), yout(:, k))
         if (present(youtb)) call from_scaled(m, copy_state(ctx, yr, 2), youtb(:, k))
         if (ctx%frozen) modes_out(:, k) = ctx%modes(:, 1)
+        if (k < nt .and. tailed(k)) exit outputs
       end do outputs
     end if
 
@@ -298,6 +312,29 @@ contains
     flag = FSUNContext_Free(sunctx)
 
   contains
+
+    !> The linear tail tried at tau, after output k0: if it holds, outputs k0+1..nt and the
+    !> sections not yet reached are the closed-form solution.
+    logical function tailed(k0)
+      integer, intent(in) :: k0
+      real(c_double) :: yt(nstate)
+      integer :: j
+      tailed = .false.
+      if (.not. use_tail) return
+      tailed = tail_try(tail, m, ctx%idx, nn, tau, copy_state(ctx, yr, 1))
+      if (.not. tailed) return
+      stats(13) = tau/m%w_ref
+      do j = k0 + 1, nt
+        call tail_state(tail, tout(j)*m%w_ref, yt)
+        call from_scaled(m, yt, yout(:, j))
+        if (ctx%frozen) modes_out(:, j) = tail%flank
+      end do
+      do j = ks, nsec
+        call tail_state(tail, tsec(j)*m%w_ref, yt)
+        call from_scaled(m, yt, ysec(:, j))
+      end do
+      ks = nsec + 1
+    end function tailed
 
     !> CVODE steps taken so far in this run (over all restarts).
     integer(8) function steps_done() result(n)

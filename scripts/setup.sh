@@ -17,7 +17,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
 need=()
-for pkg in gfortran libsundials-dev libsundials-fortran-dev cmake; do
+for pkg in gfortran libsundials-dev libsundials-fortran-dev liblapack-dev libblas-dev cmake; do
   dpkg -s "$pkg" >/dev/null 2>&1 || need+=("$pkg")
 done
 if [ ${#need[@]} -gt 0 ]; then

@@ -1,0 +1,201 @@
+!> The linear tail (docs/model.md section 13). With every tooth pair in contact on the same flank,
+!> the mesh of Eqs. 15-17 and 19-22 is a linear, isotropic spring: for Z >= 3,
+!> sum_j sin^2(phi_j) = sum_j cos^2(phi_j) = Z/2 and sum_j sin(phi_j) cos(phi_j) = 0 (Eqs. 8-9),
+!> whatever the shaft angle. Without torque ripple, unbalance, the coupled flash temperature
+!> (Eqs. 1-7 fed back) or face slices, the scaled system of Eq. 25 is then affine and
+!> time-invariant, ys' = A ys + b, and its solution is known in closed form:
+!>   ys(tau) = y* + Re sum_k v_k c_k exp(lambda_k (tau - tau_0)),  A y* + b = 0,
+!> with (lambda_k, v_k) the eigenpairs of A and c = V^-1 (ys(tau_0) - y*).
+!>
+!> The tail is used only where it is proven to hold for the rest of the run (tail_try), not
+!> guessed: every tooth j stays in contact on flank s (Eq. 16: s dn_j > c) if
+!>   s D2(tau) - c - |e(tau)| > 0,  e = (x1 + l_x - x2, y1 + l_y - y2),
+!> because dn_j = e_x sin(phi_j) - e_y cos(phi_j) + D2 (Eq. 11) and |e_x sin - e_y cos| <= |e|.
+!> With all Re(lambda_k) < 0 each modal term only shrinks, so for all tau >= tau_0
+!>   |D2(tau) - D2*| <= sum_k |v_6k| |c_k|,  |e(tau) - e*| <= sum_k |(v_1k - v_3k, v_2k - v_4k)| |c_k|,
+!> and the condition holds for ever if s D2* - c - |e*| exceeds these bounds (with a margin for
+!> the round-off of the eigenvectors). A is built from the right-hand side itself (rhs_scaled
+!> with the contact states frozen on flank s), one column per unit step: exact for an affine map;
+!> the map is checked to be affine and time-invariant at a second state and time before use.
+module spline_linear
+  use spline_kinds, only: wp
+  use spline_model, only: model_t, nstate, ndof, thermal_coupled
+  use spline_dynamics, only: rhs_scaled, from_scaled
+  use spline_mesh, only: mesh_switch_functions
+  implicit none
+  private
+  public :: tail_t, tail_possible, tail_try, tail_state
+
+  !> The closed-form tail of one run (held by the solver's context).
+  type :: tail_t
+    logical :: off = .false.           !< not possible in this run (never tried again)
+    integer :: flank = 0               !< flank of the system built (+1, -1; 0: none yet)
+    integer :: n = 0                   !< integrated states (ys_full(idx(1:n)))
+    integer :: idx(nstate) = 0
+    complex(wp), allocatable :: lam(:), v(:, :), w(:, :), c(:)
+    real(wp), allocatable :: ystar(:)  !< y* over the integrated states (scaled, Eq. 25)
+    real(wp) :: held(nstate) = 0.0_wp  !< the full scaled state (its held entries at dof 3)
+    real(wp) :: tau0 = 0.0_wp          !< scaled time the tail starts at
+  end type tail_t
+
+  interface
+    subroutine zgeev(jobvl, jobvr, n, a, lda, w, vl, ldvl, vr, ldvr, work, lwork, rwork, info)
+      import :: wp
+      character, intent(in) :: jobvl, jobvr
+      integer, intent(in) :: n, lda, ldvl, ldvr, lwork
+      complex(wp), intent(inout) :: a(lda, *)
+      complex(wp), intent(out) :: w(*), vl(ldvl, *), vr(ldvr, *), work(*)
+      real(wp), intent(out) :: rwork(*)
+      integer, intent(out) :: info
+    end subroutine zgeev
+    subroutine zgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
+      import :: wp
+      integer, intent(in) :: n, nrhs, lda, ldb
+      complex(wp), intent(inout) :: a(lda, *), b(ldb, *)
+      integer, intent(out) :: ipiv(*), info
+    end subroutine zgesv
+  end interface
+
+contains
+
+  !> Whether the model's right-hand side can be affine and time-invariant in full contact:
+  !> the case allows it (linear_tail), Z >= 3, no face slices, no coupled flash temperature,
+  !> no torque ripple, no unbalance.
+  pure logical function tail_possible(m)
+    type(model_t), intent(in) :: m
+    tail_possible = m%linear_tail .and. m%z >= 3 .and. m%n_slices == 1 .and. &
+         m%thermal /= thermal_coupled .and. m%n_ripple == 0 .and. all(m%unbalance == 0.0_wp)
+  end function tail_possible
+
+  !> Try to start the tail at scaled time tau from the full scaled state ys (integrated states
+  !> idx(1:n)): .true. if every tooth is in contact on one flank and stays there for ever
+  !> (the bound above). Builds the system of a flank on its first use; a failure to build it
+  !> (not affine, not asymptotically stable, eigenvectors near defective, LAPACK) turns the
+  !> tail off for the run.
+  logical function tail_try(tl, m, idx, n, tau, ys) result(ok)
+    type(tail_t), intent(inout) :: tl
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: idx(nstate), n
+    real(wp), intent(in) :: tau, ys(nstate)
+    real(wp) :: y(nstate), g(2*m%z), cs, q6, ex, ey, b6, bu, z(n)
+    complex(wp) :: a1, a2, a3, a4, a6
+    integer :: s, k
+    ok = .false.
+    if (tl%off) return
+    call from_scaled(m, ys, y)
+    call mesh_switch_functions(m, tau/m%w_ref, y(1:ndof), g)   ! g(2j-1) = dn_j - c, g(2j) = dn_j + c
+    if (all(g(1::2) > 0.0_wp)) then
+      s = 1
+    else if (all(g(2::2) < 0.0_wp)) then
+      s = -1
+    else
+      return
+    end if
+    if (s /= tl%flank) then
+      call build(tl, m, idx, n, tau, ys, s)
+      if (tl%off) return
+    end if
+    tl%held = ys
+    z = ys(idx(1:n)) - tl%ystar
+    tl%c = matmul(tl%w, cmplx(z, 0.0_wp, wp))
+    ! the equilibrium's margin and the bound on the motion about it
+    tl%held(idx(1:n)) = tl%ystar
+    cs = m%c_bulk/m%l_ref
+    q6 = tl%held(6)
+    ex = tl%held(1) - tl%held(3) + m%l_x/m%l_ref
+    ey = tl%held(2) - tl%held(4) + m%l_y/m%l_ref
+    b6 = 0.0_wp; bu = 0.0_wp
+    do k = 1, n
+      a1 = row(1, k); a2 = row(2, k); a3 = row(3, k); a4 = row(4, k); a6 = row(6, k)
+      b6 = b6 + abs(a6*tl%c(k))
+      bu = bu + sqrt(abs(a1 - a3)**2 + abs(a2 - a4)**2)*abs(tl%c(k))
+    end do
+    tl%held = ys
+    ok = s*q6 - cs - hypot(ex, ey) - 1.01_wp*(b6 + bu) > 1.0e-9_wp*(abs(q6) + cs)
+    if (ok) tl%tau0 = tau
+  contains
+    !> Row i of the full state in eigenvector k (0 for a held state).
+    complex(wp) function row(i, k)
+      integer, intent(in) :: i, k
+      integer :: p
+      row = (0.0_wp, 0.0_wp)
+      do p = 1, n
+        if (idx(p) == i) row = tl%v(p, k)
+      end do
+    end function row
+  end function tail_try
+
+  !> The system of flank s: A by unit steps of rhs_scaled with every contact frozen on s, checked
+  !> affine and time-invariant; y*; the eigenpairs of A and V^-1.
+  subroutine build(tl, m, idx, n, tau, ys, s)
+    type(tail_t), intent(inout) :: tl
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: idx(nstate), n, s
+    real(wp), intent(in) :: tau, ys(nstate)
+    real(wp) :: a(n, n), f0(nstate), f1(nstate), y1(nstate), d(n), scale, rwork(2*n)
+    complex(wp) :: ac(n, n), vl(1, 1), work(4*n), vr(n, n), winv(n, n), lam(n), am(n, n)
+    integer :: mode(m%z), k, ierr, info, ipiv(n)
+    character(len=256) :: msg
+    tl%off = .true.
+    tl%flank = s
+    tl%n = n
+    tl%idx = idx
+    mode = s
+    msg = ''
+    call rhs_scaled(m, tau, ys, f0, ierr, msg, mode=mode)
+    if (ierr /= 0) return
+    do k = 1, n
+      y1 = ys
+      y1(idx(k)) = y1(idx(k)) + 1.0_wp
+      call rhs_scaled(m, tau, y1, f1, ierr, msg, mode=mode)
+      if (ierr /= 0) return
+      a(:, k) = f1(idx(1:n)) - f0(idx(1:n))
+    end do
+    ! affine and time-invariant: a second state at a second time
+    y1 = ys
+    do k = 1, n
+      d(k) = 0.1_wp*(1.0_wp + abs(ys(idx(k))))*merge(1.0_wp, -1.0_wp, mod(k, 2) == 0)
+      y1(idx(k)) = ys(idx(k)) + d(k)
+    end do
+    call rhs_scaled(m, tau + 0.37_wp, y1, f1, ierr, msg, mode=mode)
+    if (ierr /= 0) return
+    scale = maxval(abs(f0(idx(1:n)))) + maxval(abs(matmul(abs(a), abs(d))))
+    if (maxval(abs(f1(idx(1:n)) - f0(idx(1:n)) - matmul(a, d))) > 1.0e-10_wp*scale) return
+    ! eigenpairs (LAPACK), asymptotic stability, V^-1
+    ac = cmplx(a, 0.0_wp, wp)
+    call zgeev('N', 'V', n, ac, n, lam, vl, 1, vr, n, work, size(work), rwork, info)
+    if (info /= 0) return
+    if (.not. maxval(real(lam)) < -1.0e-9_wp*maxval(abs(lam))) return
+    am = vr
+    winv = (0.0_wp, 0.0_wp)
+    do k = 1, n
+      winv(k, k) = (1.0_wp, 0.0_wp)
+    end do
+    call zgesv(n, n, am, n, ipiv, winv, n, info)
+    if (info /= 0) return
+    ! near-defective eigenvectors: V^-1 V far from I means c = V^-1 z cannot be trusted
+    am = matmul(winv, vr)
+    do k = 1, n
+      am(k, k) = am(k, k) - 1.0_wp
+    end do
+    if (maxval(abs(am)) > 1.0e-8_wp) return
+    ! y* = ys - A^-1 f(ys): solve with the eigenpairs (A = V diag(lam) V^-1)
+    tl%ystar = ys(idx(1:n)) - real(matmul(vr, matmul(winv, cmplx(f0(idx(1:n)), 0.0_wp, wp))/lam))
+    if (allocated(tl%lam)) deallocate(tl%lam, tl%v, tl%w, tl%c)
+    allocate(tl%lam(n), tl%v(n, n), tl%w(n, n), tl%c(n))
+    tl%lam = lam
+    tl%v = vr
+    tl%w = winv
+    tl%off = .false.
+  end subroutine build
+
+  !> The full scaled state of the tail at scaled time tau (>= its start).
+  subroutine tail_state(tl, tau, ys)
+    type(tail_t), intent(in) :: tl
+    real(wp), intent(in) :: tau
+    real(wp), intent(out) :: ys(nstate)
+    ys = tl%held
+    ys(tl%idx(1:tl%n)) = tl%ystar + real(matmul(tl%v, tl%c*exp(tl%lam*(tau - tl%tau0))))
+  end subroutine tail_state
+
+end module spline_linear
