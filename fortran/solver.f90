@@ -81,6 +81,11 @@ contains
   !> so that the difference of the two carries no independent solver noise (Benettin's method,
   !> spline_run::lyapunov_benettin); youtb(:, k) its state at tout(k). Contact switches of either
   !> copy are located (root finding) and restart both.
+  !> The linear tail (spline_linear): a single copy whose case allows it is tried at the start,
+  !> after every output and, without root finding, each quarter shaft revolution between them
+  !> (CV_NORMAL returns on CVODE's interpolant: the steps stay as they are). Once every tooth
+  !> is proven to stay in contact on one flank for ever, the remaining outputs and sections are
+  !> the closed-form solution, and stats(13) holds the time the tail began (-1: not used).
   subroutine integrate(m, y0, nt, tout, yout, modes_out, stats, ierr, errmsg, interruptible, &
        tsec, ysec, y0b, youtb)
     type(model_t), intent(in) :: m
@@ -109,7 +114,7 @@ contains
     integer(c_int), allocatable :: rootsfound(:)
     integer :: k, k0, nroots, nresync, ks, nsec, nn, c
     integer(8) :: done, done_k, allow
-    logical :: total_bound, use_tail
+    logical :: total_bound, use_tail, fresh
     character(len=40) :: stage
     type(tail_t) :: tail
 
@@ -221,6 +226,7 @@ contains
     dchk = huge(1.0_c_double)
     if (m%omega > 0.0_wp) dchk = 0.5_wp*acos(-1.0_wp)*m%w_ref/m%omega
     tau_chk = tau + dchk
+    fresh = .true.
     if (flag /= 0) then
       call fail(flag, tau, trim(stage))
     else if (.not. tailed(0)) then
@@ -240,7 +246,16 @@ contains
           end if
           tau_to = tau_out
           if (ks <= nsec) tau_to = min(tau_out, real(tsec(ks)*m%w_ref, c_double))
-          if (use_tail) tau_to = min(tau_to, tau_chk)
+          ! (not with root finding: a return starts CVODE's next root search there; not on a
+          ! first call after CVodeInit/ReInit, whose tout sets CVODE's initial step, unless tout
+          ! is more than 4 revolutions away. So a run that never takes the tail keeps the steps
+          ! it has with linear_tail off, unless it starts with such a long output interval.)
+          if (use_tail .and. .not. ctx%frozen) then
+            do while (tau_chk <= tau)
+              tau_chk = tau_chk + dchk
+            end do
+            if (.not. fresh .or. tau_to - tau > 16*dchk) tau_to = min(tau_to, tau_chk)
+          end if
           flag = FCVodeSetMaxNumSteps(mem, int(allow, c_long))
           if (flag == 0) flag = FCVode(mem, tau_to, sv, tret, CV_NORMAL)
           if (flag == CV_TOO_MUCH_WORK) then
@@ -252,6 +267,7 @@ contains
             exit outputs
           end if
           tau = tret(1)
+          fresh = .false.
           if (ks <= nsec) then
             if (tau >= tsec(ks)*m%w_ref) then     ! returned at the section instant
               call from_scaled(m, copy_state(ctx, yr, 1), ysec(:, ks))
@@ -348,6 +364,7 @@ contains
     logical function restarted(what)
       character(len=*), intent(in) :: what
       call add_counters(ctx, mem, stats)
+      fresh = .true.
       flag = FCVodeReInit(mem, tau, sv)
       restarted = flag == 0
       if (.not. restarted) call fail(flag, tau, what)
