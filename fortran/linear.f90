@@ -34,6 +34,9 @@ module spline_linear
     integer :: idx(nstate) = 0
     complex(wp), allocatable :: lam(:), v(:, :), w(:, :), c(:)
     real(wp), allocatable :: ystar(:)  !< y* over the integrated states (scaled, Eq. 25)
+    !> what mode k can move D2 and |e| by per unit |c_k|: |v_6k| + |(v_1k - v_3k, v_2k - v_4k)|
+    real(wp), allocatable :: weight(:)
+    real(wp) :: margin = 0.0_wp        !< s D2* - c - |e*| at the equilibrium, less the round-off
     real(wp) :: held(nstate) = 0.0_wp  !< the full scaled state (its held entries at dof 3)
     real(wp) :: tau0 = 0.0_wp          !< scaled time the tail starts at
   end type tail_t
@@ -77,9 +80,8 @@ contains
     type(model_t), intent(in) :: m
     integer, intent(in) :: idx(nstate), n
     real(wp), intent(in) :: tau, ys(nstate)
-    real(wp) :: y(nstate), g(2*m%z), cs, q6, ex, ey, b6, bu, z(n)
-    complex(wp) :: a1, a2, a3, a4, a6
-    integer :: s, k
+    real(wp) :: y(nstate), g(2*m%z), z(n)
+    integer :: s
     ok = .false.
     if (tl%off) return
     call from_scaled(m, ys, y)
@@ -95,34 +97,14 @@ contains
       call build(tl, m, idx, n, tau, ys, s)
       if (tl%off) return
     end if
-    tl%held = ys
+    ! the motion about the equilibrium, bounded mode by mode, against the equilibrium's margin
     z = ys(idx(1:n)) - tl%ystar
     tl%c = matmul(tl%w, cmplx(z, 0.0_wp, wp))
-    ! the equilibrium's margin and the bound on the motion about it
-    tl%held(idx(1:n)) = tl%ystar
-    cs = m%c_bulk/m%l_ref
-    q6 = tl%held(6)
-    ex = tl%held(1) - tl%held(3) + m%l_x/m%l_ref
-    ey = tl%held(2) - tl%held(4) + m%l_y/m%l_ref
-    b6 = 0.0_wp; bu = 0.0_wp
-    do k = 1, n
-      a1 = row(1, k); a2 = row(2, k); a3 = row(3, k); a4 = row(4, k); a6 = row(6, k)
-      b6 = b6 + abs(a6*tl%c(k))
-      bu = bu + sqrt(abs(a1 - a3)**2 + abs(a2 - a4)**2)*abs(tl%c(k))
-    end do
-    tl%held = ys
-    ok = s*q6 - cs - hypot(ex, ey) - 1.01_wp*(b6 + bu) > 1.0e-9_wp*(abs(q6) + cs)
-    if (ok) tl%tau0 = tau
-  contains
-    !> Row i of the full state in eigenvector k (0 for a held state).
-    complex(wp) function row(i, k)
-      integer, intent(in) :: i, k
-      integer :: p
-      row = (0.0_wp, 0.0_wp)
-      do p = 1, n
-        if (idx(p) == i) row = tl%v(p, k)
-      end do
-    end function row
+    ok = tl%margin - 1.01_wp*sum(tl%weight*abs(tl%c)) > 0.0_wp
+    if (ok) then
+      tl%tau0 = tau
+      tl%held = ys
+    end if
   end function tail_try
 
   !> The system of flank s: A by unit steps of rhs_scaled with every contact frozen on s, checked
@@ -132,8 +114,9 @@ contains
     type(model_t), intent(in) :: m
     integer, intent(in) :: idx(nstate), n, s
     real(wp), intent(in) :: tau, ys(nstate)
-    real(wp) :: a(n, n), f0(nstate), f1(nstate), y1(nstate), d(n), scale, rwork(2*n)
-    complex(wp) :: ac(n, n), vl(1, 1), work(4*n), vr(n, n), winv(n, n), lam(n), am(n, n)
+    real(wp) :: a(n, n), f0(nstate), f1(nstate), y1(nstate), d(n), scale, rwork(2*n), cs
+    complex(wp) :: ac(n, n), vl(1, 1), work(4*n), vr(n, n), winv(n, n), lam(n), am(n, n), &
+         vf(nstate, n)
     integer :: mode(m%z), k, ierr, info, ipiv(n)
     character(len=256) :: msg
     tl%off = .true.
@@ -181,8 +164,16 @@ contains
     if (maxval(abs(am)) > 1.0e-8_wp) return
     ! y* = ys - A^-1 f(ys): solve with the eigenpairs (A = V diag(lam) V^-1)
     tl%ystar = ys(idx(1:n)) - real(matmul(vr, matmul(winv, cmplx(f0(idx(1:n)), 0.0_wp, wp))/lam))
-    if (allocated(tl%lam)) deallocate(tl%lam, tl%v, tl%w, tl%c)
-    allocate(tl%lam(n), tl%v(n, n), tl%w(n, n), tl%c(n))
+    ! the bound's constants (module comment): the equilibrium's margin on flank s and each
+    ! mode's reach in D2 and e (vf: the eigenvectors over the full state, 0 on a held state)
+    y1 = ys
+    y1(idx(1:n)) = tl%ystar
+    cs = m%c_bulk/m%l_ref
+    tl%margin = s*y1(6) - cs - hypot(y1(1) - y1(3) + m%l_x/m%l_ref, y1(2) - y1(4) + m%l_y/m%l_ref) &
+         - 1.0e-9_wp*(abs(y1(6)) + cs)
+    vf = (0.0_wp, 0.0_wp)
+    vf(idx(1:n), :) = vr
+    tl%weight = abs(vf(6, :)) + sqrt(abs(vf(1, :) - vf(3, :))**2 + abs(vf(2, :) - vf(4, :))**2)
     tl%lam = lam
     tl%v = vr
     tl%w = winv

@@ -17,7 +17,7 @@ module spline_solver
   use fsunlinsol_dense_mod
   use fsundials_nonlinearsolver_mod
   use fsunnonlinsol_fixedpoint_mod
-  use spline_kinds, only: wp
+  use spline_kinds, only: wp, pi
   use spline_errors, only: err_ok, err_solver, err_interrupted, msglen
   use spline_model, only: model_t, nstate, ndof, thermal_coupled
   use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, integrated_states
@@ -221,10 +221,10 @@ contains
       flag = FCVodeRootInit(mem, nroot, c_funloc(roots_cb))
       if (flag == 0) flag = FCVodeSetNoInactiveRootWarn(mem)
     end if
-    use_tail = m%linear_tail .and. ctx%ncopy == 1 .and. tail_possible(m)
+    use_tail = ctx%ncopy == 1 .and. tail_possible(m)
     ! the tail is also tried between outputs (the transient): each quarter shaft revolution
     dchk = huge(1.0_c_double)
-    if (m%omega > 0.0_wp) dchk = 0.5_wp*acos(-1.0_wp)*m%w_ref/m%omega
+    if (m%omega > 0.0_wp) dchk = 0.5_wp*pi*m%w_ref/m%omega
     tau_chk = tau + dchk
     fresh = .true.
     if (flag /= 0) then
