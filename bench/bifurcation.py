@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 import pyspline
-from pyspline.sweep import _chunk_size
+from pyspline.sweep import chunk_size
 from pyspline.paper import cases_dir
 from speed import _write_csv
 
@@ -185,7 +185,7 @@ def main(args) -> int:
                         ex = started[label] if blocks > 1 else _start(label, this_run)
                         t0 = time.perf_counter()
                         part = pyspline.sweep(case, executor=ex, progress=False, l_x=values,
-                                              chunk=_chunk_size(ex, n))
+                                              chunk=chunk_size(ex, n))
                         wall[label][rep] += time.perf_counter() - t0
                     failed[label] += int(part.attrs.get("n_failed", 0))
                     if blocks == 1 and label == "serial" and ds is None:

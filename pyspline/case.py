@@ -104,11 +104,18 @@ class Case(Mapping):
     ``case.model`` is the case loaded into the core (built once, on first use)."""
 
     def __init__(self, fields: Mapping, name: str | None = None, source: str | None = None):
-        base = defaults()
-        merged = dict(base)
         label = name or fields.get("name") or "unnamed"
-        if not isinstance(label, str):
-            label = repr(label)[:40]
+        self._fields = dict(defaults())
+        self.source = source
+        self._model = None
+        self._update(fields, label if isinstance(label, str) else repr(label)[:40])
+        if name is not None and "name" not in {k.lower() for k in fields}:
+            self._fields["name"] = name
+            self._check_name()
+
+    def _update(self, fields: Mapping, label: str) -> None:
+        """Check and set `fields` (the others were checked when they were set)."""
+        base = defaults()
         for key, value in fields.items():
             if not isinstance(key, str):
                 raise CaseError(f"case {label}: a field name must be a string, not {key!r:.40}")
@@ -118,15 +125,13 @@ class Case(Mapping):
                 raise CaseError(f"case {label}: unknown field '{key}'"
                                 + (f": did you mean {hint}?" if hint else
                                    " (see cases/template.nml or pyspline.defaults() for the fields)"))
-            merged[k] = _coerce(label, k, value, base[k])
-        if name is not None and "name" not in {k.lower() for k in fields}:
-            merged["name"] = name
-        if len(merged["name"].encode()) > NAME_BYTES:
-            raise CaseError(f"case {merged['name'][:40]}...: field name is longer than "
+            self._fields[k] = _coerce(label, k, value, base[k])
+        self._check_name()
+
+    def _check_name(self) -> None:
+        if len(self._fields["name"].encode()) > NAME_BYTES:
+            raise CaseError(f"case {self._fields['name'][:40]}...: field name is longer than "
                             f"{NAME_BYTES} bytes (UTF-8)")
-        self._fields = merged
-        self.source = source
-        self._model = None
 
     # Mapping protocol
     def __getitem__(self, key):
@@ -155,8 +160,11 @@ class Case(Mapping):
 
     def replace(self, **changes) -> "Case":
         """A copy with some fields changed, e.g. ``case.replace(l_x=5e-5, name='lx5e-5')``."""
-        fields = {**self._fields, **changes}
-        return Case(fields, source=self.source)
+        new = Case.__new__(Case)
+        new._fields, new.source, new._model = dict(self._fields), self.source, None
+        new._update(changes, changes.get("name") if isinstance(changes.get("name"), str)
+                    else self.name)
+        return new
 
     def changed(self) -> dict:
         """The fields that differ from the defaults (what a case file needs to say)."""

@@ -33,8 +33,8 @@ from .case import Case, defaults, load_case
 from .core import STATE_NAMES
 from .errors import CaseError, SplineError
 
-__all__ = ["DASK_SWEEP_CONFIG", "local_dask_client", "open_sweep", "parse_values", "point_cases",
-           "run_point", "summarise", "sweep", "sweep_figures", "write_netcdf"]
+__all__ = ["DASK_SWEEP_CONFIG", "chunk_size", "local_dask_client", "open_sweep", "parse_values",
+           "point_cases", "run_point", "summarise", "sweep", "sweep_figures", "write_netcdf"]
 
 #: Bump when the content of a point summary changes: older point files are then recomputed.
 #: 2: the default Benettin separation (lyapunov_d0 = 0: 1e4 rtol, was 1e-8) changed exponents.
@@ -294,10 +294,20 @@ def run_point(case: Case, options: dict) -> dict:
         return s
 
 
-def run_points(cases: list, options: dict) -> list:
+class PointSummaries:
+    """The summaries of a chunk of points, as one object. Dask sends it back as one pickle
+    (its arrays as out-of-band buffers); a bare list of dicts of arrays it walks item by item,
+    which cost 7-11 ms per task of 15 points, as much as two of the points themselves."""
+    __slots__ = ("items",)
+
+    def __init__(self, items: list):
+        self.items = items
+
+
+def run_points(cases: list, options: dict) -> PointSummaries:
     """A chunk of sweep points as one task (fewer round trips through a process pool or a
     Dask scheduler): run_point for each."""
-    return [run_point(case, options) for case in cases]
+    return PointSummaries([run_point(case, options) for case in cases])
 
 
 #: Dask settings for a cluster that runs long CPU-bound sweep tasks on a few cores, where every
@@ -307,13 +317,19 @@ def run_points(cases: list, options: dict) -> list:
 #: equal chunks handed out as workers free up), the system and memory monitors (each 500 and
 #: 100 ms; a point holds a few MB), and the event-loop health check of the scheduler and of every
 #: worker (each 20 ms: most of an idle cluster's CPU, and a wake-up that preempts a run; a loop
-#: blocked for 3 s is still reported).
+#: blocked for 3 s is still reported). Last, the worker processes' malloc: the nanny sets
+#: MALLOC_TRIM_THRESHOLD_=64 KiB, which also turns off glibc's adaptive mmap threshold, so every
+#: block over 128 KiB a run allocates (its outputs, CVODE's memory) is mapped anew and faulted in,
+#: page by page: 0.6-0.8 ms a point, a sixth of its cost. A point's memory is a few MB, so
+#: keeping up to 64 MiB of free heap per worker costs nothing.
 DASK_SWEEP_CONFIG = {
     "distributed.worker.profile.enabled": False,
     "distributed.scheduler.work-stealing": False,
     "distributed.admin.system-monitor.interval": "2s",
     "distributed.worker.memory.monitor-interval": "1s",
     "distributed.admin.tick.interval": "1s",
+    "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": 64 << 20,
+    "distributed.nanny.pre-spawn-environ.MALLOC_MMAP_THRESHOLD_": 32 << 20,
 }
 
 
@@ -338,13 +354,28 @@ def local_dask_client(n_workers: int = 2, processes: bool = False, **kwargs):
         return Client(**options)
 
 
-def _chunk_size(executor, n: int) -> int:
-    """Points per task: 1 in this process or on threads (no transfer to amortise); on
-    processes and Dask, about 64 tasks per sweep (at most 32 points each), so that the
-    per-task cost of the pool or the scheduler is paid rarely but the load still balances."""
+def _workers(executor) -> int:
+    """How many tasks `executor` runs at once: a process pool's workers, a Dask client's threads
+    (at the time of the call), else 2."""
+    if isinstance(executor, cf.ProcessPoolExecutor):
+        return executor._max_workers
+    client = getattr(executor, "_client", None)        # distributed.client.ClientExecutor
+    if client is not None:
+        try:
+            return max(1, sum(client.nthreads().values()))
+        except Exception:                  # noqa: BLE001 -- a guess is enough here
+            pass
+    return 2
+
+
+def chunk_size(executor, n: int) -> int:
+    """Points per task for `n` points on `executor`: 1 in this process or on threads (nothing to
+    amortise); on processes and Dask, at most 32 points, and at least 8 tasks per worker so that
+    the workers finish together (a task's cost, 5-10 ms on Dask, is then paid once per 32 points
+    of a large sweep, while a small sweep or a large cluster gets one point per task)."""
     if executor is None or isinstance(executor, cf.ThreadPoolExecutor):
         return 1
-    return max(1, min(32, n // 64))
+    return max(1, min(32, n // (8 * _workers(executor))))
 
 
 # --------------------------------------------------------------------------- files
@@ -529,8 +560,8 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     executor : None (serial, in this process) or a concurrent.futures.Executor
         (ThreadPoolExecutor, ProcessPoolExecutor, ``distributed.Client(...).get_executor()``).
         The caller keeps ownership: it is not shut down here.
-    chunk : points per task (default: 1 serially or on threads; on processes and Dask about
-        64 tasks per sweep, at most 32 points each, to amortise the per-task cost).
+    chunk : points per task (default `chunk_size`: 1 serially or on threads; on processes and
+        Dask at most 32, and at least 8 tasks per worker).
     progress : bool, tqdm progress bar on stderr.
     out : directory or None. Each finished point is written to ``out/points/`` at once; the
         merge goes to ``out/sweep.nc`` (NetCDF-4, h5netcdf), also when the sweep is stopped by
@@ -631,7 +662,7 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     futures, bar = {}, None
     try:
         if executor is not None:       # before the bar's thread: a fork pool forks here
-            size = chunk or _chunk_size(executor, len(todo))
+            size = chunk or chunk_size(executor, len(todo))
             chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
             futures = {executor.submit(run_points, [cases[i] for i in ch], options): ch
                        for ch in chunks}
@@ -660,7 +691,7 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
                         summaries[index] = s
                         executor_errors += 1
                     else:
-                        record(index, fut.result()[k])
+                        record(index, fut.result().items[k])
                     failed += bool(summaries[index]["error"])
                 bar.update(len(chunk_indices))
                 bar.set_postfix(failed=failed, refresh=False)
@@ -672,7 +703,7 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
                 if fut.done() and not fut.cancelled() and fut.exception() is None:
                     for k, index in enumerate(chunk_indices):
                         if index not in summaries:
-                            record(index, fut.result()[k])
+                            record(index, fut.result().items[k])
             except BaseException:              # noqa: BLE001 -- keep the original exception
                 pass
         if bar is not None:

@@ -228,10 +228,15 @@ def test_dask_executor(case, processes):
         ticks.append(client.run_on_scheduler(
             lambda dask_scheduler: dask_scheduler.periodic_callbacks["tick"].callback_time))
         assert ticks == [1000] * 3
+        if processes:    # malloc keeps freed blocks for the next run (DASK_SWEEP_CONFIG)
+            env = client.run(lambda: {k: os.environ.get(k) for k in (
+                "MALLOC_TRIM_THRESHOLD_", "MALLOC_MMAP_THRESHOLD_")})
+            assert list(env.values()) == [{"MALLOC_TRIM_THRESHOLD_": str(64 << 20),
+                                           "MALLOC_MMAP_THRESHOLD_": str(32 << 20)}] * 2
 
-        def run():
+        def run():      # chunks of 3 and 1 points: each summary must reach its own point
             box["ds"] = pyspline.sweep(case, executor=client.get_executor(), progress=False,
-                                       l_x=LX)
+                                       l_x=LX, chunk=3)
 
         worker = threading.Thread(target=run, daemon=True)
         worker.start()
@@ -239,6 +244,19 @@ def test_dask_executor(case, processes):
         assert not worker.is_alive(), "the Dask sweep did not finish in 180 s"
     assert box["ds"].attrs["n_ok"] == 4
     _same(serial, box["ds"])
+
+
+def test_chunk_size():
+    """One point a task where nothing is amortised; else at most 32 points and at least 8 tasks
+    per worker, so a large pool gets single points."""
+    chunk_size = sw.chunk_size
+    assert chunk_size(None, 1000) == 1
+    with cf.ThreadPoolExecutor(2) as threads:
+        assert chunk_size(threads, 1000) == 1
+    with cf.ProcessPoolExecutor(2) as procs:
+        assert [chunk_size(procs, n) for n in (10, 61, 160, 1000)] == [1, 3, 10, 32]
+    with cf.ProcessPoolExecutor(64) as procs:
+        assert chunk_size(procs, 1000) == 1
 
 
 # --------------------------------------------------------------------------- spectrum
