@@ -121,12 +121,15 @@ def classify_period(points, rtol: float, max_period: int = 32, scale=None, *,
             raise ValueError(f"scale must be finite and positive, got {scale!r}")
     z = q / s
     n_max = min(int(max_period), n_used // 2)      # each phase compared at least once
-    residual: dict[int, float] = {}
-    period = 0
-    for n in range(1, n_max + 1):
-        residual[n] = float(np.max(np.abs(z[n:] - z[:-n])))
-        if period == 0 and residual[n] <= tol:
-            period = n
+    # all n at once: row n-1 holds max over coordinates of |z[k + n] - z[k]|, k < len - n
+    ns = np.arange(1, n_max + 1)
+    later = np.arange(len(z))[None, :] + ns[:, None]
+    zt = z.T                                     # (n_coords, n_used): the max over coordinates
+    d = np.abs(zt[:, np.minimum(later, len(z) - 1)] - zt[:, None, :]).max(axis=0)  # is a maximum
+    worst = np.where(later < len(z), d, 0.0).max(axis=1)                          # of 2-D rows
+    residual = {int(n): float(r) for n, r in zip(ns, worst)}
+    fits = np.flatnonzero(worst <= tol)
+    period = int(fits[0]) + 1 if fits.size else 0
     info = dict(residual=residual, tol=tol, n_points=n_used, n_max_tested=n_max, scale=s)
     return period, info
 
@@ -343,8 +346,9 @@ def stats(x, quantiles: bool = True) -> dict:
     """Summary of a signal, NaN ignored, in the units of `x`: ``max``, ``min``, ``mean``,
     ``rms`` (root mean square about zero, ``sqrt(mean(x**2))``), and the quantiles ``q05``,
     ``q50`` (median) and ``q95`` (unless quantiles=False: they cost a sort)."""
-    a = np.asarray(x, dtype=float).ravel()
-    a = a[~np.isnan(a)]
+    a = np.asarray(x, dtype=float)
+    nan = np.isnan(a)
+    a = a[~nan] if nan.any() else a.ravel()
     if a.size == 0:
         raise ValueError("stats of an empty (or all-NaN) array")
     out = dict(max=float(a.max()), min=float(a.min()), mean=float(a.mean()),
