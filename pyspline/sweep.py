@@ -335,7 +335,8 @@ DASK_SWEEP_CONFIG = {
 
 def local_dask_client(n_workers: int = 2, processes: bool = False, **kwargs):
     """A ``distributed.Client`` on a new LocalCluster of `n_workers` single-threaded workers,
-    set up for sweeps (DASK_SWEEP_CONFIG, no dashboard); closing the client closes the cluster:
+    set up for sweeps (DASK_SWEEP_CONFIG; its HTTP server on a free port, so that two clusters do
+    not warn about port 8787); closing the client closes the cluster:
 
         with pyspline.local_dask_client(2) as client:
             ds = pyspline.sweep(case, executor=client.get_executor(), l_x=values)
@@ -344,11 +345,12 @@ def local_dask_client(n_workers: int = 2, processes: bool = False, **kwargs):
         the GIL, so they run in parallel, with no pickling and no worker processes to feed;
         Dask's advice for code that releases the GIL. True: one process per worker (a nanny
         each), the layout of a multi-node cluster.
-    kwargs : passed to LocalCluster (e.g. dashboard_address=':8787' to watch the sweep)."""
+    kwargs : passed to LocalCluster (e.g. dashboard_address=':8787' to watch the sweep: the
+        dashboard needs bokeh)."""
     import dask
     from distributed import Client
     options = dict(n_workers=n_workers, threads_per_worker=1, processes=processes,
-                   dashboard_address=None)
+                   dashboard_address=":0")
     options.update(kwargs)
     with dask.config.set(DASK_SWEEP_CONFIG):
         return Client(**options)
