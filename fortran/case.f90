@@ -168,6 +168,13 @@ module spline_case
     end function c_file_kind
   end interface
 
+  interface   ! fortran/iolock.c: one lock around the parser's reads from internal files
+    subroutine io_lock() bind(C, name='spline_io_lock')
+    end subroutine io_lock
+    subroutine io_unlock() bind(C, name='spline_io_unlock')
+    end subroutine io_unlock
+  end interface
+
 contains
 
   !> Field number i of the namelist (1 .. nfields): name, type (i, r, l, c) and size.
@@ -276,6 +283,18 @@ contains
   !> than elements (a decimal comma), a subscript outside the array, an unclosed string, a
   !> field given twice, and control characters (not a text file).
   subroutine case_parse(text, c, ierr, errmsg, origin, show_lines)
+    character(len=*), intent(in) :: text
+    type(case_t), intent(inout) :: c
+    integer, intent(out) :: ierr
+    character(len=*), intent(out) :: errmsg
+    character(len=*), intent(in), optional :: origin
+    logical, intent(in), optional :: show_lines
+    call io_lock()           ! internal reads are not thread-safe in libgfortran (iolock.c)
+    call parse_unlocked(text, c, ierr, errmsg, origin, show_lines)
+    call io_unlock()
+  end subroutine case_parse
+
+  subroutine parse_unlocked(text, c, ierr, errmsg, origin, show_lines)
     character(len=*), intent(in) :: text
     type(case_t), intent(inout) :: c
     integer, intent(out) :: ierr
@@ -840,7 +859,7 @@ contains
       ierr = err_case
     end subroutine fail
 
-  end subroutine case_parse
+  end subroutine parse_unlocked
 
   !> A word w is a constant of field f's type (a repeat r*c counts by its constant).
   pure logical function is_value(f, w)
@@ -1151,6 +1170,18 @@ contains
     integer, intent(in), optional :: unit
     character(len=*), intent(in), optional :: lines(:)
     character(len=*), intent(out), optional :: out(:)
+    call io_lock()           ! internal reads are not thread-safe in libgfortran (iolock.c)
+    call nml_io_unlocked(c, ierr, iomsg, unit, lines, out)
+    call io_unlock()
+  end subroutine nml_io
+
+  subroutine nml_io_unlocked(c, ierr, iomsg, unit, lines, out)
+    type(case_t), intent(inout) :: c
+    integer, intent(out) :: ierr
+    character(len=*), intent(out) :: iomsg
+    integer, intent(in), optional :: unit
+    character(len=*), intent(in), optional :: lines(:)
+    character(len=*), intent(out), optional :: out(:)
     character(len=namelen) :: name
     integer :: z, dof, max_steps, max_total_steps, n_out
     real(wp) :: module_m, alpha_deg, b, s, c0, e_mod, nu, lambda_th, k_cond, rho, c_heat, j_m, j_l, j_1, &
@@ -1225,7 +1256,7 @@ contains
     c%ripple_phase_deg = ripple_phase_deg; c%unbalance = unbalance
     c%unbalance_phase_deg = unbalance_phase_deg; c%gamma_x = gamma_x; c%gamma_y = gamma_y
     c%n_slices = n_slices
-  end subroutine nml_io
+  end subroutine nml_io_unlocked
 
   !> The file name without directory and extension: the case name unless the file sets one.
   pure function case_name_of(path) result(stem)
