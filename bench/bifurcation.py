@@ -38,7 +38,6 @@ from pathlib import Path
 import numpy as np
 
 import pyspline
-from pyspline.sweep import chunk_size
 from pyspline.paper import cases_dir
 from speed import _write_csv
 
@@ -165,11 +164,11 @@ def main(args) -> int:
     labels = ["serial", "2 threads", "2 processes", "Dask LocalCluster, 2 workers",
               "Dask LocalCluster, 2 worker procs"]
     wall = {label: np.zeros(repeats) for label in labels}       # per repeat, summed over blocks
-    failed = dict.fromkeys(labels, 0)
+    failed, first_error = dict.fromkeys(labels, 0), {}
     ds = None
     # Every repeat and every block runs the executors in an order that rotates, so that a
     # machine whose speed drifts during the benchmark slows all of them alike. blocks > 1: every
-    # executor runs the same interleaved subsets l_x[b::blocks] (chunks as for the whole sweep),
+    # executor runs the same interleaved subsets l_x[b::blocks] (each sizes its own tasks),
     # and the executors stay up together. blocks = 1: each executor exists only for its own run
     # (an idle Dask cluster takes CPU from the others: docs/performance.md).
     for rep in range(repeats):
@@ -184,10 +183,12 @@ def main(args) -> int:
                     with contextlib.ExitStack() as this_run:
                         ex = started[label] if blocks > 1 else _start(label, this_run)
                         t0 = time.perf_counter()
-                        part = pyspline.sweep(case, executor=ex, progress=False, l_x=values,
-                                              chunk=chunk_size(ex, n))
+                        part = pyspline.sweep(case, executor=ex, progress=False, l_x=values)
                         wall[label][rep] += time.perf_counter() - t0
                     failed[label] += int(part.attrs.get("n_failed", 0))
+                    errors = part["error"].values[part["error"].values != ""]
+                    if len(errors) and label not in first_error:
+                        first_error[label] = str(errors[0])
                     if blocks == 1 and label == "serial" and ds is None:
                         ds = part
         print(f"repeat {rep + 1}: " + ", ".join(f"{label} {wall[label][rep]:.2f} s"
@@ -211,6 +212,8 @@ def main(args) -> int:
               f"{r['speed_up_max']:.2f})", flush=True)
     if any(failed.values()):
         print(f"failed points: {failed}")
+        for label, message in first_error.items():
+            print(f"  first error on {label}: {message}")
     _write_csv(out / "bifurcation.csv", rows)
     if ds is not None:              # the figure of the serial sweep (one block only)
         from pyspline import plots

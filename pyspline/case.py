@@ -143,6 +143,9 @@ class Case(Mapping):
     def __len__(self):
         return len(self._fields)
 
+    def __dask_tokenize__(self):     # Dask hashes task arguments: the text says it all, and
+        return ("pyspline.Case", self.text())   # costs 15 us (pickling it twice: 10 times more)
+
     def __getstate__(self):          # a loaded model is rebuilt where the case is used
         return {"_fields": self._fields, "source": self.source, "_model": None}
 

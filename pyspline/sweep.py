@@ -23,6 +23,7 @@ import os
 import re
 import shlex
 import sys
+import time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -33,8 +34,9 @@ from .case import Case, defaults, load_case
 from .core import STATE_NAMES
 from .errors import CaseError, SplineError
 
-__all__ = ["DASK_SWEEP_CONFIG", "chunk_size", "local_dask_client", "open_sweep", "parse_values",
-           "point_cases", "run_point", "summarise", "sweep", "sweep_figures", "write_netcdf"]
+__all__ = ["DASK_SWEEP_CONFIG", "local_dask_client", "open_sweep", "parse_values",
+           "point_cases", "run_point", "summarise", "sweep", "sweep_figures", "task_size",
+           "write_netcdf"]
 
 #: Bump when the content of a point summary changes: older point files are then recomputed.
 #: 2: the default Benettin separation (lyapunov_d0 = 0: 1e4 rtol, was 1e-8) changed exponents.
@@ -295,19 +297,22 @@ def run_point(case: Case, options: dict) -> dict:
 
 
 class PointSummaries:
-    """The summaries of a chunk of points, as one object. Dask sends it back as one pickle
-    (its arrays as out-of-band buffers); a bare list of dicts of arrays it walks item by item,
-    which cost 7-11 ms per task of 15 points, as much as two of the points themselves."""
-    __slots__ = ("items",)
+    """The summaries of a chunk of points, as one object, and the seconds the chunk took in the
+    worker. Dask sends it back as one pickle (its arrays as out-of-band buffers); a bare list of
+    dicts of arrays it walks item by item, which cost 7-11 ms per task of 15 points, as much as
+    two of the points themselves."""
+    __slots__ = ("items", "seconds")
 
-    def __init__(self, items: list):
-        self.items = items
+    def __init__(self, items: list, seconds: float):
+        self.items, self.seconds = items, seconds
 
 
 def run_points(cases: list, options: dict) -> PointSummaries:
     """A chunk of sweep points as one task (fewer round trips through a process pool or a
     Dask scheduler): run_point for each."""
-    return PointSummaries([run_point(case, options) for case in cases])
+    t0 = time.perf_counter()
+    items = [run_point(case, options) for case in cases]
+    return PointSummaries(items, time.perf_counter() - t0)
 
 
 #: Dask settings for a cluster that runs long CPU-bound sweep tasks on a few cores, where every
@@ -370,14 +375,23 @@ def _workers(executor) -> int:
     return 2
 
 
-def chunk_size(executor, n: int) -> int:
-    """Points per task for `n` points on `executor`: 1 in this process or on threads (nothing to
-    amortise); on processes and Dask, at most 32 points, and at least 8 tasks per worker so that
-    the workers finish together (a task's cost, 5-10 ms on Dask, is then paid once per 32 points
-    of a large sweep, while a small sweep or a large cluster gets one point per task)."""
-    if executor is None or isinstance(executor, cf.ThreadPoolExecutor):
+#: Seconds of work a task aims at, on processes and Dask (see task_size).
+TASK_SECONDS = 0.5
+
+
+def task_size(seconds_per_point: float | None, remaining: int, workers: int) -> int:
+    """Points in the next task of a sweep on processes or Dask, from the cost of a point measured
+    so far (None: nothing measured yet, one point).
+
+    A task costs the executor a fixed time (on a 2-worker Dask cluster 5-6 ms of CPU: the
+    scheduler, the client's fetch, the worker's event loop), so cheap points go in bundles that
+    take about TASK_SECONDS. That also bounds what a Ctrl-C or a crash loses (a chunk is saved
+    when it finishes). No task takes more than its share of the rest, remaining / (2 workers),
+    so tasks shrink towards the end and the workers finish together (guided scheduling)."""
+    if seconds_per_point is None:
         return 1
-    return max(1, min(32, n // (8 * _workers(executor))))
+    by_cost = int(TASK_SECONDS / max(seconds_per_point, 1e-6))
+    return max(1, min(by_cost, -(-remaining // (2 * workers))))
 
 
 # --------------------------------------------------------------------------- files
@@ -562,8 +576,9 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     executor : None (serial, in this process) or a concurrent.futures.Executor
         (ThreadPoolExecutor, ProcessPoolExecutor, ``distributed.Client(...).get_executor()``).
         The caller keeps ownership: it is not shut down here.
-    chunk : points per task (default `chunk_size`: 1 serially or on threads; on processes and
-        Dask at most 32, and at least 8 tasks per worker).
+    chunk : points per task, all submitted at once. Default: on threads one point per task; on
+        processes and Dask tasks of about TASK_SECONDS of work (from the measured cost of a
+        point), shrinking towards the end of the sweep, two per worker in flight (task_size).
     progress : bool, tqdm progress bar on stderr.
     out : directory or None. Each finished point is written to ``out/points/`` at once; the
         merge goes to ``out/sweep.nc`` (NetCDF-4, h5netcdf), also when the sweep is stopped by
@@ -662,12 +677,50 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     from tqdm import tqdm
     failed = executor_errors = 0
     futures, bar = {}, None
+    pending = list(todo)                # not yet submitted, in grid order
+    # on processes and Dask without a fixed chunk: tasks sized from the measured cost of a point
+    # (task_size), two per worker in flight; on threads, or with `chunk`, all submitted at once
+    guided = executor is not None and not chunk and not isinstance(executor, cf.ThreadPoolExecutor)
+    workers = _workers(executor) if guided else 1
+    cost = None                         # seconds per point in the last finished task
+
+    def submit():
+        while pending and (not guided or len(futures) < 2 * workers):
+            size = task_size(cost, len(pending), workers) if guided else (chunk or 1)
+            indices = pending[:size]
+            del pending[:size]
+            futures[executor.submit(run_points, [cases[i] for i in indices], options)] = indices
+
+    def take(fut):
+        """Record a finished task's points (or the executor's failure), then forget the task."""
+        nonlocal failed, executor_errors, cost
+        chunk_indices = futures[fut]
+        try:
+            exc = fut.exception()
+        except cf.CancelledError as cancelled:    # cancelled by someone else
+            exc = cancelled
+        if isinstance(exc, KeyboardInterrupt):
+            raise exc
+        if exc is None:
+            res = fut.result()
+            cost = res.seconds / max(1, len(res.items))
+        for k, index in enumerate(chunk_indices):
+            if exc is not None:      # the executor failed, not the case: not saved,
+                s = _template(options, _stat_names())   # a rerun tries it again
+                s.update(error=f"the executor failed: {type(exc).__name__}: {exc}",
+                         error_class=type(exc).__name__)
+                summaries[index] = s
+                executor_errors += 1
+            else:
+                record(index, res.items[k])
+            failed += bool(summaries[index]["error"])
+        del futures[fut]
+        bar.update(len(chunk_indices))
+        bar.set_postfix(failed=failed, refresh=False)
+
     try:
         if executor is not None:       # before the bar's thread: a fork pool forks here
-            size = chunk or chunk_size(executor, len(todo))
-            chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
-            futures = {executor.submit(run_points, [cases[i] for i in ch], options): ch
-                       for ch in chunks}
+            submit()
         bar = tqdm(total=len(todo), desc=f"sweep {' x '.join(grid)}", unit="run",
                    disable=not progress, dynamic_ncols=True)
         if executor is None:
@@ -676,27 +729,15 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
                 failed += bool(summaries[index]["error"])
                 bar.update(1)
                 bar.set_postfix(failed=failed, refresh=False)
+        elif not guided:
+            for fut in cf.as_completed(list(futures)):
+                take(fut)
         else:
-            for fut in cf.as_completed(futures):
-                chunk_indices = futures[fut]
-                try:
-                    exc = fut.exception()
-                except cf.CancelledError as cancelled:    # cancelled by someone else
-                    exc = cancelled
-                if isinstance(exc, KeyboardInterrupt):
-                    raise exc
-                for k, index in enumerate(chunk_indices):
-                    if exc is not None:      # the executor failed, not the case: not saved,
-                        s = _template(options, _stat_names())   # a rerun tries it again
-                        s.update(error=f"the executor failed: {type(exc).__name__}: {exc}",
-                                 error_class=type(exc).__name__)
-                        summaries[index] = s
-                        executor_errors += 1
-                    else:
-                        record(index, fut.result().items[k])
-                    failed += bool(summaries[index]["error"])
-                bar.update(len(chunk_indices))
-                bar.set_postfix(failed=failed, refresh=False)
+            while futures:
+                done, _ = cf.wait(list(futures), return_when=cf.FIRST_COMPLETED)
+                for fut in done:
+                    take(fut)
+                submit()
     except BaseException:
         for fut in futures:
             fut.cancel()

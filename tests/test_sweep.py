@@ -246,17 +246,35 @@ def test_dask_executor(case, processes):
     _same(serial, box["ds"])
 
 
-def test_chunk_size():
-    """One point a task where nothing is amortised; else at most 32 points and at least 8 tasks
-    per worker, so a large pool gets single points."""
-    chunk_size = sw.chunk_size
-    assert chunk_size(None, 1000) == 1
-    with cf.ThreadPoolExecutor(2) as threads:
-        assert chunk_size(threads, 1000) == 1
-    with cf.ProcessPoolExecutor(2) as procs:
-        assert [chunk_size(procs, n) for n in (10, 61, 160, 1000)] == [1, 3, 10, 32]
-    with cf.ProcessPoolExecutor(64) as procs:
-        assert chunk_size(procs, 1000) == 1
+def test_task_size():
+    """One point until a cost is measured; then about TASK_SECONDS of work a task, but never
+    more than a share of what remains (remaining / 2 workers), down to one point at the end."""
+    size, secs = sw.task_size, sw.TASK_SECONDS
+    assert size(None, 1000, 2) == 1
+    assert size(secs / 100, 1000, 2) == 100           # 5 ms points: bundles of 100
+    assert size(secs * 3, 1000, 2) == 1               # points dearer than a task: one each
+    assert size(secs / 100, 120, 2) == 30             # the guided tail: a quarter of the rest
+    assert size(secs / 100, 3, 2) == 1
+    assert size(secs / 100, 1000, 64) == 8            # a large cluster: 1000 / 128
+
+
+def test_guided_tasks_cover_every_point_once(case):
+    """On a process pool without `chunk`, tasks grow from one point to bundles and shrink
+    again, and every point is run exactly once, with the serial numbers."""
+    seen = []
+
+    class Recording(cf.ProcessPoolExecutor):
+        def submit(self, fn, *args, **kwargs):
+            seen.append(len(args[0]))
+            return super().submit(fn, *args, **kwargs)
+
+    values = np.linspace(0.0, 2e-4, 24)
+    serial = pyspline.sweep(case, progress=False, l_x=values)
+    with Recording(2) as pool:
+        ds = pyspline.sweep(case, executor=pool, progress=False, l_x=values)
+    assert sum(seen) == 24 and seen[:4] == [1, 1, 1, 1] and max(seen) > 1
+    assert ds.attrs["n_ok"] == 24
+    _same(serial, ds)
 
 
 # --------------------------------------------------------------------------- spectrum
