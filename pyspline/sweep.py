@@ -375,8 +375,9 @@ def _workers(executor) -> int:
     return 2
 
 
-#: Seconds of work a task aims at, on processes and Dask (see task_size).
-TASK_SECONDS = 0.5
+#: Seconds of work a task aims at on processes and Dask, and the least it shrinks to at the
+#: end of a sweep (see task_size).
+TASK_SECONDS, TAIL_SECONDS = 0.5, 0.05
 
 
 def task_size(seconds_per_point: float | None, remaining: int, workers: int) -> int:
@@ -387,11 +388,14 @@ def task_size(seconds_per_point: float | None, remaining: int, workers: int) -> 
     scheduler, the client's fetch, the worker's event loop), so cheap points go in bundles that
     take about TASK_SECONDS. That also bounds what a Ctrl-C or a crash loses (a chunk is saved
     when it finishes). No task takes more than its share of the rest, remaining / (2 workers),
-    so tasks shrink towards the end and the workers finish together (guided scheduling)."""
+    so tasks shrink towards the end and the workers finish together (guided scheduling), but
+    not below TAIL_SECONDS of work: a Dask task's round trip (10-30 ms) must stay shorter than
+    the task a worker holds in reserve, or the worker waits."""
     if seconds_per_point is None:
         return 1
-    by_cost = int(TASK_SECONDS / max(seconds_per_point, 1e-6))
-    return max(1, min(by_cost, -(-remaining // (2 * workers))))
+    cost = max(seconds_per_point, 1e-6)
+    share = max(-(-remaining // (2 * workers)), int(TAIL_SECONDS / cost))
+    return max(1, min(int(TASK_SECONDS / cost), share))
 
 
 # --------------------------------------------------------------------------- files
@@ -647,8 +651,8 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
             s.update(error=str(c), error_class=type(c).__name__)
             summaries[index] = s
             continue
-        hashes[index] = point_hash(c, options)
-        if points_dir is not None:
+        if points_dir is not None:     # (without `out`, hashed while the first tasks run)
+            hashes[index] = point_hash(c, options)
             saved = _load_point(points_dir / point_filename(index, hashes[index]), keys)
             if saved is not None:
                 summaries[index] = saved
@@ -686,7 +690,14 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
 
     def submit():
         while pending and (not guided or len(futures) < 2 * workers):
-            size = task_size(cost, len(pending), workers) if guided else (chunk or 1)
+            if not guided:
+                size = chunk or 1
+            elif cost is None and len(pending) > len(todo) - workers:
+                size = 1                 # one probe per worker for the cost of a point ...
+            elif cost is None:           # ... and work for the worker till the probe is back
+                size = max(1, min(32, len(todo) // (16 * workers)))
+            else:
+                size = task_size(cost, len(pending), workers)
             indices = pending[:size]
             del pending[:size]
             futures[executor.submit(run_points, [cases[i] for i in indices], options)] = indices
@@ -721,6 +732,7 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     try:
         if executor is not None:       # before the bar's thread: a fork pool forks here
             submit()
+        hashes.update((i, point_hash(cases[i], options)) for i in todo if i not in hashes)
         bar = tqdm(total=len(todo), desc=f"sweep {' x '.join(grid)}", unit="run",
                    disable=not progress, dynamic_ncols=True)
         if executor is None:

@@ -248,14 +248,16 @@ def test_dask_executor(case, processes):
 
 def test_task_size():
     """One point until a cost is measured; then about TASK_SECONDS of work a task, but never
-    more than a share of what remains (remaining / 2 workers), down to one point at the end."""
-    size, secs = sw.task_size, sw.TASK_SECONDS
+    more than a share of what remains (remaining / 2 workers) unless that is less than
+    TAIL_SECONDS of work."""
+    size, secs, tail = sw.task_size, sw.TASK_SECONDS, sw.TAIL_SECONDS
     assert size(None, 1000, 2) == 1
-    assert size(secs / 100, 1000, 2) == 100           # 5 ms points: bundles of 100
+    assert size(secs / 100, 1000, 2) == 100           # cheap points: bundles of TASK_SECONDS
     assert size(secs * 3, 1000, 2) == 1               # points dearer than a task: one each
     assert size(secs / 100, 120, 2) == 30             # the guided tail: a quarter of the rest
-    assert size(secs / 100, 3, 2) == 1
-    assert size(secs / 100, 1000, 64) == 8            # a large cluster: 1000 / 128
+    assert size(tail / 10, 12, 2) == 10               # ... but TAIL_SECONDS of work at least
+    assert size(tail / 10, 3, 2) == 10                # (a task takes what is left)
+    assert size(tail, 1000, 64) == 8                  # a large cluster: 1000 / 128
 
 
 def test_guided_tasks_cover_every_point_once(case):
