@@ -1,6 +1,6 @@
 """A bifurcation diagram of paper_lx1e-4 over l_x (issue 11's benchmark), measured side by side
 in one run: `python bench/run.py bifurcation [--points N] [--rtol R] [--repeats R] [--blocks K]
-[--accuracy] [--quick]`.
+[--scaling] [--accuracy] [--quick]`.
 
 Each point: 20 shaft revolutions of transient, then 100 revolutions sampled (exact shaft
 sections, 8 outputs per revolution for the load statistics). The same sweep runs serially, on 2
@@ -18,6 +18,10 @@ each subset, in an order that rotates from subset to subset, and its times are s
 machine whose speed drifts (a shared host: the same serial sweep took 35-42 s within an hour),
 the executors then share the drift, and the ratios mean something; the per-block speed-ups show
 the spread that remains.
+
+With --scaling every parallel executor also runs with one worker, and the speed-up from its 1 to
+its 2 workers is printed beside the speed-up over the serial sweep (what the executor itself
+costs shows as the difference).
 
 With --accuracy the question is what tolerance a diagram needs: every 10th point (100 points)
 is swept on 2 threads at rtol 1e-5 ... 1e-10 and compared with the same sweep at rtol 1e-11: the
@@ -54,18 +58,28 @@ def _warm_up():
 def _start(label, stack):
     """The executor named `label`, started and warmed up (pyspline imported in its workers), its
     shutdown registered on `stack`. Dask through pyspline.local_dask_client (DASK_SWEEP_CONFIG):
-    its default layout, worker threads in this process, and worker processes."""
+    its default layout, worker threads in this process, and worker processes. The label's first
+    word is the number of workers ("Dask LocalCluster, 2 workers": its second part's)."""
     if label == "serial":
         return None
-    if label == "2 threads":
-        return stack.enter_context(cf.ThreadPoolExecutor(2))
-    if label == "2 processes":
-        pool = stack.enter_context(cf.ProcessPoolExecutor(2))
-        list(pool.map(_warm_up_n, range(2)))                     # start the workers
+    n = int(label.split(", ")[-1].split()[0])
+    if label.endswith(("thread", "threads")):
+        return stack.enter_context(cf.ThreadPoolExecutor(n))
+    if label.endswith(("process", "processes")):
+        pool = stack.enter_context(cf.ProcessPoolExecutor(n))
+        list(pool.map(_warm_up_n, range(n)))                     # start the workers
         return pool
-    client = stack.enter_context(pyspline.local_dask_client(2, processes="procs" in label))
+    client = stack.enter_context(pyspline.local_dask_client(n, processes="proc" in label))
     client.run(_warm_up)
     return client.get_executor()
+
+
+def _one(label):
+    """The label of the same executor with one worker."""
+    for two, one in (("2 ", "1 "), ("workers", "worker"), ("threads", "thread"),
+                     ("processes", "process"), ("procs", "proc")):
+        label = label.replace(two, one)
+    return label
 
 
 def bench_case(rtol=None):
@@ -163,6 +177,8 @@ def main(args) -> int:
     pyspline.sweep(case, progress=False, l_x=l_x[:2])            # imports, first load
     labels = ["serial", "2 threads", "2 processes", "Dask LocalCluster, 2 workers",
               "Dask LocalCluster, 2 worker procs"]
+    if args.scaling:          # each parallel executor also with one worker
+        labels += [_one(label) for label in labels[1:]]
     wall = {label: np.zeros(repeats) for label in labels}       # per repeat, summed over blocks
     failed, first_error = dict.fromkeys(labels, 0), {}
     ds = None
@@ -196,6 +212,8 @@ def main(args) -> int:
     rows = []
     for label in labels:
         ratio = wall["serial"] / wall[label]                    # within each repeat
+        one = _one(label)
+        scaling = wall[one] / wall[label] if one in wall and one != label else None
         rows.append(dict(executor=label, points=n, blocks=blocks, repeats=repeats,
                          rtol=case["rtol"], wall_median_s=float(np.median(wall[label])),
                          wall_min_s=float(wall[label].min()),
@@ -203,13 +221,19 @@ def main(args) -> int:
                          speed_up_median=float(np.median(ratio)),
                          speed_up_min=float(ratio.min()), speed_up_max=float(ratio.max()),
                          walls_s=" ".join(f"{w:.2f}" for w in wall[label]),
+                         scaling_median=(float(np.median(scaling)) if scaling is not None
+                                         else ""),
+                         scaling_min=float(scaling.min()) if scaling is not None else "",
+                         scaling_max=float(scaling.max()) if scaling is not None else "",
                          failed=failed[label]))
     print(f"{'executor':34s} {'wall: median':>12s} {'(min-max)':>15s}   speed-up: median "
           f"(min-max), within each repeat")
     for r in rows:
         print(f"{r['executor']:34s} {r['wall_median_s']:10.2f} s ({r['wall_min_s']:5.2f}-"
               f"{r['wall_max_s']:5.2f})   {r['speed_up_median']:5.2f}x ({r['speed_up_min']:.2f}-"
-              f"{r['speed_up_max']:.2f})", flush=True)
+              f"{r['speed_up_max']:.2f})"
+              + (f"   over 1 worker: {r['scaling_median']:.2f}x ({r['scaling_min']:.2f}-"
+                 f"{r['scaling_max']:.2f})" if r["scaling_median"] != "" else ""), flush=True)
     if any(failed.values()):
         print(f"failed points: {failed}")
         for label, message in first_error.items():

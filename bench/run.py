@@ -80,6 +80,8 @@ def main(argv=None) -> int:
     p.add_argument("--blocks", type=int, help="bifurcation: run the sweep as this many "
                    "interleaved blocks, the executors in rotating order (default 1: each "
                    "executor runs the whole sweep once, one after the other)")
+    p.add_argument("--scaling", action="store_true", help="bifurcation: also run each parallel "
+                   "executor with one worker (speed-up from 1 to 2 workers)")
     p.add_argument("--accuracy", action="store_true", help="bifurcation: the diagram's section "
                    "error, periods, steps and wall time over rtol (every 10th point)")
     p.add_argument("--out", default="out/bench", help="output directory (default out/bench)")
