@@ -95,13 +95,22 @@ def test_bifurcation_accuracy_quick(tmp_path):
     assert len(list(csv.DictReader(open(tmp_path / "bifurcation_accuracy.csv")))) == len(rows)
 
 
+def test_bifurcation_scaling_labels():
+    """--scaling pairs each 2-worker executor with the same executor on one worker."""
+    import bifurcation
+    assert [bifurcation._one(label) for label in (
+        "2 threads", "2 processes", "Dask LocalCluster, 2 workers",
+        "Dask LocalCluster, 2 worker procs")] == [
+        "1 thread", "1 process", "Dask LocalCluster, 1 worker", "Dask LocalCluster, 1 worker proc"]
+
+
 def test_bifurcation_repeats_quick(tmp_path):
     """--repeats: every executor's walls per repeat, medians and the same diagram."""
     import argparse
 
     import bifurcation
     args = argparse.Namespace(out=str(tmp_path), accuracy=False, points=4, blocks=1, repeats=2,
-                              rtol=1e-6, quick=True)
+                              rtol=1e-6, quick=True, scaling=False)
     assert bifurcation.main(args) == 0
     table = list(csv.DictReader(open(tmp_path / "bifurcation.csv")))
     assert len(table) == 5 and {r["failed"] for r in table} == {"0"}
