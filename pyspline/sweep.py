@@ -379,6 +379,21 @@ def _workers(executor) -> int:
     return 2
 
 
+class PointCost:
+    """The cost of a sweep point so far: seconds per point over the finished tasks (None before
+    any). A task whose points all failed does not count: a case refused at once costs nothing,
+    and would make the next tasks huge."""
+
+    def __init__(self):
+        self.seconds, self._total, self._points = None, 0.0, 0
+
+    def add(self, done: PointSummaries) -> None:
+        if done.items and not all(item["error"] for item in done.items):
+            self._total += done.seconds
+            self._points += len(done.items)
+            self.seconds = self._total / self._points
+
+
 #: Seconds of work a task aims at on processes and Dask, and the least it shrinks to at the
 #: end of a sweep (see task_size).
 TASK_SECONDS, TAIL_SECONDS = 0.5, 0.05
@@ -690,25 +705,25 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     # (task_size), two per worker in flight; on threads, or with `chunk`, all submitted at once
     guided = executor is not None and not chunk and not isinstance(executor, cf.ThreadPoolExecutor)
     workers = _workers(executor) if guided else 1
-    cost = None                         # seconds per point in the last finished task
+    cost = PointCost()
 
     def submit():
         while pending and (not guided or len(futures) < 2 * workers):
             if not guided:
                 size = chunk or 1
-            elif cost is None and len(pending) > len(todo) - workers:
+            elif cost.seconds is None and len(pending) > len(todo) - workers:
                 size = 1                 # one probe per worker for the cost of a point ...
-            elif cost is None:           # ... and work for the worker till the probe is back
+            elif cost.seconds is None:   # ... and work for the worker till the probe is back
                 size = max(1, min(32, len(todo) // (16 * workers)))
             else:
-                size = task_size(cost, len(pending), workers)
+                size = task_size(cost.seconds, len(pending), workers)
             indices = pending[:size]
             del pending[:size]
             futures[executor.submit(run_points, [cases[i] for i in indices], options)] = indices
 
     def take(fut):
         """Record a finished task's points (or the executor's failure), then forget the task."""
-        nonlocal failed, executor_errors, cost
+        nonlocal failed, executor_errors
         chunk_indices = futures[fut]
         try:
             exc = fut.exception()
@@ -718,7 +733,7 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
             raise exc
         if exc is None:
             res = fut.result()
-            cost = res.seconds / max(1, len(res.items))
+            cost.add(res)
         for k, index in enumerate(chunk_indices):
             if exc is not None:      # the executor failed, not the case: not saved,
                 s = _template(options, _stat_names())   # a rerun tries it again

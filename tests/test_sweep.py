@@ -261,6 +261,20 @@ def test_task_size():
     assert size(tail, 1000, 64) == 8                  # a large cluster: 1000 / 128
 
 
+def test_point_cost_ignores_tasks_that_only_failed():
+    """Seconds per point over the tasks that ran; a task of instant refusals does not count."""
+    ok, bad = {"error": ""}, {"error": "case x: field l_x ..."}
+    cost = sw.PointCost()
+    cost.add(sw.PointSummaries([bad, bad], 0.0))
+    assert cost.seconds is None
+    cost.add(sw.PointSummaries([ok, bad], 0.4))
+    assert cost.seconds == pytest.approx(0.2)
+    cost.add(sw.PointSummaries([ok], 0.5))
+    assert cost.seconds == pytest.approx(0.3)
+    cost.add(sw.PointSummaries([bad], 0.0))
+    assert cost.seconds == pytest.approx(0.3)
+
+
 def test_guided_tasks_cover_every_point_once(case):
     """On a process pool without `chunk`, tasks grow from one point to bundles and shrink
     again, and every point is run exactly once, with the serial numbers."""
