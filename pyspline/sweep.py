@@ -1047,7 +1047,9 @@ Writes into --out DIR:
                                   (two fields: waterfall_FIELD=VALUE.png for up to 6 values)
 Ctrl-C or a crash keeps the finished points (merged into sweep.nc); running the same command
 again computes only the points that are missing (a changed case is recomputed: files are
-known by index and by a hash of the point's case).
+known by index and by a hash of the point's case). With --workers (processes) or --scheduler
+(Dask), cheap points travel in tasks of about 0.5 s of work, written when their task ends: a
+Ctrl-C loses at most the tasks running then.
 
 example: pyspline sweep cases/paper_lx1e-4.nml --set l_x=0:3e-4:61 --workers 2 --out out/lx
 """
