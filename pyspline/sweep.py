@@ -704,10 +704,13 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     # on processes and Dask without a fixed chunk: tasks sized from the measured cost of a point
     # (task_size), two per worker in flight; on threads, or with `chunk`, all submitted at once
     guided = executor is not None and not chunk and not isinstance(executor, cf.ThreadPoolExecutor)
-    workers = _workers(executor) if guided else 1
+    workers = 1
     cost = PointCost()
 
     def submit():
+        nonlocal workers
+        if guided:          # asked each time: a Dask cluster may grow or shrink during a sweep
+            workers = _workers(executor)
         while pending and (not guided or len(futures) < 2 * workers):
             if not guided:
                 size = chunk or 1

@@ -275,6 +275,41 @@ def test_point_cost_ignores_tasks_that_only_failed():
     assert cost.seconds == pytest.approx(0.3)
 
 
+def test_guided_tasks_follow_a_growing_cluster(case, monkeypatch):
+    """Two tasks per worker in flight, with the worker count asked again at every submission:
+    a Dask cluster that grows from 1 to 4 workers during the sweep gets 8 tasks at once."""
+    def slow_points(cases, opts):           # 2 ms a point
+        time.sleep(0.002 * len(cases))
+        return sw.PointSummaries([sw._template(opts, sw._stat_names()) for _ in cases],
+                                 0.002 * len(cases))
+
+    class Client:
+        calls = 0
+
+        def nthreads(self):
+            Client.calls += 1
+            return {f"w{k}": 1 for k in range(1 if Client.calls <= 3 else 4)}
+
+    class FakeDask(cf.Executor):     # not a ThreadPoolExecutor: sized like a Dask executor
+        def __init__(self):
+            self._client, self.pool = Client(), cf.ThreadPoolExecutor(8)
+            self.running, self.outstanding = [], []
+
+        def submit(self, fn, *args):
+            self.running = [f for f in self.running if not f.done()]
+            self.running.append(self.pool.submit(fn, *args))
+            self.outstanding.append(len(self.running))
+            return self.running[-1]
+
+    monkeypatch.setattr(sw, "run_points", slow_points)
+    monkeypatch.setattr(sw, "TASK_SECONDS", 0.01)          # 5 points a task
+    ex = FakeDask()
+    ds = pyspline.sweep(case, executor=ex, progress=False, l_x=np.linspace(0.0, 2e-4, 200))
+    ex.pool.shutdown()
+    assert ds.attrs["n_ok"] == 200
+    assert max(ex.outstanding[:2]) <= 2 and max(ex.outstanding) == 8
+
+
 def test_guided_tasks_cover_every_point_once(case):
     """On a process pool without `chunk`, tasks grow from one point to bundles and shrink
     again, and every point is run exactly once, with the serial numbers."""
