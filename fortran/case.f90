@@ -1154,7 +1154,9 @@ contains
     integer :: i, ierr
     lines = ''
     cc = c
+    call io_lock()           ! namelist I/O is not thread-safe in libgfortran (iolock.c)
     call nml_io(cc, ierr, iomsg, out=lines)
+    call io_unlock()
     text = ''
     do i = 1, size(lines)
       if (len_trim(lines(i)) > 0) text = text//trim(lines(i))//new_line('a')
@@ -1163,19 +1165,9 @@ contains
 
   !> The namelist group &spline_case over local variables (one per case_t component, in the
   !> same order): copy the case in, then read into it (unit or records) or write it out.
+  !> Callers hold io_lock (case_parse, case_write_text): namelist I/O on internal files is not
+  !> thread-safe in libgfortran (iolock.c).
   subroutine nml_io(c, ierr, iomsg, unit, lines, out)
-    type(case_t), intent(inout) :: c
-    integer, intent(out) :: ierr
-    character(len=*), intent(out) :: iomsg
-    integer, intent(in), optional :: unit
-    character(len=*), intent(in), optional :: lines(:)
-    character(len=*), intent(out), optional :: out(:)
-    call io_lock()           ! internal reads are not thread-safe in libgfortran (iolock.c)
-    call nml_io_unlocked(c, ierr, iomsg, unit, lines, out)
-    call io_unlock()
-  end subroutine nml_io
-
-  subroutine nml_io_unlocked(c, ierr, iomsg, unit, lines, out)
     type(case_t), intent(inout) :: c
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: iomsg
@@ -1256,7 +1248,7 @@ contains
     c%ripple_phase_deg = ripple_phase_deg; c%unbalance = unbalance
     c%unbalance_phase_deg = unbalance_phase_deg; c%gamma_x = gamma_x; c%gamma_y = gamma_y
     c%n_slices = n_slices
-  end subroutine nml_io_unlocked
+  end subroutine nml_io
 
   !> The file name without directory and extension: the case name unless the file sets one.
   pure function case_name_of(path) result(stem)
