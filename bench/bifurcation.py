@@ -55,31 +55,31 @@ def _warm_up():
     pyspline.sweep(bench_case(), progress=False, l_x=[0.0])
 
 
-def _start(label, stack):
-    """The executor named `label`, started and warmed up (pyspline imported in its workers), its
-    shutdown registered on `stack`. Dask through pyspline.local_dask_client (DASK_SWEEP_CONFIG):
-    its default layout, worker threads in this process, and worker processes. The label's first
-    word is the number of workers ("Dask LocalCluster, 2 workers": its second part's)."""
-    if label == "serial":
+#: The parallel executors, by kind: the label of n workers.
+KINDS = {
+    "threads": lambda n: f"{n} thread{'s' * (n > 1)}",
+    "processes": lambda n: f"{n} process{'es' * (n > 1)}",
+    "dask": lambda n: f"Dask LocalCluster, {n} worker{'s' * (n > 1)}",
+    "dask procs": lambda n: f"Dask LocalCluster, {n} worker proc{'s' * (n > 1)}",
+}
+
+
+def _start(kind, n, stack):
+    """The executor of `kind` with `n` workers (kind None: serial), started and warmed up
+    (pyspline imported in its workers), its shutdown registered on `stack`. Dask through
+    pyspline.local_dask_client (DASK_SWEEP_CONFIG): its default layout, worker threads in this
+    process, and worker processes."""
+    if kind is None:
         return None
-    n = int(label.split(", ")[-1].split()[0])
-    if label.endswith(("thread", "threads")):
+    if kind == "threads":
         return stack.enter_context(cf.ThreadPoolExecutor(n))
-    if label.endswith(("process", "processes")):
+    if kind == "processes":
         pool = stack.enter_context(cf.ProcessPoolExecutor(n))
         list(pool.map(_warm_up_n, range(n)))                     # start the workers
         return pool
-    client = stack.enter_context(pyspline.local_dask_client(n, processes="proc" in label))
+    client = stack.enter_context(pyspline.local_dask_client(n, processes=kind == "dask procs"))
     client.run(_warm_up)
     return client.get_executor()
-
-
-def _one(label):
-    """The label of the same executor with one worker."""
-    for two, one in (("2 ", "1 "), ("workers", "worker"), ("threads", "thread"),
-                     ("processes", "process"), ("procs", "proc")):
-        label = label.replace(two, one)
-    return label
 
 
 def bench_case(rtol=None):
@@ -175,10 +175,11 @@ def main(args) -> int:
           + (f"; {blocks} interleaved blocks" if blocks > 1 else "")
           + (f"; {repeats} repeats" if repeats > 1 else ""))
     pyspline.sweep(case, progress=False, l_x=l_x[:2])            # imports, first load
-    labels = ["serial", "2 threads", "2 processes", "Dask LocalCluster, 2 workers",
-              "Dask LocalCluster, 2 worker procs"]
+    executors = {"serial": (None, 0)}       # label: (kind, workers)
+    executors.update({label(2): (kind, 2) for kind, label in KINDS.items()})
     if args.scaling:          # each parallel executor also with one worker
-        labels += [_one(label) for label in labels[1:]]
+        executors.update({label(1): (kind, 1) for kind, label in KINDS.items()})
+    labels = list(executors)
     wall = {label: np.zeros(repeats) for label in labels}       # per repeat, summed over blocks
     failed, first_error = dict.fromkeys(labels, 0), {}
     ds = None
@@ -191,13 +192,14 @@ def main(args) -> int:
         with contextlib.ExitStack() as keep:
             started = {}
             if blocks > 1:
-                started = {label: _start(label, keep) for label in labels}
+                started = {label: _start(*executors[label], keep) for label in labels}
             for b in range(blocks):
                 values = l_x[b::blocks]
                 turn = (rep * blocks + b) % len(labels)
                 for label in labels[turn:] + labels[:turn]:
                     with contextlib.ExitStack() as this_run:
-                        ex = started[label] if blocks > 1 else _start(label, this_run)
+                        ex = (started[label] if blocks > 1
+                              else _start(*executors[label], this_run))
                         t0 = time.perf_counter()
                         part = pyspline.sweep(case, executor=ex, progress=False, l_x=values)
                         wall[label][rep] += time.perf_counter() - t0
@@ -212,8 +214,9 @@ def main(args) -> int:
     rows = []
     for label in labels:
         ratio = wall["serial"] / wall[label]                    # within each repeat
-        one = _one(label)
-        scaling = wall[one] / wall[label] if one in wall and one != label else None
+        kind, workers = executors[label]
+        one = KINDS[kind](1) if kind else None
+        scaling = wall[one] / wall[label] if one in wall and workers > 1 else None
         rows.append(dict(executor=label, points=n, blocks=blocks, repeats=repeats,
                          rtol=case["rtol"], wall_median_s=float(np.median(wall[label])),
                          wall_min_s=float(wall[label].min()),

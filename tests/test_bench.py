@@ -98,9 +98,10 @@ def test_bifurcation_accuracy_quick(tmp_path):
 def test_bifurcation_scaling_labels():
     """--scaling pairs each 2-worker executor with the same executor on one worker."""
     import bifurcation
-    assert [bifurcation._one(label) for label in (
+    assert [label(2) for label in bifurcation.KINDS.values()] == [
         "2 threads", "2 processes", "Dask LocalCluster, 2 workers",
-        "Dask LocalCluster, 2 worker procs")] == [
+        "Dask LocalCluster, 2 worker procs"]
+    assert [label(1) for label in bifurcation.KINDS.values()] == [
         "1 thread", "1 process", "Dask LocalCluster, 1 worker", "Dask LocalCluster, 1 worker proc"]
 
 
