@@ -121,12 +121,13 @@ def classify_period(points, rtol: float, max_period: int = 32, scale=None, *,
             raise ValueError(f"scale must be finite and positive, got {scale!r}")
     z = q / s
     n_max = min(int(max_period), n_used // 2)      # each phase compared at least once
-    # all n at once: row n-1 holds max over coordinates of |z[k + n] - z[k]|, k < len - n
+    # all n at once: d[n - 1, k] = max over coordinates of |z[k + n] - z[k]| (k + n past the
+    # end: masked); the coordinates come first, so that their max is one of 2-D rows
     ns = np.arange(1, n_max + 1)
     later = np.arange(len(z))[None, :] + ns[:, None]
-    zt = z.T                                     # (n_coords, n_used): the max over coordinates
-    d = np.abs(zt[:, np.minimum(later, len(z) - 1)] - zt[:, None, :]).max(axis=0)  # is a maximum
-    worst = np.where(later < len(z), d, 0.0).max(axis=1)                          # of 2-D rows
+    zt = z.T
+    d = np.abs(zt[:, np.minimum(later, len(z) - 1)] - zt[:, None, :]).max(axis=0)
+    worst = np.where(later < len(z), d, 0.0).max(axis=1)
     residual = {int(n): float(r) for n, r in zip(ns, worst)}
     fits = np.flatnonzero(worst <= tol)
     period = int(fits[0]) + 1 if fits.size else 0

@@ -385,13 +385,16 @@ class PointCost:
     and would make the next tasks huge."""
 
     def __init__(self):
-        self.seconds, self._total, self._points = None, 0.0, 0
+        self._total, self._points = 0.0, 0
+
+    @property
+    def seconds(self) -> float | None:
+        return self._total / self._points if self._points else None
 
     def add(self, done: PointSummaries) -> None:
         if done.items and not all(item["error"] for item in done.items):
             self._total += done.seconds
             self._points += len(done.items)
-            self.seconds = self._total / self._points
 
 
 #: Seconds of work a task aims at on processes and Dask, and the least it shrinks to at the
