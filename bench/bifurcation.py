@@ -5,9 +5,9 @@ in one run: `python bench/run.py bifurcation [--points N] [--rtol R] [--repeats 
 Each point: 20 shaft revolutions of transient, then 100 revolutions sampled (exact shaft
 sections, 8 outputs per revolution for the load statistics). The same sweep runs serially, on 2
 threads, on 2 processes and on a Dask LocalCluster of 2 workers (pyspline.local_dask_client:
-threads in one process, its default, then processes); the wall time of each and its speed-up
-over serial are printed and written to bifurcation.csv, with the figure of the serial run. The
-case's own tolerance (rtol 1e-9, Adams) unless --rtol is given.
+worker processes, its default, then worker threads in one process); the wall time of each and
+its speed-up over serial are printed and written to bifurcation.csv, with the figure of the
+serial run. The case's own tolerance (rtol 1e-9, Adams) unless --rtol is given.
 
 With --repeats R every executor runs the whole sweep R times, in an order that rotates from
 repeat to repeat; the median wall time and the median of the speed-ups within each repeat are
@@ -22,6 +22,12 @@ the spread that remains.
 With --scaling every parallel executor also runs with one worker, and the speed-up from its 1 to
 its 2 workers is printed beside the speed-up over the serial sweep (what the executor itself
 costs shows as the difference).
+
+Every executor's row also gives the time its points spent inside the core (Fortran: no GIL, no
+messages), summed, over the serial sweep's: how much slower a core computes while the other
+core is busy too. On 2 processes this is the host's contention (their main process waits); on
+Dask it also holds the time Dask's threads took the core from a run. 2 over it is the speed-up
+if every part of a point slowed alike and the executor cost nothing: the host's ceiling.
 
 With --accuracy the question is what tolerance a diagram needs: every 10th point (100 points)
 is swept on 2 threads at rtol 1e-5 ... 1e-10 and compared with the same sweep at rtol 1e-11: the
@@ -59,16 +65,16 @@ def _warm_up():
 KINDS = {
     "threads": lambda n: f"{n} thread{'s' * (n > 1)}",
     "processes": lambda n: f"{n} process{'es' * (n > 1)}",
-    "dask": lambda n: f"Dask LocalCluster, {n} worker{'s' * (n > 1)}",
-    "dask procs": lambda n: f"Dask LocalCluster, {n} worker proc{'s' * (n > 1)}",
+    "dask": lambda n: f"Dask LocalCluster, {n} worker proc{'s' * (n > 1)}",
+    "dask threads": lambda n: f"Dask LocalCluster, {n} worker thread{'s' * (n > 1)}",
 }
 
 
 def _start(kind, n, stack):
     """The executor of `kind` with `n` workers (kind None: serial), started and warmed up
     (pyspline imported in its workers), its shutdown registered on `stack`. Dask through
-    pyspline.local_dask_client (DASK_SWEEP_CONFIG): its default layout, worker threads in this
-    process, and worker processes."""
+    pyspline.local_dask_client (DASK_SWEEP_CONFIG): its default layout, worker processes, and
+    worker threads in this process."""
     if kind is None:
         return None
     if kind == "threads":
@@ -77,7 +83,7 @@ def _start(kind, n, stack):
         pool = stack.enter_context(cf.ProcessPoolExecutor(n))
         list(pool.map(_warm_up_n, range(n)))                     # start the workers
         return pool
-    client = stack.enter_context(pyspline.local_dask_client(n, processes=kind == "dask procs"))
+    client = stack.enter_context(pyspline.local_dask_client(n, processes=kind == "dask"))
     client.run(_warm_up)
     return client.get_executor()
 
@@ -181,6 +187,7 @@ def main(args) -> int:
         executors.update({label(1): (kind, 1) for kind, label in KINDS.items()})
     labels = list(executors)
     wall = {label: np.zeros(repeats) for label in labels}       # per repeat, summed over blocks
+    core = {label: np.zeros(repeats) for label in labels}       # summed core_wall_s of the points
     failed, first_error = dict.fromkeys(labels, 0), {}
     ds = None
     # Every repeat and every block runs the executors in an order that rotates, so that a
@@ -203,6 +210,7 @@ def main(args) -> int:
                         t0 = time.perf_counter()
                         part = pyspline.sweep(case, executor=ex, progress=False, l_x=values)
                         wall[label][rep] += time.perf_counter() - t0
+                    core[label][rep] += float(np.nansum(part["core_wall_s"].values))
                     failed[label] += int(part.attrs.get("n_failed", 0))
                     errors = part["error"].values[part["error"].values != ""]
                     if len(errors) and label not in first_error:
@@ -217,6 +225,11 @@ def main(args) -> int:
         kind, workers = executors[label]
         one = KINDS[kind](1) if kind else None
         scaling = wall[one] / wall[label] if one in wall and workers > 1 else None
+        # the wall time inside the core (Fortran, no GIL, no messages) for the same points,
+        # against the serial sweep's: how much slower the core computes while the other core is
+        # busy too (host contention; on Dask also its threads taking turns with the runs).
+        # `workers` over it is the speed-up if all work slowed alike and nothing else cost.
+        inflation = float(np.median(core[label] / core["serial"]))
         rows.append(dict(executor=label, points=n, blocks=blocks, repeats=repeats,
                          rtol=case["rtol"], wall_median_s=float(np.median(wall[label])),
                          wall_min_s=float(wall[label].min()),
@@ -228,13 +241,16 @@ def main(args) -> int:
                                          else ""),
                          scaling_min=float(scaling.min()) if scaling is not None else "",
                          scaling_max=float(scaling.max()) if scaling is not None else "",
+                         core_time_over_serial_median=inflation,
+                         ceiling=max(workers, 1) / inflation,
                          failed=failed[label]))
     print(f"{'executor':34s} {'wall: median':>12s} {'(min-max)':>15s}   speed-up: median "
-          f"(min-max), within each repeat")
+          f"(min-max), within each repeat; core time over serial's -> speed-up if all work slowed alike")
     for r in rows:
         print(f"{r['executor']:34s} {r['wall_median_s']:10.2f} s ({r['wall_min_s']:5.2f}-"
               f"{r['wall_max_s']:5.2f})   {r['speed_up_median']:5.2f}x ({r['speed_up_min']:.2f}-"
-              f"{r['speed_up_max']:.2f})"
+              f"{r['speed_up_max']:.2f})   core {r['core_time_over_serial_median']:.2f}x -> "
+              f"{r['ceiling']:.2f}x"
               + (f"   over 1 worker: {r['scaling_median']:.2f}x ({r['scaling_min']:.2f}-"
                  f"{r['scaling_max']:.2f})" if r["scaling_median"] != "" else ""), flush=True)
     if any(failed.values()):

@@ -338,31 +338,53 @@ DASK_SWEEP_CONFIG = {
 }
 
 
-def local_dask_client(n_workers: int = 2, processes: bool = False, **kwargs):
+def local_dask_client(n_workers: int = 2, processes: bool = True, **kwargs):
     """A ``distributed.Client`` on a new LocalCluster of `n_workers` single-threaded workers,
     set up for sweeps (DASK_SWEEP_CONFIG; its HTTP server on a free port, so that two clusters do
     not warn about port 8787); closing the client closes the cluster:
 
-        with pyspline.local_dask_client(2) as client:
-            ds = pyspline.sweep(case, executor=client.get_executor(), l_x=values)
+        if __name__ == "__main__":          # in a script: each worker process imports it
+            with pyspline.local_dask_client(2) as client:
+                ds = pyspline.sweep(case, executor=client.get_executor(), l_x=values)
 
-    processes : False (default): the workers are threads of this process. The core releases
-        the GIL, so they run in parallel, with no pickling and no worker processes to feed;
-        Dask's advice for code that releases the GIL. True: one process per worker (a nanny
-        each), the layout of a multi-node cluster; a script that starts them needs the
-        ``if __name__ == "__main__":`` guard. For sweeps of cheap points (a few ms each) worker
-        processes scale better: 1.75-1.92x against 1.54-1.66x on 2 cores (docs/performance.md,
-        session 9), because Dask's event loops share the cores and the GIL with worker
-        threads.
+    processes : True (default, as Dask's LocalCluster): one process per worker, with a nanny
+        each, the layout of a multi-node cluster. The worker processes start by importing the
+        script that starts them, so in a script the cluster must start under
+        ``if __name__ == "__main__":``; without the guard this raises a RuntimeError that says
+        so. False: the workers are threads of this process (the core releases the GIL): they
+        start in 0.03 s instead of 1-2 s and need no guard, but Dask's event loop then shares
+        the GIL and the cores with them, and on sweeps of cheap points (5 ms each, 2 cores) they
+        reached 1.54-1.66x where worker processes reached 1.75-1.92x (docs/performance.md).
     kwargs : passed to LocalCluster (e.g. dashboard_address=':8787' to watch the sweep: the
         dashboard needs bokeh)."""
     import dask
     from distributed import Client
+    import multiprocessing
+    if processes and getattr(multiprocessing.current_process(), "_inheriting", False):
+        # a new process still importing the script of its parent (multiprocessing's own test)
+        raise RuntimeError(_NO_MAIN_GUARD)
     options = dict(n_workers=n_workers, threads_per_worker=1, processes=processes,
                    dashboard_address=":0")
     options.update(kwargs)
     with dask.config.set(DASK_SWEEP_CONFIG):
-        return Client(**options)
+        try:
+            return Client(**options)
+        except Exception as exc:
+            if not processes:
+                raise
+            raise RuntimeError(
+                f"pyspline.local_dask_client: the Dask worker processes did not start "
+                f"({str(exc).rstrip('.')}). "
+                "If a script starts the cluster, it must do so under `if __name__ == "
+                "\"__main__\":`, because each worker process imports the script (Dask's log "
+                "above shows each worker's error); or pass processes=False for worker threads "
+                "in this process") from exc
+
+
+_NO_MAIN_GUARD = (
+    "pyspline.local_dask_client was called while a Dask worker process imported the script "
+    "that starts the cluster: in a script, start the cluster under `if __name__ == "
+    "\"__main__\":`, or pass processes=False for worker threads")
 
 
 def _workers(executor) -> int:

@@ -99,10 +99,11 @@ def test_bifurcation_scaling_labels():
     """--scaling pairs each 2-worker executor with the same executor on one worker."""
     import bifurcation
     assert [label(2) for label in bifurcation.KINDS.values()] == [
-        "2 threads", "2 processes", "Dask LocalCluster, 2 workers",
-        "Dask LocalCluster, 2 worker procs"]
+        "2 threads", "2 processes", "Dask LocalCluster, 2 worker procs",
+        "Dask LocalCluster, 2 worker threads"]
     assert [label(1) for label in bifurcation.KINDS.values()] == [
-        "1 thread", "1 process", "Dask LocalCluster, 1 worker", "Dask LocalCluster, 1 worker proc"]
+        "1 thread", "1 process", "Dask LocalCluster, 1 worker proc",
+        "Dask LocalCluster, 1 worker thread"]
 
 
 def test_bifurcation_repeats_quick(tmp_path):
@@ -119,3 +120,8 @@ def test_bifurcation_repeats_quick(tmp_path):
         walls = [float(w) for w in r["walls_s"].split()]
         assert len(walls) == 2 and float(r["wall_min_s"]) == pytest.approx(min(walls), abs=0.01)
     assert float(table[0]["speed_up_median"]) == 1.0                 # serial against itself
+    # the core's time for the same points over the serial sweep's, and 2 workers over it
+    assert float(table[0]["core_time_over_serial_median"]) == 1.0
+    for r in table[1:]:
+        assert 0.3 < float(r["core_time_over_serial_median"]) < 3
+        assert float(r["ceiling"]) == pytest.approx(2 / float(r["core_time_over_serial_median"]))

@@ -204,20 +204,24 @@ def test_ctrl_c_in_a_real_sweep(case, tmp_path):
 
 # --------------------------------------------------------------------------- Dask
 
-@pytest.mark.parametrize("processes", [True, False], ids=["worker-processes", "worker-threads"])
+@pytest.mark.parametrize("processes", [None, False], ids=["worker-processes", "worker-threads"])
 def test_dask_executor(case, processes):
-    """A local Dask cluster of two workers (pyspline.local_dask_client: worker processes, where
-    cases and summaries are pickled, and worker threads in this process) gives the serial
-    numbers (needs `distributed`, which scripts/setup.sh installs: in CI this test runs, never
-    skips)."""
+    """A local Dask cluster of two workers (pyspline.local_dask_client: worker processes, its
+    default, where cases and summaries are pickled, and worker threads in this process) gives
+    the serial numbers (needs `distributed`, which scripts/setup.sh installs: in CI this test
+    runs, never skips)."""
     if os.environ.get("CI"):
         import distributed
     else:
         distributed = pytest.importorskip("distributed")
     serial = pyspline.sweep(case, progress=False, l_x=LX)
     box = {}
-    with pyspline.local_dask_client(2, processes=processes) as client:
+    kwargs = {} if processes is None else dict(processes=processes)
+    processes = processes is None
+    with pyspline.local_dask_client(2, **kwargs) as client:
         assert len(client.scheduler_info()["workers"]) == 2
+        pids = set(client.run(os.getpid).values())
+        assert (os.getpid() not in pids and len(pids) == 2) if processes else pids == {os.getpid()}
         # the sweep settings hold in the workers: no statistical profiler, no work stealing,
         # the event-loop health check each second (Dask's default: 20 ms)
         assert all(client.run(lambda dask_worker: "profile" not in dask_worker.periodic_callbacks)
@@ -245,6 +249,26 @@ def test_dask_executor(case, processes):
         assert not worker.is_alive(), "the Dask sweep did not finish in 180 s"
     assert box["ds"].attrs["n_ok"] == 4
     _same(serial, box["ds"])
+
+
+def test_dask_worker_processes_without_main_guard(tmp_path):
+    """A script that starts worker processes without `if __name__ == "__main__":` fails with an
+    error that names the guard (each worker process imports the script), not only Dask's
+    "Nanny failed to start"."""
+    pytest.importorskip("distributed")
+    script = tmp_path / "no_guard.py"
+    script.write_text("import pyspline\n"
+                      "with pyspline.local_dask_client(2) as client:\n"
+                      "    print(client)\n")
+    run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                         timeout=120, cwd=tmp_path)
+    assert run.returncode == 1
+    last = run.stderr.strip().splitlines()[-1]
+    assert last.startswith("RuntimeError: pyspline.local_dask_client: the Dask worker processes "
+                           "did not start"), last
+    assert 'if __name__ == "__main__":' in last and "processes=False" in last
+    # each worker process was stopped by pyspline's own test, before it started processes
+    assert "local_dask_client was called while a Dask worker process imported" in run.stderr
 
 
 def test_task_size():
