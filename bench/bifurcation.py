@@ -1,6 +1,6 @@
 """A bifurcation diagram of paper_lx1e-4 over l_x (issue 11's benchmark), measured side by side
 in one run: `python bench/run.py bifurcation [--points N] [--rtol R] [--repeats R] [--blocks K]
-[--scaling] [--accuracy] [--quick]`.
+[--scaling] [--host] [--accuracy] [--quick]`.
 
 Each point: 20 shaft revolutions of transient, then 100 revolutions sampled (exact shaft
 sections, 8 outputs per revolution for the load statistics). The same sweep runs serially, on 2
@@ -29,6 +29,11 @@ core is busy too. On 2 processes this is the host's contention (their main proce
 Dask it also holds the time Dask's threads took the core from a run. 2 over it is the speed-up
 if every part of a point slowed alike and the executor cost nothing: the host's ceiling.
 
+With --host the question is what the host itself gives: 8 runs of the standalone executable
+(cases/chaos_z24.nml, no Python, nothing shared) one at a time and two at a time, 6 times in
+alternating order (host_ceiling.csv). On a shared virtual machine the two cores need not compute
+as fast together as one alone; this speed-up is then the ceiling of every executor above.
+
 With --accuracy the question is what tolerance a diagram needs: every 10th point (100 points)
 is swept on 2 threads at rtol 1e-5 ... 1e-10 and compared with the same sweep at rtol 1e-11: the
 largest error of a section point (D2 at whole revolutions) as a fraction of the diagram's range
@@ -41,6 +46,7 @@ from __future__ import annotations
 import concurrent.futures as cf
 import contextlib
 import os
+import shutil
 import subprocess
 import time
 from pathlib import Path
@@ -95,6 +101,42 @@ def bench_case(rtol=None):
     if rtol:
         kw.update(rtol=rtol, atol=rtol * 1e-2)
     return case.replace(**kw)
+
+
+def host_ceiling(out: Path, runs: int = 8, repeats: int = 6, quick: bool = False) -> list[dict]:
+    """The host's own 2-way speed-up (the module docstring's --host): `runs` runs of the
+    standalone executable on cases/chaos_z24.nml (about 0.7 s each), one at a time and two at a
+    time, in an order that alternates from repeat to repeat. No Python and nothing shared between
+    the runs: what no executor can beat on this host."""
+    exe = os.environ.get("SPLINE_DYN") or shutil.which("spline-dyn")
+    if not exe:
+        raise RuntimeError("--host needs the executable: put spline-dyn on PATH or set SPLINE_DYN")
+    # two outputs: the integration, not the CSV's formatting (8001 rows of 209 numbers: 1.3 s)
+    cmd = [exe, str(cases_dir() / "chaos_z24.nml"), "-o", os.devnull, "--set", "n_out=2"]
+    if quick:
+        cmd += ["--set", "t_transient=0", "--set", "t_end=0.02"]
+
+    def batch(width):
+        t0 = time.perf_counter()
+        with cf.ThreadPoolExecutor(width) as pool:
+            for run in pool.map(lambda _: subprocess.run(cmd, capture_output=True, text=True),
+                                range(runs)):
+                if run.returncode:
+                    raise RuntimeError(f"{' '.join(cmd)} failed: {run.stderr.strip()}")
+        return time.perf_counter() - t0
+
+    rows = []
+    for rep in range(repeats):
+        wall = {width: batch(width) for width in ((1, 2) if rep % 2 == 0 else (2, 1))}
+        rows.append(dict(runs=runs, one_at_a_time_s=wall[1], two_at_a_time_s=wall[2],
+                         speed_up=wall[1] / wall[2]))
+        print(f"repeat {rep + 1}: {runs} runs of chaos_z24 one at a time {wall[1]:.2f} s, two at "
+              f"a time {wall[2]:.2f} s: {rows[-1]['speed_up']:.2f}x", flush=True)
+    ups = [r["speed_up"] for r in rows]
+    print(f"the host's 2-way speed-up (standalone executable): median {np.median(ups):.2f}x "
+          f"({min(ups):.2f}-{max(ups):.2f})")
+    _write_csv(out / "host_ceiling.csv", rows)
+    return rows
 
 
 ACCURACY_RTOLS = (1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
@@ -165,6 +207,10 @@ def _plot_accuracy(rows, path):
 def main(args) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.host:
+        host_ceiling(out, quick=args.quick)
+        print(f"wrote {out}/host_ceiling.csv")
+        return 0
     if args.accuracy:
         accuracy(out, args.points or 1000)
         print(f"wrote {out}/bifurcation_accuracy.csv and bifurcation_accuracy.png")

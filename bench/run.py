@@ -82,6 +82,8 @@ def main(argv=None) -> int:
                    "executor runs the whole sweep once, one after the other)")
     p.add_argument("--scaling", action="store_true", help="bifurcation: also run each parallel "
                    "executor with one worker (speed-up from 1 to 2 workers)")
+    p.add_argument("--host", action="store_true", help="bifurcation: the host's own 2-way "
+                   "speed-up, from runs of the standalone executable one and two at a time")
     p.add_argument("--accuracy", action="store_true", help="bifurcation: the diagram's section "
                    "error, periods, steps and wall time over rtol (every 10th point)")
     p.add_argument("--out", default="out/bench", help="output directory (default out/bench)")

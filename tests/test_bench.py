@@ -106,13 +106,25 @@ def test_bifurcation_scaling_labels():
         "Dask LocalCluster, 1 worker thread"]
 
 
+def test_host_ceiling_quick(tmp_path, exe, monkeypatch):
+    """--host: the standalone executable's runs one and two at a time, a row per repeat."""
+    import bifurcation
+    monkeypatch.setenv("SPLINE_DYN", exe)
+    rows = bifurcation.host_ceiling(tmp_path, runs=2, repeats=2, quick=True)
+    assert len(rows) == 2
+    for r in rows:
+        assert r["speed_up"] == pytest.approx(r["one_at_a_time_s"] / r["two_at_a_time_s"])
+        assert 0.3 < r["speed_up"] < 3
+    assert len(list(csv.DictReader(open(tmp_path / "host_ceiling.csv")))) == 2
+
+
 def test_bifurcation_repeats_quick(tmp_path):
     """--repeats: every executor's walls per repeat, medians and the same diagram."""
     import argparse
 
     import bifurcation
     args = argparse.Namespace(out=str(tmp_path), accuracy=False, points=4, blocks=1, repeats=2,
-                              rtol=1e-6, quick=True, scaling=False)
+                              rtol=1e-6, quick=True, scaling=False, host=False)
     assert bifurcation.main(args) == 0
     table = list(csv.DictReader(open(tmp_path / "bifurcation.csv")))
     assert len(table) == 5 and {r["failed"] for r in table} == {"0"}
