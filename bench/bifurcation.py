@@ -29,10 +29,11 @@ core is busy too. On 2 processes this is the host's contention (their main proce
 Dask it also holds the time Dask's threads took the core from a run. 2 over it is the speed-up
 if every part of a point slowed alike and the executor cost nothing: the host's ceiling.
 
-With --host the question is what the host itself gives: 8 runs of the standalone executable
-(cases/chaos_z24.nml, no Python, nothing shared) one at a time and two at a time, 6 times in
-alternating order (host_ceiling.csv). On a shared virtual machine the two cores need not compute
-as fast together as one alone; this speed-up is then the ceiling of every executor above.
+With --host two more rows take their turns with the executors: in every block, 4 runs of the
+standalone executable (cases/chaos_z24.nml: no Python, separate processes, nothing shared) one at
+a time, and the same two at a time. Their speed-up is what the host itself gives to two workers:
+on a shared virtual machine the two cores need not compute as fast together as one alone, and
+then no executor above can beat it.
 
 With --accuracy the question is what tolerance a diagram needs: every 10th point (100 points)
 is swept on 2 threads at rtol 1e-5 ... 1e-10 and compared with the same sweep at rtol 1e-11: the
@@ -81,7 +82,7 @@ def _start(kind, n, stack):
     (pyspline imported in its workers), its shutdown registered on `stack`. Dask through
     pyspline.local_dask_client (DASK_SWEEP_CONFIG): its default layout, worker processes, and
     worker threads in this process."""
-    if kind is None:
+    if kind in (None, "host"):
         return None
     if kind == "threads":
         return stack.enter_context(cf.ThreadPoolExecutor(n))
@@ -103,40 +104,28 @@ def bench_case(rtol=None):
     return case.replace(**kw)
 
 
-def host_ceiling(out: Path, runs: int = 8, repeats: int = 6, quick: bool = False) -> list[dict]:
-    """The host's own 2-way speed-up (the module docstring's --host): `runs` runs of the
-    standalone executable on cases/chaos_z24.nml (about 0.7 s each), one at a time and two at a
-    time, in an order that alternates from repeat to repeat. No Python and nothing shared between
-    the runs: what no executor can beat on this host."""
+HOST = ("spline-dyn, 1 at a time", "spline-dyn, 2 at a time")    # --host: (kind "host", 1 | 2)
+HOST_RUNS = 4          # runs of the standalone executable per block and width
+
+
+def host_command(quick: bool = False) -> list[str]:
+    """The standalone executable on cases/chaos_z24.nml (about 0.7 s; quick: 0.01 s) for
+    --host, with two outputs: the integration, not the CSV's formatting (8001 rows of 209
+    numbers take it 1.3 s)."""
     exe = os.environ.get("SPLINE_DYN") or shutil.which("spline-dyn")
     if not exe:
         raise RuntimeError("--host needs the executable: put spline-dyn on PATH or set SPLINE_DYN")
-    # two outputs: the integration, not the CSV's formatting (8001 rows of 209 numbers: 1.3 s)
     cmd = [exe, str(cases_dir() / "chaos_z24.nml"), "-o", os.devnull, "--set", "n_out=2"]
-    if quick:
-        cmd += ["--set", "t_transient=0", "--set", "t_end=0.02"]
+    return cmd + (["--set", "t_transient=0", "--set", "t_end=0.02"] if quick else [])
 
-    def batch(width):
-        t0 = time.perf_counter()
-        with cf.ThreadPoolExecutor(width) as pool:
-            for run in pool.map(lambda _: subprocess.run(cmd, capture_output=True, text=True),
-                                range(runs)):
-                if run.returncode:
-                    raise RuntimeError(f"{' '.join(cmd)} failed: {run.stderr.strip()}")
-        return time.perf_counter() - t0
 
-    rows = []
-    for rep in range(repeats):
-        wall = {width: batch(width) for width in ((1, 2) if rep % 2 == 0 else (2, 1))}
-        rows.append(dict(runs=runs, one_at_a_time_s=wall[1], two_at_a_time_s=wall[2],
-                         speed_up=wall[1] / wall[2]))
-        print(f"repeat {rep + 1}: {runs} runs of chaos_z24 one at a time {wall[1]:.2f} s, two at "
-              f"a time {wall[2]:.2f} s: {rows[-1]['speed_up']:.2f}x", flush=True)
-    ups = [r["speed_up"] for r in rows]
-    print(f"the host's 2-way speed-up (standalone executable): median {np.median(ups):.2f}x "
-          f"({min(ups):.2f}-{max(ups):.2f})")
-    _write_csv(out / "host_ceiling.csv", rows)
-    return rows
+def host_runs(cmd: list[str], runs: int, width: int) -> None:
+    """`runs` runs of `cmd`, `width` at a time: separate processes, nothing shared."""
+    with cf.ThreadPoolExecutor(width) as pool:
+        for run in pool.map(lambda _: subprocess.run(cmd, capture_output=True, text=True),
+                            range(runs)):
+            if run.returncode:
+                raise RuntimeError(f"{' '.join(cmd)} failed: {run.stderr.strip()}")
 
 
 ACCURACY_RTOLS = (1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
@@ -207,10 +196,6 @@ def _plot_accuracy(rows, path):
 def main(args) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    if args.host:
-        host_ceiling(out, quick=args.quick)
-        print(f"wrote {out}/host_ceiling.csv")
-        return 0
     if args.accuracy:
         accuracy(out, args.points or 1000)
         print(f"wrote {out}/bifurcation_accuracy.csv and bifurcation_accuracy.png")
@@ -231,6 +216,9 @@ def main(args) -> int:
     executors.update({label(2): (kind, 2) for kind, label in KINDS.items()})
     if args.scaling:          # each parallel executor also with one worker
         executors.update({label(1): (kind, 1) for kind, label in KINDS.items()})
+    host = host_command(args.quick) if args.host else None
+    if host:                  # the host's own 2-way speed-up, beside the executors'
+        executors.update({HOST[0]: ("host", 1), HOST[1]: ("host", 2)})
     labels = list(executors)
     wall = {label: np.zeros(repeats) for label in labels}       # per repeat, summed over blocks
     core = {label: np.zeros(repeats) for label in labels}       # summed core_wall_s of the points
@@ -254,6 +242,10 @@ def main(args) -> int:
                         ex = (started[label] if blocks > 1
                               else _start(*executors[label], this_run))
                         t0 = time.perf_counter()
+                        if executors[label][0] == "host":
+                            host_runs(host, HOST_RUNS, executors[label][1])
+                            wall[label][rep] += time.perf_counter() - t0
+                            continue
                         part = pyspline.sweep(case, executor=ex, progress=False, l_x=values)
                         wall[label][rep] += time.perf_counter() - t0
                     core[label][rep] += float(np.nansum(part["core_wall_s"].values))
@@ -267,15 +259,16 @@ def main(args) -> int:
                                                 for label in labels), flush=True)
     rows = []
     for label in labels:
-        ratio = wall["serial"] / wall[label]                    # within each repeat
         kind, workers = executors[label]
-        one = KINDS[kind](1) if kind else None
+        # within each repeat; the standalone runs two at a time against one at a time
+        ratio = wall[HOST[0] if kind == "host" else "serial"] / wall[label]
+        one = KINDS[kind](1) if kind in KINDS else None
         scaling = wall[one] / wall[label] if one in wall and workers > 1 else None
         # the wall time inside the core (Fortran, no GIL, no messages) for the same points,
         # against the serial sweep's: how much slower the core computes while the other core is
         # busy too (host contention; on Dask also its threads taking turns with the runs).
         # `workers` over it is the speed-up if all work slowed alike and nothing else cost.
-        inflation = float(np.median(core[label] / core["serial"]))
+        inflation = float(np.median(core[label] / core["serial"])) if kind != "host" else None
         rows.append(dict(executor=label, points=n, blocks=blocks, repeats=repeats,
                          rtol=case["rtol"], wall_median_s=float(np.median(wall[label])),
                          wall_min_s=float(wall[label].min()),
@@ -287,16 +280,19 @@ def main(args) -> int:
                                          else ""),
                          scaling_min=float(scaling.min()) if scaling is not None else "",
                          scaling_max=float(scaling.max()) if scaling is not None else "",
-                         core_time_over_serial_median=inflation,
-                         ceiling=max(workers, 1) / inflation,
+                         core_time_over_serial_median=inflation or "",
+                         ceiling=max(workers, 1) / inflation if inflation else "",
                          failed=failed[label]))
     print(f"{'executor':34s} {'wall: median':>12s} {'(min-max)':>15s}   speed-up: median "
-          f"(min-max), within each repeat; core time over serial's -> speed-up if all work slowed alike")
+          f"(min-max), within each repeat; core time over serial's -> speed-up if all work "
+          f"slowed alike")
     for r in rows:
         print(f"{r['executor']:34s} {r['wall_median_s']:10.2f} s ({r['wall_min_s']:5.2f}-"
               f"{r['wall_max_s']:5.2f})   {r['speed_up_median']:5.2f}x ({r['speed_up_min']:.2f}-"
-              f"{r['speed_up_max']:.2f})   core {r['core_time_over_serial_median']:.2f}x -> "
-              f"{r['ceiling']:.2f}x"
+              f"{r['speed_up_max']:.2f})"
+              + (f"   core {r['core_time_over_serial_median']:.2f}x -> {r['ceiling']:.2f}x"
+                 if r["ceiling"] != "" else f"   ({HOST_RUNS} runs of chaos_z24 a block, "
+                                            "over one at a time)")
               + (f"   over 1 worker: {r['scaling_median']:.2f}x ({r['scaling_min']:.2f}-"
                  f"{r['scaling_max']:.2f})" if r["scaling_median"] != "" else ""), flush=True)
     if any(failed.values()):

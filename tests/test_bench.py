@@ -106,27 +106,23 @@ def test_bifurcation_scaling_labels():
         "Dask LocalCluster, 1 worker thread"]
 
 
-def test_host_ceiling_quick(tmp_path, exe, monkeypatch):
-    """--host: the standalone executable's runs one and two at a time, a row per repeat."""
-    import bifurcation
-    monkeypatch.setenv("SPLINE_DYN", exe)
-    rows = bifurcation.host_ceiling(tmp_path, runs=2, repeats=2, quick=True)
-    assert len(rows) == 2
-    for r in rows:
-        assert r["speed_up"] == pytest.approx(r["one_at_a_time_s"] / r["two_at_a_time_s"])
-        assert 0.3 < r["speed_up"] < 3
-    assert len(list(csv.DictReader(open(tmp_path / "host_ceiling.csv")))) == 2
-
-
-def test_bifurcation_repeats_quick(tmp_path):
-    """--repeats: every executor's walls per repeat, medians and the same diagram."""
+def test_bifurcation_repeats_quick(tmp_path, exe, monkeypatch):
+    """--repeats: every executor's walls per repeat, medians and the same diagram; --host: the
+    standalone executable's runs one and two at a time beside them."""
     import argparse
 
     import bifurcation
+    monkeypatch.setenv("SPLINE_DYN", exe)
     args = argparse.Namespace(out=str(tmp_path), accuracy=False, points=4, blocks=1, repeats=2,
-                              rtol=1e-6, quick=True, scaling=False, host=False)
+                              rtol=1e-6, quick=True, scaling=False, host=True)
     assert bifurcation.main(args) == 0
     table = list(csv.DictReader(open(tmp_path / "bifurcation.csv")))
+    host = table[-2:]
+    assert [r["executor"] for r in host] == list(bifurcation.HOST)
+    assert float(host[0]["speed_up_median"]) == 1.0             # one at a time against itself
+    assert 0.3 < float(host[1]["speed_up_median"]) < 3
+    assert host[1]["ceiling"] == ""                              # no points, no core time
+    table = table[:-2]
     assert len(table) == 5 and {r["failed"] for r in table} == {"0"}
     for r in table:
         walls = [float(w) for w in r["walls_s"].split()]
