@@ -353,13 +353,15 @@ def local_dask_client(n_workers: int = 2, processes: bool = True, **kwargs):
         ``if __name__ == "__main__":``; without the guard this raises a RuntimeError that says
         so. False: the workers are threads of this process (the core releases the GIL): they
         start in 0.03 s instead of 1-2 s and need no guard, but Dask's event loop then shares
-        the GIL and the cores with them, and on sweeps of cheap points (5 ms each, 2 cores) they
-        reached 1.54-1.66x where worker processes reached 1.75-1.92x (docs/performance.md).
+        the GIL and the cores with them: on sweeps of cheap points (5 ms each, 2 cores) they
+        scaled less than worker processes in every run measured, 1.47-1.66x against
+        1.57-1.92x (docs/performance.md, sessions 9 and 10).
     kwargs : passed to LocalCluster (e.g. dashboard_address=':8787' to watch the sweep: the
         dashboard needs bokeh)."""
+    import multiprocessing
+
     import dask
     from distributed import Client
-    import multiprocessing
     if processes and getattr(multiprocessing.current_process(), "_inheriting", False):
         # a new process still importing the script of its parent (multiprocessing's own test)
         raise RuntimeError(_NO_MAIN_GUARD)

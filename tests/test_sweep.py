@@ -204,8 +204,9 @@ def test_ctrl_c_in_a_real_sweep(case, tmp_path):
 
 # --------------------------------------------------------------------------- Dask
 
-@pytest.mark.parametrize("processes", [None, False], ids=["worker-processes", "worker-threads"])
-def test_dask_executor(case, processes):
+@pytest.mark.parametrize("kwargs", [{}, dict(processes=False)],
+                         ids=["worker-processes", "worker-threads"])
+def test_dask_executor(case, kwargs):
     """A local Dask cluster of two workers (pyspline.local_dask_client: worker processes, its
     default, where cases and summaries are pickled, and worker threads in this process) gives
     the serial numbers (needs `distributed`, which scripts/setup.sh installs: in CI this test
@@ -216,8 +217,7 @@ def test_dask_executor(case, processes):
         distributed = pytest.importorskip("distributed")
     serial = pyspline.sweep(case, progress=False, l_x=LX)
     box = {}
-    kwargs = {} if processes is None else dict(processes=processes)
-    processes = processes is None
+    processes = not kwargs                      # the default: worker processes
     with pyspline.local_dask_client(2, **kwargs) as client:
         assert len(client.scheduler_info()["workers"]) == 2
         pids = set(client.run(os.getpid).values())
