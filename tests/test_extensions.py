@@ -76,6 +76,47 @@ def test_unbalance_forced_response():
         assert err < 1e-6, (k, err)
 
 
+def test_unbalance_builds_up_at_the_lateral_critical_speed():
+    """At the first lateral critical speed (the splines moving together on their supports,
+    damping ratio 8e-4) unbalance builds the response up over 1/(zeta omega) = 0.8 s. Started at
+    its static equilibrium (which holds the unbalance force at t = 0), the run follows the
+    closed form of the linear system, y_p(t) + exp(A t) (y(0) - y_p(0)), to 1e-6 of its
+    amplitude, while that amplitude grows past 50 times the static deflection."""
+    from scipy.linalg import expm
+    lateral = np.abs(np.linalg.eigvals(jacobian(BASE.model, BASE.model.start_state())).imag)
+    w = lateral[lateral > 1000].min()                  # the first lateral natural frequency
+    case0 = BASE.replace(speed_rpm=w * 30 / np.pi, t_end=0.2, n_out=401)
+    model0 = case0.model
+    y_eq = model0.start_state()
+    A = jacobian(model0, y_eq)
+    assert model0.info()["omega"] == pytest.approx(w, rel=1e-12)
+    ev = np.linalg.eigvals(A)
+    mode = ev[np.argmin(np.abs(ev.imag - w))]
+    assert mode.imag == pytest.approx(w, rel=1e-9)     # still the critical speed at this speed
+    # equal splines moving together: the mesh does not stretch, the supports carry them
+    assert (BASE["m_1"], BASE["k_p1"], BASE["c_p1"]) == (BASE["m_2"], BASE["k_p2"], BASE["c_p2"])
+    assert -mode.real == pytest.approx(BASE["c_p1"] / (2 * BASE["m_1"]), rel=1e-6)
+    assert abs(mode) == pytest.approx(np.sqrt(BASE["k_p1"] / BASE["m_1"]), rel=1e-6)
+    assert -mode.real / abs(mode) < 1e-3               # lightly damped: a sharp resonance
+    u = 2e-6
+    B = np.zeros(14, complex)
+    f = u * w**2 / case0["m_1"]
+    B[7], B[8] = f, -1j * f
+    yp = forced_response(A, B, w)
+    case = case0.replace(unbalance=[u, 0.0])
+    res = pyspline.simulate(case)
+    c0 = case.model.start_state() - y_eq - yp(np.array([0.0]))[0]
+    ref = yp(res.t) + np.array([expm(A * t) @ c0 for t in res.t])
+    dy = res.y - y_eq
+    scale = np.abs(ref).max(axis=0)
+    for k in (0, 1, 2, 3, 7, 8, 9, 10):                 # the lateral states
+        err = np.abs(dy[:, k] - ref[:, k]).max() / scale[k]
+        assert err < 1e-6, (k, err)
+    last_turns = res.t > res.t[-1] - 4 * np.pi / w
+    assert np.abs(dy[last_turns, 0]).max() > 50 * f / w**2    # resonance, not just forcing
+    assert (np.abs(res.dn) > res.c).all()               # full contact: the linear regime
+
+
 def test_untilted_slices_reproduce_the_whole_face():
     """gamma = 0: n slices of k_m / n each are the whole face. The right-hand side agrees to
     round-off at any state (in and out of contact); trajectories agree to the integrator's
