@@ -27,7 +27,8 @@ Every executor's row also gives the time its points spent inside the core (Fortr
 messages), summed, over the serial sweep's: how much slower a core computes while the other
 core is busy too. On 2 processes this is the host's contention (their main process waits); on
 Dask it also holds the time Dask's threads took the core from a run. 2 over it is the speed-up
-if every part of a point slowed alike and the executor cost nothing: the host's ceiling.
+if every part of a point slowed alike and the executor cost nothing (an estimate of the
+host's ceiling; --host measures it).
 
 With --host two more rows take their turns with the executors: in every block, 4 runs of the
 standalone executable (cases/chaos_z24.nml: no Python, separate processes, nothing shared) one at
@@ -78,10 +79,10 @@ KINDS = {
 
 
 def _start(kind, n, stack):
-    """The executor of `kind` with `n` workers (kind None: serial), started and warmed up
-    (pyspline imported in its workers), its shutdown registered on `stack`. Dask through
-    pyspline.local_dask_client (DASK_SWEEP_CONFIG): its default layout, worker processes, and
-    worker threads in this process."""
+    """The executor of `kind` with `n` workers (kind None: serial; "host": none), started and
+    warmed up (pyspline imported in its workers), its shutdown registered on `stack`. Dask
+    through pyspline.local_dask_client (DASK_SWEEP_CONFIG): its default layout, worker
+    processes, and worker threads in this process."""
     if kind in (None, "host"):
         return None
     if kind == "threads":
@@ -109,9 +110,9 @@ HOST_RUNS = 4          # runs of the standalone executable per block and width
 
 
 def host_command(quick: bool = False) -> list[str]:
-    """The standalone executable on cases/chaos_z24.nml (about 0.7 s; quick: 0.01 s) for
-    --host, with two outputs: the integration, not the CSV's formatting (8001 rows of 209
-    numbers take it 1.3 s)."""
+    """The standalone executable on cases/chaos_z24.nml (about 0.5 s; quick: 0.01 s) for
+    --host, with two outputs: the integration, not the CSV's formatting (its 8001 rows of 209
+    numbers take about as long as the run)."""
     exe = os.environ.get("SPLINE_DYN") or shutil.which("spline-dyn")
     if not exe:
         raise RuntimeError("--host needs the executable: put spline-dyn on PATH or set SPLINE_DYN")
