@@ -271,13 +271,13 @@ def test_dask_worker_processes_without_main_guard(tmp_path):
     assert "local_dask_client was called while a Dask worker process imported" in run.stderr
 
 
-def test_dask_worker_processes_from_a_script_on_stdin():
+def test_dask_worker_processes_from_a_script_on_stdin(tmp_path):
     """Worker processes import the main script, which a script read from standard input does
     not have as a file: a clear error at once, before any process starts."""
     pytest.importorskip("distributed")
     run = subprocess.run([sys.executable, "-"], input="import pyspline\n"
                          "pyspline.local_dask_client(2)\n", capture_output=True, text=True,
-                         timeout=120)
+                         timeout=120, cwd=tmp_path)        # not the source tree's pyspline/
     assert run.returncode == 1
     last = run.stderr.strip().splitlines()[-1]
     assert last.startswith("RuntimeError: pyspline.local_dask_client: worker processes start by "
