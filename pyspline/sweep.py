@@ -351,26 +351,32 @@ def local_dask_client(n_workers: int = 2, processes: bool = True, **kwargs):
         each, the layout of a multi-node cluster. The worker processes start by importing the
         script that starts them, so in a script the cluster must start under
         ``if __name__ == "__main__":``; without the guard this raises a RuntimeError that says
-        so, as it does for a script read from standard input (no file to import). False: the workers are threads of this process (the core releases the GIL): they
-        start in 0.03 s instead of 1-2 s and need no guard, but Dask's event loop then shares
-        the GIL and the cores with them: on sweeps of cheap points (5 ms each, 2 cores) they
-        scaled less than worker processes in five of six runs: medians of 1.47-1.66x against
-        1.57-1.92x (docs/performance.md, sessions 9 and 10).
+        so, as it does for a script read from standard input (no file to import). False: the
+        workers are threads of this process (the core releases the GIL): they start in 0.03 s
+        instead of 1-2 s and need no guard, but Dask's event loop then shares the GIL and the
+        cores with them: on sweeps of cheap points (5 ms each, 2 cores) they scaled less than
+        worker processes in five of six runs: medians of 1.47-1.66x against 1.57-1.92x
+        (docs/performance.md, sessions 9 and 10).
     kwargs : passed to LocalCluster (e.g. dashboard_address=':8787' to watch the sweep: the
         dashboard needs bokeh)."""
     import multiprocessing
 
     import dask
     from distributed import Client
-    if processes and getattr(multiprocessing.current_process(), "_inheriting", False):
-        # a new process still importing the script of its parent (multiprocessing's own test)
-        raise RuntimeError(_NO_MAIN_GUARD)
-    script = getattr(sys.modules.get("__main__"), "__file__", None)
-    if processes and script is not None and not os.path.isfile(script):
-        raise RuntimeError(f"pyspline.local_dask_client: worker processes start by importing the "
-                           f"script that starts them, and {script} is not a file (a script read "
-                           f"from standard input?): save the script to a file, or pass "
-                           f"processes=False for worker threads in this process")
+    if processes:
+        if getattr(multiprocessing.current_process(), "_inheriting", False):
+            # a new process still importing the script of its parent (multiprocessing's test)
+            raise RuntimeError(
+                "pyspline.local_dask_client was called while a Dask worker process imported the "
+                "script that starts the cluster: in a script, start the cluster under `if "
+                "__name__ == \"__main__\":`, or pass processes=False for worker threads")
+        script = getattr(sys.modules.get("__main__"), "__file__", None)
+        if script is not None and not os.path.isfile(script):
+            raise RuntimeError(
+                f"pyspline.local_dask_client: worker processes start by importing the script "
+                f"that starts them, and {script} is not a file (a script read from standard "
+                f"input?): save the script to a file, or pass processes=False for worker "
+                f"threads in this process")
     options = dict(n_workers=n_workers, threads_per_worker=1, processes=processes,
                    dashboard_address=":0")
     options.update(kwargs)
@@ -387,12 +393,6 @@ def local_dask_client(n_workers: int = 2, processes: bool = True, **kwargs):
                 "\"__main__\":`, because each worker process imports the script (Dask's log "
                 "above shows each worker's error); or pass processes=False for worker threads "
                 "in this process") from exc
-
-
-_NO_MAIN_GUARD = (
-    "pyspline.local_dask_client was called while a Dask worker process imported the script "
-    "that starts the cluster: in a script, start the cluster under `if __name__ == "
-    "\"__main__\":`, or pass processes=False for worker threads")
 
 
 def _workers(executor) -> int:
