@@ -1,0 +1,4 @@
+program test_mesh
+use check
+call check_done("test_mesh")
+end program

@@ -1,0 +1,4 @@
+program test_stiffness
+use check
+call check_done("test_stiffness")
+end program
