@@ -20,6 +20,10 @@ contains
     n_checks = n_checks + 1
     if (.not. ok) n_failed = n_failed + 1
     if (present(detail)) then
+      if (len_trim(detail) == 0) then
+        print '(a,1x,a)', merge('PASS', 'FAIL', ok), name
+        return
+      end if
       print '(a,1x,a,": ",a)', merge('PASS', 'FAIL', ok), name, detail
     else
       print '(a,1x,a)', merge('PASS', 'FAIL', ok), name
