@@ -89,7 +89,7 @@ program test_geometry
   ! sines with an explicit inverse sine (the code uses an equivalent form without it)
   worst = 0.0_wp
   ok = .true.
-  lo = 15.0e-3_wp; hi = 17.0e-3_wp      ! active flank: internal tip m(Z-1)/2 .. external tip m(Z+1)/2
+  lo = 0.5_wp*2.0e-3_wp*(16 - 1); hi = 0.5_wp*2.0e-3_wp*(16 + 1)  ! internal tip .. external tip
   do k = -20, 20
     delta = k*0.5_wp*2.0e-3_wp/20      ! |Delta| <= m / 2
     rc = contact_radius(delta, -1.0_wp, r, cos(pi/6), sin(pi/6))
