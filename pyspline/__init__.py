@@ -2,9 +2,11 @@
 flash temperature (Xue, Shen & Xue 2025). The physics lives in the Fortran core (fortran/);
 this package reads cases, runs them and plots them."""
 from .case import Case, defaults, load_case
+from .cluster import local_dask_client
 from .core import Model, Result, load, mesh_stiffness, rhs, simulate, start_state, tooth_stiffness
+from .dataset import open_sweep
 from .errors import CaseError, SolverError, SplineError, SplineWarning, ThermalInterferenceError
-from .sweep import local_dask_client, open_sweep, sweep  # pyspline.sweep: the function
+from .sweep import sweep  # pyspline.sweep: the function
 
 __all__ = ["Case", "CaseError", "Model", "Result", "SolverError", "SplineError", "SplineWarning",
            "ThermalInterferenceError", "defaults", "load", "load_case", "local_dask_client",

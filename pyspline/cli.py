@@ -11,10 +11,16 @@ Also `python -m pyspline`. The standalone executable is spline-dyn (spline-dyn -
 from __future__ import annotations
 
 import argparse
+import concurrent.futures as cf
+import shlex
 import sys
 from pathlib import Path
 
 import numpy as np
+
+from .case import load_case
+from .errors import CaseError, SplineError
+from .sweep import MERGED, POINTS_DIR, parse_values, sweep
 
 
 def _summary(res) -> str:
@@ -227,6 +233,217 @@ def cmd_cases(args) -> int:
     return 0
 
 
+def _assignments(items, what) -> dict:
+    out = {}
+    for item in items or ():
+        if "=" not in item:
+            raise CaseError(f"{what} {item!r}: expected FIELD=VALUES")
+        k, v = item.split("=", 1)
+        k = k.strip().lower()
+        if k in out:
+            raise CaseError(f"{what}: field {k} given twice")
+        out[k] = v
+    return out
+
+
+def _fixed(items) -> dict:
+    """--fix FIELD=VALUE pairs -> {field: typed value}."""
+    out = {}
+    for k, v in _assignments(items, "--fix").items():
+        vals = parse_values(k, v)
+        if len(vals) != 1:
+            raise CaseError(f"--fix {k}={v}: one value expected")
+        out[k] = vals[0].item()
+    return out
+
+
+def _make_executor(args):
+    """(executor or None, its number of workers or None, closer) for --workers/--threads/
+    --scheduler; a Dask cluster's workers are its threads when the sweep starts."""
+    if args.scheduler:
+        from distributed import Client
+        client = Client(args.scheduler)
+        return client.get_executor(), max(1, sum(client.nthreads().values())), client.close
+    if args.workers > 1:
+        ex = (cf.ThreadPoolExecutor(args.workers) if args.threads
+              else cf.ProcessPoolExecutor(args.workers))
+        return ex, args.workers, lambda: ex.shutdown(wait=False, cancel_futures=True)
+    return None, None, lambda: None
+
+
+def _command(args) -> str:
+    """The command line of a parsed `pyspline sweep`, for attrs['command']."""
+    parts = ["pyspline", "sweep", args.case]
+    parts += [f"--set={v}" for v in args.set] + [f"--fix={v}" for v in args.fix or ()]
+    parts += [f"--section={args.section}", f"--out={args.out}"]
+    if args.lyapunov:
+        parts.append("--lyapunov")
+    if args.scheduler:
+        parts.append(f"--scheduler={args.scheduler}")
+    elif args.workers > 1:
+        parts += [f"--workers={args.workers}"] + (["--threads"] if args.threads else [])
+    return " ".join(shlex.quote(a) for a in parts)
+
+
+def cmd_sweep(args) -> int:
+    try:
+        grid = {k: parse_values(k, v) for k, v in _assignments(args.set, "--set").items()}
+        if not 1 <= len(grid) <= 2:
+            raise CaseError("give one or two --set FIELD=VALUES to sweep")
+        case = load_case(args.case, **_fixed(args.fix))
+    except SplineError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    out = Path(args.out)
+    executor, workers, close = _make_executor(args)
+    try:
+        ds = sweep(case, executor=executor, workers=workers, progress=not args.quiet, out=out,
+                   section=args.section, lyapunov=args.lyapunov, command=_command(args),
+                   **grid)
+    except KeyboardInterrupt:
+        print(f"\ninterrupted: the finished points are in {out / POINTS_DIR}/ and merged into "
+              f"{out / MERGED}; run the same command again to compute the rest",
+              file=sys.stderr)
+        return 130
+    finally:
+        close()
+    a = ds.attrs
+    print(f"{a['n_points']} points: {a['n_ok']} ran, {a['n_failed']} failed, "
+          f"{a['n_missing']} missing; {a['n_computed']} computed now, {a['n_reused']} reused "
+          f"from {out / POINTS_DIR}/")
+    if "chaotic" in ds:
+        n_chaos = int((ds["chaotic"] == 1).sum())
+        print(f"{n_chaos} of {a['n_ok']} points chaotic (Lyapunov exponent positive beyond its "
+              "spread): read their statistics, sections and spectra, not their trajectories")
+    if a["n_failed"] or a["n_missing"]:
+        errors = [e for e in ds["error"].values.ravel() if e]
+        print(f"first error: {errors[0]}", file=sys.stderr)
+    print(f"wrote {out / MERGED} (xarray.open_dataset(path, engine='h5netcdf') or "
+          "pyspline.open_sweep)")
+    from .plots import sweep_figures
+    for path in sweep_figures(ds, out):
+        print(f"wrote {path}")
+    # failed cases are results; points the executor lost or never ran are not
+    return 1 if a["n_missing"] or a["n_executor_errors"] else 0
+
+
+def cmd_plot(args) -> int:
+    from . import analysis, plots
+    from .core import STATE_NAMES, simulate
+    i_D2 = STATE_NAMES.index("D2")          # its column in section_y; dD2/dt is 7 later
+    out = Path(args.out)
+    status = 0
+    try:
+        fixed = _fixed(args.fix)
+    except SplineError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    for path in args.cases:
+        try:
+            case = load_case(path, **fixed).replace(section="shaft")
+            res = simulate(case)
+        except SplineError as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            status = 1
+            continue
+        spectrum = analysis.amplitude_spectrum(res.t, res.Tm) if len(res.t) >= 4 else None
+        sec = None
+        if res.section_y is not None and len(res.section_y):
+            sec = np.c_[res.section_y[:, i_D2], res.section_y[:, 7 + i_D2]]
+        thermal = case["thermal"] != "none"
+        target = out / f"{case.name}.png"
+        plots.scene(res.t, res.D2, res.vD2, res.Tm, res.tooth["F"],
+                    Tf=res.tooth["Tf"] if thermal else None, section=sec, spectrum=spectrum,
+                    speed_rpm=case["speed_rpm"], z=case["z"], path=target,
+                    title=f"{case.name}: {res.level}, {case['speed_rpm']:g} rpm, "
+                          f"T_d = {case['t_d']:g} N m, l_x = {case['l_x']:g} m, "
+                          f"l_y = {case['l_y']:g} m; section points once per revolution")
+        print(f"wrote {target}")
+    return status
+
+
+SWEEP_HELP = """\
+Run CASE over one field (--set FIELD=VALUES) or a grid of two (two --set), each point reduced
+to a summary: Poincare section of D2 and dD2/dt, its period, the largest Lyapunov exponent
+(--lyapunov), max/min/RMS of T_m, k_v and F_j, max T_f, solver statistics, the error of a
+failed point, and for a speed_rpm sweep the spectrum of T_m in shaft orders.
+
+VALUES: start:stop:num (numpy.linspace, both ends included) or a comma list (10,20,30).
+
+Writes into --out DIR:
+  DIR/points/<index>.<hash>.npz   one file per finished point, written as it finishes
+  DIR/sweep.nc                    all points merged (NetCDF-4; xarray.open_dataset(path,
+                                  engine='h5netcdf') or pyspline.open_sweep(DIR))
+  DIR/bifurcation.png             section D2 against the first field, coloured by period
+                                  (two fields: one panel per value of the second, and
+                                  DIR/period_map.png, the period over the grid)
+  DIR/lyapunov.png                with --lyapunov: the exponent against the first field
+                                  (two fields: a map over the grid)
+  DIR/waterfall.png               when speed_rpm is swept: spectrum of T_m against speed
+                                  (two fields: waterfall_FIELD=VALUE.png for up to 6 values)
+Ctrl-C or a crash keeps the finished points (merged into sweep.nc); running the same command
+again computes only the points that are missing (a changed case is recomputed: files are
+known by index and by a hash of the point's case). With --workers (processes) or --scheduler
+(Dask), points travel in tasks of up to 32 (four tasks per worker), written when their task
+ends: a Ctrl-C loses at most the tasks running then.
+
+example: pyspline sweep cases/paper_lx1e-4.nml --set l_x=0:3e-4:61 --workers 2 --out out/lx
+"""
+
+PLOT_HELP = """\
+Run each CASE (with the Poincare section once per shaft revolution) and draw one page per
+case into DIR/CASENAME.png: D2(t), T_m(t), the phase plane (D2, dD2/dt) with the exact
+section points, the tooth x time map of the tooth loads F_j, the flash temperatures T_f (thermal
+cases), and the spectrum of T_m with shaft orders (1x, 2x) and tooth-pass orders (Zx, 2Zx).
+"""
+
+
+def _at_least_one(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"must be a whole number >= 1, got {text!r}")
+    return n
+
+
+def _add_sweep_and_plot(sub) -> None:
+    """The `sweep` and `plot` subcommands."""
+    fmt = argparse.RawDescriptionHelpFormatter
+    r = sub.add_parser("sweep", help="sweep one or two case fields: sweep.nc, bifurcation, "
+                       "Lyapunov and waterfall figures in --out", description=SWEEP_HELP,
+                       formatter_class=fmt)
+    r.add_argument("case", metavar="CASE", help="case file (namelist)")
+    r.add_argument("--set", action="append", required=True, metavar="FIELD=VALUES",
+                   help="a swept field: start:stop:num or v1,v2,...; give one or two")
+    r.add_argument("--fix", action="append", metavar="FIELD=VALUE",
+                   help="change a field of the case for every point (e.g. t_end=0.5)")
+    r.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    r.add_argument("--section", choices=("shaft", "tooth"), default="shaft",
+                   help="Poincare section once per shaft revolution (default) or tooth pass")
+    r.add_argument("--lyapunov", action="store_true",
+                   help="largest Lyapunov exponent of every point (a second, perturbed "
+                        "trajectory: about 4x the run time on paper_lx1e-4)")
+    r.add_argument("--workers", type=_at_least_one, default=1, metavar="N",
+                   help="N processes (default 1: serial, in this process)")
+    r.add_argument("--threads", action="store_true",
+                   help="with --workers N: N threads instead of processes")
+    r.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run on a Dask cluster (distributed scheduler at ADDRESS, e.g. "
+                        "tcp://host:8786)")
+    r.add_argument("--quiet", action="store_true", help="no progress bar")
+    r.set_defaults(func=cmd_sweep)
+    r = sub.add_parser("plot", help="one page of figures per case: DIR/CASENAME.png",
+                       description=PLOT_HELP, formatter_class=fmt)
+    r.add_argument("cases", nargs="+", metavar="CASE", help="case file(s)")
+    r.add_argument("--out", default=".", metavar="DIR",
+                   help="output directory (default: the current one)")
+    r.add_argument("--fix", action="append", metavar="FIELD=VALUE",
+                   help="change a field of the case (e.g. t_end=0.5)")
+    r.set_defaults(func=cmd_plot)
+
+
 def main(argv=None) -> int:
     from . import __version__
     p = argparse.ArgumentParser(prog="pyspline", description=__doc__,
@@ -264,7 +481,6 @@ def main(argv=None) -> int:
     r.add_argument("--full", action="store_true", help="full length (default: 0.3 s)")
     r.add_argument("--cases")
     r.set_defaults(func=cmd_check_exe)
-    from .sweep import add_parsers      # pyspline sweep, pyspline plot (logic in sweep.py)
-    add_parsers(sub)
+    _add_sweep_and_plot(sub)
     args = p.parse_args(argv)
     return args.func(args)

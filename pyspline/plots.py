@@ -7,11 +7,15 @@ matplotlib Figure and, when given `path`, writes it there as PNG. Figures are bu
 `matplotlib.figure.Figure` and rendered by Agg, independent of pyplot and of the interactive
 backend, so sweeps do not accumulate open figures.
 
-This module imports only numpy and matplotlib: spectra, periods and exponents are computed by
-pyspline.analysis and passed in as arrays.
+`sweep_figures` draws the figures of a sweep dataset into a directory (`pyspline sweep`).
+
+This module imports only numpy and matplotlib (xarray when a sweep's waterfalls are drawn):
+spectra, periods and exponents are computed by pyspline.analysis and passed in as arrays.
 """
 from __future__ import annotations
 
+import re
+import sys
 import warnings
 from pathlib import Path
 
@@ -23,7 +27,7 @@ from matplotlib.patches import Patch
 from matplotlib.ticker import MaxNLocator
 
 __all__ = ["bifurcation", "bifurcation_grid", "lyapunov_vs_param", "param_map", "scene",
-           "waterfall"]
+           "sweep_figures", "waterfall"]
 
 # Colours of periods 1, 2, 3, 4 (Okabe-Ito, colour-blind safe) and > 4; not periodic is grey.
 PERIOD_COLOURS = {1: "#0072B2", 2: "#D55E00", 3: "#009E73", 4: "#CC79A7", 5: "#000000"}
@@ -548,3 +552,101 @@ def scene(t, D2, vD2, Tm, F, Tf=None, section=None, spectrum=None, speed_rpm=Non
     if title:
         fig.suptitle(title)
     return _finish(fig, path)
+
+
+# --------------------------------------------------------------------------- sweep figures
+
+def sweep_figures(ds, out) -> list[Path]:
+    """The figures of a sweep dataset into directory `out`: bifurcation.png (and for a grid
+    period_map.png), lyapunov.png (if computed), waterfall*.png (if speed_rpm was swept).
+    The horizontal axis is the first swept field with numeric values (a field of text values,
+    e.g. thermal, becomes the panels or the map's other axis). Returns the paths written."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    names = list(ds["error"].dims)
+    numeric = [n for n in names if ds[n].dtype.kind in "biuf"]
+    written = []
+    title_case = _case_name(ds)
+    section = ds.attrs.get("section", "")
+    if not numeric:
+        print(f"no figures: no swept field has numeric values ({', '.join(names)})",
+              file=sys.stderr)
+        return written
+    x = numeric[0]
+    other = [n for n in names if n != x]
+    if "section_D2" in ds:
+        path = out / "bifurcation.png"
+        if not other:
+            bifurcation(ds, x, path=path,
+                        title=f"{title_case}: D_2 on the {section} section vs {x}")
+        else:
+            bifurcation_grid(ds, x, other[0], path=path,
+                             title=f"{title_case}: D_2 on the {section} section")
+            param_map(ds, "period", x, other[0], path=out / "period_map.png",
+                      title=f"{title_case}: period of the {section} section sequence")
+        written.append(path)
+        if other:
+            written.append(out / "period_map.png")
+    if "lyapunov" in ds:
+        path = out / "lyapunov.png"
+        if not other:
+            lyapunov_vs_param(ds, x, path=path,
+                              title=f"{title_case}: largest Lyapunov exponent vs {x}")
+        else:
+            param_map(ds, "lyapunov", x, other[0], path=path,
+                      title=f"{title_case}: largest Lyapunov exponent")
+        written.append(path)
+    if "Tm_spectrum" in ds and "speed_rpm" in numeric:
+        written += _waterfalls(ds, out, title_case)
+    return written
+
+
+def _case_name(ds) -> str:
+    m = re.search(r"name\s*=\s*'([^']*)'", ds.attrs.get("case", ""))
+    return m.group(1) if m else "sweep"
+
+
+def _waterfall_ds(sub):
+    import xarray as xr
+    spd = sub["speed_rpm"]
+    freq = np.abs(spd.values)[:, None] * sub["order"].values[None, :] / 60.0
+    return xr.Dataset({"amplitude": (("speed_rpm", "order"),
+                                     sub["Tm_spectrum"].transpose("speed_rpm", "order").values,
+                                     {"units": "N m", "long_name": "amplitude of T_m"}),
+                       "freq_hz": (("speed_rpm", "order"), freq,
+                                   {"units": "Hz", "long_name": "frequency"})},
+                      coords={"speed_rpm": spd})
+
+
+def _z(ds) -> int | None:
+    from .case import defaults
+    m = re.search(r"\bz\s*=\s*(\d+)", ds.attrs.get("case", ""))
+    return int(m.group(1)) if m else defaults()["z"]
+
+
+def _waterfalls(ds, out, title_case) -> list[Path]:
+    names = list(ds["error"].dims)
+    z = None if "z" in names else _z(ds)
+    if len(names) == 1:
+        path = out / "waterfall.png"
+        waterfall(_waterfall_ds(ds), z=z, path=path,
+                  title=f"{title_case}: spectrum of T_m vs speed (dashed: shaft and "
+                        "tooth-pass orders)")
+        return [path]
+    other = names[0] if names[1] == "speed_rpm" else names[1]
+    values = ds[other].values
+    pick = np.unique(np.linspace(0, len(values) - 1, min(len(values), 6)).round().astype(int))
+    paths = []
+    for i in pick:
+        v = values[i]
+        sub = ds.isel({other: i})
+        path = out / f"waterfall_{other}={_fmt(v)}.png"
+        waterfall(_waterfall_ds(sub), z=z, path=path,
+                  title=f"{title_case}, {other} = {_fmt(v)}: spectrum of T_m vs speed")
+        paths.append(path)
+    return paths
+
+
+def _fmt(v) -> str:
+    v = v.item() if hasattr(v, "item") else v
+    return f"{v:g}" if isinstance(v, float) else str(v)

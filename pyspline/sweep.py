@@ -10,7 +10,8 @@ once as ``DIR/points/<index>.<hash>.npz`` and all of them are merged into ``DIR/
 directory computes only the points whose file is missing (a point is known by its grid index
 and a hash of its case text, so a changed case is never served from a stale file).
 
-The command line (``pyspline sweep``, ``pyspline plot``) is here too: `cli_sweep`, `cli_plot`.
+The Dataset and its NetCDF file are built in pyspline.dataset, a local Dask cluster in
+pyspline.cluster, the figures in pyspline.plots, the command line in pyspline.cli.
 """
 from __future__ import annotations
 
@@ -20,10 +21,7 @@ import functools
 import hashlib
 import itertools
 import os
-import re
-import shlex
 import sys
-import time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -31,12 +29,13 @@ import numpy as np
 
 from . import analysis
 from .case import Case, defaults, load_case
+from .cluster import local_dask_client
 from .core import STATE_NAMES
-from .errors import CaseError, SplineError
+from .dataset import MERGED, build_dataset, open_sweep, write_netcdf
+from .errors import CaseError
 
-__all__ = ["DASK_SWEEP_CONFIG", "local_dask_client", "open_sweep", "parse_values",
-           "point_cases", "run_point", "summarise", "sweep", "sweep_figures", "task_size",
-           "write_netcdf"]
+__all__ = ["local_dask_client", "open_sweep", "parse_values", "point_cases", "run_point",
+           "summarise", "sweep", "task_points", "write_netcdf"]
 
 #: Bump when the content of a point summary changes: older point files are then recomputed.
 #: 2: the default Benettin separation (lyapunov_d0 = 0: 1e4 rtol, was 1e-8) changed exponents.
@@ -44,43 +43,9 @@ SUMMARY_VERSION = 2
 #: Step of the common shaft-order axis of the T_m spectra [shaft orders].
 ORDER_STEP = 0.05
 SECTIONS = ("shaft", "tooth", "none")
-ENGINE = "h5netcdf"
 POINTS_DIR = "points"
-MERGED = "sweep.nc"
 
 _I_D2 = STATE_NAMES.index("D2")     # column of D2 in Result.y / section_y; dD2/dt is 7 later
-
-
-# --------------------------------------------------------------------------- field metadata
-
-@functools.cache
-def field_meta() -> dict:
-    """{field: (long_name, units)} from the comments of cases/template.nml (empty when the
-    template is not found): e.g. 'l_x' -> ('parallel misalignment of spline 1 in x', 'm')."""
-    here = Path(__file__).resolve().parent
-    for path in (here / "cases" / "template.nml", here.parent / "cases" / "template.nml"):
-        if path.is_file():
-            break
-    else:
-        return {}
-    meta = {}
-    for line in path.read_text(encoding="utf-8").splitlines():
-        m = re.match(r"\s*(\w+)\s*=[^!]*!\s*(.*)$", line)
-        if not m:
-            continue
-        comment = m.group(2)
-        u = re.search(r"\[([^\],]*)\]", comment)      # a unit has no comma
-        long = (comment[:u.start()] if u else comment).strip().rstrip(":;,").strip()
-        if "|" in long or ":" in long:      # a list of choices, not a description
-            long = m.group(1)
-        unit = u.group(1).strip() if u else ""
-        meta[m.group(1).lower()] = (long or m.group(1), "1" if unit == "-" else unit)
-    return meta
-
-
-def _field_attrs(name: str) -> dict:
-    long, units = field_meta().get(name, (name, ""))
-    return {"long_name": long, "units": units} if units else {"long_name": long}
 
 
 # --------------------------------------------------------------------------- values
@@ -297,157 +262,32 @@ def run_point(case: Case, options: dict) -> dict:
 
 
 class PointSummaries:
-    """The summaries of a chunk of points, as one object, and the seconds the chunk took in the
-    worker. Dask sends it back as one pickle (its arrays as out-of-band buffers); a bare list of
-    dicts of arrays it walks item by item, which cost 7-11 ms per task of 15 points, as much as
-    two of the points themselves."""
-    __slots__ = ("items", "seconds")
+    """The summaries of a chunk of points, as one object. Dask sends it back as one pickle (its
+    arrays as out-of-band buffers); a bare list of dicts of arrays it walks item by item, which
+    cost 7-11 ms per task of 15 points, as much as two of the points themselves."""
+    __slots__ = ("items",)
 
-    def __init__(self, items: list, seconds: float):
-        self.items, self.seconds = items, seconds
+    def __init__(self, items: list):
+        self.items = items
 
 
 def run_points(cases: list, options: dict) -> PointSummaries:
     """A chunk of sweep points as one task (fewer round trips through a process pool or a
     Dask scheduler): run_point for each."""
-    t0 = time.perf_counter()
-    items = [run_point(case, options) for case in cases]
-    return PointSummaries(items, time.perf_counter() - t0)
+    return PointSummaries([run_point(case, options) for case in cases])
 
 
-#: Dask settings for a cluster that runs long CPU-bound sweep tasks on a few cores, where every
-#: cycle Dask spends on itself is taken from a run (docs/performance.md measures them). Each
-#: turns off or slows a service such sweeps do not use: the statistical profiler (a sample of
-#: every worker thread each 10 ms), work stealing (a rebalance each 100 ms; a sweep's tasks are
-#: equal chunks handed out as workers free up), the system and memory monitors (each 500 and
-#: 100 ms; a point holds a few MB), and the event-loop health check of the scheduler and of every
-#: worker (each 20 ms: most of an idle cluster's CPU, and a wake-up that preempts a run; a loop
-#: blocked for 3 s is still reported). Last, the worker processes' malloc: the nanny sets
-#: MALLOC_TRIM_THRESHOLD_=64 KiB, which also turns off glibc's adaptive mmap threshold, so every
-#: block over 128 KiB a run allocates (its outputs, CVODE's memory) is mapped anew and faulted in,
-#: page by page: 0.6-0.8 ms a point, a sixth of its cost. A point's memory is a few MB, so
-#: keeping up to 64 MiB of free heap per worker costs nothing.
-DASK_SWEEP_CONFIG = {
-    "distributed.worker.profile.enabled": False,
-    "distributed.scheduler.work-stealing": False,
-    "distributed.admin.system-monitor.interval": "2s",
-    "distributed.worker.memory.monitor-interval": "1s",
-    "distributed.admin.tick.interval": "1s",
-    "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": 64 << 20,
-    "distributed.nanny.pre-spawn-environ.MALLOC_MMAP_THRESHOLD_": 32 << 20,
-}
+#: Most points in one task on processes and Dask: what a Ctrl-C or a crash loses per worker
+#: (a task's points are saved when it ends).
+MAX_TASK_POINTS = 32
 
 
-def local_dask_client(n_workers: int = 2, processes: bool = True, **kwargs):
-    """A ``distributed.Client`` on a new LocalCluster of `n_workers` single-threaded workers,
-    set up for sweeps (DASK_SWEEP_CONFIG; its HTTP server on a free port, so that two clusters do
-    not warn about port 8787); closing the client closes the cluster:
-
-        if __name__ == "__main__":          # in a script: each worker process imports it
-            with pyspline.local_dask_client(2) as client:
-                ds = pyspline.sweep(case, executor=client.get_executor(), l_x=values)
-
-    processes : True (default, as Dask's LocalCluster): one process per worker, with a nanny
-        each, the layout of a multi-node cluster. The worker processes start by importing the
-        script that starts them, so in a script the cluster must start under
-        ``if __name__ == "__main__":``; without the guard this raises a RuntimeError that says
-        so, as it does for a script read from standard input (no file to import). False: the
-        workers are threads of this process (the core releases the GIL): they start in 0.03 s
-        instead of 1-2 s and need no guard, but Dask's event loop then shares the GIL and the
-        cores with them: on sweeps of cheap points (5 ms each, 2 cores) they scaled less than
-        worker processes in five of six runs: medians of 1.47-1.66x against 1.57-1.92x
-        (docs/performance.md, sessions 9 and 10).
-    kwargs : passed to LocalCluster (e.g. dashboard_address=':8787' to watch the sweep: the
-        dashboard needs bokeh)."""
-    import multiprocessing
-
-    import dask
-    from distributed import Client
-    if processes:
-        if getattr(multiprocessing.current_process(), "_inheriting", False):
-            # a new process still importing the script of its parent (multiprocessing's test)
-            raise RuntimeError(
-                "pyspline.local_dask_client was called while a Dask worker process imported the "
-                "script that starts the cluster: in a script, start the cluster under `if "
-                "__name__ == \"__main__\":`, or pass processes=False for worker threads")
-        script = getattr(sys.modules.get("__main__"), "__file__", None)
-        if script is not None and not os.path.isfile(script):
-            raise RuntimeError(
-                f"pyspline.local_dask_client: worker processes start by importing the script "
-                f"that starts them, and {script} is not a file (a script read from standard "
-                f"input?): save the script to a file, or pass processes=False for worker "
-                f"threads in this process")
-    options = dict(n_workers=n_workers, threads_per_worker=1, processes=processes,
-                   dashboard_address=":0")
-    options.update(kwargs)
-    with dask.config.set(DASK_SWEEP_CONFIG):
-        try:
-            return Client(**options)
-        except Exception as exc:
-            if not processes:
-                raise
-            raise RuntimeError(
-                f"pyspline.local_dask_client: the Dask worker processes did not start "
-                f"({str(exc).rstrip('.')}). "
-                "If a script starts the cluster, it must do so under `if __name__ == "
-                "\"__main__\":`, because each worker process imports the script (Dask's log "
-                "above shows each worker's error); or pass processes=False for worker threads "
-                "in this process") from exc
-
-
-def _workers(executor) -> int:
-    """How many tasks `executor` runs at once: a process pool's workers, a Dask client's threads
-    (at the time of the call), else 2."""
-    if isinstance(executor, cf.ProcessPoolExecutor):
-        return executor._max_workers
-    client = getattr(executor, "_client", None)        # distributed.client.ClientExecutor
-    if client is not None:
-        try:
-            return max(1, sum(client.nthreads().values()))
-        except Exception:                  # noqa: BLE001 -- a guess is enough here
-            pass
-    return 2
-
-
-class PointCost:
-    """The cost of a sweep point so far: seconds per point over the finished tasks (None before
-    any). A task whose points all failed does not count: a case refused at once costs nothing,
-    and would make the next tasks huge."""
-
-    def __init__(self):
-        self._total, self._points = 0.0, 0
-
-    @property
-    def seconds(self) -> float | None:
-        return self._total / self._points if self._points else None
-
-    def add(self, done: PointSummaries) -> None:
-        if done.items and not all(item["error"] for item in done.items):
-            self._total += done.seconds
-            self._points += len(done.items)
-
-
-#: Seconds of work a task aims at on processes and Dask, and the least it shrinks to at the
-#: end of a sweep (see task_size).
-TASK_SECONDS, TAIL_SECONDS = 0.5, 0.05
-
-
-def task_size(seconds_per_point: float | None, remaining: int, workers: int) -> int:
-    """Points in the next task of a sweep on processes or Dask, from the cost of a point measured
-    so far (None: nothing measured yet, one point).
-
-    A task costs the executor a fixed time (on a 2-worker Dask cluster 5-6 ms of CPU: the
-    scheduler, the client's fetch, the worker's event loop), so cheap points go in bundles that
-    take about TASK_SECONDS. That also bounds what a Ctrl-C or a crash loses (a chunk is saved
-    when it finishes). No task takes more than its share of the rest, remaining / (2 workers),
-    so tasks shrink towards the end and the workers finish together (guided scheduling), but
-    not below TAIL_SECONDS of work: a Dask task's round trip (10-30 ms) must stay shorter than
-    the task a worker holds in reserve, or the worker waits."""
-    if seconds_per_point is None:
-        return 1
-    cost = max(seconds_per_point, 1e-6)
-    share = max(-(-remaining // (2 * workers)), int(TAIL_SECONDS / cost))
-    return max(1, min(int(TASK_SECONDS / cost), share))
+def task_points(n: int, workers: int) -> int:
+    """Points in each task of a sweep of `n` points on `workers` processes or Dask workers: a
+    quarter of a worker's share, ceil(n / (4 workers)), so that a task's fixed cost (a few ms on
+    Dask) is spread over several points and the workers still finish close together; at least
+    1, at most MAX_TASK_POINTS."""
+    return max(1, min(MAX_TASK_POINTS, -(-n // (4 * max(1, workers)))))
 
 
 # --------------------------------------------------------------------------- files
@@ -474,140 +314,6 @@ def _load_point(path: Path, keys) -> dict | None:
     return s
 
 
-# --------------------------------------------------------------------------- dataset
-
-_VAR_ATTRS = {
-    "section_t": ("time of the Poincare section point", "s"),
-    "section_D2": ("D_2 on the Poincare section", "m"),
-    "section_vD2": ("dD_2/dt on the Poincare section", "m/s"),
-    "period": ("period of the section sequence (0: not periodic; NaN: no result)", ""),
-    "period_residual": ("largest relative mismatch of the section at the period found (at the "
-                        "best period tested if none)", ""),
-    "lyapunov": ("largest Lyapunov exponent", "1/s"),
-    "lyapunov_spread": ("spread (max - min) of the running Lyapunov estimate over the last "
-                        "third of the window", "1/s"),
-    "lyapunov_rel_spread": ("lyapunov_spread / |lyapunov| (small: converged)", ""),
-    "lyapunov_slope": ("slope of the log growth over the last two thirds of the window", "1/s"),
-    "predictability_horizon": ("predictability horizon 1/lambda (inf: lambda <= 0)", "s"),
-    "chaotic": ("1: the exponent is positive beyond its own spread (chaos: read statistics, "
-                "not trajectories); 0: not; NaN: no converged estimate", ""),
-    "Tm_max": ("max of the meshing torque T_m", "N m"),
-    "Tm_min": ("min of the meshing torque T_m", "N m"),
-    "Tm_rms": ("RMS of the meshing torque T_m", "N m"),
-    "kv_max": ("max of the dynamic load coefficient k_v", ""),
-    "kv_min": ("min of the dynamic load coefficient k_v", ""),
-    "kv_rms": ("RMS of the dynamic load coefficient k_v", ""),
-    "F_max": ("max of the tooth loads F_j over all teeth", "N"),
-    "F_min": ("min of the tooth loads F_j over all teeth", "N"),
-    "F_rms": ("RMS of the tooth loads F_j over all teeth", "N"),
-    "Tf_max": ("max of the flash temperatures T_f over all teeth", "degC"),
-    "D2_max": ("max of D_2", "m"),
-    "D2_min": ("min of D_2", "m"),
-    "Tm_spectrum": ("amplitude spectrum of T_m (Hann window, mean removed; max over each order "
-                    "bin)", "N m"),
-    "wall_s": ("wall time of the run (Python call)", "s"),
-    "error": ("error message of the point ('' if it ran)", ""),
-    "error_class": ("exception class of the point's error ('' if it ran)", ""),
-    "point_hash": ("hash of the point's case text and summary options (point file name)", ""),
-}
-
-
-def _stat_attrs(name: str) -> tuple:
-    if name in _VAR_ATTRS:
-        return _VAR_ATTRS[name]
-    unit = "s" if name.endswith("_s") else ("degC" if name.endswith("_degC") else "")
-    return (f"solver statistic {name}", unit)
-
-
-def _build_dataset(grid: dict, summaries: dict, hashes: dict, options: dict, attrs: dict):
-    import xarray as xr
-
-    names = list(grid)
-    shape = tuple(len(grid[n]) for n in names)
-    keys = list(_template(options, _stat_names()))
-    ragged = [k for k in keys if k.startswith("section_")]
-    n_sec = max([len(np.atleast_1d(s[k])) for s in summaries.values() for k in ragged] or [0])
-    data = {}
-    for k in keys:
-        if k in ("error", "error_class"):
-            data[k] = np.full(shape, "", dtype=object)
-        elif k in ragged:
-            data[k] = np.full(shape + (n_sec,), np.nan)
-        elif k == "Tm_spectrum":
-            data[k] = np.full(shape + (len(options["orders"]),), np.nan)
-        else:
-            data[k] = np.full(shape, np.nan)
-    data["point_hash"] = np.full(shape, "", dtype=object)
-    for index in itertools.product(*(range(n) for n in shape)):
-        data["point_hash"][index] = hashes.get(index, "")
-        s = summaries.get(index)
-        if s is None:
-            data["error"][index] = "not computed (the sweep stopped before this point)"
-            data["error_class"][index] = "NotComputed"
-            continue
-        for k in keys:
-            v = s[k]
-            if k in ragged:
-                v = np.atleast_1d(np.asarray(v, dtype=float))
-                data[k][index + (slice(0, len(v)),)] = v
-            elif k in ("error", "error_class"):
-                data[k][index] = str(v)
-            else:
-                data[k][index] = v
-    variables = {}
-    for k, v in data.items():
-        dims = tuple(names)
-        if k in ragged:
-            dims += ("section_point",)
-        elif k == "Tm_spectrum":
-            dims += ("order",)
-        if v.dtype == object:
-            v = v.astype(str)
-        long, units = _stat_attrs(k)
-        a = {"long_name": long}
-        if units:
-            a["units"] = units
-        variables[k] = (dims, v, a)
-    coords = {n: (n, np.asarray(grid[n]), _field_attrs(n)) for n in names}
-    if options.get("orders") is not None:
-        coords["order"] = ("order", np.asarray(options["orders"], dtype=float),
-                           {"long_name": "shaft order (frequency / shaft rotation frequency)",
-                            "units": "1"})
-    ds = xr.Dataset(variables, coords=coords, attrs=attrs)
-    failed = (ds["error"] != "").values
-    ds.attrs.update(n_points=int(np.prod(shape)), n_ok=int((~failed).sum()),
-                    n_failed=int((failed & (ds["error_class"] != "NotComputed").values).sum()),
-                    n_missing=int((ds["error_class"] == "NotComputed").values.sum()))
-    return ds
-
-
-def write_netcdf(ds, path) -> Path:
-    """Write a dataset to NetCDF-4 (engine h5netcdf, float arrays compressed) through a
-    temporary file and os.replace, so a reader never sees half a file."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    enc = {k: {"zlib": True, "complevel": 4} for k, v in ds.data_vars.items()
-           if v.dtype.kind == "f" and v.size > 1}
-    try:
-        ds.to_netcdf(tmp, engine=ENGINE, encoding=enc)
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
-    return path
-
-
-def open_sweep(path):
-    """Read a sweep written by `sweep` (DIR/sweep.nc or DIR) fully into memory."""
-    import xarray as xr
-    path = Path(path)
-    if path.is_dir():
-        path = path / MERGED
-    with xr.open_dataset(path, engine=ENGINE) as ds:
-        return ds.load()
-
-
 # --------------------------------------------------------------------------- sweep
 
 def _default_orders(cases) -> np.ndarray:
@@ -622,7 +328,7 @@ def _version() -> str:
 
 
 def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapunov=False, *,
-          spectrum=None, orders=None, command=None, chunk=None, **fields):
+          spectrum=None, orders=None, command=None, chunk=None, workers=None, **fields):
     """Run `case` (a Case, dict of fields or namelist path) over one or two swept fields and
     return an xarray.Dataset of the per-point summaries.
 
@@ -632,9 +338,12 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     executor : None (serial, in this process) or a concurrent.futures.Executor
         (ThreadPoolExecutor, ProcessPoolExecutor, ``distributed.Client(...).get_executor()``).
         The caller keeps ownership: it is not shut down here.
-    chunk : points per task, all submitted at once. Default: on threads one point per task; on
-        processes and Dask tasks of about TASK_SECONDS of work (from the measured cost of a
-        point), shrinking towards the end of the sweep, two per worker in flight (task_size).
+    chunk : points per task; all tasks are submitted at once. Default: on threads one point
+        per task; on processes and Dask task_points(points to compute, workers): four tasks
+        per worker, at most MAX_TASK_POINTS points each.
+    workers : how many tasks the executor runs at once, for the default chunk (default
+        os.cpu_count(), a ProcessPoolExecutor's default; on a Dask cluster pass its
+        ``sum(client.nthreads().values())``).
     progress : bool, tqdm progress bar on stderr.
     out : directory or None. Each finished point is written to ``out/points/`` at once; the
         merge goes to ``out/sweep.nc`` (NetCDF-4, h5netcdf), also when the sweep is stopped by
@@ -733,28 +442,14 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     from tqdm import tqdm
     failed = executor_errors = 0
     futures, bar = {}, None
-    pending = list(todo)                # not yet submitted, in grid order
-    # on processes and Dask without a fixed chunk: tasks sized from the measured cost of a point
-    # (task_size), two per worker in flight; on threads, or with `chunk`, all submitted at once
-    guided = executor is not None and not chunk and not isinstance(executor, cf.ThreadPoolExecutor)
-    workers = 1
-    cost = PointCost()
+    if executor is not None and not chunk:
+        threads = isinstance(executor, cf.ThreadPoolExecutor)
+        chunk = 1 if threads else task_points(len(todo), workers or os.cpu_count() or 1)
 
     def submit():
-        nonlocal workers
-        if guided:          # asked each time: a Dask cluster may grow or shrink during a sweep
-            workers = _workers(executor)
-        while pending and (not guided or len(futures) < 2 * workers):
-            if not guided:
-                size = chunk or 1
-            elif cost.seconds is None and len(pending) > len(todo) - workers:
-                size = 1                 # one probe per worker for the cost of a point ...
-            elif cost.seconds is None:   # ... and work for the worker till the probe is back
-                size = max(1, min(32, len(todo) // (16 * workers)))
-            else:
-                size = task_size(cost.seconds, len(pending), workers)
-            indices = pending[:size]
-            del pending[:size]
+        """All tasks at once: chunks of `chunk` points, in grid order."""
+        for k in range(0, len(todo), chunk):
+            indices = todo[k:k + chunk]
             futures[executor.submit(run_points, [cases[i] for i in indices], options)] = indices
 
     def take(fut):
@@ -769,7 +464,6 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
             raise exc
         if exc is None:
             res = fut.result()
-            cost.add(res)
         for k, index in enumerate(chunk_indices):
             if exc is not None:      # the executor failed, not the case: not saved,
                 s = _template(options, _stat_names())   # a rerun tries it again
@@ -796,15 +490,9 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
                 failed += bool(summaries[index]["error"])
                 bar.update(1)
                 bar.set_postfix(failed=failed, refresh=False)
-        elif not guided:
+        else:
             for fut in cf.as_completed(list(futures)):
                 take(fut)
-        else:
-            while futures:
-                done, _ = cf.wait(list(futures), return_when=cf.FIRST_COMPLETED)
-                for fut in done:
-                    take(fut)
-                submit()
     except BaseException:
         for fut in futures:
             fut.cancel()
@@ -820,7 +508,7 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
             bar.close()
         attrs.update(n_computed=computed, n_executor_errors=executor_errors)
         try:
-            ds = _build_dataset(grid, summaries, hashes, options, attrs)
+            ds = build_dataset(grid, keys, summaries, hashes, options, attrs)
             if out is not None:
                 write_netcdf(ds, out / MERGED)
         except Exception as merge_exc:     # noqa: BLE001 -- keep the original exception
@@ -829,318 +517,7 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
         raise
     bar.close()
     attrs.update(n_computed=computed, n_executor_errors=executor_errors)
-    ds = _build_dataset(grid, summaries, hashes, options, attrs)
+    ds = build_dataset(grid, keys, summaries, hashes, options, attrs)
     if out is not None:
         write_netcdf(ds, out / MERGED)
     return ds
-
-
-# --------------------------------------------------------------------------- figures
-
-def sweep_figures(ds, out) -> list[Path]:
-    """The figures of a sweep dataset into directory `out`: bifurcation.png (and for a grid
-    period_map.png), lyapunov.png (if computed), waterfall*.png (if speed_rpm was swept).
-    The horizontal axis is the first swept field with numeric values (a field of text values,
-    e.g. thermal, becomes the panels or the map's other axis). Returns the paths written."""
-    from . import plots
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    names = list(ds["error"].dims)
-    numeric = [n for n in names if ds[n].dtype.kind in "biuf"]
-    written = []
-    title_case = _case_name(ds)
-    section = ds.attrs.get("section", "")
-    if not numeric:
-        print(f"no figures: no swept field has numeric values ({', '.join(names)})",
-              file=sys.stderr)
-        return written
-    x = numeric[0]
-    other = [n for n in names if n != x]
-    if "section_D2" in ds:
-        path = out / "bifurcation.png"
-        if not other:
-            plots.bifurcation(ds, x, path=path,
-                              title=f"{title_case}: D_2 on the {section} section vs {x}")
-        else:
-            plots.bifurcation_grid(ds, x, other[0], path=path,
-                                   title=f"{title_case}: D_2 on the {section} section")
-            plots.param_map(ds, "period", x, other[0], path=out / "period_map.png",
-                            title=f"{title_case}: period of the {section} section sequence")
-        written.append(path)
-        if other:
-            written.append(out / "period_map.png")
-    if "lyapunov" in ds:
-        path = out / "lyapunov.png"
-        if not other:
-            plots.lyapunov_vs_param(ds, x, path=path,
-                                    title=f"{title_case}: largest Lyapunov exponent vs {x}")
-        else:
-            plots.param_map(ds, "lyapunov", x, other[0], path=path,
-                            title=f"{title_case}: largest Lyapunov exponent")
-        written.append(path)
-    if "Tm_spectrum" in ds and "speed_rpm" in numeric:
-        written += _waterfalls(ds, out, title_case)
-    return written
-
-
-def _case_name(ds) -> str:
-    m = re.search(r"name\s*=\s*'([^']*)'", ds.attrs.get("case", ""))
-    return m.group(1) if m else "sweep"
-
-
-def _waterfall_ds(sub):
-    import xarray as xr
-    spd = sub["speed_rpm"]
-    freq = np.abs(spd.values)[:, None] * sub["order"].values[None, :] / 60.0
-    return xr.Dataset({"amplitude": (("speed_rpm", "order"),
-                                     sub["Tm_spectrum"].transpose("speed_rpm", "order").values,
-                                     {"units": "N m", "long_name": "amplitude of T_m"}),
-                       "freq_hz": (("speed_rpm", "order"), freq,
-                                   {"units": "Hz", "long_name": "frequency"})},
-                      coords={"speed_rpm": spd})
-
-
-def _z(ds) -> int | None:
-    m = re.search(r"\bz\s*=\s*(\d+)", ds.attrs.get("case", ""))
-    return int(m.group(1)) if m else defaults()["z"]
-
-
-def _waterfalls(ds, out, title_case) -> list[Path]:
-    from . import plots
-    names = list(ds["error"].dims)
-    z = None if "z" in names else _z(ds)
-    if len(names) == 1:
-        path = out / "waterfall.png"
-        plots.waterfall(_waterfall_ds(ds), z=z, path=path,
-                        title=f"{title_case}: spectrum of T_m vs speed (dashed: shaft and "
-                              "tooth-pass orders)")
-        return [path]
-    other = names[0] if names[1] == "speed_rpm" else names[1]
-    values = ds[other].values
-    pick = np.unique(np.linspace(0, len(values) - 1, min(len(values), 6)).round().astype(int))
-    paths = []
-    for i in pick:
-        v = values[i]
-        sub = ds.isel({other: i})
-        path = out / f"waterfall_{other}={_fmt(v)}.png"
-        plots.waterfall(_waterfall_ds(sub), z=z, path=path,
-                        title=f"{title_case}, {other} = {_fmt(v)}: spectrum of T_m vs speed")
-        paths.append(path)
-    return paths
-
-
-def _fmt(v) -> str:
-    v = _py(v)
-    return f"{v:g}" if isinstance(v, float) else str(v)
-
-
-# --------------------------------------------------------------------------- command line
-
-def _assignments(items, what) -> dict:
-    out = {}
-    for item in items or ():
-        if "=" not in item:
-            raise CaseError(f"{what} {item!r}: expected FIELD=VALUES")
-        k, v = item.split("=", 1)
-        k = k.strip().lower()
-        if k in out:
-            raise CaseError(f"{what}: field {k} given twice")
-        out[k] = v
-    return out
-
-
-def _fixed(items) -> dict:
-    """--fix FIELD=VALUE pairs -> {field: typed value}."""
-    out = {}
-    for k, v in _assignments(items, "--fix").items():
-        vals = parse_values(k, v)
-        if len(vals) != 1:
-            raise CaseError(f"--fix {k}={v}: one value expected")
-        out[k] = _py(vals[0])
-    return out
-
-
-def _make_executor(args):
-    """(executor or None, closer) for --workers/--threads/--scheduler."""
-    if args.scheduler:
-        from distributed import Client
-        client = Client(args.scheduler)
-        return client.get_executor(), client.close
-    if args.workers > 1:
-        ex = (cf.ThreadPoolExecutor(args.workers) if args.threads
-              else cf.ProcessPoolExecutor(args.workers))
-        return ex, lambda: ex.shutdown(wait=False, cancel_futures=True)
-    return None, lambda: None
-
-
-def _command(args) -> str:
-    """The command line of a parsed `pyspline sweep`, for attrs['command']."""
-    parts = ["pyspline", "sweep", args.case]
-    parts += [f"--set={v}" for v in args.set] + [f"--fix={v}" for v in args.fix or ()]
-    parts += [f"--section={args.section}", f"--out={args.out}"]
-    if args.lyapunov:
-        parts.append("--lyapunov")
-    if args.scheduler:
-        parts.append(f"--scheduler={args.scheduler}")
-    elif args.workers > 1:
-        parts += [f"--workers={args.workers}"] + (["--threads"] if args.threads else [])
-    return " ".join(shlex.quote(a) for a in parts)
-
-
-def cli_sweep(args) -> int:
-    try:
-        grid = {k: parse_values(k, v) for k, v in _assignments(args.set, "--set").items()}
-        if not 1 <= len(grid) <= 2:
-            raise CaseError("give one or two --set FIELD=VALUES to sweep")
-        case = load_case(args.case, **_fixed(args.fix))
-    except SplineError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    out = Path(args.out)
-    executor, close = _make_executor(args)
-    try:
-        ds = sweep(case, executor=executor, progress=not args.quiet, out=out,
-                   section=args.section, lyapunov=args.lyapunov, command=_command(args),
-                   **grid)
-    except KeyboardInterrupt:
-        print(f"\ninterrupted: the finished points are in {out / POINTS_DIR}/ and merged into "
-              f"{out / MERGED}; run the same command again to compute the rest",
-              file=sys.stderr)
-        return 130
-    finally:
-        close()
-    a = ds.attrs
-    print(f"{a['n_points']} points: {a['n_ok']} ran, {a['n_failed']} failed, "
-          f"{a['n_missing']} missing; {a['n_computed']} computed now, {a['n_reused']} reused "
-          f"from {out / POINTS_DIR}/")
-    if "chaotic" in ds:
-        n_chaos = int((ds["chaotic"] == 1).sum())
-        print(f"{n_chaos} of {a['n_ok']} points chaotic (Lyapunov exponent positive beyond its "
-              "spread): read their statistics, sections and spectra, not their trajectories")
-    if a["n_failed"] or a["n_missing"]:
-        errors = [e for e in ds["error"].values.ravel() if e]
-        print(f"first error: {errors[0]}", file=sys.stderr)
-    print(f"wrote {out / MERGED} (xarray.open_dataset(path, engine='h5netcdf') or "
-          "pyspline.open_sweep)")
-    for path in sweep_figures(ds, out):
-        print(f"wrote {path}")
-    # failed cases are results; points the executor lost or never ran are not
-    return 1 if a["n_missing"] or a["n_executor_errors"] else 0
-
-
-def cli_plot(args) -> int:
-    from . import plots
-    from .core import simulate
-    out = Path(args.out)
-    status = 0
-    try:
-        fixed = _fixed(args.fix)
-    except SplineError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    for path in args.cases:
-        try:
-            case = load_case(path, **fixed).replace(section="shaft")
-            res = simulate(case)
-        except SplineError as exc:
-            print(f"error: {exc}", file=sys.stderr)
-            status = 1
-            continue
-        spectrum = analysis.amplitude_spectrum(res.t, res.Tm) if len(res.t) >= 4 else None
-        sec = None
-        if res.section_y is not None and len(res.section_y):
-            sec = np.c_[res.section_y[:, _I_D2], res.section_y[:, 7 + _I_D2]]
-        thermal = case["thermal"] != "none"
-        target = out / f"{case.name}.png"
-        plots.scene(res.t, res.D2, res.vD2, res.Tm, res.tooth["F"],
-                    Tf=res.tooth["Tf"] if thermal else None, section=sec, spectrum=spectrum,
-                    speed_rpm=case["speed_rpm"], z=case["z"], path=target,
-                    title=f"{case.name}: {res.level}, {case['speed_rpm']:g} rpm, "
-                          f"T_d = {case['t_d']:g} N m, l_x = {case['l_x']:g} m, "
-                          f"l_y = {case['l_y']:g} m; section points once per revolution")
-        print(f"wrote {target}")
-    return status
-
-
-SWEEP_HELP = """\
-Run CASE over one field (--set FIELD=VALUES) or a grid of two (two --set), each point reduced
-to a summary: Poincare section of D2 and dD2/dt, its period, the largest Lyapunov exponent
-(--lyapunov), max/min/RMS of T_m, k_v and F_j, max T_f, solver statistics, the error of a
-failed point, and for a speed_rpm sweep the spectrum of T_m in shaft orders.
-
-VALUES: start:stop:num (numpy.linspace, both ends included) or a comma list (10,20,30).
-
-Writes into --out DIR:
-  DIR/points/<index>.<hash>.npz   one file per finished point, written as it finishes
-  DIR/sweep.nc                    all points merged (NetCDF-4; xarray.open_dataset(path,
-                                  engine='h5netcdf') or pyspline.open_sweep(DIR))
-  DIR/bifurcation.png             section D2 against the first field, coloured by period
-                                  (two fields: one panel per value of the second, and
-                                  DIR/period_map.png, the period over the grid)
-  DIR/lyapunov.png                with --lyapunov: the exponent against the first field
-                                  (two fields: a map over the grid)
-  DIR/waterfall.png               when speed_rpm is swept: spectrum of T_m against speed
-                                  (two fields: waterfall_FIELD=VALUE.png for up to 6 values)
-Ctrl-C or a crash keeps the finished points (merged into sweep.nc); running the same command
-again computes only the points that are missing (a changed case is recomputed: files are
-known by index and by a hash of the point's case). With --workers (processes) or --scheduler
-(Dask), cheap points travel in tasks of about 0.5 s of work, written when their task ends: a
-Ctrl-C loses at most the tasks running then.
-
-example: pyspline sweep cases/paper_lx1e-4.nml --set l_x=0:3e-4:61 --workers 2 --out out/lx
-"""
-
-PLOT_HELP = """\
-Run each CASE (with the Poincare section once per shaft revolution) and draw one page per
-case into DIR/CASENAME.png: D2(t), T_m(t), the phase plane (D2, dD2/dt) with the exact
-section points, the tooth x time map of the tooth loads F_j, the flash temperatures T_f (thermal
-cases), and the spectrum of T_m with shaft orders (1x, 2x) and tooth-pass orders (Zx, 2Zx).
-"""
-
-
-def _at_least_one(text: str) -> int:
-    import argparse
-    try:
-        n = int(text)
-    except ValueError:
-        n = 0
-    if n < 1:
-        raise argparse.ArgumentTypeError(f"must be a whole number >= 1, got {text!r}")
-    return n
-
-
-def add_parsers(sub) -> None:
-    """Add the `sweep` and `plot` subcommands to the argparse subparsers of pyspline.cli."""
-    import argparse
-    fmt = argparse.RawDescriptionHelpFormatter
-    r = sub.add_parser("sweep", help="sweep one or two case fields: sweep.nc, bifurcation, "
-                       "Lyapunov and waterfall figures in --out", description=SWEEP_HELP,
-                       formatter_class=fmt)
-    r.add_argument("case", metavar="CASE", help="case file (namelist)")
-    r.add_argument("--set", action="append", required=True, metavar="FIELD=VALUES",
-                   help="a swept field: start:stop:num or v1,v2,...; give one or two")
-    r.add_argument("--fix", action="append", metavar="FIELD=VALUE",
-                   help="change a field of the case for every point (e.g. t_end=0.5)")
-    r.add_argument("--out", required=True, metavar="DIR", help="output directory")
-    r.add_argument("--section", choices=("shaft", "tooth"), default="shaft",
-                   help="Poincare section once per shaft revolution (default) or tooth pass")
-    r.add_argument("--lyapunov", action="store_true",
-                   help="largest Lyapunov exponent of every point (a second, perturbed "
-                        "trajectory: about 4x the run time on paper_lx1e-4)")
-    r.add_argument("--workers", type=_at_least_one, default=1, metavar="N",
-                   help="N processes (default 1: serial, in this process)")
-    r.add_argument("--threads", action="store_true",
-                   help="with --workers N: N threads instead of processes")
-    r.add_argument("--scheduler", metavar="ADDRESS",
-                   help="run on a Dask cluster (distributed scheduler at ADDRESS, e.g. "
-                        "tcp://host:8786)")
-    r.add_argument("--quiet", action="store_true", help="no progress bar")
-    r.set_defaults(func=cli_sweep)
-    r = sub.add_parser("plot", help="one page of figures per case: DIR/CASENAME.png",
-                       description=PLOT_HELP, formatter_class=fmt)
-    r.add_argument("cases", nargs="+", metavar="CASE", help="case file(s)")
-    r.add_argument("--out", default=".", metavar="DIR",
-                   help="output directory (default: the current one)")
-    r.add_argument("--fix", action="append", metavar="FIELD=VALUE",
-                   help="change a field of the case (e.g. t_end=0.5)")
-    r.set_defaults(func=cli_plot)

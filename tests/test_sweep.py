@@ -222,18 +222,11 @@ def test_dask_executor(case, kwargs):
         assert len(client.scheduler_info()["workers"]) == 2
         pids = set(client.run(os.getpid).values())
         assert (os.getpid() not in pids and len(pids) == 2) if processes else pids == {os.getpid()}
-        # the sweep settings hold in the workers: no statistical profiler, no work stealing,
-        # the event-loop health check each second (Dask's default: 20 ms)
-        assert all(client.run(lambda dask_worker: "profile" not in dask_worker.periodic_callbacks)
-                   .values())
-        assert "stealing" not in client.run_on_scheduler(
-            lambda dask_scheduler: list(dask_scheduler.extensions))
-        ticks = list(client.run(lambda dask_worker: dask_worker.periodic_callbacks["tick"]
-                                .callback_time).values())
-        ticks.append(client.run_on_scheduler(
-            lambda dask_scheduler: dask_scheduler.periodic_callbacks["tick"].callback_time))
-        assert ticks == [1000] * 3
-        if processes:    # malloc keeps freed blocks for the next run (DASK_SWEEP_CONFIG)
+        if processes:    # DASK_SWEEP_CONFIG reached the worker processes: no statistical
+            import dask  # profiler, no work stealing; malloc keeps freed blocks for the next run
+            settings = client.run(lambda: [dask.config.get(k) for k in (
+                "distributed.worker.profile.enabled", "distributed.scheduler.work-stealing")])
+            assert list(settings.values()) == [[False, False]] * 2
             env = client.run(lambda: {k: os.environ.get(k) for k in (
                 "MALLOC_TRIM_THRESHOLD_", "MALLOC_MMAP_THRESHOLD_")})
             assert list(env.values()) == [{"MALLOC_TRIM_THRESHOLD_": str(64 << 20),
@@ -286,72 +279,21 @@ def test_dask_worker_processes_from_a_script_on_stdin(tmp_path):
     assert "Nanny" not in run.stderr                    # nothing was started
 
 
-def test_task_size():
-    """One point until a cost is measured; then about TASK_SECONDS of work a task, but never
-    more than a share of what remains (remaining / 2 workers) unless that is less than
-    TAIL_SECONDS of work."""
-    size, secs, tail = sw.task_size, sw.TASK_SECONDS, sw.TAIL_SECONDS
-    assert size(None, 1000, 2) == 1
-    assert size(secs / 100, 1000, 2) == 100           # cheap points: bundles of TASK_SECONDS
-    assert size(secs * 3, 1000, 2) == 1               # points dearer than a task: one each
-    assert size(secs / 100, 120, 2) == 30             # the guided tail: a quarter of the rest
-    assert size(tail / 10, 12, 2) == 10               # ... but TAIL_SECONDS of work at least
-    assert size(tail / 10, 3, 2) == 10                # (a task takes what is left)
-    assert size(tail, 1000, 64) == 8                  # a large cluster: 1000 / 128
+def test_task_points():
+    """Four tasks per worker, within 1 .. MAX_TASK_POINTS points each; the tasks cover the
+    sweep."""
+    cap = sw.MAX_TASK_POINTS
+    for n, workers in [(1, 2), (7, 2), (24, 2), (100, 3), (1000, 2), (5, 64)]:
+        size = sw.task_points(n, workers)
+        assert 1 <= size <= cap
+        tasks = -(-n // size)
+        assert tasks >= min(n, 4 * workers)                  # work for every worker
+        assert size == cap or tasks <= 4 * workers           # no smaller than that needs
 
 
-def test_point_cost_ignores_tasks_that_only_failed():
-    """Seconds per point over the tasks that ran; a task of instant refusals does not count."""
-    ok, bad = {"error": ""}, {"error": "case x: field l_x ..."}
-    cost = sw.PointCost()
-    cost.add(sw.PointSummaries([bad, bad], 0.0))
-    assert cost.seconds is None
-    cost.add(sw.PointSummaries([ok, bad], 0.4))
-    assert cost.seconds == pytest.approx(0.2)
-    cost.add(sw.PointSummaries([ok], 0.5))
-    assert cost.seconds == pytest.approx(0.3)
-    cost.add(sw.PointSummaries([bad], 0.0))
-    assert cost.seconds == pytest.approx(0.3)
-
-
-def test_guided_tasks_follow_a_growing_cluster(case, monkeypatch):
-    """Two tasks per worker in flight, with the worker count asked again at every submission:
-    a Dask cluster that grows from 1 to 4 workers during the sweep gets 8 tasks at once."""
-    def slow_points(cases, opts):           # 2 ms a point
-        time.sleep(0.002 * len(cases))
-        return sw.PointSummaries([sw._template(opts, sw._stat_names()) for _ in cases],
-                                 0.002 * len(cases))
-
-    class Client:
-        calls = 0
-
-        def nthreads(self):
-            Client.calls += 1
-            return {f"w{k}": 1 for k in range(1 if Client.calls <= 3 else 4)}
-
-    class FakeDask(cf.Executor):     # not a ThreadPoolExecutor: sized like a Dask executor
-        def __init__(self):
-            self._client, self.pool = Client(), cf.ThreadPoolExecutor(8)
-            self.running, self.outstanding = [], []
-
-        def submit(self, fn, *args):
-            self.running = [f for f in self.running if not f.done()]
-            self.running.append(self.pool.submit(fn, *args))
-            self.outstanding.append(len(self.running))
-            return self.running[-1]
-
-    monkeypatch.setattr(sw, "run_points", slow_points)
-    monkeypatch.setattr(sw, "TASK_SECONDS", 0.01)          # 5 points a task
-    ex = FakeDask()
-    ds = pyspline.sweep(case, executor=ex, progress=False, l_x=np.linspace(0.0, 2e-4, 200))
-    ex.pool.shutdown()
-    assert ds.attrs["n_ok"] == 200
-    assert max(ex.outstanding[:2]) <= 2 and max(ex.outstanding) == 8
-
-
-def test_guided_tasks_cover_every_point_once(case):
-    """On a process pool without `chunk`, tasks grow from one point to bundles and shrink
-    again, and every point is run exactly once, with the serial numbers."""
+def test_tasks_cover_every_point_once(case):
+    """On a process pool without `chunk`, tasks of task_points(n, workers) points: every point
+    runs exactly once, with the serial numbers."""
     seen = []
 
     class Recording(cf.ProcessPoolExecutor):
@@ -362,8 +304,8 @@ def test_guided_tasks_cover_every_point_once(case):
     values = np.linspace(0.0, 2e-4, 24)
     serial = pyspline.sweep(case, progress=False, l_x=values)
     with Recording(2) as pool:
-        ds = pyspline.sweep(case, executor=pool, progress=False, l_x=values)
-    assert sum(seen) == 24 and seen[:4] == [1, 1, 1, 1] and max(seen) > 1
+        ds = pyspline.sweep(case, executor=pool, workers=2, progress=False, l_x=values)
+    assert seen == [sw.task_points(24, 2)] * 8 == [3] * 8
     assert ds.attrs["n_ok"] == 24
     _same(serial, ds)
 

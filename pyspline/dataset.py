@@ -1,0 +1,187 @@
+"""The dataset of a sweep: the per-point summaries gathered into an xarray.Dataset (units and
+descriptions in each variable's attrs, from cases/template.nml for the swept fields), written
+to NetCDF-4 (engine h5netcdf) atomically, and read back (`open_sweep`)."""
+from __future__ import annotations
+
+import functools
+import itertools
+import os
+import re
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["build_dataset", "field_meta", "open_sweep", "write_netcdf"]
+
+ENGINE = "h5netcdf"
+MERGED = "sweep.nc"     #: the merged sweep in a sweep's output directory
+
+
+# --------------------------------------------------------------------------- field metadata
+
+@functools.cache
+def field_meta() -> dict:
+    """{field: (long_name, units)} from the comments of cases/template.nml (empty when the
+    template is not found): e.g. 'l_x' -> ('parallel misalignment of spline 1 in x', 'm')."""
+    here = Path(__file__).resolve().parent
+    for path in (here / "cases" / "template.nml", here.parent / "cases" / "template.nml"):
+        if path.is_file():
+            break
+    else:
+        return {}
+    meta = {}
+    for line in path.read_text(encoding="utf-8").splitlines():
+        m = re.match(r"\s*(\w+)\s*=[^!]*!\s*(.*)$", line)
+        if not m:
+            continue
+        comment = m.group(2)
+        u = re.search(r"\[([^\],]*)\]", comment)      # a unit has no comma
+        long = (comment[:u.start()] if u else comment).strip().rstrip(":;,").strip()
+        if "|" in long or ":" in long:      # a list of choices, not a description
+            long = m.group(1)
+        unit = u.group(1).strip() if u else ""
+        meta[m.group(1).lower()] = (long or m.group(1), "1" if unit == "-" else unit)
+    return meta
+
+
+def _field_attrs(name: str) -> dict:
+    long, units = field_meta().get(name, (name, ""))
+    return {"long_name": long, "units": units} if units else {"long_name": long}
+
+
+# --------------------------------------------------------------------------- dataset
+
+_VAR_ATTRS = {
+    "section_t": ("time of the Poincare section point", "s"),
+    "section_D2": ("D_2 on the Poincare section", "m"),
+    "section_vD2": ("dD_2/dt on the Poincare section", "m/s"),
+    "period": ("period of the section sequence (0: not periodic; NaN: no result)", ""),
+    "period_residual": ("largest relative mismatch of the section at the period found (at the "
+                        "best period tested if none)", ""),
+    "lyapunov": ("largest Lyapunov exponent", "1/s"),
+    "lyapunov_spread": ("spread (max - min) of the running Lyapunov estimate over the last "
+                        "third of the window", "1/s"),
+    "lyapunov_rel_spread": ("lyapunov_spread / |lyapunov| (small: converged)", ""),
+    "lyapunov_slope": ("slope of the log growth over the last two thirds of the window", "1/s"),
+    "predictability_horizon": ("predictability horizon 1/lambda (inf: lambda <= 0)", "s"),
+    "chaotic": ("1: the exponent is positive beyond its own spread (chaos: read statistics, "
+                "not trajectories); 0: not; NaN: no converged estimate", ""),
+    "Tm_max": ("max of the meshing torque T_m", "N m"),
+    "Tm_min": ("min of the meshing torque T_m", "N m"),
+    "Tm_rms": ("RMS of the meshing torque T_m", "N m"),
+    "kv_max": ("max of the dynamic load coefficient k_v", ""),
+    "kv_min": ("min of the dynamic load coefficient k_v", ""),
+    "kv_rms": ("RMS of the dynamic load coefficient k_v", ""),
+    "F_max": ("max of the tooth loads F_j over all teeth", "N"),
+    "F_min": ("min of the tooth loads F_j over all teeth", "N"),
+    "F_rms": ("RMS of the tooth loads F_j over all teeth", "N"),
+    "Tf_max": ("max of the flash temperatures T_f over all teeth", "degC"),
+    "D2_max": ("max of D_2", "m"),
+    "D2_min": ("min of D_2", "m"),
+    "Tm_spectrum": ("amplitude spectrum of T_m (Hann window, mean removed; max over each order "
+                    "bin)", "N m"),
+    "wall_s": ("wall time of the run (Python call)", "s"),
+    "error": ("error message of the point ('' if it ran)", ""),
+    "error_class": ("exception class of the point's error ('' if it ran)", ""),
+    "point_hash": ("hash of the point's case text and summary options (point file name)", ""),
+}
+
+
+def _stat_attrs(name: str) -> tuple:
+    if name in _VAR_ATTRS:
+        return _VAR_ATTRS[name]
+    unit = "s" if name.endswith("_s") else ("degC" if name.endswith("_degC") else "")
+    return (f"solver statistic {name}", unit)
+
+
+def build_dataset(grid: dict, keys: list, summaries: dict, hashes: dict, options: dict,
+                  attrs: dict):
+    """The Dataset of a sweep over `grid` ({field: values}): `keys` are the keys every summary
+    has, `summaries` and `hashes` are by grid index (a point without a summary is marked
+    NotComputed), `options` the summary options, `attrs` the Dataset's attrs (the counts
+    n_points, n_ok, n_failed, n_missing are added)."""
+    import xarray as xr
+
+    names = list(grid)
+    shape = tuple(len(grid[n]) for n in names)
+    ragged = [k for k in keys if k.startswith("section_")]
+    n_sec = max([len(np.atleast_1d(s[k])) for s in summaries.values() for k in ragged] or [0])
+    data = {}
+    for k in keys:
+        if k in ("error", "error_class"):
+            data[k] = np.full(shape, "", dtype=object)
+        elif k in ragged:
+            data[k] = np.full(shape + (n_sec,), np.nan)
+        elif k == "Tm_spectrum":
+            data[k] = np.full(shape + (len(options["orders"]),), np.nan)
+        else:
+            data[k] = np.full(shape, np.nan)
+    data["point_hash"] = np.full(shape, "", dtype=object)
+    for index in itertools.product(*(range(n) for n in shape)):
+        data["point_hash"][index] = hashes.get(index, "")
+        s = summaries.get(index)
+        if s is None:
+            data["error"][index] = "not computed (the sweep stopped before this point)"
+            data["error_class"][index] = "NotComputed"
+            continue
+        for k in keys:
+            v = s[k]
+            if k in ragged:
+                v = np.atleast_1d(np.asarray(v, dtype=float))
+                data[k][index + (slice(0, len(v)),)] = v
+            elif k in ("error", "error_class"):
+                data[k][index] = str(v)
+            else:
+                data[k][index] = v
+    variables = {}
+    for k, v in data.items():
+        dims = tuple(names)
+        if k in ragged:
+            dims += ("section_point",)
+        elif k == "Tm_spectrum":
+            dims += ("order",)
+        if v.dtype == object:
+            v = v.astype(str)
+        long, units = _stat_attrs(k)
+        a = {"long_name": long}
+        if units:
+            a["units"] = units
+        variables[k] = (dims, v, a)
+    coords = {n: (n, np.asarray(grid[n]), _field_attrs(n)) for n in names}
+    if options.get("orders") is not None:
+        coords["order"] = ("order", np.asarray(options["orders"], dtype=float),
+                           {"long_name": "shaft order (frequency / shaft rotation frequency)",
+                            "units": "1"})
+    ds = xr.Dataset(variables, coords=coords, attrs=attrs)
+    failed = (ds["error"] != "").values
+    ds.attrs.update(n_points=int(np.prod(shape)), n_ok=int((~failed).sum()),
+                    n_failed=int((failed & (ds["error_class"] != "NotComputed").values).sum()),
+                    n_missing=int((ds["error_class"] == "NotComputed").values.sum()))
+    return ds
+
+
+def write_netcdf(ds, path) -> Path:
+    """Write a dataset to NetCDF-4 (engine h5netcdf, float arrays compressed) through a
+    temporary file and os.replace, so a reader never sees half a file."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    enc = {k: {"zlib": True, "complevel": 4} for k, v in ds.data_vars.items()
+           if v.dtype.kind == "f" and v.size > 1}
+    try:
+        ds.to_netcdf(tmp, engine=ENGINE, encoding=enc)
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return path
+
+
+def open_sweep(path):
+    """Read a sweep written by `sweep` (DIR/sweep.nc or DIR) fully into memory."""
+    import xarray as xr
+    path = Path(path)
+    if path.is_dir():
+        path = path / MERGED
+    with xr.open_dataset(path, engine=ENGINE) as ds:
+        return ds.load()
