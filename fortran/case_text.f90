@@ -130,7 +130,6 @@ contains
     dist = d(len(a), len(b))
   end function distance
 
-
   pure logical function word_char(ch)
     character, intent(in) :: ch
     word_char = .not. (ch == ' ' .or. iachar(ch) < 32 .or. iachar(ch) == 127 .or. &
@@ -289,7 +288,6 @@ contains
       c = s
     end if
   end function clip
-
 
   !> A number for messages: 3 decimals (or digits), a three-digit exponent where needed.
   pure function num(x, digits) result(s)
