@@ -2,6 +2,7 @@
 import json
 import math
 import os
+import re
 import subprocess
 from pathlib import Path
 
@@ -9,7 +10,7 @@ import f90nml
 import pytest
 
 import pyspline
-from conftest import CASES, PAPER
+from conftest import CASES, PAPER, ROOT
 
 
 @pytest.mark.parametrize("fields,words", [
@@ -85,6 +86,29 @@ def test_template_lists_every_field_with_the_core_defaults():
     assert set(tpl) == set(defaults)
     for k, v in defaults.items():
         assert tpl[k] == v, k
+
+
+def _table_units():
+    """Field name -> unit, from the core's one field table (fortran/case_type.f90 `fields`)."""
+    src = (ROOT / "fortran" / "case_type.f90").read_text()
+    return dict(re.findall(r"field_t\('(\w+)', '[irlc]', \w+, '([^']*)'", src))
+
+
+def test_template_gives_each_field_the_unit_of_the_core_table():
+    """cases/template.nml's comment of each field names its unit in brackets, [unit], as the
+    core's field table has it (no brackets where the table has no unit)."""
+    units = _table_units()
+    assert set(units) == set(pyspline.defaults())
+    seen = set()
+    for line in (CASES / "template.nml").read_text().splitlines():
+        m = re.match(r"\s*(\w+)\s*=[^!]*!(.*)", line)
+        if not m:
+            continue
+        name, comment = m.group(1).lower(), m.group(2)
+        brackets = re.findall(r"\[([^\]]*)\]", comment)
+        assert (brackets[0] if brackets else "") == units[name], (name, comment)
+        seen.add(name)
+    assert seen == set(units)
 
 
 # ------------------------------------------------------------------ one reader, one diagnosis
@@ -319,3 +343,41 @@ def test_cli_reproduce_refuses_files_it_did_not_write(tmp_path, capsys):
     assert main(["reproduce", "--out", str(out), "--quick"]) == 2
     assert "summary.json" in capsys.readouterr().err
     assert (out / "summary.json").read_text() == "{}"
+
+
+def test_byte_order_mark_is_accepted(tmp_path, exe):
+    """A case file that starts with a UTF-8 byte-order mark (EF BB BF, which some editors
+    write) is read as without it, by pyspline and by spline-dyn, to the same numbers."""
+    body = "&spline_case\n  t_end = 2e-3, n_out = 5\n  c0 = 1.5e-4\n/\n"
+    plain, marked = tmp_path / "plain.nml", tmp_path / "marked.nml"
+    plain.write_bytes(body.encode())
+    marked.write_bytes(b"\xef\xbb\xbf" + body.encode())
+    case = pyspline.load_case(marked)
+    assert case["c0"] == 1.5e-4 and case["n_out"] == 5 and case["name"] == "marked"
+    assert dict(case.replace(name="plain")) == dict(pyspline.load_case(plain))
+    outs = []
+    for path in (plain, marked):
+        out = tmp_path / (path.stem + ".csv")
+        run = subprocess.run([exe, str(path), "-o", str(out)], capture_output=True, text=True,
+                             timeout=60, stdin=subprocess.DEVNULL)
+        assert run.returncode == 0, run.stderr
+        outs.append([ln for ln in out.read_text().splitlines() if not ln.startswith("#")])
+    assert outs[0] == outs[1] and len(outs[0]) == 6
+
+
+@pytest.mark.parametrize("name", [k for k, v in pyspline.defaults().items()
+                                  if isinstance(v, float) or (isinstance(v, list)
+                                                              and isinstance(v[0], float))])
+def test_non_finite_real_field_is_named(name):
+    """Every real field is checked finite under its own name (the paper's fields; those
+    beyond the paper together): the validation's values line up with the field table."""
+    d = pyspline.defaults()[name]
+    value = [math.nan] * len(d) if isinstance(d, list) else math.nan
+    with pytest.raises(pyspline.CaseError) as exc:
+        pyspline.load_case(dict(PAPER, name="nan", **{name: value})).model
+    beyond = list(pyspline.defaults()).index("fillet")
+    if list(pyspline.defaults()).index(name) > beyond:
+        assert "field fillet_radius .. gamma_y (the fields beyond the paper) must be finite" \
+            in str(exc.value)
+    else:
+        assert str(exc.value) == f"case nan: field {name} is not a finite number"
