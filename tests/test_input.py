@@ -130,7 +130,7 @@ def _exe_error(exe, args, tmp_path):
 @pytest.mark.parametrize("name", BAD_FILES)
 def test_python_and_executable_say_the_same(name, exe, tmp_path):
     """A bad case file gets the same message, word for word, from pyspline and spline-dyn:
-    the file is parsed by one reader (fortran/case.f90 case_parse) and validated by one check."""
+    the file is parsed by one reader (fortran/case_parse.f90 case_parse) and validated by one check."""
     path = str(CORPUS / name)
     with pytest.raises(pyspline.CaseError) as exc:
         pyspline.simulate(pyspline.load_case(path))
