@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import functools
 import os
+import re
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -29,6 +30,7 @@ except ImportError as exc:  # the source tree shadows the installed package
 from .errors import CaseError, decode
 
 GROUP = "spline_case"
+_CONTROL = re.compile(rb"[\x00-\x1f\x7f]")
 NAME_BYTES = 128   #: longest case name (UTF-8 bytes; fortran/case.f90 namelen)
 _api = _core.spline_api
 _MODEL_BYTES = int(_api.api_model_size())
@@ -52,22 +54,26 @@ def _layout() -> tuple:
     return tuple(rows), nv, nc
 
 
-def _fields_of(values: np.ndarray, chars: np.ndarray) -> dict:
-    """A case's fields (Python types) from the core's value arrays (fortran/case_values.f90)."""
+def _fields_of(values: np.ndarray, chars: np.ndarray) -> tuple[dict, bool]:
+    """A case's fields (Python types) from the core's value arrays (fortran/case_values.f90),
+    and whether its strings are the bytes the core holds (not when Python strips a leading
+    blank or replaces bytes that are no UTF-8)."""
     rows = _layout()[0]
     v = values.tolist()
     s = chars.astype(np.uint8).tobytes()
-    out = {}
+    out, exact = {}, True
     for name, kind, i, n in rows:
         if kind == "c":
-            out[name] = s[i:i + n].decode("utf-8", "replace").strip()
+            raw = s[i:i + n].rstrip(b" ")
+            out[name] = text = raw.decode("utf-8", "replace").strip()
+            exact = exact and text.encode() == raw
         elif kind == "r":
             out[name] = v[i] if n == 1 else v[i:i + n]
         elif kind == "i":
             out[name] = int(v[i])
         else:
             out[name] = v[i] != 0.0
-    return out
+    return out, exact
 
 
 def _values_of(fields: Mapping):
@@ -105,7 +111,7 @@ def defaults() -> dict:
     values, chars, ierr, msg = _api.api_defaults(nv, nc)
     if ierr:
         raise CaseError(decode(msg))
-    return _fields_of(values, chars)
+    return _fields_of(values, chars)[0]
 
 
 def _shown(path: str) -> str:
@@ -283,20 +289,17 @@ def load_case(source, **overrides) -> Case:
         os.fsencode(path), 0 if overrides else 1, _MODEL_BYTES, nv, nc)
     if stage == 0:
         raise CaseError(decode(msg))
-    fields = _fields_of(values, chars)
+    fields, exact = _fields_of(values, chars)
     if overrides:
         return Case({**fields, **overrides}, source=path)
-    label = fields["name"] or "unnamed"
-    for name, kind, _, _ in rows:        # what Case() checks that the reader lets through
-        if kind == "c":                  # (a tab in a string, a control character in the stem)
-            _coerce(label, name, fields[name], "")
+    if _CONTROL.search(chars.astype(np.uint8).tobytes()):   # what Case() refuses that the
+        for name, kind, _, _ in rows:                        # reader lets through: a tab in
+            if kind == "c":                                  # a string, a control character
+                _coerce(fields["name"] or "unnamed", name, fields[name], "")   # in the stem
     case = Case.__new__(Case)
     case._fields, case.source, case._model = fields, path, None
     case._check_name()
-    # the model built from the file is the one the fields build, unless Python's reading of a
-    # string differs from the bytes (padding, invalid UTF-8): then .model builds it again
-    if stage == 2 and all(fields[n].encode() == chars[i:i + k].astype(np.uint8).tobytes().rstrip(b" ")
-                          for n, kind, i, k in rows if kind == "c"):
+    if stage == 2 and exact:   # else .model builds it again from the fields Python holds
         model.flags.writeable = False
         case._model = (model, sizes, warn)
     return case

@@ -43,7 +43,8 @@ def _errors() -> dict:
 
 def _warn(text) -> None:
     """The core's warnings (one per line, the words spline-dyn prints) as SplineWarning."""
-    for line in decode(text).splitlines():
+    text = decode(text)
+    for line in text.splitlines() if text else ():
         if line.strip():
             warnings.warn(line.strip(), SplineWarning, stacklevel=3)
 
