@@ -3,7 +3,9 @@ side in one run: `python bench/run.py parallel [--quick]`.
 
 - 8 runs of paper_lx1e-4 (1 s simulated each): serially, on 2 threads, on 2 processes;
 - simulate's fixed cost per call: a case with t_end tiny, both for a loaded model and for a
-  fresh Case (which includes loading: the namelist text read by the core, Eq. 18);
+  fresh Case (which includes loading: the fields handed to the core as values, Eq. 18);
+- loading a shipped case file with its model built, `load_case(path).model` (one core call:
+  check, read, parse, validate, build): the median of single calls;
 - one RHS call from Python through a loaded model (api_rhs).
 Medians of `repeat` repetitions; writes parallel.csv into --out.
 """
@@ -26,6 +28,18 @@ from speed import _write_csv
 def _wall(fn, repeat):
     times = []
     for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def _median_call(fn, k):
+    """The median time of k single calls of fn (a load is too short to time in a batch: the
+    median drops the calls another process interrupted)."""
+    fn()
+    times = []
+    for _ in range(k):
         t0 = time.perf_counter()
         fn()
         times.append(time.perf_counter() - t0)
@@ -67,6 +81,11 @@ def measure(quick=False):
         pyspline.simulate(c)
     rows.append(dict(what="simulate, fixed cost per call (new Case: load + run)",
                      seconds=(time.perf_counter() - t0) / k, ratio=float("nan")))
+    for name in ("paper_lx1e-4.nml", "physical_z24.nml"):
+        path = cases_dir() / name
+        per = _median_call(lambda: pyspline.load_case(path).model, 200 if quick else 2000)
+        rows.append(dict(what=f"load_case(path).model, {name} (median)", seconds=per,
+                         ratio=float("nan")))
     y = loaded.start_state()
     m = 20_000 if quick else 200_000
     rhs = loaded.rhs

@@ -1,8 +1,10 @@
 !> The thin interface that f2py wraps (signatures and GIL release: fortran/_core.pyf).
 !>
-!> A case is handed over in memory as namelist text (api_load) and comes back as a loaded
-!> model: the bytes of its model_t, owned by the caller (a numpy int32 array: f2py maps no
-!> 1-byte integer kind to C correctly). Every other entry
+!> A case crosses in one call (api_load_file for a file, api_load_fields for fields Python
+!> holds): checked, parsed, validated and built, it comes back as its fields (two flat arrays
+!> laid out by the field table: spline_case_values) and as a loaded model: the bytes of its
+!> model_t, owned by the caller (a numpy int32 array: f2py maps no 1-byte integer kind to C
+!> correctly), with the sizes and warnings Python needs. Every other entry
 !> point takes those bytes, so nothing here keeps state between calls: any number of loaded
 !> cases can be used at once, from any thread, and a loaded case can be pickled to another
 !> process of the same build. The bytes are checked (size and a marker) on every call.
@@ -13,8 +15,8 @@ module spline_api
   use, intrinsic :: iso_c_binding, only: c_double, c_int
   use spline_kinds, only: wp
   use spline_errors, only: err_ok, err_case, nerr, err_names, msglen
-  use spline_case, only: case_t, case_read_text, case_write_text, case_parse, case_name_of, &
-       case_suggest, case_field
+  use spline_case, only: case_t, case_read_file, case_read_text, case_suggest, case_field
+  use spline_case_values, only: case_value_sizes, case_to_values, case_from_values
   use spline_model, only: model_t, model_from_case, model_magic, nstate, ndof, nkterms, &
        kterm_names, thermal_coupled, model_warnings
   use spline_mesh, only: mesh_switch_functions
@@ -24,44 +26,127 @@ module spline_api
        tooth_q_units, output_times, section_count, lyapunov_count, run_warnings
   implicit none
   private
-  public :: api_load, api_model_size, api_simulate, api_rhs, api_rhs_mesh, api_start_state
+  public :: api_load_file, api_load_fields, api_load_text, api_model_size, api_simulate
+  public :: api_rhs, api_rhs_mesh, api_start_state
   public :: api_output_times, api_model_info, api_defaults, api_names, api_tooth_stiffness
-  public :: api_time_rhs, api_counts, api_parse, api_field_hint, api_warnings
+  public :: api_time_rhs, api_field_hint, api_warnings
 
   integer, parameter :: ninfo = 12   !< entries of api_model_info
+  integer, parameter :: nsizes = 5   !< entries of a load's sizes (load_model)
 
 contains
 
-  !> Parse the text of a case file (its bytes, read by the caller after checking it is a
-  !> regular file) with the reader spline-dyn uses (case_parse: the same diagnosis, naming
-  !> path and line), and return the case as namelist text with every field (canon; the name
-  !> defaults to the file's stem). Ranges are not checked here (api_load does).
-  !> The text comes as its n byte values (0..255) in 4-byte integers: a character argument
-  !> would end at the first NUL byte (f2py passes a C string), and a NUL must reach the reader.
-  subroutine api_parse(text, n, path, canon, ierr, errmsg)
-    integer(c_int), intent(in) :: n
-    integer(c_int), intent(in) :: text(n)
+  !> Load a case file in one call: check the path (case_check_file: a regular file of at most
+  !> max_case_bytes), read and parse it (case_read_file: the reader and messages of spline-dyn,
+  !> naming path and line; the name defaults to the file's stem), return its fields (values,
+  !> chars: laid out by the field table, spline_case_values) and, if build /= 0, validate it and
+  !> build its model (load_model). stage: 0 the file was refused (ierr, errmsg say why), 1 read
+  !> (not built, or the build failed: ierr, errmsg), 2 built. Called without the GIL.
+  subroutine api_load_file(path, build, nb, nv, nc, model, sizes, values, chars, warn, stage, &
+       ierr, errmsg)
     character(len=*), intent(in) :: path
-    character(len=8192), intent(out) :: canon
+    integer(c_int), intent(in) :: build, nb, nv, nc
+    integer(c_int), intent(out) :: model(nb), sizes(nsizes), chars(nc)
+    real(c_double), intent(out) :: values(nv)
+    character(len=2048), intent(out) :: warn
+    integer(c_int), intent(out) :: stage, ierr
+    character(len=msglen), intent(out) :: errmsg
+    type(case_t) :: c
+    integer :: ie
+    model = 0; sizes = 0; values = 0; chars = iachar(' '); warn = ''; stage = 0
+    call case_read_file(path, c, ie, errmsg)
+    if (ie == err_ok) call fields_out(c, values, chars, ie, errmsg)
+    if (ie == err_ok) then
+      stage = 1
+      if (build /= 0) call load_model(c, model, sizes, warn, ie, errmsg)
+      if (build /= 0 .and. ie == err_ok) stage = 2
+    end if
+    ierr = ie
+  end subroutine api_load_file
+
+  !> Validate a case given as its fields (values, chars: as api_load_file returns them) and
+  !> build its model (load_model). Called without the GIL.
+  subroutine api_load_fields(values, nv, chars, nc, nb, model, sizes, warn, ierr, errmsg)
+    integer(c_int), intent(in) :: nv, nc, nb
+    real(c_double), intent(in) :: values(nv)
+    integer(c_int), intent(in) :: chars(nc)
+    integer(c_int), intent(out) :: model(nb), sizes(nsizes)
+    character(len=2048), intent(out) :: warn
     integer(c_int), intent(out) :: ierr
     character(len=msglen), intent(out) :: errmsg
     type(case_t) :: c
-    character(len=:), allocatable :: full, t
+    character(len=nc) :: s
     integer :: ie, i
-    canon = ''
-    allocate(character(len=n) :: t)
-    do i = 1, n
-      t(i:i) = achar(iand(text(i), 255))
+    model = 0; sizes = 0; warn = ''
+    do i = 1, nc
+      s(i:i) = achar(iand(chars(i), 255))
     end do
-    c = case_t()
-    c%name = case_name_of(path)
-    call case_parse(t, c, ie, errmsg, path)
-    if (ie == err_ok) then
-      call case_write_text(c, full)
-      canon = full
-    end if
+    call case_from_values(values, s, c, ie, errmsg)
+    if (ie == err_ok) call load_model(c, model, sizes, warn, ie, errmsg)
     ierr = ie
-  end subroutine api_parse
+  end subroutine api_load_fields
+
+  !> Read a case from namelist text (messages name the case, no line), validate it and build
+  !> its model (load_model): for the values api_load_fields cannot carry (an integer beyond
+  !> 32 bits, a string longer than its field), so that the reader says what is wrong.
+  subroutine api_load_text(text, nb, model, sizes, warn, ierr, errmsg)
+    character(len=*), intent(in) :: text
+    integer(c_int), intent(in) :: nb
+    integer(c_int), intent(out) :: model(nb), sizes(nsizes)
+    character(len=2048), intent(out) :: warn
+    integer(c_int), intent(out) :: ierr
+    character(len=msglen), intent(out) :: errmsg
+    type(case_t) :: c
+    integer :: ie
+    model = 0; sizes = 0; warn = ''
+    call case_read_text(text, c, ie, errmsg)
+    if (ie == err_ok) call load_model(c, model, sizes, warn, ie, errmsg)
+    ierr = ie
+  end subroutine api_load_text
+
+  !> The fields of c as api_load_file returns them (characters as byte values 0..255).
+  subroutine fields_out(c, values, chars, ierr, errmsg)
+    type(case_t), intent(in) :: c
+    real(c_double), intent(out) :: values(:)
+    integer(c_int), intent(out) :: chars(:)
+    integer, intent(out) :: ierr
+    character(len=*), intent(out) :: errmsg
+    character(len=size(chars)) :: s
+    integer :: nv, nc, i
+    call case_value_sizes(nv, nc)
+    ierr = err_ok; errmsg = ''
+    if (size(values) /= nv .or. size(chars) /= nc) then
+      ierr = err_case
+      errmsg = 'case values: the arrays do not match the field table (api_names(''fields''))'
+      return
+    end if
+    call case_to_values(c, values, s)
+    do i = 1, nc
+      chars(i) = iachar(s(i:i))
+    end do
+  end subroutine fields_out
+
+  !> Validate c and build its model (model_from_case) into the caller's bytes, with what
+  !> Python needs to use it (sizes: z, n_out, Poincare section points, Benettin
+  !> renormalisations, face slices (0 for an unsliced face)) and its warnings (model_warnings,
+  !> one per line).
+  subroutine load_model(c, model, sizes, warn, ierr, errmsg)
+    type(case_t), intent(in) :: c
+    integer(c_int), intent(out) :: model(:), sizes(nsizes)
+    character(len=*), intent(out) :: warn
+    integer, intent(out) :: ierr
+    character(len=*), intent(out) :: errmsg
+    type(model_t) :: m
+    model = 0; sizes = 0; warn = ''
+    call model_from_case(c, m, ierr, errmsg)
+    if (ierr == err_ok .and. size(model) /= api_model_size()) then
+      ierr = err_case; errmsg = 'api_load: the model array has the wrong size (api_model_size)'
+    end if
+    if (ierr /= err_ok) return
+    model = transfer(m, model)
+    sizes = [m%z, m%n_out, section_count(m), lyapunov_count(m), merge(m%n_slices, 0, m%n_slices > 1)]
+    warn = model_warnings(m)
+  end subroutine load_model
 
   !> The case field nearest to a misspelt name (blank if none is near): the suggestion of the
   !> reader's 'did you mean', for the fields Python is given as a dict.
@@ -91,35 +176,11 @@ contains
     end if
   end subroutine api_warnings
 
-  !> 4-byte words in a loaded model (the size of the array api_load fills).
+  !> 4-byte words in a loaded model (the size of the array the api_load_* calls fill).
   integer(c_int) function api_model_size() result(nb)
     type(model_t) :: m
     nb = int((storage_size(m) + 31)/32, c_int)
   end function api_model_size
-
-  !> Read a case from namelist text, validate it and build its model (model_from_case).
-  !> model: the loaded model's bytes; z, nt: teeth and output times (to size api_simulate).
-  subroutine api_load(text, nb, model, z, nt, ierr, errmsg)
-    character(len=*), intent(in) :: text
-    integer(c_int), intent(in) :: nb
-    integer(c_int), intent(out) :: model(nb)
-    integer(c_int), intent(out) :: z, nt, ierr
-    character(len=msglen), intent(out) :: errmsg
-    type(case_t) :: c
-    type(model_t) :: m
-    integer :: ie
-    model = 0; z = 0; nt = 0
-    call case_read_text(text, c, ie, errmsg)
-    if (ie == err_ok) call model_from_case(c, m, ie, errmsg)
-    if (ie == err_ok .and. nb /= api_model_size()) then
-      ie = err_case; errmsg = 'api_load: the model array has the wrong size (api_model_size)'
-    end if
-    if (ie == err_ok) then
-      model = transfer(m, model)
-      z = m%z; nt = m%n_out
-    end if
-    ierr = ie
-  end subroutine api_load
 
   !> The model_t in the bytes of a loaded model; ierr = err_case if they are not one.
   subroutine unpack(model, m, ierr, errmsg)
@@ -137,29 +198,10 @@ contains
     errmsg = 'not a loaded case of this build of pyspline (load the case again)'
   end subroutine unpack
 
-  !> Sizes of a loaded model's extras: Poincare section points nsec and Benettin
-  !> renormalisations nlyap (0 when the case asks for none).
-  !> nslice: face-width slices of the face-load output (0 for an unsliced face).
-  subroutine api_counts(model, nb, nsec, nlyap, nslice, ierr, errmsg)
-    integer(c_int), intent(in) :: nb
-    integer(c_int), intent(in) :: model(nb)
-    integer(c_int), intent(out) :: nsec, nlyap, nslice, ierr
-    character(len=msglen), intent(out) :: errmsg
-    type(model_t) :: m
-    integer :: ie
-    nsec = 0; nlyap = 0; nslice = 0
-    call unpack(model, m, ie, errmsg)
-    if (ie == err_ok) then
-      nsec = section_count(m); nlyap = lyapunov_count(m)
-      if (m%n_slices > 1) nslice = m%n_slices
-    end if
-    ierr = ie
-  end subroutine api_counts
-
   !> Simulate a loaded model: output times t, SI states y (nt x 14), per-tooth quantities tooth
   !> (nt x z x nq, order of api_names('tooth')), meshing torque tm and run statistics; the
   !> Poincare section (times sec_t, SI states sec_y: nsec x 14) and the Benettin record (times
-  !> lyap_t, cumulative log growth lyap_g), sized by api_counts; for a sliced face (nslice > 0,
+  !> lyap_t, cumulative log growth lyap_g), sized by the load's sizes; for a sliced face (nslice > 0,
   !> nft = nt, else both 0) the load of every slice face(nt, z, nslice) and the tilting moment
   !> tilt(nt, 2) (M_x, M_y) on spline 1 [N m].
   !> A SIGINT during the run stops it (ierr 4). Called without the GIL.
@@ -299,12 +341,17 @@ contains
     ierr = ie
   end subroutine api_model_info
 
-  !> Every case field with its default, as namelist text (Python reads its defaults here).
-  subroutine api_defaults(text)
-    character(len=8192), intent(out) :: text
-    character(len=:), allocatable :: full
-    call case_write_text(case_t(), full)
-    text = full
+  !> Every case field with its default (case_t's component defaults), laid out as
+  !> api_load_file returns fields: Python reads its defaults here.
+  subroutine api_defaults(nv, nc, values, chars, ierr, errmsg)
+    integer(c_int), intent(in) :: nv, nc
+    real(c_double), intent(out) :: values(nv)
+    integer(c_int), intent(out) :: chars(nc)
+    integer(c_int), intent(out) :: ierr
+    character(len=msglen), intent(out) :: errmsg
+    integer :: ie
+    call fields_out(case_t(), values, chars, ie, errmsg)
+    ierr = ie
   end subroutine api_defaults
 
   !> Name (and unit) number i of a list: 'tooth' (per-tooth quantities), 'stats', 'info'

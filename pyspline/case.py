@@ -1,23 +1,22 @@
 """Case input: the fields of a case (namelist group ``&spline_case``), read from files or given
-as a dict, and handed to the core in memory as namelist text.
+as a dict, and handed to the core in memory as field values.
 
 The defaults live in the Fortran core only (``case_t`` in fortran/case.f90): Python reads them
 from the core once, so a field that Python knows is a field the executable knows, with the same
-default. A case file is read by the core's reader (api_parse, the one spline-dyn uses), so a
-bad file gets the same message from both; ranges are checked by the core too. What Python
-checks itself: that the path is a regular file (the same words as fortran/case.f90
-case_check_file) and the Python types of a dict's values.
+default. A case file is loaded by the core in one call (api_load_file: the path checked, read
+and parsed by the reader spline-dyn uses, then validated and built), so a bad file gets the same
+message from both; the fields come back as two flat arrays laid out by the core's field table
+(fortran/case_values.f90), and go back to the core the same way. What Python checks itself: the
+Python types of a dict's values.
 """
 from __future__ import annotations
 
-import errno
 import functools
 import os
-import stat
+import re
 from collections.abc import Mapping
 from pathlib import Path
 
-import f90nml
 import numpy as np
 
 try:
@@ -31,56 +30,93 @@ except ImportError as exc:  # the source tree shadows the installed package
 from .errors import CaseError, decode
 
 GROUP = "spline_case"
+_CONTROL = re.compile(rb"[\x00-\x1f\x7f]")
 NAME_BYTES = 128   #: longest case name (UTF-8 bytes; fortran/case.f90 namelen)
-MAX_CASE_BYTES = 1048576   #: largest case file (fortran/case.f90 max_case_bytes)
+_api = _core.spline_api
+_MODEL_BYTES = int(_api.api_model_size())
+
+
+@functools.cache
+def _layout() -> tuple:
+    """The core's field table (api_names('fields')) as (name, kind, offset, size) in the
+    order of the value arrays, and the sizes of the real array and the character buffer."""
+    rows, nv, nc = [], 0, 0
+    for i in range(1, 1000):
+        name, unit = (x.decode().strip() for x in _api.api_names("fields", i))
+        if not name:
+            break
+        kind, n = unit[0], int(unit[1:] or 1)
+        rows.append((name, kind, nc if kind == "c" else nv, n))
+        if kind == "c":
+            nc += n
+        else:
+            nv += n
+    return tuple(rows), nv, nc
+
+
+def _fields_of(values: np.ndarray, chars: np.ndarray) -> tuple[dict, bool]:
+    """A case's fields (Python types) from the core's value arrays (fortran/case_values.f90),
+    and whether its strings are the bytes the core holds (not when Python strips a leading
+    blank or replaces bytes that are no UTF-8)."""
+    rows = _layout()[0]
+    v = values.tolist()
+    s = chars.astype(np.uint8).tobytes()
+    out, exact = {}, True
+    for name, kind, i, n in rows:
+        if kind == "c":
+            raw = s[i:i + n].rstrip(b" ")
+            out[name] = text = raw.decode("utf-8", "replace").strip()
+            exact = exact and text.encode() == raw
+        elif kind == "r":
+            out[name] = v[i] if n == 1 else v[i:i + n]
+        elif kind == "i":
+            out[name] = int(v[i])
+        else:
+            out[name] = v[i] != 0.0
+    return out, exact
+
+
+def _values_of(fields: Mapping):
+    """The value arrays of a case's (checked) fields, or None if one cannot cross as a value
+    (an integer beyond 32 bits, a string longer than its field): that case goes as text, for
+    the reader's message."""
+    rows, nv, nc = _layout()
+    v = np.zeros(nv)
+    s = bytearray(b" " * nc)
+    for name, kind, i, n in rows:
+        x = fields[name]
+        if kind == "c":
+            try:
+                b = x.encode("utf-8")
+            except UnicodeEncodeError:      # a lone surrogate: the text path says so
+                return None
+            if len(b) > n:
+                return None
+            s[i:i + len(b)] = b
+        elif kind == "i":
+            if not -2147483647 <= x <= 2147483647:
+                return None
+            v[i] = x
+        elif n == 1:
+            v[i] = x
+        else:
+            v[i:i + n] = x
+    return v, np.frombuffer(bytes(s), dtype=np.uint8).astype(np.int32)
 
 
 @functools.cache
 def defaults() -> dict:
     """Every case field with its default, as the Fortran core defines them."""
-    text = _core.spline_api.api_defaults().decode()
-    nml = f90nml.reads(text)
-    return {k.lower(): _clean(v) for k, v in nml[GROUP].items()}
-
-
-def _clean(v):
-    return v.strip() if isinstance(v, str) else v
+    rows, nv, nc = _layout()
+    values, chars, ierr, msg = _api.api_defaults(nv, nc)
+    if ierr:
+        raise CaseError(decode(msg))
+    return _fields_of(values, chars)[0]
 
 
 def _shown(path: str) -> str:
     """A path as messages show it (fortran/case.f90 shown): the last 237 characters of a long one."""
     return path if len(path) <= 240 else "..." + path[-237:]
-
-
-def _check_file(path: str) -> None:
-    """Refuse, before opening, a path that is not a regular file of at most MAX_CASE_BYTES (a
-    FIFO blocks the open, a device never ends): fortran/case.f90 case_check_file, same words."""
-    shown = _shown(path)
-    try:
-        st = os.stat(path)
-    except FileNotFoundError:
-        if os.path.islink(path):
-            raise CaseError(f"case file {shown} does not exist (a dangling symbolic link)") from None
-        raise CaseError(f"case file {shown} does not exist") from None
-    except OSError as exc:
-        why = os.strerror(exc.errno) if exc.errno else str(exc)
-        if exc.errno == errno.ELOOP:
-            raise CaseError(f"case file {shown}: {why} (a symbolic-link loop)") from None
-        raise CaseError(f"case file {shown}: {why}") from None
-    except ValueError as exc:          # an embedded NUL character
-        raise CaseError(f"case file {shown!r}: {exc}") from None
-    mode = st.st_mode
-    kinds = [(stat.S_ISDIR, "is a directory, not a case file"),
-             (stat.S_ISFIFO, "is a FIFO (named pipe), not a case file"),
-             (stat.S_ISCHR, "is a character device, not a case file"),
-             (stat.S_ISBLK, "is a block device, not a case file"),
-             (stat.S_ISSOCK, "is a socket, not a case file")]
-    if not stat.S_ISREG(mode):
-        why = next((w for test, w in kinds if test(mode)), "is not a regular file")
-        raise CaseError(f"case file {shown} {why}")
-    if st.st_size > MAX_CASE_BYTES:
-        raise CaseError(f"case file {shown} is {st.st_size} bytes: a case file holds at most "
-                        f"{MAX_CASE_BYTES} bytes")
 
 
 def field_hint(word: str) -> str:
@@ -100,8 +136,9 @@ def _fortran(v) -> str:
 
 
 class Case(Mapping):
-    """A validated set of case fields (SI units). Immutable; ``replace`` makes variants.
-    ``case.model`` is the case loaded into the core (built once, on first use)."""
+    """A set of case fields (SI units), their Python types checked. Immutable; ``replace``
+    makes variants. ``case.model`` is the case loaded into the core (validated and built once:
+    by load_case for a file, else on first use)."""
 
     def __init__(self, fields: Mapping, name: str | None = None, source: str | None = None):
         label = name or fields.get("name") or "unnamed"
@@ -155,8 +192,9 @@ class Case(Mapping):
 
     @property
     def model(self):
-        """The case loaded into the core (pyspline.Model), built on first use and kept."""
-        if self._model is None:
+        """The case loaded into the core (pyspline.Model), built on first use and kept (a
+        case file's is built by load_case, in the same core call that read the file)."""
+        if not hasattr(self._model, "bytes"):    # None, or the parts load_case built
             from .core import Model
             self._model = Model(self)
         return self._model
@@ -231,7 +269,9 @@ def _coerce(label, key, value, default):
 def load_case(source, **overrides) -> Case:
     """Read a case: a namelist file path (group &spline_case), a dict of fields, or a Case.
     Keyword overrides replace fields. Any bad input raises CaseError naming the case (for a
-    file: the path, line and field, in the words spline-dyn uses)."""
+    file: the path, line and field, in the words spline-dyn uses). A file is read, validated
+    and built by one core call: ``load_case(path).model`` costs nothing more (a case whose
+    model cannot be built raises when ``.model`` is used, as a dict's does)."""
     if isinstance(source, Case):
         return source.replace(**overrides) if overrides else source
     if isinstance(source, Mapping):
@@ -242,17 +282,24 @@ def load_case(source, **overrides) -> Case:
     path = os.fspath(source)
     if isinstance(path, bytes):
         path = os.fsdecode(path)
-    _check_file(path)
-    try:
-        with open(path, "rb") as f:
-            data = f.read(MAX_CASE_BYTES + 1)
-    except OSError as exc:
-        raise CaseError(f"case file {_shown(path)}: cannot read it: "
-                        f"{os.strerror(exc.errno) if exc.errno else exc}") from None
-    # the byte values as an array: a NUL byte must reach the reader (bytes would end there)
-    codes = np.frombuffer(data, dtype=np.uint8).astype(np.int32)
-    canon, ierr, msg = _core.spline_api.api_parse(codes, os.fsencode(path))
-    if ierr:
+    if "\0" in path:                   # C would see a shorter path
+        raise CaseError(f"case file {_shown(path)!r}: embedded null byte")
+    rows, nv, nc = _layout()
+    model, sizes, values, chars, warn, stage, ierr, msg = _api.api_load_file(
+        os.fsencode(path), 0 if overrides else 1, _MODEL_BYTES, nv, nc)
+    if stage == 0:
         raise CaseError(decode(msg))
-    fields = {k.lower(): _clean(v) for k, v in f90nml.reads(canon.decode("utf-8", "replace"))[GROUP].items()}
-    return Case({**fields, **overrides}, source=path)
+    fields, exact = _fields_of(values, chars)
+    if overrides:
+        return Case({**fields, **overrides}, source=path)
+    if _CONTROL.search(chars.astype(np.uint8).tobytes()):   # what Case() refuses that the
+        for name, kind, _, _ in rows:                        # reader lets through: a tab in
+            if kind == "c":                                  # a string, a control character
+                _coerce(fields["name"] or "unnamed", name, fields[name], "")   # in the stem
+    case = Case.__new__(Case)
+    case._fields, case.source, case._model = fields, path, None
+    case._check_name()
+    if stage == 2 and exact:   # else .model builds it again from the fields Python holds
+        model.flags.writeable = False
+        case._model = (model, sizes, warn)
+    return case

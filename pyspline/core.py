@@ -1,8 +1,8 @@
 """Python face of the Fortran core: load a case, simulate it, evaluate its right-hand side.
 
-Nothing here computes physics. A case goes to the core in memory as namelist text (the reader
-the executable uses) and comes back as a loaded model: the bytes of its model_t, held by the
-caller (``Model``). Every call takes those bytes, so loaded cases never alias, any number can
+Nothing here computes physics. A case goes to the core in memory as its field values (laid out
+by the core's field table) and comes back as a loaded model: the bytes of its model_t, held by
+the caller (``Model``). Every call takes those bytes, so loaded cases never alias, any number can
 be used at once, and simulate and start_state release the GIL: a thread pool runs scenes in
 parallel. A SIGINT during a run stops it within one right-hand-side call (KeyboardInterrupt).
 """
@@ -16,13 +16,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import _core
-from .case import Case, load_case
+from .case import _MODEL_BYTES, Case, _values_of, load_case
 from .errors import BY_NAME, SplineError, SplineWarning, decode
 
 _api = _core.spline_api
 STATE_NAMES = ("x1", "y1", "x2", "y2", "D1", "D2", "D3")
 THERMAL_LEVELS = ("none", "bulk", "oneway", "coupled")   #: stats["thermal_level"] 0..3
-_MODEL_BYTES = int(_api.api_model_size())
 
 
 @functools.cache
@@ -44,7 +43,8 @@ def _errors() -> dict:
 
 def _warn(text) -> None:
     """The core's warnings (one per line, the words spline-dyn prints) as SplineWarning."""
-    for line in decode(text).splitlines():
+    text = decode(text)
+    for line in text.splitlines() if text else ():
         if line.strip():
             warnings.warn(line.strip(), SplineWarning, stacklevel=3)
 
@@ -71,14 +71,20 @@ class Model:
 
     def __init__(self, case):
         case = load_case(case)
-        data, z, nt, ierr, msg = _api.api_load(case.text().encode("utf-8"), _MODEL_BYTES)
-        raise_for(ierr, msg)
-        data.flags.writeable = False
-        nsec, nlyap, nslice, ierr, msg = _api.api_counts(data)
-        raise_for(ierr, msg)
-        self.case, self.bytes, self.z, self.n_out = case, data, int(z), int(nt)
-        self.n_section, self.n_lyapunov, self.n_slices = int(nsec), int(nlyap), int(nslice)
-        _warn(_api.api_warnings(data, np.zeros(1), 0))   # the core's model warnings (k_m)
+        if isinstance(case._model, tuple):       # built by load_case with the file's fields
+            data, sizes, warn = case._model
+        else:                                    # one core call: validate and build
+            packed = _values_of(case._fields)
+            if packed is None:                   # a value only the reader can judge
+                data, sizes, warn, ierr, msg = _api.api_load_text(case.text().encode("utf-8"),
+                                                                  _MODEL_BYTES)
+            else:
+                data, sizes, warn, ierr, msg = _api.api_load_fields(*packed, _MODEL_BYTES)
+            raise_for(ierr, msg)
+            data.flags.writeable = False
+        self.case, self.bytes = case, data
+        self.z, self.n_out, self.n_section, self.n_lyapunov, self.n_slices = sizes.tolist()
+        _warn(warn)                              # the core's model warnings (k_m)
 
     def __getstate__(self):
         return {k: getattr(self, k) for k in self.__slots__ if k != "__weakref__"}

@@ -381,3 +381,57 @@ def test_non_finite_real_field_is_named(name):
             in str(exc.value)
     else:
         assert str(exc.value) == f"case nan: field {name} is not a finite number"
+
+
+# ------------------------------------------------------------------ one core call per case file
+
+@pytest.mark.parametrize("name", ["paper_lx1e-4.nml", "physical_z24.nml", "chaos_z24.nml"])
+def test_file_load_builds_the_model_its_fields_build(name):
+    """load_case(path) reads, validates and builds in one core call; that model is the one
+    the case's fields build when handed back (api_load_fields) and the one its text builds
+    (the reader again): the same sizes, derived quantities, start state and right-hand side."""
+    from pyspline import core
+    case = pyspline.load_case(CASES / name)
+    built, fields = case.model, core.Model(dict(case))
+    model, sizes, warn, ierr, msg = core._api.api_load_text(case.text().encode(), core._MODEL_BYTES)
+    assert ierr == 0
+    text = core.Model.__new__(core.Model)
+    for k, v in dict(case=case, bytes=model, z=sizes[0], n_out=sizes[1], n_section=sizes[2],
+                     n_lyapunov=sizes[3], n_slices=sizes[4]).items():
+        object.__setattr__(text, k, v)
+    y = built.start_state()
+    said = [((m.z, m.n_out, m.n_section, m.n_lyapunov, m.n_slices), m.info(),
+             m.start_state().tolist(), m.rhs(1e-3, y).tolist()) for m in (built, fields, text)]
+    assert said[0] == said[1] == said[2]
+    assert built.case is case and case.model is built
+
+
+def test_file_strings_read_as_python_holds_them(tmp_path):
+    """A string Python reads differently from the core's bytes (a leading blank, stripped) is
+    the case Python holds: its model names the case as Python does."""
+    path = tmp_path / "lead.nml"
+    path.write_text("&spline_case\n  name = '  lead'\n  b = -0.03\n/\n")
+    case = pyspline.load_case(path)
+    assert case.name == "lead"
+    with pytest.raises(pyspline.CaseError, match=r"^case lead: field b "):
+        case.model
+
+
+@pytest.mark.parametrize("path,words", [
+    ("a\0b.nml", "embedded null byte"),
+    ("/nonexistent/" + "x" * 5000 + ".nml", "File name too long"),
+    ("", "does not exist"),
+])
+def test_odd_paths_are_clear_case_errors(path, words):
+    with pytest.raises(pyspline.CaseError, match=words) as exc:
+        pyspline.load_case(path)
+    assert str(exc.value).startswith("case file ") and len(str(exc.value)) < 300
+
+
+def test_values_a_value_array_cannot_carry_get_the_reader_s_message():
+    """An integer beyond 32 bits or a string longer than its field goes to the core as text,
+    so the reader says what is wrong, as it does in a file."""
+    with pytest.raises(pyspline.CaseError, match="does not fit a 32-bit integer"):
+        pyspline.load(dict(PAPER, name="big", n_out=2 ** 40))
+    with pytest.raises(pyspline.CaseError, match="is longer than 16 characters"):
+        pyspline.load(dict(PAPER, name="long", method="adams" * 4))

@@ -1,0 +1,177 @@
+!> A case's fields as two flat arrays, laid out by the field table (case_field, the order of
+!> case_t): every number and logical (an integer as its value, a logical as 1 or 0) in one
+!> real array, every character field (blank-padded to its size) in one string. This is how a
+!> case crosses to Python and back (fortran/api.f90), with no text to tokenise or re-read.
+module spline_case_values
+  use spline_kinds, only: wp
+  use spline_errors, only: err_ok, err_case
+  use spline_case, only: case_t, case_field
+  implicit none
+  private
+  public :: case_value_sizes, case_to_values, case_from_values
+
+contains
+
+  !> Entries of the real array (nv) and characters of the string (nc) of a case.
+  subroutine case_value_sizes(nv, nc)
+    integer, intent(out) :: nv, nc
+    character(len=32) :: name
+    character(len=1) :: kind
+    integer :: i, n
+    nv = 0; nc = 0
+    do i = 1, huge(i)
+      call case_field(i, name, kind, n)
+      if (len_trim(name) == 0) exit
+      if (kind == 'c') then
+        nc = nc + n
+      else
+        nv = nv + n
+      end if
+    end do
+  end subroutine case_value_sizes
+
+  !> The fields of c into v and s (sized by case_value_sizes).
+  subroutine case_to_values(c, v, s)
+    type(case_t), intent(in) :: c
+    real(wp), intent(out) :: v(:)
+    character(len=*), intent(out) :: s
+    type(case_t) :: cc
+    integer :: ierr
+    character(len=80) :: errmsg
+    cc = c
+    v = 0; s = ''
+    call walk(cc, v, s, .true., ierr, errmsg)
+  end subroutine case_to_values
+
+  !> A case from v and s (as case_to_values lays them out). ierr = err_case if the arrays do
+  !> not match the field table, or an integer field is no 32-bit whole number (Python sends
+  !> those as text instead, for the reader's message).
+  subroutine case_from_values(v, s, c, ierr, errmsg)
+    real(wp), intent(in) :: v(:)
+    character(len=*), intent(in) :: s
+    type(case_t), intent(out) :: c
+    integer, intent(out) :: ierr
+    character(len=*), intent(out) :: errmsg
+    real(wp), allocatable :: vv(:)
+    character(len=:), allocatable :: ss
+    integer :: nv, nc
+    c = case_t()
+    call case_value_sizes(nv, nc)
+    if (size(v) /= nv .or. len(s) /= nc) then
+      ierr = err_case
+      errmsg = 'case values: the arrays do not match the field table (api_names(''fields''))'
+      return
+    end if
+    vv = v; ss = s
+    call walk(c, vv, ss, .false., ierr, errmsg)
+  end subroutine case_from_values
+
+  !> Every field of c in the order of the field table, copied to (put) or from the arrays; a
+  !> field whose type or size differs from the table's is an error (this list is out of step).
+  subroutine walk(c, v, s, put, ierr, errmsg)
+    type(case_t), intent(inout) :: c
+    real(wp), intent(inout) :: v(:)
+    character(len=*), intent(inout) :: s
+    logical, intent(in) :: put
+    integer, intent(out) :: ierr
+    character(len=*), intent(out) :: errmsg
+    integer :: k, iv, is
+    k = 0; iv = 0; is = 0
+    ierr = err_ok; errmsg = ''
+    call ch(c%name); call i(c%z); call r(c%module_m); call r(c%alpha_deg); call r(c%b)
+    call r(c%s); call r(c%c0); call r(c%e_mod); call r(c%nu); call r(c%lambda_th)
+    call r(c%k_cond); call r(c%rho); call r(c%c_heat); call r(c%j_m); call r(c%j_l)
+    call r(c%j_1); call r(c%j_2); call r(c%m_1); call r(c%m_2); call r(c%k_p1); call r(c%k_p2)
+    call r(c%c_p1); call r(c%c_p2); call r(c%k_t1); call r(c%k_t2); call r(c%c_t1)
+    call r(c%c_t2); call r(c%k_m); call r(c%c_m); call r(c%t_d); call r(c%t_l)
+    call r(c%speed_rpm); call r(c%grav); call r(c%l_x); call r(c%l_y); call i(c%dof)
+    call ch(c%thermal); call r(c%t_bulk); call r(c%f_m); call r(c%u_flash); call r(c%eta_hertz)
+    call ch(c%method); call ch(c%jacobian); call ch(c%nonlinear); call l(c%roots)
+    call l(c%stald); call l(c%linear_tail); call r(c%rtol); call r(c%atol); call i(c%max_steps)
+    call i(c%max_total_steps); call r(c%t0); call r(c%t_end); call r(c%t_transient)
+    call i(c%n_out); call ch(c%start); call ra(c%dq0); call ra(c%dv0); call r(c%l_ref)
+    call r(c%w_ref); call ch(c%fidelity); call r(c%fidelity_tol); call ch(c%section)
+    call l(c%lyapunov); call r(c%lyapunov_interval); call r(c%lyapunov_d0); call l(c%fillet)
+    call r(c%fillet_radius); call r(c%r_bore); call r(c%r_rim); call r(c%zeta_m)
+    call ra(c%ripple_order); call ra(c%ripple_amp); call ra(c%ripple_phase_deg)
+    call ra(c%unbalance); call ra(c%unbalance_phase_deg); call r(c%gamma_x); call r(c%gamma_y)
+    call i(c%n_slices)
+    if (ierr == err_ok .and. (iv /= size(v) .or. is /= len(s))) call mismatch()
+    if (ierr == err_ok) call field(' ', 0)       ! no field beyond the last
+  contains
+    !> The next field of the table must have this type and size.
+    subroutine field(kind, n)
+      character(len=1), intent(in) :: kind
+      integer, intent(in) :: n
+      character(len=32) :: name
+      character(len=1) :: fk
+      integer :: fn
+      k = k + 1
+      call case_field(k, name, fk, fn)
+      if (fk /= kind .or. fn /= n) call mismatch()
+    end subroutine field
+    subroutine mismatch()
+      ierr = err_case
+      errmsg = 'case values: fortran/case_values.f90 is out of step with the field table'
+    end subroutine mismatch
+    subroutine r(x)
+      real(wp), intent(inout) :: x
+      call field('r', 1)
+      if (ierr /= err_ok) return
+      iv = iv + 1
+      if (put) then
+        v(iv) = x
+      else
+        x = v(iv)
+      end if
+    end subroutine r
+    subroutine ra(x)
+      real(wp), intent(inout) :: x(:)
+      call field('r', size(x))
+      if (ierr /= err_ok) return
+      if (put) then
+        v(iv+1:iv+size(x)) = x
+      else
+        x = v(iv+1:iv+size(x))
+      end if
+      iv = iv + size(x)
+    end subroutine ra
+    subroutine i(x)
+      integer, intent(inout) :: x
+      call field('i', 1)
+      if (ierr /= err_ok) return
+      iv = iv + 1
+      if (put) then
+        v(iv) = real(x, wp)
+      else if (v(iv) == aint(v(iv)) .and. abs(v(iv)) <= real(huge(x), wp)) then
+        x = int(v(iv))
+      else
+        ierr = err_case
+        errmsg = 'case values: an integer field holds no 32-bit whole number'
+      end if
+    end subroutine i
+    subroutine l(x)
+      logical, intent(inout) :: x
+      call field('l', 1)
+      if (ierr /= err_ok) return
+      iv = iv + 1
+      if (put) then
+        v(iv) = merge(1.0_wp, 0.0_wp, x)
+      else
+        x = v(iv) /= 0.0_wp
+      end if
+    end subroutine l
+    subroutine ch(x)
+      character(len=*), intent(inout) :: x
+      call field('c', len(x))
+      if (ierr /= err_ok) return
+      if (put) then
+        s(is+1:is+len(x)) = x
+      else
+        x = s(is+1:is+len(x))
+      end if
+      is = is + len(x)
+    end subroutine ch
+  end subroutine walk
+
+end module spline_case_values
