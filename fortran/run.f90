@@ -223,7 +223,7 @@ contains
     allocate(modes(m%z*m%n_slices, m%n_out))
     call output_times(m, t)
     call start_state(m, y0, ierr, errmsg)
-    if (ierr /= 0) return
+    if (ierr /= err_ok) return
     ! A section does not stop CVODE, but with root finding the first step after each restart
     ! depends on the next requested time, which may be a section time (spline_solver::integrate):
     ! a run that asks for a section takes its times whether or not the caller keeps the points
@@ -238,7 +238,7 @@ contains
       call integrate(m, y0, m%n_out, t, y, modes, stats(1:nsolver_stats), ierr, errmsg, &
            interruptible, ts, ysec)
     end if
-    if (ierr /= 0) return
+    if (ierr /= err_ok) return
     call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt)
   end subroutine run_level
 
@@ -256,14 +256,14 @@ contains
     real(wp), intent(out), optional :: face(:, :, :), tilt(:, :)
     real(wp) :: row(m%z, ntooth_q), fs(m%n_slices, m%z), mt(2)
     integer :: k
-    ierr = 0
+    ierr = err_ok
     do k = 1, size(t)
       if (modes(1, k) == 2) then
         call tooth_quantities(m, t(k), y(:, k), row, tm(k), ierr, errmsg, fslice=fs, mtilt=mt)
       else
         call tooth_quantities(m, t(k), y(:, k), row, tm(k), ierr, errmsg, modes(:, k), fs, mt)
       end if
-      if (ierr /= 0) return
+      if (ierr /= err_ok) return
       tooth(k, :, :) = row
       if (present(face)) face(k, :, :) = transpose(fs)
       if (present(tilt)) tilt(k, :) = mt

@@ -622,7 +622,7 @@ contains
     ys => FN_VGetArrayPointer(sv_y)
     fs => FN_VGetArrayPointer(sv_f)
     n = ctx%n
-    ierr = 0
+    ierr = err_ok
     do c = 1, ctx%ncopy
       o = (c - 1)*n
       yf = copy_state(ctx, ys, c)
@@ -635,10 +635,10 @@ contains
         call rhs_scaled(ctx%m, tau, yf, ff, ierr, ctx%cb_msg, ctx%modes(:, c), cstats=ctx%cstats)
       end if
       fs(o+1:o+n) = ff(ctx%idx(1:n))
-      if (ierr /= 0) exit
+      if (ierr /= err_ok) exit
     end do
     ret = 0
-    if (ierr /= 0) then
+    if (ierr /= err_ok) then
       ctx%cb_ierr = ierr
       ret = -1
     else if (interrupted(ctx)) then
