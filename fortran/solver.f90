@@ -3,8 +3,9 @@
 !> thermal level, on the root/tip branch switches of Eqs. 13-14).
 !>
 !> Reentrant: all run state sits in a solver_ctx_t local to `integrate`, which CVODE hands to
-!> the callbacks as their user data. No module variable changes during a run. Every SUNDIALS
-!> return value is checked. Version-specific calls (context creation) are in sundials_context_new.
+!> the callbacks as their user data. No module variable changes during a run. The SUNDIALS
+!> objects are made in cvode_setup and freed in cvode_free; every SUNDIALS return value is
+!> checked. Version-specific calls (context creation) are in sundials_context_new.
 module spline_solver
   use, intrinsic :: iso_c_binding
   use fcvode_mod
@@ -82,31 +83,28 @@ module spline_solver
   end interface
 
 contains
+
   !> Integrate the model from y0 (SI, at m%t0) and return the SI state at the times tout(1:nt)
   !> (ascending, >= t0) in yout(:, k), the contact states there (2: decided by the state) and
   !> the solver statistics. interruptible: a SIGINT during the run stops it (err_interrupted).
   !> tsec (optional, ascending, > t0): Poincare section times; ysec(:, i) gets the SI state at
-  !> tsec(i). Sections do not stop CVODE: it is asked for the state at exactly that instant
-  !> (CV_NORMAL) and returns its own dense output there, the order-q Nordsieck interpolant of
-  !> the step that covers it. That is the state a root function on the shaft angle would return
-  !> (CVODE locates roots on the same interpolant), at the integration's own accuracy; since the
-  !> instants are known in closed form, no root function is needed, and unlike a stop time
-  !> (CVodeSetStopTime) the steps go on as they would (stopping at every revolution cost 20 %
-  !> more work on paper_lx1e-4, docs/performance.md). One exception: the first step after a
-  !> (re)start (CVodeInit, CVodeReInit at a contact switch) is sized from the distance to the
-  !> next requested time, which may be a section time; so with root finding a section can
-  !> change the steps (chaos_z24 with section = 'tooth' takes 289308 steps instead of 290972).
-  !> y0b, youtb (optional, together): a second copy of the system started at y0b, integrated
-  !> beside the first as one CVODE system, with the same steps, order and corrector iterations,
-  !> so that the difference of the two carries no independent solver noise (Benettin's method,
-  !> spline_lyapunov::lyapunov_benettin); youtb(:, k) its state at tout(k). Contact switches of
-  !> either copy are located (root finding) and restart both.
+  !> tsec(i). Sections do not stop CVODE: asked for the state at that instant (CV_NORMAL), it
+  !> returns its dense output there, the order-q Nordsieck interpolant of the step that covers it
+  !> (the state a root function on the shaft angle would give: CVODE locates roots on the same
+  !> interpolant), and unlike a stop time (CVodeSetStopTime, 20 % more work on paper_lx1e-4,
+  !> docs/performance.md) the steps go on as they would. One exception: the first step after a
+  !> (re)start (CVodeInit; CVodeReInit at a contact switch) is sized from the distance to the
+  !> next requested time, which may be a section time; so with root finding a section can change
+  !> the steps (chaos_z24 with section = 'tooth': 289308 steps instead of 290972).
+  !> y0b, youtb (optional, together): a second copy started at y0b, integrated beside the first
+  !> as one CVODE system (same steps, order and corrector iterations: their difference carries
+  !> no independent solver noise; spline_lyapunov::lyapunov_benettin); youtb(:, k) its state at
+  !> tout(k). Contact switches of either copy are located (root finding) and restart both.
   !> The linear tail (spline_linear): a single copy whose case allows it is tried at the start,
   !> after every output and, without root finding, each quarter shaft revolution between them
   !> (CV_NORMAL returns on CVODE's interpolant: the steps stay as they are). Once every tooth
   !> is proven to stay in contact on one flank for ever, the remaining outputs and sections are
-  !> the closed-form solution, and stats(ist_linear_tail_t) holds the time the tail began
-  !> (-1: not used).
+  !> the closed-form solution; stats(ist_linear_tail_t) holds the time the tail began (-1: none).
   subroutine integrate(m, y0, nt, tout, yout, modes_out, stats, ierr, errmsg, interruptible, &
        tsec, ysec, y0b, youtb)
     type(model_t), intent(in) :: m
@@ -129,8 +127,10 @@ contains
     real(c_double) :: tau                          !< where the integration stands (scaled time)
     real(c_double) :: tau_chk, dchk                !< next linear-tail check, and their spacing
     integer(c_int) :: flag, nroot
-    integer :: k, nroots, nresync, ks, nsec
-    logical :: total_bound, use_tail, fresh
+    integer :: k, nroots, nresync   !< output; switches located; missed switches resynchronised
+    integer :: ks, nsec             !< next section to store; sections
+    logical :: use_tail, fresh      !< the linear tail is tried; CVODE has just (re)started
+    logical :: total_bound          !< the work bound met is max_total_steps (else max_steps)
     character(len=40) :: stage
     type(tail_t) :: tail
 
@@ -259,11 +259,10 @@ contains
     end function integrate_to_output
 
     !> Where the next CVode call returns: the output time tau_out, or an earlier section time
-    !> or tail check. (Tail checks not with root finding: a return starts CVODE's next root
-    !> search there; not on a first call after CVodeInit/ReInit, whose tout sets CVODE's
-    !> initial step, unless tout is more than 4 revolutions away. So a run that never takes the
-    !> tail keeps the steps it has with linear_tail off, unless it starts with such a long
-    !> output interval.)
+    !> or tail check. Tail checks are not taken with root finding (a return starts CVODE's next
+    !> root search there), nor on a first call after CVodeInit/ReInit (its tout sets CVODE's
+    !> initial step) unless tout is more than 4 revolutions away: a run that never takes the
+    !> tail keeps the steps it has with linear_tail off, unless it starts so far from an output.
     real(c_double) function next_stop(tau_out) result(tau_to)
       real(c_double), intent(in) :: tau_out
       tau_to = tau_out
