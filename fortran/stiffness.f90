@@ -25,7 +25,6 @@
 !> Gauss-Legendre nodes are generated one at a time (Newton on P_n): no work arrays.
 module spline_stiffness
   use spline_kinds, only: wp, pi
-  use spline_errors, only: err_ok, err_case
   implicit none
   private
   public :: hertz_stiffness, external_tooth_stiffness, internal_tooth_stiffness, &
@@ -78,10 +77,10 @@ contains
 
     kb = 0.0_wp; ks = 0.0_wp; ka = 0.0_wp
     call check_common('external_tooth_stiffness', z, m, alpha, b, e, nu, nquad, ierr, errmsg)
-    if (ierr /= err_ok) return
+    if (ierr /= 0) return
     rb = 0.5_wp*m*z*cos(alpha)
     psi0 = pi/(2.0_wp*z) + involute(alpha)                 ! alpha_2 of Tian
-    ierr = err_case
+    ierr = 1
     if (.not. (r_root > 0.0_wp)) then
       errmsg = 'external_tooth_stiffness: r_root must be > 0, got '//num(r_root)
       return
@@ -103,7 +102,7 @@ contains
            ' is smaller than the half thickness of the tooth at the base circle'
       return
     end if
-    ierr = err_ok; errmsg = ''
+    ierr = 0; errmsg = ''
 
     g = e/(2.0_wp*(1.0_wp + nu))
     xc = r_contact*cos(psic); hc = r_contact*sin(psic)
@@ -145,10 +144,10 @@ contains
 
     kb = 0.0_wp; ks = 0.0_wp; ka = 0.0_wp
     call check_common('internal_tooth_stiffness', z, m, alpha, b, e, nu, nquad, ierr, errmsg)
-    if (ierr /= err_ok) return
+    if (ierr /= 0) return
     rb = 0.5_wp*m*z*cos(alpha)
     psi0 = pi/(2.0_wp*z) - involute(alpha)     ! ring tooth half angle extrapolated to t = 0
-    ierr = err_case
+    ierr = 1
     if (.not. (r_tip >= rb)) then
       errmsg = 'internal_tooth_stiffness: r_tip = '//num(r_tip)// &
            ' must not be inside the base circle (base radius '//num(rb)//')'
@@ -173,7 +172,7 @@ contains
            ' lies beyond the radius where the tooth space closes'
       return
     end if
-    ierr = err_ok; errmsg = ''
+    ierr = 0; errmsg = ''
 
     g = e/(2.0_wp*(1.0_wp + nu))
     tc = roll(r_contact, rb)
@@ -200,13 +199,13 @@ contains
     kh = 0.0_wp; km = 0.0_wp
     rp = 0.5_wp*m*z
     call external_tooth_stiffness(z, m, alpha, b, rf1, e, nu, rp, nquad, kb1, ks1, ka1, ierr, errmsg)
-    if (ierr /= err_ok) then
+    if (ierr /= 0) then
       errmsg = 'spline_mesh_stiffness (rf1, pitch point): '//trim(errmsg)
       return
     end if
     call internal_tooth_stiffness(z, m, alpha, b, rf2, ra2, e, nu, rp, nquad, kb2, ks2, ka2, &
          ierr, errmsg)
-    if (ierr /= err_ok) then
+    if (ierr /= 0) then
       errmsg = 'spline_mesh_stiffness (rf2, ra2, pitch point): '//trim(errmsg)
       return
     end if
@@ -279,12 +278,12 @@ contains
     kf = 0.0_wp
     if (present(detail)) detail = 0.0_wp
     call check_common(who, z, m, alpha, b, e, nu, 1, ierr, errmsg)
-    if (ierr /= err_ok) return
+    if (ierr /= 0) return
     rp = 0.5_wp*m*z; rb = rp*cos(alpha)
     psi0 = pi/(2.0_wp*z) + involute(alpha)
     call check_fillet(who, z, m, alpha, rp - r_root, rho_f, 'r_root', r_root, thf, ierr, errmsg)
-    if (ierr /= err_ok) return
-    ierr = err_case
+    if (ierr /= 0) return
+    ierr = 1
     if (.not. (r_int > 0.0_wp .and. r_int < r_root)) then
       errmsg = who//': r_int (bore radius) = '//num(r_int)//' must be in (0, r_root = '//num(r_root)//')'
       return
@@ -296,7 +295,7 @@ contains
            num(r_root)//', >= base radius '//num(rb)//', below the pointed tip'
       return
     end if
-    ierr = err_ok; errmsg = ''
+    ierr = 0; errmsg = ''
     am = atan(tc) - psic                    ! load angle (Tian's alpha_1)
     uf = rb/cos(am) - r_root                ! line of action crosses the centre line at r_b/cos(alpha_m)
     call fillet_stiffness_of(who, thf, r_root/r_int, uf, 2.0_wp*r_root*thf, am, e, b, kf, ierr, &
@@ -329,12 +328,12 @@ contains
     kf = 0.0_wp
     if (present(detail)) detail = 0.0_wp
     call check_common(who, z, m, alpha, b, e, nu, 1, ierr, errmsg)
-    if (ierr /= err_ok) return
+    if (ierr /= 0) return
     rp = 0.5_wp*m*z; rb = rp*cos(alpha)
     psi0 = pi/(2.0_wp*z) - involute(alpha)
     call check_fillet(who, z, m, alpha, r_root - rp, rho_f, 'r_root', r_root, thf, ierr, errmsg)
-    if (ierr /= err_ok) return
-    ierr = err_case
+    if (ierr /= 0) return
+    ierr = 1
     if (.not. (r_out > r_root)) then
       errmsg = who//': r_out (outer radius of the ring body) = '//num(r_out)// &
            ' must be larger than r_root = '//num(r_root)
@@ -347,7 +346,7 @@ contains
            num(r_root)//', >= base radius '//num(rb)//', where the ring tooth has thickness'
       return
     end if
-    ierr = err_ok; errmsg = ''
+    ierr = 0; errmsg = ''
     am = atan(tc) + psic
     uf = r_root - rb/cos(am)
     call fillet_stiffness_of(who, thf, r_out/r_root, uf, 2.0_wp*r_root*thf, am, e, b, kf, ierr, &
@@ -367,7 +366,7 @@ contains
     real(wp) :: c, coef(4)
     call sainsot_fillet_compliance(thf, hf, uf, sf, am, e, b, c, coef)
     if (.not. (c > 0.0_wp)) then      ! the fit's quadratic form left its positive range
-      ierr = err_case
+      ierr = 1
       errmsg = who//': Sainsot''s fit gives no positive compliance at h_f = '//num(hf)// &
            ', theta_f = '//num(thf)//' (r_int/r_out, rho_f, r_root out of range)'
       return
@@ -395,17 +394,17 @@ contains
     kf1 = 0.0_wp; kf2 = 0.0_wp
     call spline_mesh_stiffness(z, m, alpha, b, e, nu, rf1, rf2, ra2, nquad, kh, kb1, ks1, ka1, &
          kb2, ks2, ka2, km, ierr, errmsg)
-    if (ierr /= err_ok .or. .not. fillet) return
+    if (ierr /= 0 .or. .not. fillet) return
     rp = 0.5_wp*m*z
     km = 0.0_wp
     call fillet_foundation_stiffness(z, m, alpha, b, rf1, rho_f1, rint1, e, nu, rp, kf1, ierr, errmsg)
-    if (ierr /= err_ok) then
+    if (ierr /= 0) then
       errmsg = 'spline_mesh_stiffness_fillet (rf1, rho_f1, rint1, pitch point): '//trim(errmsg)
       return
     end if
     call fillet_foundation_stiffness_internal(z, m, alpha, b, rf2, rho_f2, rout2, e, nu, rp, kf2, &
          ierr, errmsg)
-    if (ierr /= err_ok) then
+    if (ierr /= 0) then
       errmsg = 'spline_mesh_stiffness_fillet (rf2, rho_f2, rout2, pitch point): '//trim(errmsg)
       return
     end if
@@ -424,7 +423,7 @@ contains
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
     thf = 0.0_wp
-    ierr = err_case
+    ierr = 1
     if (.not. (hd > 0.0_wp)) then
       errmsg = who//': '//rname//' = '//num(r_root)//' must lie beyond the pitch circle (radius '// &
            num(0.5_wp*m*z)//'), on the root side'
@@ -437,7 +436,7 @@ contains
         errmsg = who//': the root fillets overlap (theta_f = '//num(thf)//' >= pi/z): rho_f = '// &
              num(rho_f)//' or '//rname//' = '//num(r_root)//' too large'
       else
-        ierr = err_ok; errmsg = ''
+        ierr = 0; errmsg = ''
       end if
     end if
   end subroutine check_fillet
@@ -451,7 +450,7 @@ contains
     integer, intent(in) :: nquad
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
-    ierr = err_case
+    ierr = 1
     if (.not. (z >= 3.0_wp)) then
       errmsg = who//': z (number of teeth) must be >= 3, got '//num(z)
     else if (.not. (m > 0.0_wp)) then
@@ -467,7 +466,7 @@ contains
     else if (nquad < 1) then
       errmsg = who//': nquad (Gauss points) must be >= 1'
     else
-      ierr = err_ok; errmsg = ''
+      ierr = 0; errmsg = ''
     end if
   end subroutine check_common
 
