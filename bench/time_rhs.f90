@@ -74,7 +74,7 @@ contains
     integer, intent(in) :: code
     character(len=*), intent(in) :: msg
     write(error_unit, '(a)') 'time-rhs: '//trim(msg)
-    error stop err_exit_code(code)
+    stop err_exit_code(code), quiet=.true.
   end subroutine stop_with
 
 end program time_rhs

@@ -27,12 +27,9 @@ module spline_solver
   implicit none
   private
   public :: integrate, nstats, stat_names
-  public :: ist_steps, ist_rhs_evals, ist_jac_evals, ist_lin_rhs_evals, ist_err_test_fails, &
-       ist_nonlin_conv_fails, ist_roots_found, ist_root_fn_evals, ist_last_step, &
-       ist_mode_resyncs, ist_coupling_residual, ist_coupling_iterations, ist_linear_tail_t
 
   !> The solver's statistics: their positions in stats (order of stat_names).
-  integer, parameter :: ist_steps = 1, ist_rhs_evals = 2, ist_jac_evals = 3, &
+  integer, parameter, public :: ist_steps = 1, ist_rhs_evals = 2, ist_jac_evals = 3, &
        ist_lin_rhs_evals = 4, ist_err_test_fails = 5, ist_nonlin_conv_fails = 6, &
        ist_roots_found = 7, ist_root_fn_evals = 8, ist_last_step = 9, ist_mode_resyncs = 10, &
        ist_coupling_residual = 11, ist_coupling_iterations = 12, ist_linear_tail_t = 13
@@ -87,24 +84,22 @@ contains
   !> Integrate the model from y0 (SI, at m%t0) and return the SI state at the times tout(1:nt)
   !> (ascending, >= t0) in yout(:, k), the contact states there (2: decided by the state) and
   !> the solver statistics. interruptible: a SIGINT during the run stops it (err_interrupted).
-  !> tsec (optional, ascending, > t0): Poincare section times; ysec(:, i) gets the SI state at
-  !> tsec(i). Sections do not stop CVODE: asked for the state at that instant (CV_NORMAL), it
-  !> returns its dense output there, the order-q Nordsieck interpolant of the step that covers it
-  !> (the state a root function on the shaft angle would give: CVODE locates roots on the same
-  !> interpolant), and unlike a stop time (CVodeSetStopTime, 20 % more work on paper_lx1e-4,
-  !> docs/performance.md) the steps go on as they would. One exception: the first step after a
-  !> (re)start (CVodeInit; CVodeReInit at a contact switch) is sized from the distance to the
-  !> next requested time, which may be a section time; so with root finding a section can change
-  !> the steps (chaos_z24 with section = 'tooth': 289308 steps instead of 290972).
+  !> tsec (optional, ascending, > t0): section times; ysec(:, i) the SI state at tsec(i).
+  !> Sections do not stop CVODE: asked for the state at that instant (CV_NORMAL), it returns its
+  !> dense output there (the interpolant CVODE also locates roots on), and unlike a stop time
+  !> (20 % more work on paper_lx1e-4, docs/performance.md) the steps go on as they would, except
+  !> that the first step after a (re)start (CVodeInit; CVodeReInit at a contact switch) is sized
+  !> from the next requested time: with root finding a section can change the steps (chaos_z24
+  !> with section = 'tooth': 289308 steps instead of 290972).
   !> y0b, youtb (optional, together): a second copy started at y0b, integrated beside the first
   !> as one CVODE system (same steps, order and corrector iterations: their difference carries
-  !> no independent solver noise; spline_lyapunov::lyapunov_benettin); youtb(:, k) its state at
-  !> tout(k). Contact switches of either copy are located (root finding) and restart both.
+  !> no independent solver noise; spline_lyapunov); youtb(:, k) its state at tout(k). Contact
+  !> switches of either copy are located (root finding) and restart both.
   !> The linear tail (spline_linear): a single copy whose case allows it is tried at the start,
-  !> after every output and, without root finding, each quarter shaft revolution between them
-  !> (CV_NORMAL returns on CVODE's interpolant: the steps stay as they are). Once every tooth
-  !> is proven to stay in contact on one flank for ever, the remaining outputs and sections are
-  !> the closed-form solution; stats(ist_linear_tail_t) holds the time the tail began (-1: none).
+  !> after every output and, without root finding, each quarter shaft revolution between them.
+  !> Once every tooth is proven to stay in contact on one flank for ever, the remaining outputs
+  !> and sections are the closed-form solution; stats(ist_linear_tail_t) is the time the tail
+  !> began (-1: none).
   subroutine integrate(m, y0, nt, tout, yout, modes_out, stats, ierr, errmsg, interruptible, &
        tsec, ysec, y0b, youtb)
     type(model_t), intent(in) :: m
@@ -223,8 +218,7 @@ contains
       tau_out = tout(k)*m%w_ref
       done_k = steps_done()
       do while (tau < tau_out)
-        ! The work bounds hold across the restarts at contact switches and section times
-        ! (each restart is a new CVode call, whose own count starts at 0): max_steps per
+        ! Work bounds across restarts (each a new CVode call, counting from 0): max_steps per
         ! output interval, max_total_steps over the run.
         done = steps_done()
         allow = min(m%max_steps - (done - done_k), m%max_total_steps - done)
