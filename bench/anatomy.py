@@ -1,7 +1,7 @@
 """Cost anatomy (`python bench/run.py anatomy`): where the time of a run goes.
 
-For each case: the time per right-hand-side call (ns) measured in a Fortran loop (the core's
-instrumentation call api_time_rhs), against the flop floor (bench/floor.f90: a branch-free
+For each case: the time per right-hand-side call (ns) measured in a Fortran loop (bench/time_rhs.f90,
+the meson target time-rhs, built on demand with meson into bench/build/meson), against the flop floor (bench/floor.f90: a branch-free
 kernel doing only the arithmetic the mesh cannot avoid, with its flop count; built here on
 demand with f2py into bench/build/); then one run's time per step and its shares: RHS (the
 integrator's calls), Jacobian (difference-quotient calls), roots (root-function evaluations,
@@ -10,12 +10,12 @@ of the core time) and Python (wall time outside the core: case file, f2py, resul
 """
 from __future__ import annotations
 
+import functools
 import statistics
 import time
 from pathlib import Path
 
 from pyspline import load, load_case, simulate
-from pyspline.core import _api, raise_for
 from pyspline.paper import cases_dir
 from speed import _write_csv
 
@@ -38,6 +38,43 @@ def _floor_module():
                         "-m", "_floor", "--opt=-O2"], cwd=build, check=True, capture_output=True)
         return importlib.import_module("_floor")
 
+
+@functools.lru_cache(maxsize=None)
+def _time_rhs_exe() -> Path:
+    """bench/time_rhs.f90 linked with the core (meson target time-rhs, built with the SUNDIALS
+    the installed pyspline links, into bench/build/meson; rebuilt when the sources change)."""
+    import subprocess
+    import sys
+    from pyspline import _build_info
+    build = HERE / "build" / "meson"
+    meson = [sys.executable, "-m", "mesonbuild.mesonmain"]
+    if not (build / "build.ninja").exists():
+        prefix = (str(Path(_build_info.SUNDIALS_LIBDIR).parent) if _build_info.SUNDIALS_LIBDIR
+                  else "")
+        subprocess.run(meson + ["setup", str(build), str(HERE.parent),
+                                f"-Dsundials_prefix={prefix}"], check=True, capture_output=True)
+    subprocess.run(meson + ["compile", "-C", str(build), "time-rhs"], check=True,
+                   capture_output=True)
+    return build / "time-rhs"
+
+
+def time_rhs(model, n):
+    """Seconds per RHS call and per root-function evaluation of a loaded model at its static
+    equilibrium (bench/time_rhs.f90)."""
+    import subprocess
+    import tempfile
+    import numpy as np
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "model.bin"
+        np.asarray(model.bytes, dtype=np.int32).tofile(path)
+        out = subprocess.run([str(_time_rhs_exe()), str(path), str(n)], capture_output=True,
+                             text=True)
+    if out.returncode != 0:
+        raise RuntimeError(f"time-rhs failed ({out.returncode}): {out.stderr.strip()}")
+    t_rhs, t_roots = map(float, out.stdout.split())
+    return t_rhs, t_roots
+
+
 CASES = ("paper_lx1e-4", "paper_T100", "physical_lx1e-4")
 
 
@@ -49,8 +86,7 @@ def rhs_cost(case, n=200_000, repeat=5):
     floor = _floor_module()
     samples = []
     for _ in range(repeat):
-        t_rhs, t_roots, ierr, msg = _api.api_time_rhs(model.bytes, n)
-        raise_for(ierr, msg)
+        t_rhs, t_roots = time_rhs(model, n)
         t_floor, flops = floor.time_floor(case["z"], n, y)
         samples.append((t_rhs, t_floor, t_roots))
     med = [statistics.median(s[i] for s in samples) for i in range(3)]

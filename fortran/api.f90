@@ -18,18 +18,19 @@ module spline_api
   use spline_case, only: case_t, case_read_file, case_read_text, case_suggest, case_field
   use spline_case_values, only: case_value_sizes, case_to_values, case_from_values
   use spline_model, only: model_t, model_from_case, model_magic, nstate, ndof, nkterms, &
-       kterm_names, thermal_coupled, model_warnings
-  use spline_mesh, only: mesh_switch_functions
+       kterm_names, model_warnings
   use spline_stiffness, only: external_tooth_stiffness, internal_tooth_stiffness
-  use spline_dynamics, only: accelerations, start_state, rhs_scaled, to_scaled
+  use spline_dynamics, only: accelerations, start_state
   use spline_run, only: nstats, stat_names, run_case, tooth_quantities, ntooth_q, tooth_q_names, &
-       tooth_q_units, output_times, section_count, lyapunov_count, run_warnings
+       tooth_q_units, output_times, run_warnings
+  use spline_sections, only: section_count
+  use spline_lyapunov, only: lyapunov_count
   implicit none
   private
   public :: api_load_file, api_load_fields, api_load_text, api_model_size, api_simulate
   public :: api_rhs, api_rhs_mesh, api_start_state
   public :: api_output_times, api_model_info, api_defaults, api_names, api_tooth_stiffness
-  public :: api_time_rhs, api_field_hint, api_warnings
+  public :: api_field_hint, api_warnings
 
   integer, parameter :: ninfo = 12   !< entries of api_model_info
   integer, parameter :: nsizes = 5   !< entries of a load's sizes (load_model)
@@ -411,56 +412,5 @@ contains
     ierr = ie
     if (ie == 0) errmsg = ''
   end subroutine api_tooth_stiffness
-
-  !> Instrumentation for the cost anatomy (bench/): elapsed seconds per call of the scaled
-  !> right-hand side (Eq. 25) of a loaded model at its static equilibrium (every tooth in
-  !> contact, time advanced per call), and of the root functions. No physics of its own.
-  subroutine api_time_rhs(model, nb, n, t_rhs, t_roots, ierr, errmsg)
-    integer(c_int), intent(in) :: nb, n
-    integer(c_int), intent(in) :: model(nb)
-    real(c_double), intent(out) :: t_rhs, t_roots
-    integer(c_int), intent(out) :: ierr
-    character(len=msglen), intent(out) :: errmsg
-    type(model_t) :: m
-    real(wp) :: y(nstate), ys(nstate), f(nstate), acc, dt
-    real(wp), allocatable :: g(:), gb(:)
-    integer :: ie, k
-    integer(8) :: c0, c1, rate
-    t_rhs = 0; t_roots = 0
-    call unpack(model, m, ie, errmsg)
-    if (ie == err_ok) then
-      m%start_equilibrium = .true.
-      m%dq0 = 0; m%dv0 = 0
-      call start_state(m, y, ie, errmsg)
-    end if
-    ierr = ie
-    if (ie /= err_ok .or. n < 1) return
-    allocate(g(2*m%z*m%n_slices), gb(2*m%z))   ! a switch pair per contact (tooth or slice)
-    call to_scaled(m, y, ys)
-    dt = 1.0e-3_wp/n
-    acc = 0
-    call system_clock(c0, rate)
-    do k = 1, n
-      call rhs_scaled(m, m%t0*m%w_ref + k*dt, ys, f, ie, errmsg)
-      acc = acc + f(nstate)
-    end do
-    call system_clock(c1)
-    t_rhs = real(c1 - c0, wp)/rate/n
-    if (ie /= err_ok) then
-      ierr = ie; return
-    end if
-    call system_clock(c0)
-    do k = 1, n
-      if (m%thermal == thermal_coupled) then
-        call mesh_switch_functions(m, m%t0 + k*dt, y(1:ndof), g, y(ndof+1:), gb)
-      else
-        call mesh_switch_functions(m, m%t0 + k*dt, y(1:ndof), g)
-      end if
-      acc = acc + g(1)
-    end do
-    call system_clock(c1)
-    t_roots = real(c1 - c0, wp)/rate/n
-    if (acc == 1.2345e300_wp) errmsg = 'unreachable'     ! keeps both loops from being optimised out
-  end subroutine api_time_rhs
 
 end module spline_api

@@ -2,6 +2,7 @@
 !> coordinates of Eq. 24, its scaled first-order form (Eq. 25), and the static equilibrium.
 module spline_dynamics
   use spline_kinds, only: wp
+  use spline_errors, only: err_ok, err_solver
   use spline_model, only: model_t, ndof, nstate
   use spline_mesh, only: mesh_eval, mesh_switch_functions, coupling_stats_t
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -35,7 +36,7 @@ contains
     type(coupling_stats_t), intent(inout), optional :: cstats
     real(wp) :: fx1, fy1, tm, s1, s3, th1dd, fu(4)
     call mesh_eval(m, t, q, v, fx1, fy1, tm, ierr, errmsg, mode=mode, branch=branch, cstats=cstats)
-    if (ierr /= 0) return
+    if (ierr /= err_ok) return
     a(1) = (fx1 - m%c_p1*v(1) - m%k_p1*q(1))/m%m_1
     a(2) = (fy1 - m%c_p1*v(2) - m%k_p1*q(2))/m%m_1 - m%grav
     a(3) = (-fx1 - m%c_p2*v(3) - m%k_p2*q(3))/m%m_2
@@ -134,13 +135,13 @@ contains
     integer, intent(out) :: ierr
     character(len=*), intent(inout) :: errmsg
     y = 0.0_wp
-    ierr = 0
+    ierr = err_ok
     if (m%start_equilibrium) call static_equilibrium(m, m%t0, y(1:ndof), ierr, errmsg)
-    if (ierr /= 0) return
+    if (ierr /= err_ok) return
     y(1:ndof) = y(1:ndof) + m%dq0
     y(ndof+1:) = m%dv0
     if (.not. all(ieee_is_finite(y))) then
-      ierr = 2
+      ierr = err_solver
       errmsg = 'case '//trim(m%name)//': the start state is not finite (NaN or Inf): use '// &
            'start = ''rest'''
     end if
@@ -174,7 +175,7 @@ contains
     q(6) = -sign(m%c_bulk, m%t_d) - m%t_d/(m%z*m%k_m*m%r_b)
     lam_prev = 0.0_wp; q_prev = 0.0_wp; dq_prev = 0.0_wp
     call residual(q, r)
-    if (ierr /= 0) return
+    if (ierr /= err_ok) return
     do it = 1, max_newton
       ! contact states at q (Eq. 16, as the right-hand side decides them)
       call mesh_switch_functions(m, t, q, g)
@@ -188,20 +189,20 @@ contains
         qn = q
         qn(k) = q(k) + h
         call residual(qn, rn, modes)
-        if (ierr /= 0) return
+        if (ierr /= err_ok) return
         jac(:, k) = (rn - r)/h
       end do
       call solve_dense(jac, -r, dq, ierr)
-      if (ierr /= 0 .and. lam_prev > 1.0e-6_wp) then
+      if (ierr /= err_ok .and. lam_prev > 1.0e-6_wp) then
         ! singular here (e.g. the step left every tooth out of contact): back to half the step
         lam_prev = 0.5_wp*lam_prev
         q = q_prev + lam_prev*dq_prev
         call residual(q, r)
-        if (ierr /= 0) return
+        if (ierr /= err_ok) return
         cycle
       end if
-      if (ierr /= 0) then
-        ierr = 2
+      if (ierr /= err_ok) then
+        ierr = err_solver
         errmsg = 'case '//trim(m%name)//': no unique static equilibrium (a free body, e.g. '// &
              'the mesh out of contact under zero torque): use start = ''rest'''
         return
@@ -219,9 +220,9 @@ contains
       do ls = 1, 30
         qn = q + lam*dq
         call residual(qn, rn)
-        if (ierr /= 0) return
+        if (ierr /= err_ok) return
         call solve_dense(jac, -rn, dqbar, ierr)
-        if (ierr /= 0) exit
+        if (ierr /= err_ok) exit
         if (norm2(dqbar) < (1.0_wp - 0.25_wp*lam)*norm2(dq)) exit
         lam = 0.5_wp*lam
       end do
@@ -229,14 +230,14 @@ contains
         lam = 1.0_wp
         qn = q + dq
         call residual(qn, rn)
-        if (ierr /= 0) return
+        if (ierr /= err_ok) return
       end if
-      ierr = 0
+      ierr = err_ok
       q_prev = q; dq_prev = dq; lam_prev = lam
       q = qn
       r = rn
     end do
-    ierr = 2
+    ierr = err_solver
     write(errmsg, '(a,i0,a)') 'case '//trim(m%name)//': static equilibrium did not converge in ', &
          max_newton, ' Newton steps: use start = ''rest'''
   contains
@@ -253,7 +254,7 @@ contains
   !> Gaussian elimination with partial pivoting for the small Newton systems, on the matrix
   !> equilibrated by rows and then columns (the stiffnesses of a case span many decades: mesh
   !> k_m Z against shafts k_t, so a pivot is judged against its own row and column, not the
-  !> largest entry). ierr = 1: singular (a zero row or column, or a pivot below 1e-13).
+  !> largest entry). ierr = err_solver: singular (a zero row or column, or a pivot below 1e-13).
   subroutine solve_dense(a_in, b, x, ierr)
     real(wp), intent(in) :: a_in(:, :), b(:)
     real(wp), intent(out) :: x(:)
@@ -264,7 +265,7 @@ contains
     a = a_in
     rhs = b
     x = 0.0_wp
-    ierr = 1
+    ierr = err_solver
     do i = 1, n
       rs(i) = maxval(abs(a(i, :)))
       if (.not. rs(i) > 0.0_wp) return
@@ -276,11 +277,11 @@ contains
       if (.not. cs(i) > 0.0_wp) return
       a(:, i) = a(:, i)/cs(i)
     end do
-    ierr = 0
+    ierr = err_ok
     do i = 1, n
       p = maxloc(abs(a(i:, i)), dim=1) + i - 1
       if (.not. abs(a(p, i)) > 1.0e-13_wp) then
-        ierr = 1; return
+        ierr = err_solver; return
       end if
       if (p /= i) then
         rowtmp = a(i, :); a(i, :) = a(p, :); a(p, :) = rowtmp

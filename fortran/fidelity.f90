@@ -1,5 +1,5 @@
 !> The fidelity ladder ("model no more than a scene needs"): error estimates for the cheaper
-!> model levels against the level a case sets, used by fidelity = 'auto' (spline_run).
+!> model levels against the level a case sets, and the level fidelity = 'auto' runs (auto_level, called by spline_run::run_case).
 !>
 !> Both estimates are relative to the static tooth load F0 = |T_d| / (Z r_b) (Eq. 22 with every
 !> tooth equal) and bound the change of a tooth force as k_m times a displacement the cheaper
@@ -12,12 +12,49 @@
 !>  - a temperature dT left out of Eq. 2 moves the backlash by kappa dT, kappa = 2 lambda s cos(alpha).
 module spline_fidelity
   use spline_kinds, only: wp
-  use spline_model, only: model_t
+  use spline_model, only: model_t, thermal_none, thermal_bulk, thermal_oneway, thermal_coupled, &
+       set_thermal_level
   implicit none
   private
-  public :: static_tooth_load, lateral_estimate, backlash_estimate
+  public :: static_tooth_load, lateral_estimate, backlash_estimate, auto_level, auto_tol
+
+  real(wp), parameter :: fidelity_margin = 0.5_wp   !< auto reduces when estimate <= margin * tol
 
 contains
+
+  !> fidelity = 'auto': run is m at the cheapest level of the ladder whose estimated error
+  !> against the level m sets is within auto_tol(m), and that reports the same quantities
+  !> (run = m otherwise). The estimates are not bounds: measured errors reach 1.3 of them,
+  !> paper_T50/T100 one-way over 1 s (`python bench/run.py ladder`), hence the margin.
+  !>  - dof 7 -> 3 when lateral_estimate <= tol;
+  !>  - thermal bulk -> none when backlash_estimate(T_M) <= tol;
+  !>  - thermal coupled -> oneway (same T_f output, no iteration in the RHS), checked afterwards
+  !>    by spline_run::run_case: if backlash_estimate(max T_f of the one-way run) > tol the case
+  !>    is run coupled.
+  !> eps_lat, eps_th: the estimates (0 when not computed).
+  subroutine auto_level(m, run, eps_lat, eps_th)
+    type(model_t), intent(in) :: m
+    type(model_t), intent(out) :: run
+    real(wp), intent(out) :: eps_lat, eps_th
+    real(wp) :: tol
+    run = m
+    eps_lat = 0.0_wp; eps_th = 0.0_wp
+    tol = auto_tol(m)
+    if (.not. m%auto) return
+    eps_lat = lateral_estimate(m)
+    if (m%dof == 7 .and. eps_lat <= tol) run%dof = 3
+    if (m%thermal == thermal_bulk) then
+      eps_th = backlash_estimate(m, m%t_bulk)
+      if (eps_th <= tol) call set_thermal_level(run, thermal_none)
+    end if
+    if (m%thermal == thermal_coupled) call set_thermal_level(run, thermal_oneway)
+  end subroutine auto_level
+
+  !> The error an estimate may reach for fidelity = 'auto' to take a cheaper level.
+  pure real(wp) function auto_tol(m) result(tol)
+    type(model_t), intent(in) :: m
+    tol = fidelity_margin*m%fidelity_tol
+  end function auto_tol
 
   !> F0 = |T_d| / (Z r_b): the tooth load of the static, aligned mesh (Eq. 22) [N].
   pure real(wp) function static_tooth_load(m) result(f0)

@@ -19,6 +19,7 @@
 !> the map is checked to be affine and time-invariant at a second state and time before use.
 module spline_linear
   use spline_kinds, only: wp
+  use spline_errors, only: err_ok
   use spline_model, only: model_t, nstate, ndof, thermal_coupled
   use spline_dynamics, only: rhs_scaled, from_scaled
   use spline_mesh, only: mesh_switch_functions
@@ -126,12 +127,12 @@ contains
     mode = s
     msg = ''
     call rhs_scaled(m, tau, ys, f0, ierr, msg, mode=mode)
-    if (ierr /= 0) return
+    if (ierr /= err_ok) return
     do k = 1, n
       y1 = ys
       y1(idx(k)) = y1(idx(k)) + 1.0_wp
       call rhs_scaled(m, tau, y1, f1, ierr, msg, mode=mode)
-      if (ierr /= 0) return
+      if (ierr /= err_ok) return
       a(:, k) = f1(idx(1:n)) - f0(idx(1:n))
     end do
     ! affine and time-invariant: a second state at a second time
@@ -141,7 +142,7 @@ contains
       y1(idx(k)) = ys(idx(k)) + d(k)
     end do
     call rhs_scaled(m, tau + 0.37_wp, y1, f1, ierr, msg, mode=mode)
-    if (ierr /= 0) return
+    if (ierr /= err_ok) return
     scale = maxval(abs(f0(idx(1:n)))) + maxval(abs(matmul(abs(a), abs(d))))
     if (maxval(abs(f1(idx(1:n)) - f0(idx(1:n)) - matmul(a, d))) > 1.0e-10_wp*scale) return
     ! eigenpairs (LAPACK), asymptotic stability, V^-1

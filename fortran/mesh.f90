@@ -3,7 +3,7 @@
 !> (Eqs. 1, 3-7, 12-14) and the energy-consistent mesh forces on the bodies (Eqs. 19-22, corrected).
 module spline_mesh
   use spline_kinds, only: wp, max_teeth
-  use spline_errors, only: err_thermal
+  use spline_errors, only: err_ok, err_solver, err_thermal
   use spline_model, only: model_t, thermal_oneway, thermal_coupled
   use spline_geometry, only: tooth_angles, profile_shift, contact_radius
   use spline_thermal, only: thermal_backlash, flash_temperature
@@ -57,7 +57,7 @@ contains
     integer :: j, mj, iters, is, ns
     logical :: want_flash, coupled
 
-    ierr = 0
+    ierr = err_ok
     call tooth_angles(m%z, m%omega, t, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
     ! relative centre offset of spline 1 (misaligned, Section 1) against spline 2
     ex = q(1) + m%l_x - q(3)
@@ -126,11 +126,11 @@ contains
             cstats%max_iterations = max(cstats%max_iterations, iters)
             cstats%worst_residual = max(cstats%worst_residual, resid)
           end if
-          if (ierr /= 0) then
+          if (ierr /= err_ok) then
             write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': thermal interference: '// &
                  'the flash temperature closes the backlash of tooth ', j, ' at t = ', t, &
                  ' s (Eq. 2: c_j <= 0)'
-            if (ierr == 2) write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)// &
+            if (ierr == err_solver) write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)// &
                  ': flash-temperature coupling did not converge on tooth ', j, ' at t = ', t, ' s'
             ierr = err_thermal
             return
@@ -207,7 +207,7 @@ contains
   !>   g(T) = T - T_f(F(T)),  F(T) = k_m (dn - mode (c_bulk - kappa T)) + c_m d(dn)/dt.
   !> Secant iteration from T = 0 and T = T_f(F(0)); it stops when a step is below
   !> 1e-14 (1 + T) degC. The map T -> T_f(F(T)) contracts by about k_m kappa dT_f/dF (~1e-3 for the
-  !> paper's k_m), so 3-5 iterations reach round-off. ierr = 1: backlash closed; 2: no convergence.
+  !> paper's k_m), so 3-5 iterations reach round-off. ierr = err_thermal: backlash closed; err_solver: no convergence.
   !> Eqs. 3-4 make T_f a power of the load at a given contact point: f_e / sqrt(B) ~ f_e^(3/4), so
   !> T_f(F) = T_f(1 N) |F|^(3/4). Eqs. 3-7 are evaluated once per tooth, each iteration costs two sqrt.
   !> iters, resid: the secant iterations taken and the residual |g| accepted.
@@ -219,7 +219,7 @@ contains
     integer, intent(out) :: iters, ierr
     real(wp) :: ta, ga, tb, gb, tn, tf_unit, tfb
     integer :: k
-    ierr = 0
+    ierr = err_ok
     iters = 0
     resid = 0.0_wp
     tf_unit = flash_of(m, 1.0_wp, r1, r2)
@@ -230,7 +230,7 @@ contains
     if (ga /= 0.0_wp) then
       tfb = tf_at(tb)
       if (tfb < 0.0_wp) then
-        ierr = 1; return
+        ierr = err_thermal; return
       end if
       gb = tb - tfb
       do k = 1, max_coupling_iter
@@ -240,20 +240,20 @@ contains
         tb = tn
         tfb = tf_at(tb)
         if (tfb < 0.0_wp) then
-          ierr = 1; return
+          ierr = err_thermal; return
         end if
         gb = tb - tfb
         if (abs(tb - ta) <= coupling_tol*(1.0_wp + abs(tb))) exit
       end do
       if (k > max_coupling_iter) then
-        ierr = 2; return
+        ierr = err_solver; return
       end if
       iters = k
       resid = abs(gb)
       t = tb
     end if
     if (thermal_backlash(m%c_bulk, m%kappa, t) <= 0.0_wp) then
-      ierr = 1; return
+      ierr = err_thermal; return
     end if
     f = contact_force(m, dn, ddn, mode, thermal_backlash(m%c_bulk, m%kappa, t))
   contains

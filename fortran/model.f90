@@ -152,11 +152,11 @@ contains
          ra2, rho_f, rho_f, r_bore, r_rim, c%fillet, stiffness_nquad, m%k_terms(1), m%k_terms(2), &
          m%k_terms(3), m%k_terms(4), m%k_terms(5), m%k_terms(6), m%k_terms(7), m%k_terms(8), &
          m%k_terms(9), m%k_terms(10), ierr, errmsg)
-    if (ierr == 0) then        ! Eq. 18 without the fillet terms (k_f1 = k_f2 = 0 when off)
+    if (ierr == err_ok) then        ! Eq. 18 without the fillet terms (k_f1 = k_f2 = 0 when off)
       m%k_m_nofillet = 1.0_wp/(1.0_wp/m%k_terms(1) + 1.0_wp/m%k_terms(2) + 1.0_wp/m%k_terms(3) &
            + 1.0_wp/m%k_terms(4) + 1.0_wp/m%k_terms(6) + 1.0_wp/m%k_terms(7) + 1.0_wp/m%k_terms(8))
     end if
-    if (ierr /= 0) then
+    if (ierr /= err_ok) then
       m%k_terms = 0.0_wp
       if (c%k_m == 0.0_wp) then
         errmsg = 'case '//trim(m%name)//': field k_m = 0 asks for the potential-energy stiffness '// &
@@ -164,7 +164,7 @@ contains
              '(or fillet = .false., fillet_radius, r_bore, r_rim)'
         ierr = err_case; return
       end if
-      ierr = 0
+      ierr = err_ok
     end if
     if (c%k_m == 0.0_wp) then
       m%k_m = m%k_terms(ik_m)

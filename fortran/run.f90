@@ -1,28 +1,33 @@
-!> One simulation of a case, shared by the executable and the Python API: output times,
-!> start state (static equilibrium by default), integration, and the per-tooth quantities
-!> (Eqs. 11, 15-22 and, for the thermal levels that have it, Eqs. 1-7) at every output time.
+!> One simulation of a case, shared by the executable and the Python API: the model level to run
+!> (fidelity = 'auto': spline_fidelity), output times, start state (static equilibrium by
+!> default), integration (with the Poincare section of spline_sections and the Lyapunov exponent
+!> of spline_lyapunov when the case asks), the per-tooth quantities (Eqs. 11, 15-22 and, for the
+!> thermal levels that have it, Eqs. 1-7) at every output time, and the checks of the result.
 module spline_run
-  use spline_kinds, only: wp, pi
+  use spline_kinds, only: wp
   use spline_errors, only: err_ok, err_solver, itoa
-  use spline_model, only: model_t, nstate, ndof, thermal_none, thermal_bulk, thermal_oneway, &
-       thermal_coupled, set_thermal_level
-  use spline_dynamics, only: start_state, to_scaled, from_scaled, integrated_states
+  use spline_model, only: model_t, nstate, ndof, thermal_oneway, thermal_coupled, set_thermal_level
+  use spline_dynamics, only: start_state
   use spline_mesh, only: mesh_eval
   use spline_solver, only: integrate, nsolver_stats => nstats, solver_stat_names => stat_names
-  use spline_fidelity, only: lateral_estimate, backlash_estimate
+  use spline_fidelity, only: auto_level, auto_tol, backlash_estimate
+  use spline_sections, only: section_count, section_times
+  use spline_lyapunov, only: lyapunov_benettin
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
   public :: run_case, output_times, tooth_outputs, tooth_quantities, ntooth_q, tooth_q_names, tooth_q_units
-  public :: nstats, stat_names, section_count, section_times, lyapunov_count, run_warnings
+  public :: nstats, stat_names, run_warnings
 
   !> Statistics of a run: the solver's, then the core's elapsed time, the model level that ran
   !> (dof, thermal 0 none .. 3 coupled), the fidelity estimates of spline_fidelity, and the
   !> one-way check of Eq. 2 (result_checks): the number of (output time, tooth) samples whose
   !> flash temperature would have closed the backlash, and the first time of one [s].
-  real(wp), parameter :: fidelity_margin = 0.5_wp   !< auto reduces when estimate <= margin * tol
+  integer, parameter :: ist_core_wall = nsolver_stats + 1, ist_dof = nsolver_stats + 2, &
+       ist_thermal_level = nsolver_stats + 3, ist_eps_lateral = nsolver_stats + 4, &
+       ist_eps_thermal = nsolver_stats + 5, ist_closed = nsolver_stats + 6, &
+       ist_closed_t = nsolver_stats + 7
   integer, parameter :: nstats = nsolver_stats + 7
-  integer, parameter :: ist_closed = nsolver_stats + 6, ist_closed_t = nsolver_stats + 7
   character(len=24), parameter :: stat_names(nstats) = [solver_stat_names, [character(len=24) :: &
        'core_wall_s', 'dof', 'thermal_level', 'fidelity_eps_lateral', 'fidelity_eps_thermal', &
        'backlash_closed', 'backlash_closed_t_s']]
@@ -53,14 +58,9 @@ contains
 
   !> Run a validated case: y(:, k) is the SI state at t(k), tooth(k, j, :) the quantities named
   !> in tooth_q_names for tooth j, tm(k) the meshing torque (Eq. 22).
-  !> fidelity = 'auto' runs the cheapest level of the ladder whose estimated error against the
-  !> level the case sets is within fidelity_tol, and that reports the same quantities. With
-  !> tol = fidelity_margin * fidelity_tol (the estimates are not bounds: measured errors reach
-  !> 1.3 of them, paper_T50/T100 one-way over 1 s, `pyspline bench ladder`):
-  !>  - dof 7 -> 3 when lateral_estimate <= tol;
-  !>  - thermal bulk -> none when backlash_estimate(T_M) <= tol;
-  !>  - thermal coupled -> oneway (same T_f output, no iteration in the RHS), checked afterwards:
-  !>    if backlash_estimate(max T_f of the one-way run) > tol the case is run coupled.
+  !> fidelity = 'auto' runs the cheapest level of the ladder within fidelity_tol (auto_level);
+  !> a coupled case runs one-way first and is run again coupled if the one-way flash
+  !> temperature's estimate (backlash_estimate of its largest T_f) exceeds auto_tol.
   !> interruptible: a SIGINT stops the run with err_interrupted (callers that can raise it).
   !> Optional extras, sized by the caller: sec_t(section_count(m)), sec_y(nstate, ...) get the
   !> Poincare section (times, SI states); lyap_t(lyapunov_count(m)), lyap_g(...) the Benettin
@@ -78,26 +78,15 @@ contains
     real(wp), intent(out), optional :: sec_t(:), sec_y(:, :), lyap_t(:), lyap_g(:)
     real(wp), intent(out), optional :: face(:, :, :), tilt(:, :)
     type(model_t) :: run
-    real(wp) :: eps_lat, eps_th, tol, closed, t_closed
+    real(wp) :: eps_lat, eps_th, closed, t_closed
     integer(8) :: c0, c1, rate
     call system_clock(c0, rate)
-    run = m
-    eps_lat = 0.0_wp; eps_th = 0.0_wp
-    tol = fidelity_margin*m%fidelity_tol
-    if (m%auto) then
-      eps_lat = lateral_estimate(m)
-      if (m%dof == 7 .and. eps_lat <= tol) run%dof = 3
-      if (m%thermal == thermal_bulk) then
-        eps_th = backlash_estimate(m, m%t_bulk)
-        if (eps_th <= tol) call set_thermal_level(run, thermal_none)
-      end if
-      if (m%thermal == thermal_coupled) call set_thermal_level(run, thermal_oneway)
-    end if
+    call auto_level(m, run, eps_lat, eps_th)
     call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
          face, tilt)
     if (ierr == err_ok .and. m%auto .and. m%thermal == thermal_coupled) then
       eps_th = backlash_estimate(m, maxval(abs(tooth(:, :, iq_tf))))
-      if (eps_th > tol) then
+      if (eps_th > auto_tol(m)) then
         call set_thermal_level(run, thermal_coupled)
         call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
              face, tilt)
@@ -112,8 +101,13 @@ contains
     if (ierr == err_ok) call result_checks(run, t, y, tooth, tm, closed, t_closed, ierr, errmsg, &
          sec_t, sec_y, lyap_t, lyap_g)
     call system_clock(c1)
-    stats(nsolver_stats+1:) = [real(c1 - c0, wp)/rate, real(run%dof, wp), real(run%thermal, wp), &
-         eps_lat, eps_th, closed, t_closed]
+    stats(ist_core_wall) = real(c1 - c0, wp)/rate
+    stats(ist_dof) = real(run%dof, wp)
+    stats(ist_thermal_level) = real(run%thermal, wp)
+    stats(ist_eps_lateral) = eps_lat
+    stats(ist_eps_thermal) = eps_th
+    stats(ist_closed) = closed
+    stats(ist_closed_t) = t_closed
   end subroutine run_case
 
   !> The checks of a finished run: no output may be NaN or infinite (ierr = err_solver with a
@@ -229,9 +223,11 @@ contains
     allocate(modes(m%z*m%n_slices, m%n_out))
     call output_times(m, t)
     call start_state(m, y0, ierr, errmsg)
-    if (ierr /= 0) return
-    ! The section times stop the integrator, so they shape the steps: a run that asks for a
-    ! section takes them whether or not the caller keeps the points (same numbers everywhere).
+    if (ierr /= err_ok) return
+    ! A section does not stop CVODE, but with root finding the first step after each restart
+    ! depends on the next requested time, which may be a section time (spline_solver::integrate):
+    ! a run that asks for a section takes its times whether or not the caller keeps the points
+    ! (same numbers everywhere).
     if (present(sec_t)) then
       call section_times(m, sec_t)
       call integrate(m, y0, m%n_out, t, y, modes, stats(1:nsolver_stats), ierr, errmsg, &
@@ -242,121 +238,9 @@ contains
       call integrate(m, y0, m%n_out, t, y, modes, stats(1:nsolver_stats), ierr, errmsg, &
            interruptible, ts, ysec)
     end if
-    if (ierr /= 0) return
+    if (ierr /= err_ok) return
     call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt)
   end subroutine run_level
-
-  !> Period of the Poincare section [s]: the shaft revolution 2 pi / omega (section 1) or the
-  !> tooth pass 2 pi / (Z omega) (section 2); 0 without a section.
-  pure real(wp) function section_period(m) result(p)
-    type(model_t), intent(in) :: m
-    p = 0.0_wp
-    if (m%section == 1) p = 2.0_wp*pi/m%omega
-    if (m%section == 2) p = 2.0_wp*pi/(m%z*m%omega)
-  end function section_period
-
-  !> Range k0..k1 of the section times k p in the output window [t0 + t_transient, t_end]
-  !> (after t0; a relative 1e-9 of p absorbs the round-off of t/p).
-  pure subroutine section_range(m, k0, k1)
-    type(model_t), intent(in) :: m
-    integer(8), intent(out) :: k0, k1
-    real(wp) :: p
-    p = section_period(m)
-    k0 = 1; k1 = 0
-    if (p <= 0.0_wp) return
-    k0 = ceiling((m%t0 + m%t_transient)/p - 1.0e-9_wp, 8)
-    if (k0*p <= m%t0) k0 = k0 + 1
-    k1 = floor(m%t_end/p + 1.0e-9_wp, 8)
-  end subroutine section_range
-
-  !> Number of Poincare section points of a run.
-  pure integer function section_count(m) result(n)
-    type(model_t), intent(in) :: m
-    integer(8) :: k0, k1
-    call section_range(m, k0, k1)
-    n = int(max(k1 - k0 + 1, 0_8))
-  end function section_count
-
-  !> The section times: the instants at which the shaft (or the tooth pass) angle omega t is a
-  !> whole number of turns. The shaft turns at the constant speed omega (Eqs. 8-9), so the
-  !> section condition omega t = 2 pi k has these roots in closed form.
-  pure subroutine section_times(m, ts)
-    type(model_t), intent(in) :: m
-    real(wp), intent(out) :: ts(:)
-    integer(8) :: k0, k1, k
-    call section_range(m, k0, k1)
-    do k = k0, k1
-      ts(k - k0 + 1) = min(k*section_period(m), m%t_end)
-    end do
-  end subroutine section_times
-
-  !> Number of Benettin renormalisations over the output window (0 without lyapunov).
-  pure integer function lyapunov_count(m) result(n)
-    type(model_t), intent(in) :: m
-    n = 0
-    if (m%lyapunov .and. m%lyap_dt > 0.0_wp) &
-         n = max(1, ceiling((m%t_end - m%t0 - m%t_transient)/m%lyap_dt - 1.0e-9_wp))
-  end function lyapunov_count
-
-  !> Largest Lyapunov exponent by Benettin's method: from the state y_start at t_start, a
-  !> reference and a copy perturbed by d0 (in the scaled states of Eq. 25, along a fixed
-  !> direction) are integrated over intervals of lyap_dt; after each the separation d is
-  !> measured, ln(d / d0) added to the sum g, and the copy pulled back to distance d0 along the
-  !> separation. lam(t) = g(t) / (t - t_start) converges to the exponent [1/s]. The two are
-  !> integrated as one CVODE system (integrate's y0b), with the same steps, order and corrector
-  !> iterations, so their difference carries no independent solver noise (integrated apart, a
-  !> separation of 1e-8 at rtol 1e-8 measured that noise: tests/test_chaos.py). Both restart at
-  !> every renormalisation. The frozen states of the torsional level (dof 3) are left out of d.
-  subroutine lyapunov_benettin(m, t_start, y_start, lt, lg, ierr, errmsg, interruptible)
-    type(model_t), intent(in) :: m
-    real(wp), intent(in) :: t_start, y_start(nstate)
-    real(wp), intent(out) :: lt(:), lg(:)
-    integer, intent(out) :: ierr
-    character(len=*), intent(out) :: errmsg
-    logical, intent(in), optional :: interruptible
-    type(model_t) :: mm
-    real(wp) :: y(nstate), yp(nstate), t0, t1, ys(nstate), yps(nstate), dv(nstate), d, g
-    real(wp) :: tout(1), y1(nstate, 1), yp1(nstate, 1), st(nsolver_stats)
-    integer :: idx(nstate), n, k, i, modes(m%z*m%n_slices, 1)
-    call integrated_states(m, idx, n)
-    mm = m
-    y = y_start
-    dv = 0.0_wp
-    dv(idx(1:n)) = 1.0_wp/sqrt(real(n, wp))         ! unit direction in the scaled states
-    call to_scaled(m, y, ys)
-    yps = ys + m%lyap_d0*dv
-    call from_scaled(m, yps, yp)
-    t0 = t_start
-    g = 0.0_wp
-    do k = 1, size(lt)
-      t1 = min(t_start + k*m%lyap_dt, m%t_end)
-      mm%t0 = t0
-      tout = t1
-      call integrate(mm, y, 1, tout, y1, modes, st, ierr, errmsg, interruptible, y0b=yp, &
-           youtb=yp1)
-      if (ierr /= err_ok) return
-      call to_scaled(m, y1(:, 1), ys)
-      call to_scaled(m, yp1(:, 1), yps)
-      dv = 0.0_wp
-      dv(idx(1:n)) = yps(idx(1:n)) - ys(idx(1:n))
-      d = norm2(dv)
-      if (.not. (d > 0.0_wp)) then       ! the copy fell onto the reference: perturb afresh
-        dv = 0.0_wp
-        dv(idx(1:n)) = 1.0_wp/sqrt(real(n, wp))
-        d = m%lyap_d0
-      end if
-      g = g + log(d/m%lyap_d0)
-      lt(k) = t1
-      lg(k) = g
-      yps = ys
-      do i = 1, n
-        yps(idx(i)) = ys(idx(i)) + dv(idx(i))*(m%lyap_d0/d)
-      end do
-      y = y1(:, 1)
-      call from_scaled(m, yps, yp)
-      t0 = t1
-    end do
-  end subroutine lyapunov_benettin
 
   !> Per-tooth quantities at the output times, with the contact states the integration used
   !> (2: decided by the state).
@@ -372,14 +256,14 @@ contains
     real(wp), intent(out), optional :: face(:, :, :), tilt(:, :)
     real(wp) :: row(m%z, ntooth_q), fs(m%n_slices, m%z), mt(2)
     integer :: k
-    ierr = 0
+    ierr = err_ok
     do k = 1, size(t)
       if (modes(1, k) == 2) then
         call tooth_quantities(m, t(k), y(:, k), row, tm(k), ierr, errmsg, fslice=fs, mtilt=mt)
       else
         call tooth_quantities(m, t(k), y(:, k), row, tm(k), ierr, errmsg, modes(:, k), fs, mt)
       end if
-      if (ierr /= 0) return
+      if (ierr /= err_ok) return
       tooth(k, :, :) = row
       if (present(face)) face(k, :, :) = transpose(fs)
       if (present(tilt)) tilt(k, :) = mt

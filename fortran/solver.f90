@@ -3,8 +3,9 @@
 !> thermal level, on the root/tip branch switches of Eqs. 13-14).
 !>
 !> Reentrant: all run state sits in a solver_ctx_t local to `integrate`, which CVODE hands to
-!> the callbacks as their user data. No module variable changes during a run. Every SUNDIALS
-!> return value is checked. Version-specific calls (context creation) are in sundials_context_new.
+!> the callbacks as their user data. No module variable changes during a run. The SUNDIALS
+!> objects are made in cvode_setup and freed in cvode_free; every SUNDIALS return value is
+!> checked. Version-specific calls (context creation) are in sundials_context_new.
 module spline_solver
   use, intrinsic :: iso_c_binding
   use fcvode_mod
@@ -27,6 +28,11 @@ module spline_solver
   private
   public :: integrate, nstats, stat_names
 
+  !> The solver's statistics: their positions in stats (order of stat_names).
+  integer, parameter, public :: ist_steps = 1, ist_rhs_evals = 2, ist_jac_evals = 3, &
+       ist_lin_rhs_evals = 4, ist_err_test_fails = 5, ist_nonlin_conv_fails = 6, &
+       ist_roots_found = 7, ist_root_fn_evals = 8, ist_last_step = 9, ist_mode_resyncs = 10, &
+       ist_coupling_residual = 11, ist_coupling_iterations = 12, ist_linear_tail_t = 13
   integer, parameter :: nstats = 13
   character(len=24), parameter :: stat_names(nstats) = [character(len=24) :: &
        'steps', 'rhs_evals', 'jac_evals', 'lin_rhs_evals', 'err_test_fails', &
@@ -52,6 +58,16 @@ module spline_solver
     character(len=msglen) :: cvode_msg = '' !< CVODE's own last error text
   end type solver_ctx_t
 
+  !> The SUNDIALS objects of one run (cvode_setup makes them, cvode_free frees them).
+  type :: cvode_t
+    type(c_ptr) :: sunctx = c_null_ptr
+    type(c_ptr) :: mem = c_null_ptr         !< CVODE
+    type(N_Vector), pointer :: sv => null() !< the state vector, on the caller's array
+    type(SUNMatrix), pointer :: amat => null()
+    type(SUNLinearSolver), pointer :: ls => null()
+    type(SUNNonlinearSolver), pointer :: nls => null()
+  end type cvode_t
+
   interface   ! fortran/interrupt.c
     integer(c_int) function sigint_watch() bind(C, name='spline_sigint_watch')
       import :: c_int
@@ -68,24 +84,22 @@ contains
   !> Integrate the model from y0 (SI, at m%t0) and return the SI state at the times tout(1:nt)
   !> (ascending, >= t0) in yout(:, k), the contact states there (2: decided by the state) and
   !> the solver statistics. interruptible: a SIGINT during the run stops it (err_interrupted).
-  !> tsec (optional, ascending, > t0): Poincare section times; ysec(:, i) gets the SI state at
-  !> tsec(i): CVode is asked for the state at exactly that instant (CV_NORMAL), and returns
-  !> its own dense output there, the order-q Nordsieck interpolant of the step that covers it.
-  !> That is the state a root function on the shaft angle would return (CVODE locates roots on
-  !> the same interpolant), at the integration's own accuracy; since the instants are known in
-  !> closed form, no root function is needed, and unlike a stop time (CVodeSetStopTime) it
-  !> leaves CVODE's step sequence alone (stopping at every revolution cost 20 % more work on
-  !> paper_lx1e-4, docs/performance.md).
-  !> y0b, youtb (optional, together): a second copy of the system started at y0b, integrated
-  !> beside the first as one CVODE system, with the same steps, order and corrector iterations,
-  !> so that the difference of the two carries no independent solver noise (Benettin's method,
-  !> spline_run::lyapunov_benettin); youtb(:, k) its state at tout(k). Contact switches of either
-  !> copy are located (root finding) and restart both.
+  !> tsec (optional, ascending, > t0): section times; ysec(:, i) the SI state at tsec(i).
+  !> Sections do not stop CVODE: asked for the state at that instant (CV_NORMAL), it returns its
+  !> dense output there (the interpolant CVODE also locates roots on), and unlike a stop time
+  !> (20 % more work on paper_lx1e-4, docs/performance.md) the steps go on as they would, except
+  !> that the first step after a (re)start (CVodeInit; CVodeReInit at a contact switch) is sized
+  !> from the next requested time: with root finding a section can change the steps (chaos_z24
+  !> with section = 'tooth': 289308 steps instead of 290972).
+  !> y0b, youtb (optional, together): a second copy started at y0b, integrated beside the first
+  !> as one CVODE system (same steps, order and corrector iterations: their difference carries
+  !> no independent solver noise; spline_lyapunov); youtb(:, k) its state at tout(k). Contact
+  !> switches of either copy are located (root finding) and restart both.
   !> The linear tail (spline_linear): a single copy whose case allows it is tried at the start,
-  !> after every output and, without root finding, each quarter shaft revolution between them
-  !> (CV_NORMAL returns on CVODE's interpolant: the steps stay as they are). Once every tooth
-  !> is proven to stay in contact on one flank for ever, the remaining outputs and sections are
-  !> the closed-form solution, and stats(13) holds the time the tail began (-1: not used).
+  !> after every output and, without root finding, each quarter shaft revolution between them.
+  !> Once every tooth is proven to stay in contact on one flank for ever, the remaining outputs
+  !> and sections are the closed-form solution; stats(ist_linear_tail_t) is the time the tail
+  !> began (-1: none).
   subroutine integrate(m, y0, nt, tout, yout, modes_out, stats, ierr, errmsg, interruptible, &
        tsec, ysec, y0b, youtb)
     type(model_t), intent(in) :: m
@@ -103,243 +117,218 @@ contains
     real(wp), intent(in), optional :: y0b(nstate)
     real(wp), intent(out), optional :: youtb(nstate, nt)
     type(solver_ctx_t), target :: ctx
-    real(c_double), allocatable, target :: yr(:)
-    real(c_double) :: tau, tau_out, tau_to, tret(1), hlast(1), tau_chk, dchk
-    type(c_ptr) :: sunctx, mem
-    type(N_Vector), pointer :: sv
-    type(SUNMatrix), pointer :: amat
-    type(SUNLinearSolver), pointer :: ls
-    type(SUNNonlinearSolver), pointer :: nls
+    type(cvode_t) :: cv
+    real(c_double), allocatable, target :: yr(:)   !< CVODE's state vector (the copies' integrated states)
+    real(c_double) :: tau                          !< where the integration stands (scaled time)
+    real(c_double) :: tau_chk, dchk                !< next linear-tail check, and their spacing
     integer(c_int) :: flag, nroot
-    integer(c_int), allocatable :: rootsfound(:)
-    integer :: k, k0, nroots, nresync, ks, nsec, nn, c
-    integer(8) :: done, done_k, allow
-    logical :: total_bound, use_tail, fresh
+    integer :: k, nroots, nresync   !< output; switches located; missed switches resynchronised
+    integer :: ks, nsec             !< next section to store; sections
+    logical :: use_tail, fresh      !< the linear tail is tried; CVODE has just (re)started
+    logical :: total_bound          !< the work bound met is max_total_steps (else max_steps)
     character(len=40) :: stage
     type(tail_t) :: tail
 
-    ierr = err_ok
-    errmsg = ''
-    stats = 0.0_wp
-    stats(13) = -1.0_wp
-    yout = 0.0_wp
-    modes_out = 2
-    ctx%m = m
-    nroots = 0; nresync = 0
-    ctx%frozen = m%roots
-    if (present(y0b)) ctx%ncopy = 2
-    if (present(youtb)) youtb = 0.0_wp
-    nroot = 0
-    if (ctx%frozen) then
-      allocate(ctx%modes(m%z*m%n_slices, ctx%ncopy))
-      nroot = 2*m%z*m%n_slices
-      if (m%thermal == thermal_coupled) then
-        allocate(ctx%branches(2, m%z, ctx%ncopy))
-        nroot = 4*m%z
-      end if
-    end if
-    ctx%nrc = nroot
-    nroot = nroot*ctx%ncopy
-    allocate(rootsfound(nroot))
-    nsec = 0
-    if (present(tsec)) nsec = size(tsec)
-    if (present(ysec)) ysec = 0.0_wp
-    ks = 1
-    call integrated_states(m, ctx%idx, ctx%n)
-    nn = ctx%n
-    call to_scaled(m, y0, ctx%ys_full(:, 1))
-    if (ctx%ncopy == 2) call to_scaled(m, y0b, ctx%ys_full(:, 2))
-    ! dof 3: the lateral states are held at the start displacement, at rest
-    if (nn < nstate) ctx%ys_full(ndof+1:ndof+4, :) = 0.0_wp
-    yr = [(ctx%ys_full(ctx%idx(1:nn), c), c = 1, ctx%ncopy)]
-    tau = m%t0*m%w_ref
-    k = 0
-    if (ctx%frozen) then
-      do c = 1, ctx%ncopy
-        call sync_modes(ctx, c, tau, yr, k)
-      end do
-    end if
-    if (present(interruptible)) ctx%watch = interruptible
-    if (ctx%watch) ctx%sigint0 = sigint_watch()
-
-    ! set-up: each call checked in turn (stage names the first one that failed)
-    nullify(sv, amat, ls, nls)
-    mem = c_null_ptr
-    stage = 'creating the SUNDIALS context'
-    flag = sundials_context_new(sunctx)
-    if (flag == 0) then
-      stage = 'creating the state vector'
-      sv => FN_VMake_Serial(int(size(yr), c_long), yr, sunctx)
-      if (.not. associated(sv)) flag = -1
-    end if
-    if (flag == 0) flag = FN_VEnableFusedOps_Serial(sv, 1)   ! fused kernels: less work per step
-    if (flag == 0) then
-      stage = 'creating CVODE'
-      if (m%method_bdf == 1) then
-        mem = FCVodeCreate(CV_BDF, sunctx)
-      else
-        mem = FCVodeCreate(CV_ADAMS, sunctx)
-      end if
-      if (.not. c_associated(mem)) flag = -1
-    end if
-    if (flag == 0) then
-      stage = 'initialising CVODE'
-      flag = FCVodeInit(mem, c_funloc(rhs_cb), tau, sv)
-    end if
-    if (flag == 0) flag = FCVodeSetUserData(mem, c_loc(ctx))
-    if (flag == 0) flag = FCVodeSetErrHandlerFn(mem, c_funloc(err_cb), c_loc(ctx))
-    if (flag == 0) then
-      stage = 'setting the tolerances'
-      flag = FCVodeSStolerances(mem, real(m%rtol, c_double), real(m%atol, c_double))
-    end if
-    if (flag == 0) then
-      stage = 'attaching the (non)linear solver'
-      if (m%newton) then
-        amat => FSUNDenseMatrix(int(size(yr), c_long), int(size(yr), c_long), sunctx)
-        if (associated(amat)) ls => FSUNLinSol_Dense(sv, amat, sunctx)
-        if (associated(ls)) then
-          flag = FCVodeSetLinearSolver(mem, ls, amat)
-        else
-          flag = -1
-        end if
-      else
-        nls => FSUNNonlinSol_FixedPoint(sv, 0, sunctx)   ! functional iteration, no Anderson acceleration
-        if (associated(nls)) then
-          flag = FCVodeSetNonlinearSolver(mem, nls)
-        else
-          flag = -1
-        end if
-      end if
-    end if
-    if (flag == 0) then
-      stage = 'setting the solver options'
-      flag = FCVodeSetMaxNumSteps(mem, int(m%max_steps, c_long))
-    end if
-    if (flag == 0 .and. m%stald .and. m%method_bdf == 1) flag = FCVodeSetStabLimDet(mem, 1)
-    if (flag == 0 .and. ctx%frozen) then
-      stage = 'setting up root finding'
-      flag = FCVodeRootInit(mem, nroot, c_funloc(roots_cb))
-      if (flag == 0) flag = FCVodeSetNoInactiveRootWarn(mem)
-    end if
-    use_tail = ctx%ncopy == 1 .and. tail_possible(m)
-    ! the tail is also tried between outputs (the transient): each quarter shaft revolution
-    dchk = huge(1.0_c_double)
-    if (m%omega > 0.0_wp) dchk = 0.5_wp*pi*m%w_ref/m%omega
-    tau_chk = tau + dchk
-    fresh = .true.
+    call start_run()
+    call cvode_setup(m, ctx, yr, tau, nroot, cv, flag, stage)
+    call schedule_tail_checks()
     if (flag /= 0) then
       call fail(flag, tau, trim(stage))
-    else if (.not. tailed(0)) then
+    else if (.not. take_linear_tail(0)) then
       outputs: do k = 1, nt
-        tau_out = tout(k)*m%w_ref
-        done_k = steps_done()
-        do while (tau < tau_out)
-          ! The work bounds hold across the restarts at contact switches and section times
-          ! (each restart is a new CVode call, whose own count starts at 0): max_steps per
-          ! output interval, max_total_steps over the run.
-          done = steps_done()
-          allow = min(m%max_steps - (done - done_k), m%max_total_steps - done)
-          total_bound = m%max_total_steps - done <= m%max_steps - (done - done_k)
-          if (allow <= 0) then
-            call fail_work(tau)
-            exit outputs
-          end if
-          tau_to = tau_out
-          if (ks <= nsec) tau_to = min(tau_out, real(tsec(ks)*m%w_ref, c_double))
-          ! (not with root finding: a return starts CVODE's next root search there; not on a
-          ! first call after CVodeInit/ReInit, whose tout sets CVODE's initial step, unless tout
-          ! is more than 4 revolutions away. So a run that never takes the tail keeps the steps
-          ! it has with linear_tail off, unless it starts with such a long output interval.)
-          if (use_tail .and. .not. ctx%frozen) then
-            do while (tau_chk <= tau)
-              tau_chk = tau_chk + dchk
-            end do
-            if (.not. fresh .or. tau_to - tau > 16*dchk) tau_to = min(tau_to, tau_chk)
-          end if
-          flag = FCVodeSetMaxNumSteps(mem, int(allow, c_long))
-          if (flag == 0) flag = FCVode(mem, tau_to, sv, tret, CV_NORMAL)
-          if (flag == CV_TOO_MUCH_WORK) then
-            call fail_work(tret(1))
-            exit outputs
-          end if
-          if (flag < 0) then
-            call fail(flag, tret(1), 'integrating')
-            exit outputs
-          end if
-          tau = tret(1)
-          fresh = .false.
-          if (ks <= nsec) then
-            if (tau >= tsec(ks)*m%w_ref) then     ! returned at the section instant
-              call from_scaled(m, copy_state(ctx, yr, 1), ysec(:, ks))
-              ks = ks + 1
-            end if
-          end if
-          if (use_tail .and. tau >= tau_chk .and. flag /= CV_ROOT_RETURN) then
-            tau_chk = tau_chk + dchk
-            if (tailed(k - 1)) exit outputs
-          end if
-          if (flag == CV_ROOT_RETURN) then
-            ! Step onto the switch, flip the states of the teeth that crossed, restart.
-            flag = FCVodeGetRootInfo(mem, rootsfound)
-            if (flag /= 0) then
-              call fail(flag, tau, 'reading the roots found')
-              exit outputs
-            end if
-            call apply_roots(ctx, rootsfound, nroots)
-            if (.not. restarted('restarting at a contact switch')) exit outputs
-          end if
-        end do
-        if (interrupted(ctx)) then
-          call fail(-1_c_int, tau, 'integrating')
-          exit outputs
+        if (.not. integrate_to_output(k)) exit outputs
+        if (.not. store_output(k)) exit outputs
+        if (k < nt) then
+          if (take_linear_tail(k)) exit outputs
         end if
-        ! Safety net: a grazing contact can touch a switch without a sign change over a step.
-        if (ctx%frozen) then
-          k0 = nresync
-          do c = 1, ctx%ncopy
-            call sync_modes(ctx, c, tau, yr, nresync)
-          end do
-          if (nresync > k0 .and. k < nt) then
-            if (.not. restarted('restarting after a missed switch')) exit outputs
-          end if
-        end if
-        call from_scaled(m, copy_state(ctx, yr, 1), yout(:, k))
-        if (present(youtb)) call from_scaled(m, copy_state(ctx, yr, 2), youtb(:, k))
-        if (ctx%frozen) modes_out(:, k) = ctx%modes(:, 1)
-        if (k < nt .and. tailed(k)) exit outputs
       end do outputs
     end if
-
-    if (c_associated(mem)) then
-      call add_counters(ctx, mem, stats)
-      flag = FCVodeGetLastStep(mem, hlast)
-      if (flag == 0) stats(9) = hlast(1)/m%w_ref
-      call FCVodeFree(mem)
-    end if
-    stats(7) = nroots
-    stats(10) = nresync
-    stats(11) = ctx%cstats%worst_residual
-    stats(12) = ctx%cstats%max_iterations
+    call collect_stats()
     if (ctx%watch) call sigint_unwatch()
-    if (associated(ls)) flag = FSUNLinSolFree(ls)
-    if (associated(nls)) flag = FSUNNonlinSolFree(nls)
-    if (associated(amat)) call FSUNMatDestroy(amat)
-    if (associated(sv)) call FN_VDestroy(sv)
-    flag = FSUNContext_Free(sunctx)
+    call cvode_free(cv)
 
   contains
 
-    !> The linear tail tried at tau, after output k0: if it holds, outputs k0+1..nt and the
-    !> sections not yet reached are the closed-form solution.
-    logical function tailed(k0)
+    !> Outputs zeroed; the run context: the copies' scaled start states, the integrated states
+    !> (dof 3 holds the lateral ones), contact states from the start state, the SIGINT watch.
+    subroutine start_run()
+      integer :: c, nn, nstart
+      nstart = 0
+      ierr = err_ok
+      errmsg = ''
+      stats = 0.0_wp
+      stats(ist_linear_tail_t) = -1.0_wp
+      yout = 0.0_wp
+      modes_out = 2
+      ctx%m = m
+      nroots = 0; nresync = 0
+      ctx%frozen = m%roots
+      if (present(y0b)) ctx%ncopy = 2
+      if (present(youtb)) youtb = 0.0_wp
+      nroot = 0
+      if (ctx%frozen) then
+        allocate(ctx%modes(m%z*m%n_slices, ctx%ncopy))
+        nroot = 2*m%z*m%n_slices
+        if (m%thermal == thermal_coupled) then
+          allocate(ctx%branches(2, m%z, ctx%ncopy))
+          nroot = 4*m%z
+        end if
+      end if
+      ctx%nrc = nroot
+      nroot = nroot*ctx%ncopy
+      nsec = 0
+      if (present(tsec)) nsec = size(tsec)
+      if (present(ysec)) ysec = 0.0_wp
+      ks = 1
+      call integrated_states(m, ctx%idx, ctx%n)
+      nn = ctx%n
+      call to_scaled(m, y0, ctx%ys_full(:, 1))
+      if (ctx%ncopy == 2) call to_scaled(m, y0b, ctx%ys_full(:, 2))
+      ! dof 3: the lateral states are held at the start displacement, at rest
+      if (nn < nstate) ctx%ys_full(ndof+1:ndof+4, :) = 0.0_wp
+      yr = [(ctx%ys_full(ctx%idx(1:nn), c), c = 1, ctx%ncopy)]
+      tau = m%t0*m%w_ref
+      if (ctx%frozen) then
+        do c = 1, ctx%ncopy
+          call sync_modes(ctx, c, tau, yr, nstart)   ! the start's states (not counted)
+        end do
+      end if
+      if (present(interruptible)) ctx%watch = interruptible
+      if (ctx%watch) ctx%sigint0 = sigint_watch()
+    end subroutine start_run
+
+    !> The linear tail is also tried between outputs (the transient): each quarter shaft revolution.
+    subroutine schedule_tail_checks()
+      use_tail = ctx%ncopy == 1 .and. tail_possible(m)
+      dchk = huge(1.0_c_double)
+      if (m%omega > 0.0_wp) dchk = 0.5_wp*pi*m%w_ref/m%omega
+      tau_chk = tau + dchk
+      fresh = .true.
+    end subroutine schedule_tail_checks
+
+    !> Integrate from tau to the output time tout(k): CVODE calls up to the next output, section
+    !> time or tail check, within the work bounds; section states stored, contact switches
+    !> applied. .false.: the run ends here (an error: ierr set; or the linear tail took over).
+    logical function integrate_to_output(k) result(going)
+      integer, intent(in) :: k
+      real(c_double) :: tau_out, tau_to, tret(1)
+      integer(c_int) :: flag
+      integer(8) :: done, done_k, allow
+      going = .false.
+      tau_out = tout(k)*m%w_ref
+      done_k = steps_done()
+      do while (tau < tau_out)
+        ! Work bounds across restarts (each a new CVode call, counting from 0): max_steps per
+        ! output interval, max_total_steps over the run.
+        done = steps_done()
+        allow = min(m%max_steps - (done - done_k), m%max_total_steps - done)
+        total_bound = m%max_total_steps - done <= m%max_steps - (done - done_k)
+        if (allow <= 0) then
+          call fail_work(tau)
+          return
+        end if
+        tau_to = next_stop(tau_out)
+        flag = FCVodeSetMaxNumSteps(cv%mem, int(allow, c_long))
+        if (flag == 0) flag = FCVode(cv%mem, tau_to, cv%sv, tret, CV_NORMAL)
+        if (flag == CV_TOO_MUCH_WORK) then
+          call fail_work(tret(1))
+          return
+        end if
+        if (flag < 0) then
+          call fail(flag, tret(1), 'integrating')
+          return
+        end if
+        tau = tret(1)
+        fresh = .false.
+        call store_section()
+        if (use_tail .and. tau >= tau_chk .and. flag /= CV_ROOT_RETURN) then
+          tau_chk = tau_chk + dchk
+          if (take_linear_tail(k - 1)) return
+        end if
+        if (flag == CV_ROOT_RETURN) then
+          if (.not. switch_contacts()) return
+        end if
+      end do
+      going = .true.
+    end function integrate_to_output
+
+    !> Where the next CVode call returns: the output time tau_out, or an earlier section time
+    !> or tail check. Tail checks are not taken with root finding (a return starts CVODE's next
+    !> root search there), nor on a first call after CVodeInit/ReInit (its tout sets CVODE's
+    !> initial step) unless tout is more than 4 revolutions away: a run that never takes the
+    !> tail keeps the steps it has with linear_tail off, unless it starts so far from an output.
+    real(c_double) function next_stop(tau_out) result(tau_to)
+      real(c_double), intent(in) :: tau_out
+      tau_to = tau_out
+      if (ks <= nsec) tau_to = min(tau_out, real(tsec(ks)*m%w_ref, c_double))
+      if (use_tail .and. .not. ctx%frozen) then
+        do while (tau_chk <= tau)
+          tau_chk = tau_chk + dchk
+        end do
+        if (.not. fresh .or. tau_to - tau > 16*dchk) tau_to = min(tau_to, tau_chk)
+      end if
+    end function next_stop
+
+    !> CVode returned at the next section instant: store the SI state there.
+    subroutine store_section()
+      if (ks > nsec) return
+      if (tau >= tsec(ks)*m%w_ref) then
+        call from_scaled(m, copy_state(ctx, yr, 1), ysec(:, ks))
+        ks = ks + 1
+      end if
+    end subroutine store_section
+
+    !> CVode stopped on a contact switch: step onto it, flip the states of the teeth that
+    !> crossed, restart. .false. if a call failed (ierr, errmsg set).
+    logical function switch_contacts() result(ok)
+      integer(c_int) :: rootsfound(nroot), flag
+      flag = FCVodeGetRootInfo(cv%mem, rootsfound)
+      ok = flag == 0
+      if (.not. ok) then
+        call fail(flag, tau, 'reading the roots found')
+        return
+      end if
+      call apply_roots(ctx, rootsfound, nroots)
+      ok = restart_cvode('restarting at a contact switch')
+    end function switch_contacts
+
+    !> At output time tout(k) (tau): stop on a SIGINT; resynchronise contact states that missed
+    !> a switch (a grazing contact can touch one without a sign change over a step), restarting
+    !> CVODE if any did; store the outputs. .false. if the run ends here (ierr, errmsg set).
+    logical function store_output(k) result(going)
+      integer, intent(in) :: k
+      integer :: c, k0
+      going = .false.
+      if (interrupted(ctx)) then
+        call fail(-1_c_int, tau, 'integrating')
+        return
+      end if
+      if (ctx%frozen) then
+        k0 = nresync
+        do c = 1, ctx%ncopy
+          call sync_modes(ctx, c, tau, yr, nresync)
+        end do
+        if (nresync > k0 .and. k < nt) then
+          if (.not. restart_cvode('restarting after a missed switch')) return
+        end if
+      end if
+      call from_scaled(m, copy_state(ctx, yr, 1), yout(:, k))
+      if (present(youtb)) call from_scaled(m, copy_state(ctx, yr, 2), youtb(:, k))
+      if (ctx%frozen) modes_out(:, k) = ctx%modes(:, 1)
+      going = .true.
+    end function store_output
+
+    !> Try the linear tail at tau, after output k0: if it holds, fill outputs k0+1..nt and the
+    !> sections not yet reached with the closed-form solution and return .true. (the run is done).
+    logical function take_linear_tail(k0) result(taken)
       integer, intent(in) :: k0
       real(c_double) :: yt(nstate)
       integer :: j
-      tailed = .false.
+      taken = .false.
       if (.not. use_tail) return
-      tailed = tail_try(tail, m, ctx%idx, nn, tau, copy_state(ctx, yr, 1))
-      if (.not. tailed) return
-      stats(13) = tau/m%w_ref
+      taken = tail_try(tail, m, ctx%idx, ctx%n, tau, copy_state(ctx, yr, 1))
+      if (.not. taken) return
+      stats(ist_linear_tail_t) = tau/m%w_ref
       do j = k0 + 1, nt
         call tail_state(tail, tout(j)*m%w_ref, yt)
         call from_scaled(m, yt, yout(:, j))
@@ -350,25 +339,39 @@ contains
         call from_scaled(m, yt, ysec(:, j))
       end do
       ks = nsec + 1
-    end function tailed
+    end function take_linear_tail
 
     !> CVODE steps taken so far in this run (over all restarts).
     integer(8) function steps_done() result(n)
       integer(c_long) :: cnt(1)
-      n = nint(stats(1), 8)
-      if (FCVodeGetNumSteps(mem, cnt) == 0) n = n + cnt(1)
+      n = nint(stats(ist_steps), 8)
+      if (FCVodeGetNumSteps(cv%mem, cnt) == 0) n = n + cnt(1)
     end function steps_done
 
-    !> CVODE restarted at tau (a contact switch: the right-hand side's branch changed), its
+    !> Restart CVODE at tau (a contact switch: the right-hand side's branch changed), its
     !> counters kept first (CVodeReInit zeroes them); .false. if it failed (ierr, errmsg set).
-    logical function restarted(what)
+    logical function restart_cvode(what) result(ok)
       character(len=*), intent(in) :: what
-      call add_counters(ctx, mem, stats)
+      integer(c_int) :: flag
+      call add_counters(ctx, cv%mem, stats)
       fresh = .true.
-      flag = FCVodeReInit(mem, tau, sv)
-      restarted = flag == 0
-      if (.not. restarted) call fail(flag, tau, what)
-    end function restarted
+      flag = FCVodeReInit(cv%mem, tau, cv%sv)
+      ok = flag == 0
+      if (.not. ok) call fail(flag, tau, what)
+    end function restart_cvode
+
+    !> The statistics CVODE and the run kept (order of stat_names).
+    subroutine collect_stats()
+      real(c_double) :: hlast(1)
+      if (c_associated(cv%mem)) then
+        call add_counters(ctx, cv%mem, stats)
+        if (FCVodeGetLastStep(cv%mem, hlast) == 0) stats(ist_last_step) = hlast(1)/m%w_ref
+      end if
+      stats(ist_roots_found) = nroots
+      stats(ist_mode_resyncs) = nresync
+      stats(ist_coupling_residual) = ctx%cstats%worst_residual
+      stats(ist_coupling_iterations) = ctx%cstats%max_iterations
+    end subroutine collect_stats
 
     !> The run hit a work bound: name the field that sets it.
     subroutine fail_work(tau)
@@ -413,6 +416,89 @@ contains
 
   end subroutine integrate
 
+  !> Create CVODE for the run of ctx on the state vector yr at tau, with its tolerances,
+  !> (non)linear solver, step bound and, when the contact states are frozen, nroot root
+  !> functions. Each SUNDIALS call is checked in turn: flag /= 0 is the first failure, stage
+  !> names the step. cv holds what was made (cvode_free frees it, whatever failed).
+  subroutine cvode_setup(m, ctx, yr, tau, nroot, cv, flag, stage)
+    type(model_t), intent(in) :: m
+    type(solver_ctx_t), intent(inout), target :: ctx
+    real(c_double), intent(inout), target :: yr(:)
+    real(c_double), intent(in) :: tau
+    integer(c_int), intent(in) :: nroot
+    type(cvode_t), intent(out) :: cv
+    integer(c_int), intent(out) :: flag
+    character(len=*), intent(out) :: stage
+    stage = 'creating the SUNDIALS context'
+    flag = sundials_context_new(cv%sunctx)
+    if (flag == 0) then
+      stage = 'creating the state vector'
+      cv%sv => FN_VMake_Serial(int(size(yr), c_long), yr, cv%sunctx)
+      if (.not. associated(cv%sv)) flag = -1
+    end if
+    if (flag == 0) flag = FN_VEnableFusedOps_Serial(cv%sv, 1)   ! fused kernels: less work per step
+    if (flag == 0) then
+      stage = 'creating CVODE'
+      if (m%method_bdf == 1) then
+        cv%mem = FCVodeCreate(CV_BDF, cv%sunctx)
+      else
+        cv%mem = FCVodeCreate(CV_ADAMS, cv%sunctx)
+      end if
+      if (.not. c_associated(cv%mem)) flag = -1
+    end if
+    if (flag == 0) then
+      stage = 'initialising CVODE'
+      flag = FCVodeInit(cv%mem, c_funloc(rhs_cb), tau, cv%sv)
+    end if
+    if (flag == 0) flag = FCVodeSetUserData(cv%mem, c_loc(ctx))
+    if (flag == 0) flag = FCVodeSetErrHandlerFn(cv%mem, c_funloc(err_cb), c_loc(ctx))
+    if (flag == 0) then
+      stage = 'setting the tolerances'
+      flag = FCVodeSStolerances(cv%mem, real(m%rtol, c_double), real(m%atol, c_double))
+    end if
+    if (flag == 0) then
+      stage = 'attaching the (non)linear solver'
+      if (m%newton) then
+        cv%amat => FSUNDenseMatrix(int(size(yr), c_long), int(size(yr), c_long), cv%sunctx)
+        if (associated(cv%amat)) cv%ls => FSUNLinSol_Dense(cv%sv, cv%amat, cv%sunctx)
+        if (associated(cv%ls)) then
+          flag = FCVodeSetLinearSolver(cv%mem, cv%ls, cv%amat)
+        else
+          flag = -1
+        end if
+      else
+        cv%nls => FSUNNonlinSol_FixedPoint(cv%sv, 0, cv%sunctx)   ! functional iteration, no Anderson acceleration
+        if (associated(cv%nls)) then
+          flag = FCVodeSetNonlinearSolver(cv%mem, cv%nls)
+        else
+          flag = -1
+        end if
+      end if
+    end if
+    if (flag == 0) then
+      stage = 'setting the solver options'
+      flag = FCVodeSetMaxNumSteps(cv%mem, int(m%max_steps, c_long))
+    end if
+    if (flag == 0 .and. m%stald .and. m%method_bdf == 1) flag = FCVodeSetStabLimDet(cv%mem, 1)
+    if (flag == 0 .and. ctx%frozen) then
+      stage = 'setting up root finding'
+      flag = FCVodeRootInit(cv%mem, nroot, c_funloc(roots_cb))
+      if (flag == 0) flag = FCVodeSetNoInactiveRootWarn(cv%mem)
+    end if
+  end subroutine cvode_setup
+
+  !> Free what cvode_setup made (the statistics read first: integrate's collect_stats).
+  subroutine cvode_free(cv)
+    type(cvode_t), intent(inout) :: cv
+    integer(c_int) :: flag
+    if (c_associated(cv%mem)) call FCVodeFree(cv%mem)
+    if (associated(cv%ls)) flag = FSUNLinSolFree(cv%ls)
+    if (associated(cv%nls)) flag = FSUNNonlinSolFree(cv%nls)
+    if (associated(cv%amat)) call FSUNMatDestroy(cv%amat)
+    if (associated(cv%sv)) call FN_VDestroy(cv%sv)
+    flag = FSUNContext_Free(cv%sunctx)
+  end subroutine cvode_free
+
   !> A SIGINT arrived since the run began (only for runs that watch).
   logical function interrupted(ctx)
     type(solver_ctx_t), intent(in) :: ctx
@@ -427,15 +513,15 @@ contains
     type(c_ptr), intent(in) :: mem
     real(wp), intent(inout) :: stats(nstats)
     integer(c_long) :: cnt(1)
-    call add(1, FCVodeGetNumSteps(mem, cnt))
-    call add(2, FCVodeGetNumRhsEvals(mem, cnt))
+    call add(ist_steps, FCVodeGetNumSteps(mem, cnt))
+    call add(ist_rhs_evals, FCVodeGetNumRhsEvals(mem, cnt))
     if (ctx%m%newton) then
-      call add(3, FCVodeGetNumJacEvals(mem, cnt))
-      call add(4, FCVodeGetNumLinRhsEvals(mem, cnt))
+      call add(ist_jac_evals, FCVodeGetNumJacEvals(mem, cnt))
+      call add(ist_lin_rhs_evals, FCVodeGetNumLinRhsEvals(mem, cnt))
     end if
-    call add(5, FCVodeGetNumErrTestFails(mem, cnt))
-    call add(6, FCVodeGetNumNonlinSolvConvFails(mem, cnt))
-    if (ctx%frozen) call add(8, FCVodeGetNumGEvals(mem, cnt))
+    call add(ist_err_test_fails, FCVodeGetNumErrTestFails(mem, cnt))
+    call add(ist_nonlin_conv_fails, FCVodeGetNumNonlinSolvConvFails(mem, cnt))
+    if (ctx%frozen) call add(ist_root_fn_evals, FCVodeGetNumGEvals(mem, cnt))
   contains
     subroutine add(i, flag)          ! the getter has filled cnt by the time this runs
       integer, intent(in) :: i
@@ -529,7 +615,7 @@ contains
     ys => FN_VGetArrayPointer(sv_y)
     fs => FN_VGetArrayPointer(sv_f)
     n = ctx%n
-    ierr = 0
+    ierr = err_ok
     do c = 1, ctx%ncopy
       o = (c - 1)*n
       yf = copy_state(ctx, ys, c)
@@ -542,10 +628,10 @@ contains
         call rhs_scaled(ctx%m, tau, yf, ff, ierr, ctx%cb_msg, ctx%modes(:, c), cstats=ctx%cstats)
       end if
       fs(o+1:o+n) = ff(ctx%idx(1:n))
-      if (ierr /= 0) exit
+      if (ierr /= err_ok) exit
     end do
     ret = 0
-    if (ierr /= 0) then
+    if (ierr /= err_ok) then
       ctx%cb_ierr = ierr
       ret = -1
     else if (interrupted(ctx)) then

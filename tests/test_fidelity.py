@@ -9,7 +9,7 @@ import pyspline
 from conftest import CASES, PAPER
 
 SHORT = dict(t_end=0.1, n_out=161, start="rest")
-MARGIN = 0.5                       # run.f90: auto reduces when estimate <= MARGIN * tol
+MARGIN = 0.5                       # fidelity.f90: auto reduces when estimate <= MARGIN * tol
 F0 = 30.7 / (16 * 0.016 * math.cos(math.radians(30)))   # static tooth load |T_d| / (Z r_b)
 
 

@@ -199,9 +199,11 @@ def run_all(directory, quick=False, names=ALL_CASES, progress=True):
     for name in tqdm(names, desc="paper scenarios", unit="case", disable=not progress):
         case = load_paper_case(name, directory, quick)
         res = simulate(case)
-        # The exact Poincare section comes from a second run that stops on every revolution
-        # (section = 'shaft'): the stops change the step sequence, so the rows that check
-        # symmetries to round-off keep the case's own run.
+        # The exact Poincare section comes from a second run (section = 'shaft', two outputs).
+        # A section does not stop CVODE, but with root finding the first step after each
+        # restart at a contact switch is sized from the next requested time (a section time or
+        # an output), so that run's steps can differ: the rows that check symmetries to
+        # round-off keep the case's own run.
         sec = simulate(case.replace(section="shaft", n_out=2, max_steps=case["max_total_steps"]))
         res.section_t, res.section_y = sec.section_t, sec.section_y
         results[name] = res
