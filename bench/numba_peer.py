@@ -378,8 +378,10 @@ def rhs_eval(params, t, y, scaled=False):
     return du
 
 
-def solve(params, y0, t_eval, rtol=1e-8, atol=1e-10, mxstep=1_000_000, scaled=True):
-    """Integrate with numbalsoda's LSODA. y0 (14, SI) and t_eval (s; t_eval[0] is the start
+def solve(params, y0, t_eval, rtol=1e-8, atol=1e-10, mxstep=1_000_000, scaled=True,
+          method="lsoda"):
+    """Integrate with numbalsoda's LSODA (method 'lsoda') or DOP853 ('dop853', Hairer's
+    explicit Runge-Kutta 8(5,3); mxstep is then its budget of steps over the whole run). y0 (14, SI) and t_eval (s; t_eval[0] is the start
     time) as for oracle.rhs. atol is on the scaled states of Eq. 25 (atol*l [m] on lengths,
     atol*l*w [m/s] on velocities) when scaled=True, else in SI for every state. mxstep: steps
     allowed between two output times.
@@ -391,8 +393,10 @@ def solve(params, y0, t_eval, rtol=1e-8, atol=1e-10, mxstep=1_000_000, scaled=Tr
     t_eval = np.asarray(t_eval, dtype=float)
     u0 = np.asarray(y0, dtype=float) / scale
     tau = t_eval * w
-    usol, success = numbalsoda.lsoda(fn.address, u0, tau, data=data, rtol=float(rtol),
-                                     atol=float(atol), mxstep=int(mxstep))
+    if method not in ("lsoda", "dop853"):
+        raise ValueError(f"method {method!r}: 'lsoda' or 'dop853'")
+    usol, success = getattr(numbalsoda, method)(fn.address, u0, tau, data=data, rtol=float(rtol),
+                                                atol=float(atol), mxstep=int(mxstep))
     if data[_ERR] != 0.0:
         raise ValueError("thermal interference: backlash c_j <= 0 (Eq. 2) during the solve")
     return usol * scale, bool(success), int(data[_NCALLS])

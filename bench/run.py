@@ -27,11 +27,11 @@ def cmd_bench(args) -> int:
         rows, notes = bench.work_precision(out, quick=args.quick, cases=args.cases)
         for n in notes:
             print(n)
-        print(f"{'case':14s} {'method':28s} {'rtol':>7s} {'time [s]':>9s} {'RHS':>8s} "
+        print(f"{'case':14s} {'method':30s} {'rtol':>7s} {'time [s]':>9s} {'RHS':>8s} "
               f"{'err':>9s} {'scd':>5s}  status")
         for r in rows:
             err = max(r["err_Tm"], r["err_F"])
-            print(f"{r['case']:14s} {r['method']:28s} {r['rtol']:7.0e} {r['time_s']:9.4f} "
+            print(f"{r['case']:14s} {r['method']:30s} {r['rtol']:7.0e} {r['time_s']:9.4f} "
                   f"{r['rhs_evals']:8d} {err:9.1e} {r['scd']:5.1f}  {r['status']}")
         for r in bench.speed_ratios(rows):
             if r["ratio"] is None:

@@ -121,18 +121,21 @@ def _numba_peer():
     return numba_peer
 
 
-def run_numbalsoda(case, rtol, peer):
-    """numbalsoda LSODA on the numba RHS (scaled states, atol = 1e-2 rtol as for CVODE); the
-    compilation is done before the clock starts (a warm-up solve)."""
+def run_numbalsoda(case, rtol, peer, method="LSODA"):
+    """numbalsoda LSODA or DOP853 on the numba RHS (scaled states, atol = 1e-2 rtol as for
+    CVODE); the compilation is done before the clock starts (a warm-up solve)."""
     params = _peer_fields(case)
     y0 = start_state(case)
     t_eval = load(case).output_times()
-    peer.solve(params, y0, t_eval[:2], rtol=rtol, atol=rtol * 1e-2)        # compile, warm up
+    kw = dict(rtol=rtol, atol=rtol * 1e-2, method=method.lower())
+    if method == "DOP853":
+        kw["mxstep"] = 10**8              # DOP853's budget is for the whole run
+    peer.solve(params, y0, t_eval[:2], **kw)        # compile, warm up
     t0 = time.perf_counter()
-    y, ok, nfev = peer.solve(params, y0, t_eval, rtol=rtol, atol=rtol * 1e-2)
+    y, ok, nfev = peer.solve(params, y0, t_eval, **kw)
     wall = time.perf_counter() - t0
     if not ok:
-        raise SplineError(f"numbalsoda LSODA failed at rtol {rtol:g}")
+        raise SplineError(f"numbalsoda {method} failed at rtol {rtol:g}")
     return wall, t_eval, y, nfev
 
 
@@ -184,7 +187,8 @@ def work_precision(out, quick=False, progress=True, cases=None):
         jobs += [("scipy", m, kind, rt) for m in SCIPY_METHODS for kind in ("fortran", "numpy")
                  for rt in rtols_sp if kind == "fortran" or oracle is not None]
         if peer is not None:
-            jobs += [("numbalsoda", "LSODA", "numba", rt) for rt in rtols_cv]
+            jobs += [("numbalsoda", m, "numba", rt) for m in ("LSODA", "DOP853")
+                     for rt in rtols_cv]
         for solver, method, opt, rtol in tqdm(jobs, desc=f"work-precision {name}",
                                               disable=not progress):
             label = (f"CVODE {method}{' + roots' if opt else ''}" if solver == "cvode"
@@ -201,7 +205,7 @@ def work_precision(out, quick=False, progress=True, cases=None):
                     wall, tm, F, nfev = statistics.median(times), res.Tm, res.F, \
                         res.stats["rhs_evals"]
                 elif solver == "numbalsoda":
-                    wall, t, y, nfev = run_numbalsoda(case, rtol, peer)
+                    wall, t, y, nfev = run_numbalsoda(case, rtol, peer, method)
                     tm, F = _mesh_outputs(case, t, y)
                 else:
                     wall, t, y, nfev = run_scipy(case, method, rtol, opt, oracle, budget)
