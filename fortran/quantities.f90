@@ -24,7 +24,8 @@ module spline_quantities
        quantity_t('x2', 'm', 'x displacement of spline 2'), &
        quantity_t('y2', 'm', 'y displacement of spline 2'), &
        quantity_t('D1', 'm', 'torsional displacement D_1 (motor - spline 1, on the base circle)'), &
-       quantity_t('D2', 'm', 'relative displacement D_2 (spline 1 - spline 2, on the base circle)'), &
+       quantity_t('D2', 'm', &
+            'relative displacement D_2 (spline 1 - spline 2, on the base circle)'), &
        quantity_t('D3', 'm', 'torsional displacement D_3 (spline 2 - load, on the base circle)'), &
        quantity_t('vx1', 'm/s', 'velocity of x1'), quantity_t('vy1', 'm/s', 'velocity of y1'), &
        quantity_t('vx2', 'm/s', 'velocity of x2'), quantity_t('vy2', 'm/s', 'velocity of y2'), &

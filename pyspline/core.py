@@ -163,9 +163,9 @@ TOOTH_QUANTITIES = {n: (d, u) for n, u, d in _names("tooth")}
 STATE_NAMES = tuple(STATE_QUANTITIES)[:len(STATE_QUANTITIES) // 2]   #: x1 .. D3 (positions)
 
 
-def _attrs(name: str, table: dict = QUANTITIES) -> dict:
-    """xarray attrs of a quantity of the core's table: long_name, units (if it has one)."""
-    long, unit = table[name]
+def _attrs(name: str) -> dict:
+    """xarray attrs of an output quantity of the core's table: long_name, units (if any)."""
+    long, unit = QUANTITIES[name]
     return {"long_name": long, "units": cf_units(unit)} if unit else {"long_name": long}
 
 
@@ -309,8 +309,8 @@ def simulate(case) -> Result:
     if model.n_lyapunov:
         span = lyap_t - (t[0] if len(t) else 0.0)
         lyap = dict(t=lyap_t, log_growth=lyap_g, exponent=float(lyap_g[-1] / span[-1]))
-    return Result(case=model.case, t=t, y=y, tooth={n: tooth[:, :, i] for i, (n, *_) in enumerate(q)},
-                  Tm=tm, stats=st, section_t=sec_t, section_y=sec_y, lyapunov=lyap,
+    return Result(case=model.case, t=t, y=y,
+                  tooth={n: tooth[:, :, i] for i, (n, *_) in enumerate(q)}, Tm=tm, stats=st, section_t=sec_t, section_y=sec_y, lyapunov=lyap,
                   face=face if model.n_slices else None, tilt=tilt if model.n_slices else None)
 
 
