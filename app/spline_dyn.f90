@@ -14,8 +14,8 @@ program spline_dyn
   use spline_errors, only: err_ok, err_case, err_interrupted, err_exit_code, msglen
   use spline_case, only: case_t, case_read_file, case_parse, case_name_of
   use spline_model, only: model_t, model_from_case, model_warnings, nstate, nkterms, kterm_names
-  use spline_run, only: nstats, stat_names, run_case, run_warnings, ntooth_q, tooth_q_names, &
-       tooth_q_units
+  use spline_run, only: run_case, run_warnings
+  use spline_quantities, only: nstats, stat_q, ntooth_q, tooth_q, nout_q, output_q
   implicit none
 
   type :: string_t
@@ -71,8 +71,6 @@ program spline_dyn
   integer :: ierr, i, j, k, n, q, u, nargs, nsets, ios
   integer(c_int) :: sigint0
   logical :: have_out, options_done
-  character(len=8), parameter :: state_names(nstate) = [character(len=8) :: 'x1', 'y1', 'x2', &
-       'y2', 'D1', 'D2', 'D3', 'vx1', 'vy1', 'vx2', 'vy2', 'vD1', 'vD2', 'vD3']
 
   ! arguments (any length: allocated from get_command_argument's length)
   nargs = command_argument_count()
@@ -168,19 +166,20 @@ program spline_dyn
        merge(' N/m (computed, Eq. 18)', ' N/m (case)            ', m%k_m_computed)
   write(u, '(a)', advance='no', iostat=ios) '# stats:'
   do i = 1, nstats
-    write(u, '(1x,a,"=",g0)', advance='no', iostat=ios) trim(stat_names(i)), stats(i)
+    write(u, '(1x,a,"=",g0)', advance='no', iostat=ios) trim(stat_q(i)%name), stats(i)
   end do
   write(u, '(a)', iostat=ios) ''
-  write(u, '(a)', advance='no', iostat=ios) 't [s]'
-  do i = 1, nstate
-    write(u, '(a)', advance='no', iostat=ios) ','//trim(state_names(i))// &
-         trim(merge(" [m]  ", " [m/s]", i <= 7))
+  ! the header: every column 'NAME [UNIT]' (spline_quantities output_q, its order), per-tooth
+  ! quantities as NAME_j for teeth j = 1..Z
+  do i = 1, nout_q - ntooth_q
+    if (i > 1) write(u, '(a)', advance='no', iostat=ios) ','
+    write(u, '(a," [",a,"]")', advance='no', iostat=ios) trim(output_q(i)%name), &
+         trim(output_q(i)%unit)
   end do
-  write(u, '(a)', advance='no', iostat=ios) ',Tm [N m],kv [-]'
   do q = 1, ntooth_q
     do j = 1, m%z
-      write(u, '(",",a,"_",i0," [",a,"]")', advance='no', iostat=ios) trim(tooth_q_names(q)), j, &
-           trim(tooth_q_units(q))
+      write(u, '(",",a,"_",i0," [",a,"]")', advance='no', iostat=ios) trim(tooth_q(q)%name), j, &
+           trim(tooth_q(q)%unit)
     end do
   end do
   write(u, '(a)', iostat=ios) ''
@@ -190,7 +189,8 @@ program spline_dyn
   allocate(character(len=26*size(row)) :: record)
   do k = 1, m%n_out
     if (ios /= 0) exit
-    row = [t(k), y(:, k), tm(k), abs(tm(k))/m%t_d, ((tooth(k, j, q), j = 1, m%z), q = 1, ntooth_q)]
+    row = [t(k), y(:, k), tm(k), abs(tm(k))/m%t_d, &   ! the columns of output_q
+         ((tooth(k, j, q), j = 1, m%z), q = 1, ntooth_q)]
     n = c_csv_record(row, size(row), record, len(record))
     if (n < 0) then                        ! cannot happen: a number takes at most 26 bytes
       ios = 1
@@ -227,7 +227,7 @@ program spline_dyn
   write(*, '(a,2es12.4)') '  tooth force F_j min/max [N]:      ', minval(tooth(:, :, 1)), &
        maxval(tooth(:, :, 1))
   do i = 1, nstats
-    write(*, '(2x,a24,g0)') stat_names(i), stats(i)
+    write(*, '(2x,a24,g0)') stat_q(i)%name, stats(i)
   end do
 
 contains

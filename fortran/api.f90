@@ -15,14 +15,16 @@ module spline_api
   use, intrinsic :: iso_c_binding, only: c_double, c_int
   use spline_kinds, only: wp
   use spline_errors, only: err_ok, err_case, nerr, err_names, msglen
-  use spline_case, only: case_t, case_read_file, case_read_text, case_suggest, case_field
+  use spline_case, only: case_t, case_read_file, case_read_text, case_suggest, case_field, &
+       case_field_meta
   use spline_case_values, only: case_value_sizes, case_to_values, case_from_values
   use spline_model, only: model_t, model_from_case, model_magic, nstate, ndof, nkterms, &
        kterm_names, model_warnings
   use spline_stiffness, only: external_tooth_stiffness, internal_tooth_stiffness
   use spline_dynamics, only: accelerations, start_state
-  use spline_run, only: nstats, stat_names, run_case, tooth_quantities, ntooth_q, tooth_q_names, &
-       tooth_q_units, output_times, run_warnings
+  use spline_run, only: run_case, tooth_quantities, output_times, run_warnings
+  use spline_quantities, only: quantity_t, nstats, stat_q, ntooth_q, tooth_q, state_q, nout_q, &
+       output_q
   use spline_sections, only: section_count
   use spline_lyapunov, only: lyapunov_count
   implicit none
@@ -118,7 +120,7 @@ contains
     ierr = err_ok; errmsg = ''
     if (size(values) /= nv .or. size(chars) /= nc) then
       ierr = err_case
-      errmsg = 'case values: the arrays do not match the field table (api_names(''fields''))'
+      errmsg = 'case values: the arrays do not match the field table (api_names(''layout''))'
       return
     end if
     call case_to_values(c, values, s)
@@ -355,27 +357,41 @@ contains
     ierr = ie
   end subroutine api_defaults
 
-  !> Name (and unit) number i of a list: 'tooth' (per-tooth quantities), 'stats', 'info'
-  !> (api_model_info), 'kterms' (Eq. 18 terms), 'errors' (error codes 0..nerr, i = code + 1) or
-  !> 'fields' (the case fields; unit: type i, r, l or c and the size, e.g. 'r7', 'c16').
-  subroutine api_names(kind, i, name, unit)
+  !> Name, unit and one-line description of entry i (1, 2, ...) of a list; blank past its end.
+  !> Units are SI ('-' a ratio, '' none). Lists: 'outputs' (every output quantity in the order
+  !> of the executable's CSV columns: t, the states, Tm, kv, the per-tooth quantities),
+  !> 'states' (a state vector's), 'tooth' (the per-tooth quantities, order of api_simulate's
+  !> tooth), 'stats' (a run's statistics): the table of spline_quantities; 'fields' (the case
+  !> fields, case_type.f90's table); 'layout' (the case fields, unit: type i, r, l or c and
+  !> the size, e.g. 'r7', 'c16': how api_load_fields lays them out); 'info'
+  !> (api_model_info), 'kterms' (Eq. 18 terms), 'errors' (error codes 0..nerr, i = code + 1).
+  subroutine api_names(kind, i, name, unit, descr)
     character(len=*), intent(in) :: kind
     integer(c_int), intent(in) :: i
     character(len=32), intent(out) :: name, unit
+    character(len=128), intent(out) :: descr
     character(len=16), parameter :: info_names(ninfo) = [character(len=16) :: 'r_b', 'r_pitch', &
          'omega', 'l_ref', 'w_ref', 'c_bulk', 'kappa', 'k_m', 'k_m_computed', 'thermal_level', &
          'c_m', 'm_e']
     character(len=8), parameter :: info_units(ninfo) = [character(len=8) :: 'm', 'm', 'rad/s', &
          'm', 'rad/s', 'm', 'm/degC', 'N/m', '', '', 'N s/m', 'kg']
+    character(len=1) :: ftype
     integer :: n
-    name = ''; unit = ''
+    name = ''; unit = ''; descr = ''
     select case (kind)
+    case ('outputs')
+      if (i >= 1 .and. i <= nout_q) call row(output_q(i))
+    case ('states')
+      if (i >= 1 .and. i <= size(state_q)) call row(state_q(i))
     case ('tooth')
-      if (i >= 1 .and. i <= ntooth_q) then
-        name = tooth_q_names(i); unit = tooth_q_units(i)
-      end if
+      if (i >= 1 .and. i <= ntooth_q) call row(tooth_q(i))
     case ('stats')
-      if (i >= 1 .and. i <= nstats) name = stat_names(i)
+      if (i >= 1 .and. i <= nstats) call row(stat_q(i))
+    case ('fields')
+      call case_field_meta(i, name, ftype, n, unit, descr)
+    case ('layout')
+      call case_field(i, name, unit, n)
+      if (len_trim(name) > 0 .and. (n > 1 .or. unit == 'c')) write(unit, '(a,i0)') trim(unit), n
     case ('info')
       if (i >= 1 .and. i <= ninfo) then
         name = info_names(i); unit = info_units(i)
@@ -386,10 +402,12 @@ contains
       end if
     case ('errors')
       if (i >= 1 .and. i <= nerr + 1) name = err_names(i - 1)
-    case ('fields')
-      call case_field(i, name, unit, n)
-      if (len_trim(name) > 0 .and. (n > 1 .or. unit == 'c')) write(unit, '(a,i0)') trim(unit), n
     end select
+  contains
+    subroutine row(q)
+      type(quantity_t), intent(in) :: q
+      name = q%name; unit = q%unit; descr = q%descr
+    end subroutine row
   end subroutine api_names
 
   !> Bending, shear and axial stiffness of one involute tooth (potential energy method) for any

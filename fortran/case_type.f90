@@ -86,8 +86,8 @@ module spline_case_type
   !> each element (rule 'r': within lo .. hi; 'p': positive and within lo .. hi; 'n': 0 or
   !> within lo .. hi, and not negative; 'z': 0 or within lo .. hi; ' ': none here, or a rule
   !> of its own there), with the note its message gives. Same order as case_t (the namelist
-  !> order; tests/test_input.py checks the table against the defaults, tests/test_docs.py
-  !> the units against cases/template.nml).
+  !> order; tests/test_input.py checks the table against the defaults and its units against
+  !> cases/template.nml; Python reads names, units and descriptions through api_names('fields')).
   type :: field_t
     character(len=20) :: name
     character(len=1) :: kind

@@ -59,7 +59,7 @@ contains
     call case_value_sizes(nv, nc)
     if (size(v) /= nv .or. len(s) /= nc) then
       ierr = err_case
-      errmsg = 'case values: the arrays do not match the field table (api_names(''fields''))'
+      errmsg = 'case values: the arrays do not match the field table (api_names(''layout''))'
       return
     end if
     vv = v; ss = s

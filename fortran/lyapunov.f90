@@ -6,7 +6,8 @@ module spline_lyapunov
   use spline_errors, only: err_ok
   use spline_model, only: model_t, nstate
   use spline_dynamics, only: to_scaled, from_scaled, integrated_states
-  use spline_solver, only: integrate, nsolver_stats => nstats
+  use spline_solver, only: integrate
+  use spline_quantities, only: nsolver_stats
   implicit none
   private
   public :: lyapunov_count, lyapunov_benettin

@@ -9,35 +9,17 @@ module spline_run
   use spline_model, only: model_t, nstate, ndof, thermal_oneway, thermal_coupled, set_thermal_level
   use spline_dynamics, only: start_state
   use spline_mesh, only: mesh_eval
-  use spline_solver, only: integrate, nsolver_stats => nstats, solver_stat_names => stat_names
+  use spline_solver, only: integrate
+  use spline_quantities, only: nsolver_stats, nstats, ntooth_q, iq_tf, tooth_q, state_q, &
+       ist_core_wall, ist_dof, ist_thermal_level, ist_eps_lateral, ist_eps_thermal, ist_closed, &
+       ist_closed_t
   use spline_fidelity, only: auto_level, auto_tol, backlash_estimate
   use spline_sections, only: section_count, section_times
   use spline_lyapunov, only: lyapunov_benettin
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
-  public :: run_case, output_times, tooth_outputs, tooth_quantities, ntooth_q, tooth_q_names, tooth_q_units
-  public :: nstats, stat_names, run_warnings
-
-  !> Statistics of a run: the solver's, then the core's elapsed time, the model level that ran
-  !> (dof, thermal 0 none .. 3 coupled), the fidelity estimates of spline_fidelity, and the
-  !> one-way check of Eq. 2 (result_checks): the number of (output time, tooth) samples whose
-  !> flash temperature would have closed the backlash, and the first time of one [s].
-  integer, parameter :: ist_core_wall = nsolver_stats + 1, ist_dof = nsolver_stats + 2, &
-       ist_thermal_level = nsolver_stats + 3, ist_eps_lateral = nsolver_stats + 4, &
-       ist_eps_thermal = nsolver_stats + 5, ist_closed = nsolver_stats + 6, &
-       ist_closed_t = nsolver_stats + 7
-  integer, parameter :: nstats = nsolver_stats + 7
-  character(len=24), parameter :: stat_names(nstats) = [solver_stat_names, [character(len=24) :: &
-       'core_wall_s', 'dof', 'thermal_level', 'fidelity_eps_lateral', 'fidelity_eps_thermal', &
-       'backlash_closed', 'backlash_closed_t_s']]
-
-  integer, parameter :: ntooth_q = 8
-  integer, parameter :: iq_tf = 6                  !< position of T_f in tooth_q_names
-  character(len=4), parameter :: tooth_q_names(ntooth_q) = [character(len=4) :: &
-       'F', 'Fx', 'Fy', 'dn', 'c', 'Tf', 'rc1', 'rc2']
-  character(len=4), parameter :: tooth_q_units(ntooth_q) = [character(len=4) :: &
-       'N', 'N', 'N', 'm', 'm', 'degC', 'm', 'm']
+  public :: run_case, output_times, tooth_outputs, tooth_quantities, run_warnings
 
 contains
 
@@ -56,8 +38,8 @@ contains
     end if
   end subroutine output_times
 
-  !> Run a validated case: y(:, k) is the SI state at t(k), tooth(k, j, :) the quantities named
-  !> in tooth_q_names for tooth j, tm(k) the meshing torque (Eq. 22).
+  !> Run a validated case: y(:, k) is the SI state at t(k), tooth(k, j, :) the quantities of
+  !> spline_quantities tooth_q for tooth j, tm(k) the meshing torque (Eq. 22).
   !> fidelity = 'auto' runs the cheapest level of the ladder within fidelity_tol (auto_level);
   !> a coupled case runs one-way first and is run again coupled if the one-way flash
   !> temperature's estimate (backlash_estimate of its largest T_f) exceeds auto_tol.
@@ -125,19 +107,17 @@ contains
     integer, intent(inout) :: ierr
     character(len=*), intent(inout) :: errmsg
     real(wp), intent(in), optional :: sec_t(:), sec_y(:, :), lyap_t(:), lyap_g(:)
-    character(len=4), parameter :: state_names(nstate) = [character(len=4) :: 'x1', 'y1', 'x2', &
-         'y2', 'D1', 'D2', 'D3', 'vx1', 'vy1', 'vx2', 'vy2', 'vD1', 'vD2', 'vD3']
     integer :: k, j, q, i
     closed = 0.0_wp; t_closed = 0.0_wp
     do k = 1, size(t)
       if (.not. ieee_is_finite(t(k))) call bad('the output time', '', k)
       do i = 1, nstate
-        if (.not. ieee_is_finite(y(i, k))) call bad('the state '//trim(state_names(i)), '', k)
+        if (.not. ieee_is_finite(y(i, k))) call bad('the state '//trim(state_q(i)%name), '', k)
       end do
       if (.not. ieee_is_finite(tm(k))) call bad('the meshing torque T_m', '', k)
       do q = 1, ntooth_q
         do j = 1, size(tooth, 2)
-          if (.not. ieee_is_finite(tooth(k, j, q))) call bad(trim(tooth_q_names(q))//' of tooth', &
+          if (.not. ieee_is_finite(tooth(k, j, q))) call bad(trim(tooth_q(q)%name)//' of tooth', &
                ' '//itoa(j), k)
         end do
       end do
@@ -270,7 +250,7 @@ contains
     end do
   end subroutine tooth_outputs
 
-  !> Every per-tooth quantity (order of tooth_q_names) and the meshing torque at one state y (SI):
+  !> Every per-tooth quantity (order of spline_quantities tooth_q) and the meshing torque at one state y (SI):
   !> Eqs. 11, 15-17, 19-22 and, where the thermal level has them, Eqs. 1-7 and 12-14.
   subroutine tooth_quantities(m, t, y, row, tm, ierr, errmsg, mode, fslice, mtilt)
     type(model_t), intent(in) :: m

@@ -24,20 +24,13 @@ module spline_solver
   use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, integrated_states
   use spline_mesh, only: mesh_switch_functions, coupling_stats_t
   use spline_linear, only: tail_t, tail_possible, tail_try, tail_state
+  use spline_quantities, only: nstats => nsolver_stats, ist_steps, ist_rhs_evals, ist_jac_evals, &
+       ist_lin_rhs_evals, ist_err_test_fails, ist_nonlin_conv_fails, ist_roots_found, &
+       ist_root_fn_evals, ist_last_step, ist_mode_resyncs, ist_coupling_residual, &
+       ist_coupling_iterations, ist_linear_tail_t
   implicit none
   private
-  public :: integrate, nstats, stat_names
-
-  !> The solver's statistics: their positions in stats (order of stat_names).
-  integer, parameter, public :: ist_steps = 1, ist_rhs_evals = 2, ist_jac_evals = 3, &
-       ist_lin_rhs_evals = 4, ist_err_test_fails = 5, ist_nonlin_conv_fails = 6, &
-       ist_roots_found = 7, ist_root_fn_evals = 8, ist_last_step = 9, ist_mode_resyncs = 10, &
-       ist_coupling_residual = 11, ist_coupling_iterations = 12, ist_linear_tail_t = 13
-  integer, parameter :: nstats = 13
-  character(len=24), parameter :: stat_names(nstats) = [character(len=24) :: &
-       'steps', 'rhs_evals', 'jac_evals', 'lin_rhs_evals', 'err_test_fails', &
-       'nonlin_conv_fails', 'roots_found', 'root_fn_evals', 'last_step_s', &
-       'mode_resyncs', 'coupling_residual_degC', 'coupling_iterations', 'linear_tail_t_s']
+  public :: integrate
 
   !> Everything a run changes, owned by `integrate` and given to CVODE as user data.
   type :: solver_ctx_t
@@ -360,7 +353,7 @@ contains
       if (.not. ok) call fail(flag, tau, what)
     end function restart_cvode
 
-    !> The statistics CVODE and the run kept (order of stat_names).
+    !> The statistics CVODE and the run kept (positions ist_* of spline_quantities).
     subroutine collect_stats()
       real(c_double) :: hlast(1)
       if (c_associated(cv%mem)) then
@@ -506,7 +499,7 @@ contains
     if (ctx%watch) interrupted = sigint_count() /= ctx%sigint0
   end function interrupted
 
-  !> Add CVODE's counters since the last (re)initialisation to stats (order of stat_names).
+  !> Add CVODE's counters since the last (re)initialisation to stats (positions ist_* of spline_quantities).
   !> A counter that cannot be read (nonzero flag) adds nothing.
   subroutine add_counters(ctx, mem, stats)
     type(solver_ctx_t), intent(in) :: ctx

@@ -38,14 +38,14 @@ _MODEL_BYTES = int(_api.api_model_size())
 
 @functools.cache
 def _layout() -> tuple:
-    """The core's field table (api_names('fields')) as (name, kind, offset, size) in the
+    """The core's field table (api_names('layout')) as (name, kind, offset, size) in the
     order of the value arrays, and the sizes of the real array and the character buffer."""
     rows, nv, nc = [], 0, 0
     for i in range(1, 1000):
-        name, unit = (x.decode().strip() for x in _api.api_names("fields", i))
+        name, layout, _ = (x.decode().strip() for x in _api.api_names("layout", i))
         if not name:
             break
-        kind, n = unit[0], int(unit[1:] or 1)
+        kind, n = layout[0], int(layout[1:] or 1)
         rows.append((name, kind, nc if kind == "c" else nv, n))
         if kind == "c":
             nc += n

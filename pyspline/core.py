@@ -20,25 +20,32 @@ from .case import _MODEL_BYTES, Case, _values_of, load_case
 from .errors import BY_NAME, SplineError, SplineWarning, decode
 
 _api = _core.spline_api
-STATE_NAMES = ("x1", "y1", "x2", "y2", "D1", "D2", "D3")
 THERMAL_LEVELS = ("none", "bulk", "oneway", "coupled")   #: stats["thermal_level"] 0..3
 
 
 @functools.cache
 def _names(kind: str) -> tuple:
+    """The core's list `kind` (api_names in fortran/api.f90): (name, unit, description) per
+    entry; units SI, '-' a ratio, '' none. The output quantities and statistics are the table
+    of fortran/quantities.f90, the case fields that of fortran/case_type.f90."""
     out = []
-    for i in range(1, 100):
-        name, unit = (decode(s) for s in _api.api_names(kind, i))
+    for i in range(1, 1000):
+        name, unit, descr = (decode(s) for s in _api.api_names(kind, i))
         if not name:
             break
-        out.append((name, unit))
+        out.append((name, unit, descr))
     return tuple(out)
+
+
+def cf_units(unit: str) -> str:
+    """A unit of the core's tables as a netCDF/CF 'units' attribute: '1' for a ratio ('-')."""
+    return "1" if unit == "-" else unit
 
 
 @functools.cache
 def _errors() -> dict:
     """Error code of the core -> exception class (codes and names from fortran/errors.f90)."""
-    return {i: BY_NAME.get(name, SplineError) for i, (name, _) in enumerate(_names("errors"))}
+    return {i: BY_NAME.get(name, SplineError) for i, (name, *_) in enumerate(_names("errors"))}
 
 
 def _warn(text) -> None:
@@ -121,7 +128,7 @@ class Model:
         ydot, mesh, tm, ierr, msg = _api.api_rhs_mesh(self.bytes, self.z, len(q), t,
                                                       np.asarray(y, dtype=float))
         raise_for(ierr, msg)
-        return ydot, {n: mesh[:, i] for i, (n, _) in enumerate(q)}, float(tm)
+        return ydot, {n: mesh[:, i] for i, (n, *_) in enumerate(q)}, float(tm)
 
     def output_times(self) -> np.ndarray:
         t, ierr, msg = _api.api_output_times(self.bytes, self.n_out)
@@ -135,10 +142,10 @@ class Model:
         of the geometry)."""
         info, terms, ierr, msg = _api.api_model_info(self.bytes)
         raise_for(ierr, msg)
-        out = {n: float(v) for (n, _), v in zip(_names("info"), info)}
+        out = {n: float(v) for (n, *_), v in zip(_names("info"), info)}
         out["k_m_computed"] = bool(out["k_m_computed"])
         out["thermal_level"] = int(out["thermal_level"])
-        out["k_terms"] = {n: float(v) for (n, _), v in zip(_names("kterms"), terms)}
+        out["k_terms"] = {n: float(v) for (n, *_), v in zip(_names("kterms"), terms)}
         return out
 
 
@@ -147,24 +154,19 @@ def load(case) -> Model:
     return case if isinstance(case, Model) else load_case(case).model
 
 
-#: Result quantities: name -> (long name, units); per tooth (time, tooth) and states (time).
-TOOTH_QUANTITIES = {
-    "F": ("tooth load F_j (Eqs. 15-17)", "N"),
-    "Fx": ("x component of the tooth load", "N"),
-    "Fy": ("y component of the tooth load", "N"),
-    "dn": ("relative displacement along the line of action dn_j (Eq. 11)", "m"),
-    "c": ("backlash c_j (Eq. 2)", "m"),
-    "Tf": ("flash temperature T_f (Eqs. 3-7)", "degC"),
-    "rc1": ("contact-point radius on the external spline (Eqs. 13-14)", "m"),
-    "rc2": ("contact-point radius on the internal spline (Eqs. 13-14)", "m"),
-}
-STATE_QUANTITIES = {
-    "x1": ("x displacement of spline 1", "m"), "y1": ("y displacement of spline 1", "m"),
-    "x2": ("x displacement of spline 2", "m"), "y2": ("y displacement of spline 2", "m"),
-    "D1": ("torsional displacement D_1 (motor - spline 1, on the base circle)", "m"),
-    "D2": ("relative displacement D_2 (spline 1 - spline 2, on the base circle)", "m"),
-    "D3": ("torsional displacement D_3 (spline 2 - load, on the base circle)", "m"),
-}
+#: Result quantities from the core's table (fortran/quantities.f90): name -> (description,
+#: unit), every output (time t, states, Tm, kv, per-tooth), the states (position and velocity,
+#: order of a state vector) and the per-tooth quantities (time, tooth).
+QUANTITIES = {n: (d, u) for n, u, d in _names("outputs")}
+STATE_QUANTITIES = {n: (d, u) for n, u, d in _names("states")}
+TOOTH_QUANTITIES = {n: (d, u) for n, u, d in _names("tooth")}
+STATE_NAMES = tuple(STATE_QUANTITIES)[:len(STATE_QUANTITIES) // 2]   #: x1 .. D3 (positions)
+
+
+def _attrs(name: str) -> dict:
+    """xarray attrs of an output quantity of the core's table: long_name, units (if any)."""
+    long, unit = QUANTITIES[name]
+    return {"long_name": long, "units": cf_units(unit)} if unit else {"long_name": long}
 
 
 def _tooth_quantity(name: str) -> property:
@@ -179,15 +181,13 @@ def _tooth_quantity(name: str) -> property:
 
 
 def _state(name: str) -> property:
-    velocity = name not in STATE_NAMES
-    i = STATE_NAMES.index(name[1:] if velocity else name) + (7 if velocity else 0)
+    i = tuple(STATE_QUANTITIES).index(name)
 
     def get(self):
         return self.y[:, i]
     get.__name__ = name
-    long, unit = STATE_QUANTITIES[name[1:] if velocity else name]
-    doc = f"velocity of {name[1:]} [{unit}/s]" if velocity else f"{long} [{unit}]"
-    return property(get, doc=doc + ", shape (nt,)")
+    long, unit = STATE_QUANTITIES[name]
+    return property(get, doc=f"{long} [{unit}], shape (nt,)")
 
 
 @dataclass
@@ -256,34 +256,22 @@ class Result:
         from . import __version__
         z = next(iter(self.tooth.values())).shape[1] if self.tooth else 0
         tooth_no = np.arange(1, z + 1)
-        coords = {"time": ("time", np.asarray(self.t), {"long_name": "time", "units": "s"}),
+        coords = {"time": ("time", np.asarray(self.t), _attrs("t")),
                   "tooth": ("tooth", tooth_no, {"long_name": "tooth number j"})}
-        data = {}
-        for i, n in enumerate(STATE_NAMES):
-            long, unit = STATE_QUANTITIES[n]
-            data[n] = ("time", self.y[:, i], {"long_name": long, "units": unit})
-        for i, n in enumerate(STATE_NAMES):
-            data["v" + n] = ("time", self.y[:, 7 + i],
-                             {"long_name": f"velocity of {n}",
-                              "units": STATE_QUANTITIES[n][1] + "/s"})
-        data["Tm"] = ("time", self.Tm, {"long_name": "meshing torque T_m (Eq. 22)",
-                                        "units": "N m"})
-        data["kv"] = ("time", self.kv, {"long_name": "dynamic load coefficient k_v = |T_m|/T_d",
-                                        "units": "1"})
-        units = dict(_names("tooth"))
+        data = {n: ("time", self.y[:, i], _attrs(n)) for i, n in enumerate(STATE_QUANTITIES)}
+        data["Tm"] = ("time", self.Tm, _attrs("Tm"))
+        data["kv"] = ("time", self.kv, _attrs("kv"))
         for n, arr in self.tooth.items():
-            long, unit = TOOTH_QUANTITIES.get(n, (n, units.get(n, "")))
-            data[n] = (("time", "tooth"), arr, {"long_name": long, "units": unit})
+            data[n] = (("time", "tooth"), arr, _attrs(n))
         if self.section_t is not None and len(self.section_t):
             sec = np.asarray(self.section_y).reshape(-1, 14)
             data["section_t"] = ("section_point", self.section_t,
                                  {"long_name": "time of the Poincare section point "
                                   f"({self.case['section']})", "units": "s"})
-            for i, n in enumerate(STATE_NAMES + tuple("v" + n for n in STATE_NAMES)):
-                unit = STATE_QUANTITIES[n.removeprefix("v") if i >= 7 else n][1]
-                data["section_" + n] = ("section_point", sec[:, i],
-                                        {"long_name": f"{n} on the Poincare section",
-                                         "units": unit + ("/s" if i >= 7 else "")})
+            for i, n in enumerate(STATE_QUANTITIES):
+                a = _attrs(n)
+                a["long_name"] += " on the Poincare section"
+                data["section_" + n] = ("section_point", sec[:, i], a)
         attrs = {"case": self.case.text(), "name": self.case.name,
                  "pyspline_version": __version__}
         if self.stats:
@@ -301,9 +289,6 @@ class Result:
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
-_FLOAT_STATS = ("_s", "_degC")
-
-
 def simulate(case) -> Result:
     """Run one case (a Case, a dict of fields, a namelist path or a loaded Model) and return a
     Result. Raises CaseError, SolverError or ThermalInterferenceError with a message naming the
@@ -317,16 +302,15 @@ def simulate(case) -> Result:
                           model.n_lyapunov, nft, model.n_slices)
     wall = time.perf_counter() - t0
     raise_for(ierr, msg)
-    st = {n: (float(v) if n.endswith(_FLOAT_STATS) or n.startswith("fidelity_eps") else int(v))
-          for (n, _), v in zip(s, stats)}
+    st = {n: (float(v) if unit else int(v)) for (n, unit, _), v in zip(s, stats)}  # counts: int
     st["wall_s"] = wall
     _warn(_api.api_warnings(model.bytes, stats, 1))      # the run's (one-way backlash, Eq. 2)
     lyap = None
     if model.n_lyapunov:
         span = lyap_t - (t[0] if len(t) else 0.0)
         lyap = dict(t=lyap_t, log_growth=lyap_g, exponent=float(lyap_g[-1] / span[-1]))
-    return Result(case=model.case, t=t, y=y, tooth={n: tooth[:, :, i] for i, (n, _) in enumerate(q)},
-                  Tm=tm, stats=st, section_t=sec_t, section_y=sec_y, lyapunov=lyap,
+    return Result(case=model.case, t=t, y=y,
+                  tooth={n: tooth[:, :, i] for i, (n, *_) in enumerate(q)}, Tm=tm, stats=st, section_t=sec_t, section_y=sec_y, lyapunov=lyap,
                   face=face if model.n_slices else None, tilt=tilt if model.n_slices else None)
 
 

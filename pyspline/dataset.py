@@ -1,15 +1,17 @@
 """The dataset of a sweep: the per-point summaries gathered into an xarray.Dataset (units and
-descriptions in each variable's attrs, from cases/template.nml for the swept fields), written
-to NetCDF-4 (engine h5netcdf) atomically, and read back (`open_sweep`)."""
+descriptions in each variable's attrs: from the core's tables for the swept fields, the
+statistics and the summaries of a result quantity), written to NetCDF-4 (engine h5netcdf)
+atomically, and read back (`open_sweep`)."""
 from __future__ import annotations
 
 import functools
 import itertools
 import os
-import re
 from pathlib import Path
 
 import numpy as np
+
+from .core import QUANTITIES, TOOTH_QUANTITIES, _names, cf_units
 
 __all__ = ["build_dataset", "field_meta", "open_sweep", "write_netcdf"]
 
@@ -21,27 +23,10 @@ MERGED = "sweep.nc"     #: the merged sweep in a sweep's output directory
 
 @functools.cache
 def field_meta() -> dict:
-    """{field: (long_name, units)} from the comments of cases/template.nml (empty when the
-    template is not found): e.g. 'l_x' -> ('parallel misalignment of spline 1 in x', 'm')."""
-    here = Path(__file__).resolve().parent
-    for path in (here / "cases" / "template.nml", here.parent / "cases" / "template.nml"):
-        if path.is_file():
-            break
-    else:
-        return {}
-    meta = {}
-    for line in path.read_text(encoding="utf-8").splitlines():
-        m = re.match(r"\s*(\w+)\s*=[^!]*!\s*(.*)$", line)
-        if not m:
-            continue
-        comment = m.group(2)
-        u = re.search(r"\[([^\],]*)\]", comment)      # a unit has no comma
-        long = (comment[:u.start()] if u else comment).strip().rstrip(":;,").strip()
-        if "|" in long or ":" in long:      # a list of choices, not a description
-            long = m.group(1)
-        unit = u.group(1).strip() if u else ""
-        meta[m.group(1).lower()] = (long or m.group(1), "1" if unit == "-" else unit)
-    return meta
+    """{field: (long_name, units)} from the core's field table (fortran/case_type.f90, through
+    api_names('fields')): e.g. 'l_x' -> ('parallel misalignment of spline 1 in x', 'm'); a
+    ratio's unit is '1'; an option whose description lists its choices is named by its name."""
+    return {n: (n if "|" in d else d or n, cf_units(u)) for n, u, d in _names("fields")}
 
 
 def _field_attrs(name: str) -> dict:
@@ -53,8 +38,6 @@ def _field_attrs(name: str) -> dict:
 
 _VAR_ATTRS = {
     "section_t": ("time of the Poincare section point", "s"),
-    "section_D2": ("D_2 on the Poincare section", "m"),
-    "section_vD2": ("dD_2/dt on the Poincare section", "m/s"),
     "period": ("period of the section sequence (0: not periodic; NaN: no result)", ""),
     "period_residual": ("largest relative mismatch of the section at the period found (at the "
                         "best period tested if none)", ""),
@@ -66,20 +49,8 @@ _VAR_ATTRS = {
     "predictability_horizon": ("predictability horizon 1/lambda (inf: lambda <= 0)", "s"),
     "chaotic": ("1: the exponent is positive beyond its own spread (chaos: read statistics, "
                 "not trajectories); 0: not; NaN: no converged estimate", ""),
-    "Tm_max": ("max of the meshing torque T_m", "N m"),
-    "Tm_min": ("min of the meshing torque T_m", "N m"),
-    "Tm_rms": ("RMS of the meshing torque T_m", "N m"),
-    "kv_max": ("max of the dynamic load coefficient k_v", ""),
-    "kv_min": ("min of the dynamic load coefficient k_v", ""),
-    "kv_rms": ("RMS of the dynamic load coefficient k_v", ""),
-    "F_max": ("max of the tooth loads F_j over all teeth", "N"),
-    "F_min": ("min of the tooth loads F_j over all teeth", "N"),
-    "F_rms": ("RMS of the tooth loads F_j over all teeth", "N"),
-    "Tf_max": ("max of the flash temperatures T_f over all teeth", "degC"),
-    "D2_max": ("max of D_2", "m"),
-    "D2_min": ("min of D_2", "m"),
     "Tm_spectrum": ("amplitude spectrum of T_m (Hann window, mean removed; max over each order "
-                    "bin)", "N m"),
+                    "bin)", cf_units(QUANTITIES["Tm"][1])),
     "wall_s": ("wall time of the run (Python call)", "s"),
     "error": ("error message of the point ('' if it ran)", ""),
     "error_class": ("exception class of the point's error ('' if it ran)", ""),
@@ -87,11 +58,28 @@ _VAR_ATTRS = {
 }
 
 
+#: Summaries of a result quantity of the core's table: name -> (what, quantity); their unit is
+#: the quantity's, their long_name what of its description.
+_OF_QUANTITY = {f"{q}_{w}": (w, q) for q in ("Tm", "kv", "F") for w in ("max", "min", "rms")}
+_OF_QUANTITY.update(Tf_max=("max", "Tf"), D2_max=("max", "D2"), D2_min=("min", "D2"),
+                    section_D2=("section", "D2"), section_vD2=("section", "vD2"))
+_WHAT = {"max": "max of the {}", "min": "min of the {}", "rms": "RMS of the {}",
+         "section": "{} on the Poincare section"}
+
+
 def _stat_attrs(name: str) -> tuple:
+    """(long_name, units) of a sweep variable: the sweep's own (_VAR_ATTRS), a summary of a
+    result quantity or a run statistic (the core's tables), else (name, '')."""
     if name in _VAR_ATTRS:
         return _VAR_ATTRS[name]
-    unit = "s" if name.endswith("_s") else ("degC" if name.endswith("_degC") else "")
-    return (f"solver statistic {name}", unit)
+    if name in _OF_QUANTITY:
+        what, q = _OF_QUANTITY[name]
+        long, unit = QUANTITIES[q]
+        if q in TOOTH_QUANTITIES and what != "section":
+            long += " over all teeth"
+        return _WHAT[what].format(long), cf_units(unit)
+    stats = {n: (d, cf_units(u)) for n, u, d in _names("stats")}
+    return stats.get(name, (name, ""))
 
 
 def build_dataset(grid: dict, keys: list, summaries: dict, hashes: dict, options: dict,

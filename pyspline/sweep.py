@@ -181,7 +181,7 @@ def _template(options: dict, stat_names: Sequence[str]) -> dict:
 @functools.cache
 def _stat_names() -> tuple:
     from .core import _names
-    return tuple(n for n, _ in _names("stats")) + ("wall_s",)
+    return tuple(n for n, *_ in _names("stats")) + ("wall_s",)
 
 
 def _binned_spectrum(t, x, speed_rpm, orders_axis) -> np.ndarray:
@@ -357,7 +357,7 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     orders : shaft-order axis of the spectrum (default 0 .. 2Z+2 in steps of 0.05).
     command : text stored in attrs['command'] (default: this call, abbreviated).
 
-    Dataset: coordinates = the swept values (units from cases/template.nml); per point
+    Dataset: coordinates = the swept values (units from the core's field table); per point
     section_t/section_D2/section_vD2 (dim 'section_point', NaN-padded), period and
     period_residual; lyapunov, lyapunov_spread, lyapunov_rel_spread, lyapunov_slope,
     predictability_horizon, chaotic (1 if the exponent exceeds its spread; if lyapunov);

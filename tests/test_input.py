@@ -10,7 +10,7 @@ import f90nml
 import pytest
 
 import pyspline
-from conftest import CASES, PAPER, ROOT
+from conftest import CASES, PAPER
 
 
 @pytest.mark.parametrize("fields,words", [
@@ -89,9 +89,10 @@ def test_template_lists_every_field_with_the_core_defaults():
 
 
 def _table_units():
-    """Field name -> unit, from the core's one field table (fortran/case_type.f90 `fields`)."""
-    src = (ROOT / "fortran" / "case_type.f90").read_text()
-    return dict(re.findall(r"field_t\('(\w+)', '[irlc]', \w+, '([^']*)'", src))
+    """Field name -> unit, from the core's one field table (fortran/case_type.f90 `fields`,
+    through api_names('fields'))."""
+    from pyspline.core import _names
+    return {name: unit for name, unit, _ in _names("fields")}
 
 
 def test_template_gives_each_field_the_unit_of_the_core_table():
@@ -184,7 +185,7 @@ def test_not_a_case_file_same_words(kind, exe, tmp_path):
 def test_field_table_matches_the_defaults():
     """The reader's table of fields (type and size) agrees with case_t's defaults."""
     from pyspline.core import _names
-    table = {name: unit for name, unit in _names("fields")}
+    table = {name: layout for name, layout, _ in _names("layout")}
     defaults = pyspline.defaults()
     assert set(table) == set(defaults)
     for name, v in defaults.items():

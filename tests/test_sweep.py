@@ -403,7 +403,7 @@ def test_cli_help_says_what_it_writes(capsys):
 def test_result_to_xarray_roundtrip(case, tmp_path):
     res = pyspline.simulate(case.replace(section="shaft", lyapunov=True))
     names = dir(res)
-    for n in ["F", "D2", "vD2", "Tm", "kv", "x1", "vD3"] + [n for n, _ in _names("tooth")]:
+    for n in ["F", "D2", "vD2", "Tm", "kv", "x1", "vD3"] + [n for n, *_ in _names("tooth")]:
         assert n in names
     assert res.F is res.tooth["F"]
     np.testing.assert_array_equal(res.vD2, res.y[:, 12])
