@@ -160,7 +160,8 @@ def note(ax, text, loc="upper left", **kw):
 
 
 def no_content(span, unit) -> str:
-    return f"no dynamic content (span {eng(span, 2)} {unit}: round-off)"
+    unit = "" if unit in ("", "-") else f" {unit}"
+    return f"no dynamic content (span {eng(span, 2)}{unit}: round-off)"
 
 
 # --------------------------------------------------------------------------- colour limits

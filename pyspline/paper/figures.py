@@ -41,7 +41,7 @@ def _tooth_bars(ax_f, ax_fx, res):
         ax.set_xticks(j)
         ax.axhline(0, color="k", lw=0.5)
     ax_f.legend(fontsize=7, loc="lower right")
-    ax_fx.set_title(f"sum of F_jx at that instant: {res.Fx[k].sum():.2e} N", fontsize=8)
+    ax_fx.set_title(f"sum of F_jx at that instant: {eng(res.Fx[k].sum(), 3)} N", fontsize=8)
 
 
 def dynamics_figure(res, path, title):
