@@ -14,12 +14,13 @@ import argparse
 import concurrent.futures as cf
 import shlex
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 from .case import load_case
-from .errors import CaseError, SplineError
+from .errors import CaseError, SolverError, SplineError, SplineWarning, ThermalInterferenceError
 from .sweep import MERGED, POINTS_DIR, parse_values, sweep
 
 
@@ -32,6 +33,17 @@ def _summary(res) -> str:
             f"D2 [{res.D2.min():.4e}, {res.D2.max():.4e}] m  "
             f"{res.level}  "
             f"steps {s['steps']}  {s['wall_s']*1e3:.0f} ms")
+
+
+#: exit status of each failure (README, "Errors and exit codes"; spline-dyn's err_exit_code)
+EXIT_CODES = ((CaseError, 2), (SolverError, 3), (ThermalInterferenceError, 4),
+              (KeyboardInterrupt, 130))
+
+
+def exit_code(exc: BaseException) -> int:
+    """The exit status of a failure: CaseError 2, SolverError 3, ThermalInterferenceError 4,
+    KeyboardInterrupt 130, anything else 1."""
+    return next((code for cls, code in EXIT_CODES if isinstance(exc, cls)), 1)
 
 
 def _one_line(exc: BaseException) -> str:
@@ -93,7 +105,8 @@ def _save_result(res, out: Path, taken: set) -> tuple[Path, str]:
 
 
 def cmd_run(args) -> int:
-    """Run each case; a failure of any kind in one prints one line and the next case runs."""
+    """Run each case; a failure of any kind in one prints one line and the next case runs.
+    The exit status is that of the first failure (`exit_code`), 0 if every case ran."""
     from .core import simulate
     status = 0
     taken: set = set()
@@ -112,7 +125,7 @@ def cmd_run(args) -> int:
             return 130
         except Exception as exc:      # any failure: one line, then the next case
             print(f"error: {path}: {_one_line(exc)}", file=sys.stderr)
-            status = 1
+            status = status or exit_code(exc)
     return status
 
 
@@ -293,7 +306,7 @@ def cmd_sweep(args) -> int:
         case = load_case(args.case, **_fixed(args.fix))
     except SplineError as exc:
         print(f"error: {exc}", file=sys.stderr)
-        return 2
+        return exit_code(exc)
     out = Path(args.out)
     executor, workers, close = _make_executor(args)
     try:
@@ -328,7 +341,10 @@ def cmd_sweep(args) -> int:
 
 
 def cmd_plot(args) -> int:
+    """One scene per case; a case that fails prints one line and the next one is drawn. The
+    exit status is that of the first failure (`exit_code`), 0 if every case was drawn."""
     from . import analysis, plots
+    from .plotstyle import eng
     from .core import STATE_NAMES, simulate
     i_D2 = STATE_NAMES.index("D2")          # its column in section_y; dD2/dt is 7 later
     out = Path(args.out)
@@ -337,14 +353,14 @@ def cmd_plot(args) -> int:
         fixed = _fixed(args.fix)
     except SplineError as exc:
         print(f"error: {exc}", file=sys.stderr)
-        return 2
+        return exit_code(exc)
     for path in args.cases:
         try:
             case = load_case(path, **fixed).replace(section="shaft")
             res = simulate(case)
         except SplineError as exc:
             print(f"error: {exc}", file=sys.stderr)
-            status = 1
+            status = status or exit_code(exc)
             continue
         spectrum = analysis.amplitude_spectrum(res.t, res.Tm) if len(res.t) >= 4 else None
         sec = None
@@ -354,10 +370,10 @@ def cmd_plot(args) -> int:
         target = out / f"{case.name}.png"
         plots.scene(res.t, res.D2, res.vD2, res.Tm, res.tooth["F"],
                     Tf=res.tooth["Tf"] if thermal else None, section=sec, spectrum=spectrum,
-                    speed_rpm=case["speed_rpm"], z=case["z"], path=target,
-                    title=f"{case.name}: {res.level}, {case['speed_rpm']:g} rpm, "
-                          f"T_d = {case['t_d']:g} N m, l_x = {case['l_x']:g} m, "
-                          f"l_y = {case['l_y']:g} m; section points once per revolution")
+                    speed_rpm=case["speed_rpm"], z=case["z"], path=target, rtol=case["rtol"],
+                    title=f"{case.name}: {res.level}, {eng(case['speed_rpm'])} rpm, "
+                          f"T_d = {eng(case['t_d'])} N m, l_x = {eng(case['l_x'])} m, "
+                          f"l_y = {eng(case['l_y'])} m; section points once per revolution")
         print(f"wrote {target}")
     return status
 
@@ -483,4 +499,21 @@ def main(argv=None) -> int:
     r.set_defaults(func=cmd_check_exe)
     _add_sweep_and_plot(sub)
     args = p.parse_args(argv)
-    return args.func(args)
+    with warnings.catch_warnings():
+        warnings.showwarning = _show_warning
+        try:
+            return args.func(args)
+        except KeyboardInterrupt:
+            print("interrupted", file=sys.stderr)
+            return 130
+        except SplineError as exc:    # a command without its own handling: README's codes
+            print(f"error: {_one_line(exc)}", file=sys.stderr)
+            return exit_code(exc)
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None):
+    """A SplineWarning as the README says: one 'warning:' line on stderr; others as usual."""
+    if issubclass(category, SplineWarning):
+        print(f"warning: {' '.join(str(message).split())}", file=sys.stderr)
+    else:
+        sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))

@@ -1,446 +1,70 @@
-"""Figures of parameter sweeps and single runs: bifurcation diagrams, Lyapunov exponents,
-waterfalls of spectra and a one-page "scene" of a run.
+"""Figures of single runs and sweeps: `scene`, one page on one run (what `pyspline plot`
+draws), and, from pyspline.sweepplots, bifurcation diagrams, Lyapunov exponents, waterfalls of
+spectra and `sweep_figures` (what `pyspline sweep` draws).
 
-Each function takes numpy arrays, or an xarray.Dataset (any mapping from names to arrays works
-the same way; with a Dataset the units come from each variable's ``attrs['units']``), returns a
+Each function takes numpy arrays (the sweep figures also an xarray.Dataset), returns a
 matplotlib Figure and, when given `path`, writes it there as PNG. Figures are built on
 `matplotlib.figure.Figure` and rendered by Agg, independent of pyplot and of the interactive
 backend, so sweeps do not accumulate open figures.
 
-`sweep_figures` draws the figures of a sweep dataset into a directory (`pyspline sweep`).
+No figure magnifies round-off: a signal whose span is below the solver's resolution
+(plotstyle.roundoff_span: 3e-7 of its size, or 10 rtol) is drawn on a range around its value
+and labelled "no dynamic content"; colour scales come from the second half of a run (a start
+transient is clipped, and the colour bar says so); spectra end at the Nyquist frequency of the
+data and say when the tooth pass lies beyond it (with a SplineWarning).
 
-This module imports only numpy and matplotlib (xarray when a sweep's waterfalls are drawn):
-spectra, periods and exponents are computed by pyspline.analysis and passed in as arrays.
+Imports only numpy, matplotlib and pyspline.errors (xarray when a sweep's waterfalls are
+drawn), no compiled core.
 """
 from __future__ import annotations
 
-import re
-import sys
-import warnings
-from pathlib import Path
-
 import numpy as np
-from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm, TwoSlopeNorm
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
-from matplotlib.patches import Patch
 from matplotlib.ticker import MaxNLocator
 
-__all__ = ["bifurcation", "bifurcation_grid", "lyapunov_vs_param", "param_map", "scene",
+from . import plotstyle as ps
+from .plotstyle import eng
+from .sweepplots import (bifurcation, bifurcation_grid, lyapunov_vs_param, param_map,
+                         sweep_figures, waterfall)
+
+__all__ = ["bifurcation", "bifurcation_grid", "eng", "lyapunov_vs_param", "param_map", "scene",
            "sweep_figures", "waterfall"]
-
-# Colours of periods 1, 2, 3, 4 (Okabe-Ito, colour-blind safe) and > 4; not periodic is grey.
-PERIOD_COLOURS = {1: "#0072B2", 2: "#D55E00", 3: "#009E73", 4: "#CC79A7", 5: "#000000"}
-NOT_PERIODIC = "0.6"
-SHAFT_STYLE = dict(color="0.25", ls=(0, (4, 3)), lw=0.9)
-TOOTH_STYLE = dict(color="tab:red", ls=(0, (6, 3)), lw=1.1)
-
-_PREFIXES = ((1e-9, "n"), (1e-6, "µ"), (1e-3, "m"), (1.0, ""), (1e3, "k"), (1e6, "M"))
-_PREFIXABLE = {"m", "m/s", "N", "N m", "N*m", "Nm", "s"}
-
-
-def _finish(fig: Figure, path) -> Figure:
-    if path is not None:
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(path, dpi=110)
-    return fig
-
-
-def _array(ds, name, dims=None) -> np.ndarray:
-    """ds[name] as a float array; for an xarray object, `dims` first in that order."""
-    v = ds[name]
-    if dims is not None and hasattr(v, "dims") and hasattr(v, "transpose"):
-        v = v.transpose(*dims, ..., missing_dims="ignore")
-    return np.asarray(v, dtype=float)
-
-
-def _units(ds, name, default="", units=None) -> str:
-    """Units of ds[name]: `units[name]` if given, else attrs['units'], else `default`."""
-    if units and name in units:
-        return str(units[name])
-    try:
-        return str(ds[name].attrs.get("units", default))
-    except AttributeError:
-        return default
-
-
-def _long_name(ds, name) -> str:
-    try:
-        return str(ds[name].attrs.get("long_name", name))
-    except AttributeError:
-        return str(name)
-
-
-def _label(ds, name, default_units="", units=None, factor_unit=None) -> str:
-    """'long_name [units]' from a variable's attrs (or `units`), else 'name [units]';
-    `factor_unit` replaces the unit (an SI-prefixed one)."""
-    u = factor_unit if factor_unit is not None else _units(ds, name, default_units, units)
-    long = _long_name(ds, name)
-    return f"{long} [{u}]" if u else long
-
-
-def _prefix(values, unit: str) -> tuple[float, str]:
-    """(factor, unit) with an SI prefix so that the largest |value| / factor is in [1, 1000);
-    only for the units in _PREFIXABLE (angles, rpm, degC stay as they are)."""
-    a = np.abs(np.asarray(values, dtype=float))
-    a = a[np.isfinite(a)]
-    if unit not in _PREFIXABLE or a.size == 0 or a.max() == 0:
-        return 1.0, unit
-    big = a.max()
-    factor, p = _PREFIXES[0]
-    for f, sym in _PREFIXES:
-        if big >= f:
-            factor, p = f, sym
-    return factor, p + unit
-
-
-def _order_marks(z):
-    """(order, label, style) of the shaft orders 1x, 2x and tooth-pass orders Zx, 2Zx."""
-    marks = [(1, "1x", SHAFT_STYLE), (2, "2x", SHAFT_STYLE)]
-    if z:
-        marks += [(z, f"{z}x", TOOTH_STYLE), (2 * z, f"{2 * z}x", TOOTH_STYLE)]
-    return marks
-
-
-def _peak_hold(f, a, f_max, columns=500):
-    """Keep the bins up to f_max; when there are more than `columns`, merge neighbours into
-    `columns` groups keeping the largest amplitude, so that narrow tones stay visible at screen
-    resolution. f, a: (rows, bins)."""
-    keep = (f <= f_max).any(axis=0)
-    f, a = f[:, keep], a[:, keep]
-    g = int(np.ceil(f.shape[1] / columns))
-    if g <= 1:
-        return f, a
-    pad = (-f.shape[1]) % g
-    f = np.pad(f, ((0, 0), (0, pad)), constant_values=np.nan)
-    a = np.pad(a, ((0, 0), (0, pad)), constant_values=np.nan)
-    shape = (f.shape[0], f.shape[1] // g, g)
-    with warnings.catch_warnings():       # all-NaN groups (beyond a run's Nyquist) stay NaN
-        warnings.simplefilter("ignore", RuntimeWarning)
-        return np.nanmean(f.reshape(shape), axis=2), np.nanmax(a.reshape(shape), axis=2)
-
-
-# --------------------------------------------------------------------------- bifurcation
-
-def bifurcation(ds, param: str, coord: str = "section_D2", period: str = "period",
-                path=None, title: str | None = None, units: dict | None = None) -> Figure:
-    """Bifurcation diagram: the section coordinate ``ds[coord]`` (dims (param,
-    'section_point'), NaN-padded) against the swept ``ds[param]`` (dim (param,)), each point
-    coloured by ``ds[period]`` (dim (param,)): period 1, 2, 3, 4, > 4 in distinct colours, not
-    periodic (0, negative or NaN) in grey. Units come from each variable's attrs['units'] or
-    from `units` ({name: unit}, for a dict of arrays; the coordinate defaults to m). Axes in
-    m, m/s, N or N m get a readable SI prefix (um, mm/s, kN)."""
-    p = _array(ds, param)
-    y = _array(ds, coord, dims=(param, "section_point") if hasattr(ds, "dims") else None)
-    per = _array(ds, period)
-    if y.ndim == 1:
-        y = y[:, None]
-    if y.shape[0] != p.shape[0] or per.shape != p.shape:
-        raise ValueError(f"{coord} must have shape ({len(p)}, n_points) and {period} ({len(p)},),"
-                         f" got {y.shape} and {per.shape}")
-    factor, unit = _prefix(y, _units(ds, coord, "m", units))
-    px, ux = _prefix(p, _units(ds, param, "", units))
-    long = _long_name(ds, coord)
-    fig = Figure(figsize=(9, 5.5), layout="constrained")
-    ax = fig.add_subplot()
-    handles = _bifurcation_points(ax, p / px, y / factor, per)
-    ax.set_xlabel(_label(ds, param, factor_unit=ux))
-    ax.set_ylabel(_label(ds, coord, factor_unit=unit))
-    ax.legend(handles=handles, fontsize=8, loc="best", title="runs by period",
-              title_fontsize=8, framealpha=0.9)
-    ax.set_title(title or f"bifurcation diagram: {long} vs {_long_name(ds, param)}")
-    return _finish(fig, path)
-
-
-def _period_class(per) -> np.ndarray:
-    """0: not periodic (0, negative, NaN); 1..4: the period; 5: period > 4."""
-    per = np.asarray(per, dtype=float)
-    return np.where(np.isfinite(per) & (per > 0), np.minimum(np.nan_to_num(per), 5), 0).astype(int)
-
-
-def _period_name(c: int) -> str:
-    return "not periodic" if c == 0 else ("period > 4" if c == 5 else f"period {c}")
-
-
-def _bifurcation_points(ax, x, y, per, counts=True, ms=9) -> list:
-    """Scatter y (n, n_points) against x (n,) on ax, coloured by period class; legend handles."""
-    cls = _period_class(per)
-    handles = []
-    for c in (0, 1, 2, 3, 4, 5):
-        rows = cls == c
-        if not rows.any():
-            continue
-        xs = np.repeat(x[rows], y.shape[1])
-        ys = y[rows].ravel()
-        ok = np.isfinite(ys)
-        colour = NOT_PERIODIC if c == 0 else PERIOD_COLOURS[c]
-        ax.scatter(xs[ok], ys[ok], s=ms / 3 if c == 0 else ms, c=colour, lw=0,
-                   alpha=0.6 if c == 0 else 1.0, zorder=1 if c == 0 else 2, rasterized=True)
-        label = f"{_period_name(c)} ({rows.sum()})" if counts else _period_name(c)
-        handles.append(Line2D([], [], ls="", marker="o", ms=6, color=colour, label=label))
-    ax.grid(alpha=0.3, lw=0.5)
-    return handles
-
-
-def _axis_values(ds, name, units=None):
-    """(numeric positions, tick labels or None, factor, unit) of a coordinate; text values
-    (e.g. thermal = 'none', 'bulk') are placed at 0, 1, 2 ... and labelled."""
-    raw = np.asarray(ds[name])
-    if raw.dtype.kind in "biuf":
-        v = raw.astype(float)
-        factor, unit = _prefix(v, _units(ds, name, "", units))
-        return v / factor, None, factor, unit
-    return (np.arange(len(raw), dtype=float), [str(r) for r in raw], 1.0,
-            _units(ds, name, "", units))
-
-
-def bifurcation_grid(ds, param: str, by: str, coord: str = "section_D2",
-                     period: str = "period", max_panels: int = 12, path=None,
-                     title: str | None = None, units: dict | None = None) -> Figure:
-    """Bifurcation diagrams of a two-field sweep: one panel per value of ``ds[by]`` (at most
-    `max_panels`, evenly chosen, first and last included), each showing ``ds[coord]`` (dims
-    (param, by, 'section_point')) against ``ds[param]``, coloured by ``ds[period]`` (dims
-    (param, by)) as in `bifurcation`. Panels share both axes; one legend for all."""
-    p = _array(ds, param)
-    b = np.asarray(ds[by])
-    y = _array(ds, coord, dims=(param, by, "section_point") if hasattr(ds, "dims") else None)
-    per = _array(ds, period, dims=(param, by) if hasattr(ds, "dims") else None)
-    if y.ndim == 2:
-        y = y[:, :, None]
-    if y.shape[:2] != (len(p), len(b)) or per.shape != (len(p), len(b)):
-        raise ValueError(f"{coord} must have shape ({len(p)}, {len(b)}, n_points) and {period} "
-                         f"({len(p)}, {len(b)}), got {y.shape} and {per.shape}")
-    pick = np.unique(np.linspace(0, len(b) - 1, min(len(b), max(1, max_panels)))
-                     .round().astype(int))
-    factor, unit = _prefix(y, _units(ds, coord, "m", units))
-    px, ux = _prefix(p, _units(ds, param, "", units))
-    bv, blabels, bf, bu = _axis_values(ds, by, units)
-    n = len(pick)
-    ncols = min(4, int(np.ceil(np.sqrt(n))))
-    nrows = int(np.ceil(n / ncols))
-    fig = Figure(figsize=(3.6 * ncols + 1.0, 2.9 * nrows + 1.2), layout="constrained")
-    axes = fig.subplots(nrows, ncols, sharex=True, sharey=True, squeeze=False)
-    seen = {}
-    for k, j in enumerate(pick):
-        ax = axes.flat[k]
-        for h in _bifurcation_points(ax, p / px, y[:, j, :] / factor, per[:, j], counts=False,
-                                     ms=6):
-            seen.setdefault(h.get_label(), h)
-        value = blabels[j] if blabels else f"{bv[j]:.4g}" + (f" {bu}" if bu else "")
-        ax.set_title(f"{by} = {value}", fontsize=9)
-    for ax in axes.flat[n:]:
-        ax.set_axis_off()
-    for k in range(max(0, n - ncols), n):     # the lowest panel of each column
-        axes.flat[k].tick_params(labelbottom=True)
-        axes.flat[k].set_xlabel(_label(ds, param, factor_unit=ux), fontsize=9)
-    for ax in axes[:, 0]:
-        ax.set_ylabel(_label(ds, coord, factor_unit=unit), fontsize=9)
-    order = [_period_name(c) for c in (1, 2, 3, 4, 5, 0)]
-    handles = [seen[name] for name in order if name in seen]
-    fig.legend(handles=handles, fontsize=8, loc="outside lower center", ncols=len(handles),
-               frameon=False)
-    shown = "" if n == len(b) else f" ({n} of {len(b)} values of {by})"
-    fig.suptitle((title or f"bifurcation diagrams: {_long_name(ds, coord)} vs "
-                  f"{_long_name(ds, param)}") + shown)
-    return _finish(fig, path)
-
-
-def param_map(ds, var: str, x: str, y: str, path=None, title: str | None = None,
-              units: dict | None = None) -> Figure:
-    """A quantity of a two-field sweep as a map over the grid: ``ds[var]`` (dims (x, y))
-    with ``ds[x]`` across and ``ds[y]`` up, one cell per run. A period (`var` named
-    'period...') is drawn in the period colours of `bifurcation` (not periodic grey, no result
-    white); a quantity of both signs (e.g. a Lyapunov exponent) on a blue-red scale centred on
-    zero; anything else on viridis. Cells without a value (NaN: failed runs) stay white."""
-    v = _array(ds, var, dims=(x, y) if hasattr(ds, "dims") else None)
-    xv, xlab, _, xu = _axis_values(ds, x, units)
-    yv, ylab, _, yu = _axis_values(ds, y, units)
-    if v.shape != (len(xv), len(yv)):
-        raise ValueError(f"{var} must have shape ({len(xv)}, {len(yv)}), got {v.shape}")
-    fig = Figure(figsize=(9, 6.5), layout="constrained")
-    ax = fig.add_subplot()
-    ax.set_facecolor("white")
-    X, Y = np.meshgrid(xv, yv, indexing="ij")
-    if var.startswith("period"):
-        cls = np.where(np.isfinite(v), _period_class(v), -1).astype(float)
-        cls[cls < 0] = np.nan
-        colours = [NOT_PERIODIC] + [PERIOD_COLOURS[c] for c in (1, 2, 3, 4, 5)]
-        mesh = ax.pcolormesh(X, Y, np.ma.masked_invalid(cls), shading="nearest",
-                             cmap=ListedColormap(colours),
-                             norm=BoundaryNorm(np.arange(-0.5, 6.5), 6), edgecolors="w",
-                             linewidth=0.3 if max(v.shape) <= 30 else 0, rasterized=True)
-        cb = fig.colorbar(mesh, ax=ax, pad=0.01, ticks=np.arange(6))
-        cb.ax.set_yticklabels(["not periodic", "1", "2", "3", "4", "> 4"])
-        cb.set_label("period of the section sequence (white: no result)")
-    else:
-        finite = v[np.isfinite(v)]
-        lo, hi = (finite.min(), finite.max()) if finite.size else (0.0, 1.0)
-        if lo < 0 < hi:
-            norm, cmap = TwoSlopeNorm(0.0, lo, hi), "RdBu_r"
-        else:
-            norm, cmap = None, "viridis"
-        mesh = ax.pcolormesh(X, Y, np.ma.masked_invalid(v), shading="nearest", cmap=cmap,
-                             norm=norm, rasterized=True)
-        cb = fig.colorbar(mesh, ax=ax, pad=0.01)
-        cb.set_label(_label(ds, var, units=units))
-    for lab, set_ticks, set_labels, pos in ((xlab, ax.set_xticks, ax.set_xticklabels, xv),
-                                            (ylab, ax.set_yticks, ax.set_yticklabels, yv)):
-        if lab:
-            set_ticks(pos)
-            set_labels(lab)
-    ax.set_xlabel(_label(ds, x, factor_unit=xu))
-    ax.set_ylabel(_label(ds, y, factor_unit=yu))
-    ax.set_title(title or f"{_long_name(ds, var)} over {x} and {y}")
-    return _finish(fig, path)
-
-
-# --------------------------------------------------------------------------- Lyapunov
-
-def lyapunov_vs_param(ds, param: str, var: str = "lyapunov", path=None,
-                      title: str | None = None, units: dict | None = None) -> Figure:
-    """Largest Lyapunov exponent ``ds[var]`` [1/s] against the swept ``ds[param]``, with a zero
-    line (above it, shaded: chaos) and, on the right axis (log scale), the predictability
-    horizon 1/lambda [s] of the runs with lambda > 0 (lambda <= 0: no horizon, infinite).
-    Error bars of half the spread ``ds[var + '_spread']`` when the dataset has it (e.g. the
-    spread of `largest_lyapunov_fit`); a run then counts as chaotic (gets a horizon) only if its
-    exponent exceeds its whole spread, so an estimate of +2 1/s with a spread of 20 is not
-    called chaos.
-    `units` as in `bifurcation`."""
-    p = _array(ds, param)
-    lam = _array(ds, var)
-    unit = _units(ds, var, "1/s", units)
-    px, ux = _prefix(p, _units(ds, param, "", units))
-    x = p / px
-    fig = Figure(figsize=(9, 5.5), layout="constrained")
-    ax = fig.add_subplot()
-    ax.axhline(0, color="k", lw=0.8)
-    spread = _array(ds, var + "_spread") if var + "_spread" in ds else None
-    ax.errorbar(x, lam, yerr=None if spread is None else spread / 2, fmt="o-", ms=4, lw=1,
-                color="tab:blue", ecolor="0.5", capsize=2)
-    # chaotic: positive beyond its spread (analysis.is_chaotic, restated: this module stands alone)
-    pos = np.isfinite(lam) & (lam > (0.0 if spread is None else
-                                     np.maximum(np.nan_to_num(spread, nan=0.0), 0.0)))
-    lo, hi = ax.get_ylim()
-    if hi > 0:
-        ax.axhspan(0, hi, color="tab:red", alpha=0.06, lw=0)
-        ax.set_ylim(lo, hi)
-    ax.set_xlabel(_label(ds, param, factor_unit=ux))
-    ax.set_ylabel(f"largest Lyapunov exponent lambda [{unit}]")
-    ax.grid(alpha=0.3, lw=0.5)
-    h_unit = "s" if unit == "1/s" else f"1/({unit})"
-    handles = [Line2D([], [], marker="o", color="tab:blue", label="lambda (left axis)"),
-               Patch(facecolor="tab:red", alpha=0.15, label="lambda > 0: chaotic")]
-    if pos.any():
-        ax2 = ax.twinx()
-        ax2.plot(x[pos], 1.0 / lam[pos], "s", mfc="none", mec="tab:orange", ms=6)
-        ax2.set_yscale("log")
-        ax2.set_ylabel(f"predictability horizon 1/lambda [{h_unit}]", color="tab:orange")
-        ax2.tick_params(axis="y", colors="tab:orange", which="both")
-        handles.append(Line2D([], [], ls="", marker="s", mfc="none", mec="tab:orange",
-                              label="horizon 1/lambda where lambda > its spread "
-                                    "(right axis)"))
-    fig.legend(handles=handles, fontsize=8, loc="outside lower center", ncols=3, frameon=False)
-    ax.set_title(title or f"largest Lyapunov exponent vs {_long_name(ds, param)}")
-    return _finish(fig, path)
-
-
-# --------------------------------------------------------------------------- waterfall
-
-def waterfall(ds, speed: str = "speed_rpm", freq: str = "freq_hz", amp: str = "amplitude",
-              z: int | None = None, max_order: float | None = None, path=None,
-              style: str = "map", floor: float = 1e-4, title: str | None = None,
-              units: dict | None = None) -> Figure:
-    """Spectra against speed: frequency [Hz] on x, speed [rpm] on y.
-
-    ``ds[amp]`` has dims (speed, freq); ``ds[freq]`` is 1-D (one frequency grid for all) or
-    (speed, freq). Amplitudes are on a log scale from `floor` times the largest one up: as
-    colour (style 'map', default) or as the height of one line per speed above its speed
-    (style 'lines', full height 0.9 of the smallest speed step). Neighbouring bins are merged
-    keeping the largest (peak hold) down to about 500 columns, so narrow tones stay visible.
-    Shaft orders 1x, 2x (grey/white) and, given `z`, the tooth-pass orders Zx, 2Zx (red) are
-    dashed diagonal lines f = k rpm / 60. The frequency axis ends at `max_order` shaft orders of
-    the highest speed (default 2.5 Z if `z` is given), or at the highest frequency."""
-    rpm = _array(ds, speed)
-    a = _array(ds, amp, dims=(speed, freq) if hasattr(ds, "dims") else None)
-    f = _array(ds, freq)
-    if f.ndim == 1:
-        f = np.broadcast_to(f, a.shape)
-    if a.shape != f.shape or a.ndim != 2 or a.shape[0] != rpm.shape[0]:
-        raise ValueError(f"{amp} must have shape ({len(rpm)}, n_freq) matching {freq}, got "
-                         f"{a.shape} and {f.shape}")
-    if style not in ("map", "lines"):
-        raise ValueError(f"style must be 'map' or 'lines', got {style!r}")
-    order = np.argsort(rpm)
-    rpm, a, f = rpm[order], a[order], f[order]
-    if max_order is None and z:
-        max_order = 2.5 * z
-    f_max = np.nanmax(f)
-    if max_order is not None:
-        f_max = min(f_max, max_order * np.abs(rpm).max() / 60.0)
-    f, a = _peak_hold(f, a, f_max)
-    amp_unit = _units(ds, amp, "", units)
-    top = np.nanmax(a)
-    top = top if top > 0 else 1.0
-    fig = Figure(figsize=(10, 6.5), layout="constrained")
-    ax = fig.add_subplot()
-    dark = style == "map"
-    if dark:
-        rr = np.broadcast_to(rpm[:, None], a.shape)
-        mesh = ax.pcolormesh(f, rr, np.clip(a, top * floor, None), shading="nearest",
-                             norm=LogNorm(vmin=top * floor, vmax=top), cmap="magma",
-                             rasterized=True)
-        cb = fig.colorbar(mesh, ax=ax, pad=0.01)
-        cb.set_label(f"amplitude [{amp_unit}]" if amp_unit else "amplitude")
-    else:
-        step = np.diff(rpm).min() if len(rpm) > 1 else 1.0
-        decades = -np.log10(floor)
-        for r, fi, ai in zip(rpm, f, a):
-            h = np.clip(np.log10(np.clip(ai, top * floor, None) / top) / decades + 1, 0, 1)
-            ax.fill_between(fi, r, r + 0.9 * step * h, color="tab:blue", alpha=0.25, lw=0)
-            ax.plot(fi, r + 0.9 * step * h, lw=0.7, color="tab:blue")
-        ax.text(0.99, 0.01, f"line height: log scale, {top * floor:.2g} to {top:.3g} "
-                f"{amp_unit}".rstrip(), transform=ax.transAxes, ha="right", va="bottom",
-                fontsize=8, bbox=dict(fc="w", ec="none", alpha=0.8))
-    ax.set_xlim(0, f_max)
-    y_lo, y_hi = ax.get_ylim()
-    for k, text, st in _order_marks(z):
-        colour = "w" if dark and st is SHAFT_STYLE else st["color"]
-        ax.plot([0.0, k * y_hi / 60.0], [0.0, y_hi], **dict(st, color=colour))
-        if k * y_hi / 60.0 <= f_max:      # label where the line leaves the plot
-            ax.text(k * y_hi / 60.0, y_hi, text, ha="center", va="bottom", fontsize=8,
-                    color=st["color"])
-        else:
-            ax.text(f_max, 60.0 * f_max / k, text + " ", ha="right", va="bottom", fontsize=8,
-                    color=colour, fontweight="bold")
-    ax.set_ylim(y_lo, y_hi)
-    ax.set_xlabel(_label(ds, freq, units=units) if _units(ds, freq, "", units)
-                  else "frequency [Hz]")
-    ax.set_ylabel(_label(ds, speed, units=units) if _units(ds, speed, "", units)
-                  else "shaft speed [rpm]")
-    what = "" if not z else f", tooth pass {z}x"
-    ax.set_title(title or f"spectra vs speed (dashed: shaft orders 1x, 2x{what})", pad=16)
-    return _finish(fig, path)
 
 
 # --------------------------------------------------------------------------- scene
 
-def _tooth_map(fig, ax, t, q, label, cmap):
+def _time_signal(ax, t, x, name, unit, colour, rtol, scale=0.0):
+    """x(t) on ax with an SI prefix and no offset text; a round-off signal (`ps.roundoff_span`)
+    on +-1 % around its value, with a note. Returns (factor, prefixed unit, span or None)."""
+    span = ps.roundoff_span(x, scale, rtol)
+    size = ps.scale_of(x, scale)
+    k, u = ps.prefix([size] if span is not None else x, unit)
+    ax.plot(t, x / k, lw=0.7, color=colour)
+    ax.set_ylabel(f"{name} [{u}]" if u else name)
+    ax.grid(alpha=0.3, lw=0.5)
+    ax.ticklabel_format(axis="y", useOffset=False)
+    if span is not None:
+        ax.set_ylim(*(v / k for v in ps.flat_limits(float(np.nanmean(x)), scale)))
+        ps.note(ax, ps.no_content(span, unit))
+    return k, u, span
+
+
+def _tooth_map(fig, ax, t, q, label, cmap, rtol):
     q = np.asarray(q, dtype=float)
+    ax.set_xlabel("time t [s]")
     if q.ndim == 1:                      # a per-time summary (e.g. max over teeth)
-        ax.plot(t, q, lw=0.7, color="tab:red")
-        ax.set_xlabel("time t [s]")
-        ax.set_ylabel(label)
-        ax.grid(alpha=0.3, lw=0.5)
+        _time_signal(ax, t, q, label, "", "tab:red", rtol)
         return
     zt = q.shape[1]
+    lo, hi, words = ps.settled_limits(t, q, rtol)
     im = ax.imshow(q.T, aspect="auto", origin="lower", cmap=cmap, interpolation="nearest",
-                   extent=(t[0], t[-1], 0.5, zt + 0.5))
-    ax.set_xlabel("time t [s]")
+                   extent=(t[0], t[-1], 0.5, zt + 0.5), vmin=lo, vmax=hi)
     ax.set_ylabel("tooth j")
     ax.yaxis.set_major_locator(MaxNLocator(nbins=8, integer=True, min_n_ticks=1))
-    cb = fig.colorbar(im, ax=ax, pad=0.02)
-    cb.set_label(label)
+    cb = fig.colorbar(im, ax=ax, pad=0.02, extend="both" if "clipped" in words else "neither",
+                      format=ps.ENG_FORMATTER)
+    cb.set_label(f"{label}\n({words})" if words else label)
 
 
 def _absent(ax, text):
@@ -450,19 +74,25 @@ def _absent(ax, text):
 
 
 def scene(t, D2, vD2, Tm, F, Tf=None, section=None, spectrum=None, speed_rpm=None,
-          z: int | None = None, path=None, title: str | None = None) -> Figure:
+          z: int | None = None, path=None, title: str | None = None,
+          rtol: float = 1e-8) -> Figure:
     """One page on one run.
 
     t [s] (nt,); D2 [m] and vD2 = dD2/dt [m/s] (nt,); Tm, the meshing torque [N m] (nt,);
     F, the tooth loads [N] (nt, Z); Tf, flash temperatures [degC] (nt, Z) or their maximum
     over the teeth (nt,); section, Poincare points (n, 2) as (D2 [m], dD2/dt [m/s]); spectrum,
     ``(freq_hz, amplitude)`` of Tm [Hz, N m] (e.g. from analysis.amplitude_spectrum);
-    speed_rpm [rpm] and z (teeth) for the order marks (z defaults to F.shape[1]).
+    speed_rpm [rpm] and z (teeth) for the order marks (z defaults to F.shape[1]); rtol, the
+    relative tolerance the run was computed with (case['rtol']), for the round-off test.
 
     Panels: D2(t); T_m(t); phase plane (D2, dD2/dt) with the section points; tooth x time map
-    of F; the same of T_f (or its max over teeth); spectrum of T_m up to 2.5 Z shaft orders,
-    with shaft orders (1x, 2x) and tooth-pass orders (Zx, 2Zx) dashed and a shaft-order axis
-    on top. A panel whose data is not given says so."""
+    of F; the same of T_f (or its max over teeth); spectrum of T_m up to 2.5 Z shaft orders
+    and at most the Nyquist frequency, with shaft orders (1x, 2x) and tooth-pass orders (Zx,
+    2Zx) dashed and a shaft-order axis on top. A panel whose data is not given says so; a
+    signal that is round-off says "no dynamic content" (dD2/dt with D2, on a range of omega
+    |D2|, omega the shaft's angular speed); the colour maps take their range from the
+    second half of the run; a tooth pass above the Nyquist frequency is named on the spectrum
+    and warned about (SplineWarning, with the n_out that resolves it)."""
     t = np.asarray(t, dtype=float)
     D2 = np.asarray(D2, dtype=float)
     vD2 = np.asarray(vD2, dtype=float)
@@ -475,6 +105,10 @@ def scene(t, D2, vD2, Tm, F, Tf=None, section=None, spectrum=None, speed_rpm=Non
             raise ValueError(f"{name} has {arr.shape[0]} samples, t has {t.shape[0]}")
     if z is None:
         z = F.shape[1]
+    duration = float(t[-1] - t[0]) if len(t) > 1 else 0.0
+    f_shaft = None if not speed_rpm else abs(float(speed_rpm)) / 60.0
+    omega = 2 * np.pi * (f_shaft or (1.0 / duration if duration > 0 else 1.0))
+    v_scale = omega * ps.scale_of(D2)
     fig = Figure(figsize=(16, 11), layout="constrained")
     gs = fig.add_gridspec(3, 3, height_ratios=(1, 1, 1.2), width_ratios=(1, 1, 1.05))
     ax_d = fig.add_subplot(gs[0, :2])
@@ -484,32 +118,15 @@ def scene(t, D2, vD2, Tm, F, Tf=None, section=None, spectrum=None, speed_rpm=Non
     ax_tf = fig.add_subplot(gs[2, 1])
     ax_s = fig.add_subplot(gs[2, 2])
 
-    kd, ud = _prefix(D2, "m")
-    kv, uv = _prefix(vD2, "m/s")
-    ax_d.plot(t, D2 / kd, lw=0.7)
-    ax_d.set_ylabel(f"D_2 [{ud}]")
+    kd, ud, d_flat = _time_signal(ax_d, t, D2, "D_2", "m", "tab:blue", rtol)
     ax_d.set_title("relative displacement D_2 on the line of action", fontsize=10)
     ax_d.tick_params(labelbottom=False)
-    ax_t.plot(t, Tm, lw=0.7, color="tab:green")
-    ax_t.set_ylabel("T_m [N m]")
+    _, _, tm_flat = _time_signal(ax_t, t, Tm, "T_m", "N m", "tab:green", rtol)
     ax_t.set_xlabel("time t [s]")
     ax_t.set_title("meshing torque T_m", fontsize=10)
-    for ax in (ax_d, ax_t):
-        ax.grid(alpha=0.3, lw=0.5)
-        ax.ticklabel_format(axis="y", useOffset=False)
 
-    ax_p.plot(D2 / kd, vD2 / kv, lw=0.4, color="0.55", label="trajectory")
-    if section is not None:
-        s = np.asarray(section, dtype=float).reshape(-1, 2)
-        ax_p.plot(s[:, 0] / kd, s[:, 1] / kv, "o", ms=4, color="tab:red", zorder=3,
-                  label=f"section points ({len(s)})")
-    ax_p.legend(fontsize=8, loc="upper right")
-    ax_p.set_xlabel(f"D_2 [{ud}]")
-    ax_p.set_ylabel(f"dD_2/dt [{uv}]")
-    ax_p.set_title("phase plane", fontsize=10)
-    ax_p.grid(alpha=0.3, lw=0.5)
-
-    _tooth_map(fig, ax_f, t, F, "tooth load F_j [N]", "viridis")
+    _phase_plane(ax_p, D2, vD2, section, (kd, ud, d_flat), v_scale)
+    _tooth_map(fig, ax_f, t, F, "tooth load F_j [N]", "viridis", rtol)
     ax_f.set_title("tooth load F_j", fontsize=10)
     if Tf is None:
         _absent(ax_tf, "flash temperature T_f\nnot given")
@@ -517,136 +134,80 @@ def scene(t, D2, vD2, Tm, F, Tf=None, section=None, spectrum=None, speed_rpm=Non
         Tf = np.asarray(Tf, dtype=float)
         two_d = Tf.ndim == 2
         _tooth_map(fig, ax_tf, t, Tf, "flash temperature T_f [°C]" if two_d
-                   else "max over teeth of T_f [°C]", "inferno")
+                   else "max over teeth of T_f [°C]", "inferno", rtol)
         ax_tf.set_title("flash temperature T_f" if two_d else "flash temperature, hottest tooth",
                         fontsize=10)
-
     if spectrum is None:
         _absent(ax_s, "spectrum of T_m not given\n(spectrum=amplitude_spectrum(t, Tm))")
     else:
-        fr, am = (np.asarray(v, dtype=float) for v in spectrum)
-        f_shaft = None if speed_rpm is None else abs(float(speed_rpm)) / 60.0
-        f_max = fr.max() if not f_shaft else min(fr.max(), 2.5 * z * f_shaft)
-        keep = (fr > 0) & (fr <= f_max)
-        ax_s.semilogy(fr[keep], am[keep], lw=0.8, color="tab:green")
-        pos = am[keep][am[keep] > 0]
-        if pos.size:
-            ax_s.set_ylim(max(pos.min(), pos.max() * 1e-4), pos.max() * 3)
-        ax_s.set_xlim(0, f_max)
-        if f_shaft:
-            handles = []
-            for k, text, st in _order_marks(z):
-                if k * f_shaft <= f_max:
-                    ax_s.axvline(k * f_shaft, **st)
-            handles.append(Line2D([], [], **SHAFT_STYLE, label="shaft orders 1x, 2x"))
-            handles.append(Line2D([], [], **TOOTH_STYLE, label=f"tooth pass {z}x, {2 * z}x"))
-            ax_s.legend(handles=handles, fontsize=8, loc="upper right", framealpha=0.9)
-            sec = ax_s.secondary_xaxis("top", functions=(lambda f: f / f_shaft,
-                                                         lambda o: o * f_shaft))
-            sec.set_xlabel("shaft order", fontsize=8)
-            sec.tick_params(labelsize=8)
-        ax_s.set_xlabel("frequency [Hz]")
-        ax_s.set_ylabel("amplitude of T_m [N m]")
-        ax_s.set_title("spectrum of T_m", fontsize=10)
-        ax_s.grid(alpha=0.3, lw=0.5, which="major")
+        _spectrum(ax_s, spectrum, f_shaft, z, speed_rpm, duration, tm_flat)
     if title:
         fig.suptitle(title)
-    return _finish(fig, path)
+    return ps.finish(fig, path)
 
 
-# --------------------------------------------------------------------------- sweep figures
-
-def sweep_figures(ds, out) -> list[Path]:
-    """The figures of a sweep dataset into directory `out`: bifurcation.png (and for a grid
-    period_map.png), lyapunov.png (if computed), waterfall*.png (if speed_rpm was swept).
-    The horizontal axis is the first swept field with numeric values (a field of text values,
-    e.g. thermal, becomes the panels or the map's other axis). Returns the paths written."""
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    names = list(ds["error"].dims)
-    numeric = [n for n in names if ds[n].dtype.kind in "biuf"]
-    written = []
-    title_case = _case_name(ds)
-    section = ds.attrs.get("section", "")
-    if not numeric:
-        print(f"no figures: no swept field has numeric values ({', '.join(names)})",
-              file=sys.stderr)
-        return written
-    x = numeric[0]
-    other = [n for n in names if n != x]
-    if "section_D2" in ds:
-        path = out / "bifurcation.png"
-        if not other:
-            bifurcation(ds, x, path=path,
-                        title=f"{title_case}: D_2 on the {section} section vs {x}")
-        else:
-            bifurcation_grid(ds, x, other[0], path=path,
-                             title=f"{title_case}: D_2 on the {section} section")
-            param_map(ds, "period", x, other[0], path=out / "period_map.png",
-                      title=f"{title_case}: period of the {section} section sequence")
-        written.append(path)
-        if other:
-            written.append(out / "period_map.png")
-    if "lyapunov" in ds:
-        path = out / "lyapunov.png"
-        if not other:
-            lyapunov_vs_param(ds, x, path=path,
-                              title=f"{title_case}: largest Lyapunov exponent vs {x}")
-        else:
-            param_map(ds, "lyapunov", x, other[0], path=path,
-                      title=f"{title_case}: largest Lyapunov exponent")
-        written.append(path)
-    if "Tm_spectrum" in ds and "speed_rpm" in numeric:
-        written += _waterfalls(ds, out, title_case)
-    return written
+def _phase_plane(ax, D2, vD2, section, d_axis, v_scale):
+    """(D2, dD2/dt) with the section points; when D2 is round-off, both axes are drawn on
+    +-1 % around their values (dD2/dt of v_scale), and the panel says so."""
+    kd, ud, d_flat = d_axis
+    v_flat = None if d_flat is None else float(np.ptp(vD2))   # v = dD2/dt: flat with D2
+    kv, uv = ps.prefix([v_scale] if v_flat is not None else vD2, "m/s")
+    ax.plot(D2 / kd, vD2 / kv, lw=0.4, color="0.55", label="trajectory")
+    if section is not None:
+        s = np.asarray(section, dtype=float).reshape(-1, 2)
+        ax.plot(s[:, 0] / kd, s[:, 1] / kv, "o", ms=4, color="tab:red", zorder=3,
+                label=f"section points ({len(s)})")
+    ax.legend(fontsize=8, loc="upper right")
+    ax.set_xlabel(f"D_2 [{ud}]")
+    ax.set_ylabel(f"dD_2/dt [{uv}]")
+    ax.set_title("phase plane", fontsize=10)
+    ax.grid(alpha=0.3, lw=0.5)
+    ax.ticklabel_format(useOffset=False)
+    ax.xaxis.set_major_locator(MaxNLocator(nbins=6))
+    words = []
+    if d_flat is not None:
+        ax.set_xlim(*(v / kd for v in ps.flat_limits(float(np.nanmean(D2)), 0.0)))
+        words.append(f"D_2: {ps.no_content(d_flat, 'm')}")
+    if v_flat is not None:
+        ax.set_ylim(*(v / kv for v in ps.flat_limits(float(np.nanmean(vD2)), v_scale)))
+        words.append(f"dD_2/dt: {ps.no_content(v_flat, 'm/s')}")
+    if words:
+        ps.note(ax, "\n".join(words), loc="lower left")
 
 
-def _case_name(ds) -> str:
-    m = re.search(r"name\s*=\s*'([^']*)'", ds.attrs.get("case", ""))
-    return m.group(1) if m else "sweep"
-
-
-def _waterfall_ds(sub):
-    import xarray as xr
-    spd = sub["speed_rpm"]
-    freq = np.abs(spd.values)[:, None] * sub["order"].values[None, :] / 60.0
-    return xr.Dataset({"amplitude": (("speed_rpm", "order"),
-                                     sub["Tm_spectrum"].transpose("speed_rpm", "order").values,
-                                     {"units": "N m", "long_name": "amplitude of T_m"}),
-                       "freq_hz": (("speed_rpm", "order"), freq,
-                                   {"units": "Hz", "long_name": "frequency"})},
-                      coords={"speed_rpm": spd})
-
-
-def _z(ds) -> int | None:
-    from .case import defaults
-    m = re.search(r"\bz\s*=\s*(\d+)", ds.attrs.get("case", ""))
-    return int(m.group(1)) if m else defaults()["z"]
-
-
-def _waterfalls(ds, out, title_case) -> list[Path]:
-    names = list(ds["error"].dims)
-    z = None if "z" in names else _z(ds)
-    if len(names) == 1:
-        path = out / "waterfall.png"
-        waterfall(_waterfall_ds(ds), z=z, path=path,
-                  title=f"{title_case}: spectrum of T_m vs speed (dashed: shaft and "
-                        "tooth-pass orders)")
-        return [path]
-    other = names[0] if names[1] == "speed_rpm" else names[1]
-    values = ds[other].values
-    pick = np.unique(np.linspace(0, len(values) - 1, min(len(values), 6)).round().astype(int))
-    paths = []
-    for i in pick:
-        v = values[i]
-        sub = ds.isel({other: i})
-        path = out / f"waterfall_{other}={_fmt(v)}.png"
-        waterfall(_waterfall_ds(sub), z=z, path=path,
-                  title=f"{title_case}, {other} = {_fmt(v)}: spectrum of T_m vs speed")
-        paths.append(path)
-    return paths
-
-
-def _fmt(v) -> str:
-    v = v.item() if hasattr(v, "item") else v
-    return f"{v:g}" if isinstance(v, float) else str(v)
+def _spectrum(ax, spectrum, f_shaft, z, speed_rpm, duration, tm_flat):
+    """The spectrum of T_m up to 2.5 Z shaft orders and at most the Nyquist frequency (the
+    highest frequency given), with the order marks; says when the tooth pass is beyond the
+    Nyquist frequency (and warns) or when T_m is round-off."""
+    fr, am = (np.asarray(v, dtype=float) for v in spectrum)
+    f_nyq = fr.max()
+    f_max = f_nyq if not f_shaft else min(f_nyq, 2.5 * z * f_shaft)
+    keep = (fr > 0) & (fr <= f_max)
+    ax.semilogy(fr[keep], am[keep], lw=0.8, color="0.6" if tm_flat is not None else "tab:green")
+    pos = am[keep][am[keep] > 0]
+    if pos.size:
+        ax.set_ylim(max(pos.min(), pos.max() * 1e-4), pos.max() * 3)
+    ax.set_xlim(0, f_max)
+    words = []
+    if tm_flat is not None:
+        words.append(f"T_m: {ps.no_content(tm_flat, 'N m')}:\nthese amplitudes are round-off")
+    if f_shaft:
+        for k, text, st in ps.order_marks(z):
+            if k * f_shaft <= f_max:
+                ax.axvline(k * f_shaft, **st)
+        handles = [Line2D([], [], **ps.SHAFT_STYLE, label="shaft orders 1x, 2x"),
+                   Line2D([], [], **ps.TOOTH_STYLE, label=f"tooth pass {z}x, {2 * z}x")]
+        ax.legend(handles=handles, fontsize=8, loc="upper right", framealpha=0.9)
+        sec = ax.secondary_xaxis("top", functions=(lambda f: f / f_shaft,
+                                                   lambda o: o * f_shaft))
+        sec.set_xlabel("shaft order", fontsize=8)
+        sec.tick_params(labelsize=8)
+        if z and z * f_shaft > f_nyq:
+            text = ps.nyquist_note(z, z * f_shaft, f_nyq, speed_rpm, duration)
+            words.append(text.replace(": ", ":\n", 1).replace(" (", "\n(", 1))
+    if words:
+        ps.note(ax, "\n".join(words), loc="lower left")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("amplitude of T_m [N m]")
+    ax.set_title("spectrum of T_m", fontsize=10)
+    ax.grid(alpha=0.3, lw=0.5, which="major")

@@ -9,14 +9,21 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from .. import plotstyle as ps  # noqa: E402
+from ..plotstyle import eng  # noqa: E402
 from . import SETTLE, poincare, poincare_count  # noqa: E402
 
 
 def _time_panel(ax, res, y, label, unit):
+    """y(t); a y that is round-off (plotstyle.roundoff_span) on +-1 % around its value, noted."""
     ax.plot(res.t, y, lw=0.7)
     ax.ticklabel_format(axis="y", useOffset=False)
     ax.set_xlabel("time t [s]")
     ax.set_ylabel(f"{label} [{unit}]")
+    span = ps.roundoff_span(y, rtol=res.case["rtol"])
+    if span is not None:
+        ax.set_ylim(*ps.flat_limits(float(np.mean(y)), 0.0))
+        ps.note(ax, ps.no_content(span, unit))
 
 
 def _tooth_bars(ax_f, ax_fx, res):
@@ -34,7 +41,7 @@ def _tooth_bars(ax_f, ax_fx, res):
         ax.set_xticks(j)
         ax.axhline(0, color="k", lw=0.5)
     ax_f.legend(fontsize=7, loc="lower right")
-    ax_fx.set_title(f"sum of F_jx at that instant: {res.Fx[k].sum():.2e} N", fontsize=8)
+    ax_fx.set_title(f"sum of F_jx at that instant: {eng(res.Fx[k].sum(), 3)} N", fontsize=8)
 
 
 def dynamics_figure(res, path, title):
@@ -67,7 +74,7 @@ def misalignment_figure(results, names, path):
     for row, name in zip(axs, names):
         res = results[name]
         lx = res.case["l_x"]
-        _time_panel(row[0], res, res.D2 * 1e3, f"D_2, l_x = {lx:g} m", "mm")
+        _time_panel(row[0], res, res.D2 * 1e3, f"D_2, l_x = {eng(lx)} m", "mm")
         p = poincare(res)
         row[1].plot(res.D2 * 1e3, res.vD2, lw=0.4, color="0.6")
         row[1].plot(p[:, 0] * 1e3, p[:, 1], "o", ms=3, color="tab:red",
@@ -91,7 +98,8 @@ def temperature_figure(results, names, path, title=None):
     for row, name in zip(axs, names):
         res = results[name]
         _tooth_bars(row[0], row[1], res)
-        row[0].set_title(f"{name}: T_M = {res.case['t_bulk']:g} degC, l_x = {res.case['l_x']:g} m",
+        row[0].set_title(f"{name}: T_M = {eng(res.case['t_bulk'])} degC, "
+                         f"l_x = {eng(res.case['l_x'])} m",
                          fontsize=9)
         _time_panel(row[2], res, res.Tm, "meshing torque T_m", "N m")
         _time_panel(row[3], res, res.kv, "dynamic load coefficient k_v", "-")
@@ -110,10 +118,10 @@ def flash_figure(results, names, path):
         axs[0].plot(last.t, last.Tf[:, j], lw=0.5)
     axs[0].set_xlabel("time t [s]")
     axs[0].set_ylabel("flash temperature T_fj [degC]")
-    axs[0].set_title(f"every tooth, l_x = {last.case['l_x']:g} m", fontsize=9)
+    axs[0].set_title(f"every tooth, l_x = {eng(last.case['l_x'])} m", fontsize=9)
     for name in names:
         res = results[name]
-        axs[1].plot(res.t, res.Tf.max(axis=1), lw=0.6, label=f"l_x = {res.case['l_x']:g} m")
+        axs[1].plot(res.t, res.Tf.max(axis=1), lw=0.6, label=f"l_x = {eng(res.case['l_x'])} m")
     axs[1].set_xlabel("time t [s]")
     axs[1].set_ylabel("max over teeth of T_fj [degC]")
     axs[1].set_yscale("symlog", linthresh=1e-6)
@@ -123,7 +131,7 @@ def flash_figure(results, names, path):
     axs[2].plot(np.array(lx) * 1e3, tmax, "o-")
     axs[2].set_xlabel("misalignment l_x [mm]")
     axs[2].set_ylabel("largest flash temperature [degC]")
-    fig.suptitle(f"Flash temperature (paper Figs. 9-10), f_m = {last.case['f_m']:g}")
+    fig.suptitle(f"Flash temperature (paper Figs. 9-10), f_m = {eng(last.case['f_m'])}")
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)
