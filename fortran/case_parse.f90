@@ -8,7 +8,7 @@
 module spline_case_parse
   use spline_kinds, only: wp
   use spline_errors, only: err_ok, err_case, itoa
-  use spline_case_type, only: case_t, fields, nfields, field_index, namelen, ndof_case
+  use spline_case_type, only: case_t, fields, nfields, namelen, ndof_case
   use spline_case_text, only: lower, unquote, shown, clip, hint, is_digits, is_integer, &
        is_real, is_logical, is_value, expected, kind_word, element
   use spline_case_lex, only: tokenize, tk_word, tk_string, tk_equals, tk_comma, tk_slash, &
@@ -162,7 +162,7 @@ contains
         return
       end if
       name = lower(tok(p))
-      f = field_index(name)
+      f = field_of(name)
       if (f == 0) then
         call fail(line, 'unknown field '''//clip(tok(p))//''''//hint(name)); return
       end if
@@ -217,7 +217,7 @@ contains
         ! a word that names a field, or begins a line and is no value of this field: the
         ! '=' after a field name is missing
         if (tk(p) == tk_word) then
-          if (field_index(lower(tok(p))) > 0) then
+          if (field_of(lower(tok(p))) > 0) then
             call fail(tl(p), 'field '//lower(tok(p))//': expected ''='' after the field name, '// &
                  'found '//after(p)); return
           end if
@@ -327,11 +327,16 @@ contains
         end if
         n0 = verify(v, '+-0')          ! first significant digit
         if (n0 == 0) return            ! zero
+        ios = 0
         if (len(v) - n0 + 1 > 10) then
           ios = 1
         else
-          read(v, *, iostat=ios) iv
-          if (ios == 0 .and. abs(iv) > huge(0)) ios = 1
+          iv = 0
+          do n0 = n0, len(v)           ! at most 10 digits: no overflow of 64 bits
+            iv = 10*iv + (iachar(v(n0:n0)) - iachar('0'))
+          end do
+          if (v(1:1) == '-') iv = -iv
+          if (abs(iv) > huge(0)) ios = 1
         end if
         if (ios /= 0) then
           call fail(line, 'field '//trim(fields(f)%name)//' = '//clip(v)// &
@@ -480,6 +485,20 @@ contains
     end subroutine fail
 
   end subroutine parse_unlocked
+
+  !> Position of a field (lower-case name) in the table, 0 if none: spline_case_type's
+  !> field_index, comparing only names of the same length (it runs for every word of a text).
+  pure integer function field_of(name) result(f)
+    character(len=*), intent(in) :: name
+    integer, parameter :: name_len(nfields) = len_trim(fields%name)
+    integer :: n
+    n = len_trim(name)
+    do f = 1, nfields
+      if (name_len(f) /= n) cycle
+      if (fields(f)%name(1:n) == name(1:n)) return
+    end do
+    f = 0
+  end function field_of
 
   !> Element k of field f (the field table's numbering) of c: x, i, l or s by the field's type.
   !> One branch per field, in the order of the table (tests/test_input.py sets every element).
