@@ -1,19 +1,19 @@
 !> Reading a case's text (case_parse): the one diagnosis of a case, for the executable and for
 !> Python alike (pyspline hands the bytes of a case file to api_parse). The text is tokenised
 !> (spline_case_lex) and checked here, every error naming the line, the field and what was
-!> expected (unknown fields get the nearest field name as a suggestion); only text that
-!> passed is then read by the compiler's namelist input, one element per record, into a local
-!> copy (nml_io), so reading a case changes no module variable (reentrant). Writing a case as
-!> namelist text (case_write_text) uses the same namelist group.
+!> expected (unknown fields get the nearest field name as a suggestion). Each checked value is
+!> converted once and assigned to its element of a local copy (set_element), kept only if the
+!> whole text passed, so reading a case changes no module variable (reentrant). Writing a case
+!> as namelist text (case_write_text) uses the compiler's namelist output.
 module spline_case_parse
   use spline_kinds, only: wp
   use spline_errors, only: err_ok, err_case, itoa
-  use spline_case_type, only: case_t, fields, nfields, field_index, namelen, ndof_case
-  use spline_case_text, only: lower, unquote, quoted, shown, clip, hint, is_digits, is_integer, &
+  use spline_case_type, only: case_t, fields, nfields, namelen, ndof_case
+  use spline_case_text, only: lower, unquote, shown, clip, hint, is_digits, is_integer, &
        is_real, is_logical, is_value, expected, kind_word, element
   use spline_case_lex, only: tokenize, tk_word, tk_string, tk_equals, tk_comma, tk_slash, &
        tk_group, tk_subscript, tk_badstring, tk_other
-  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan, ieee_value, ieee_quiet_nan
   implicit none
   private
   public :: case_parse, case_write_text
@@ -67,9 +67,8 @@ contains
     logical, intent(in), optional :: show_lines
     integer, allocatable :: tk(:), ta(:), tb(:), tl(:)
     integer, allocatable :: set_line(:, :)
-    character(len=:), allocatable :: recs(:), from
-    character(len=256) :: iomsg
-    integer :: ntok, p, f, i0, i1, group_line, nrec
+    character(len=:), allocatable :: from
+    integer :: ntok, p, f, i0, i1, group_line
     logical :: lines_on
     type(case_t) :: work
     character(len=namelen) :: name_now
@@ -81,7 +80,7 @@ contains
     lines_on = len(from) > 0
     if (present(show_lines)) lines_on = lines_on .and. show_lines
     name_now = c%name
-    allocate(character(len=2*namelen + 48) :: recs(nfields*ndof_case + 2))
+    work = c
 
     call tokenize(text, tk, ta, tb, tl, ntok, i0, i1)
     if (i0 > 0) then
@@ -110,13 +109,9 @@ contains
     group_line = tl(1)
     p = 2
 
-    ! the items, checked first (nothing assigned yet), each element to one record in its
-    ! canonical form (short, whatever the text held: no element is given twice, so there are
-    ! at most nfields x 7 records)
+    ! the items, each checked element assigned to the copy (kept if the whole text passes)
     allocate(set_line(nfields, ndof_case))
     set_line = 0
-    nrec = 1
-    recs(1) = '&spline_case'
     do
       if (p > ntok) then
         call fail(tl(ntok), 'the group &spline_case opened on line '//itoa(group_line)// &
@@ -142,15 +137,6 @@ contains
       call fail(tl(p + 1), 'text after the end of the group &spline_case: '''// &
            clip(tok(p + 1))//''''); return
     end if
-    nrec = nrec + 1
-    recs(nrec) = '/'
-
-    ! the checked elements, read by the namelist input into a copy, then kept
-    work = c
-    call nml_io(work, ierr, iomsg, lines=recs(1:nrec))
-    if (ierr /= 0) then
-      call fail(0, 'the namelist input refused the checked text: '//trim(iomsg)); return
-    end if
     c = work
     ierr = err_ok
 
@@ -161,7 +147,10 @@ contains
       character(len=:), allocatable :: name
       integer :: lo, hi, k, r, q, line, pv
       logical :: after_sep
-      character(len=:), allocatable :: v, canon
+      character(len=:), allocatable :: v, sv
+      real(wp) :: x
+      integer :: iv
+      logical :: lv
       line = tl(p)
       if (tk(p) /= tk_word) then
         select case (tk(p))
@@ -173,7 +162,7 @@ contains
         return
       end if
       name = lower(tok(p))
-      f = field_index(name)
+      f = field_of(name)
       if (f == 0) then
         call fail(line, 'unknown field '''//clip(tok(p))//''''//hint(name)); return
       end if
@@ -228,7 +217,7 @@ contains
         ! a word that names a field, or begins a line and is no value of this field: the
         ! '=' after a field name is missing
         if (tk(p) == tk_word) then
-          if (field_index(lower(tok(p))) > 0) then
+          if (field_of(lower(tok(p))) > 0) then
             call fail(tl(p), 'field '//lower(tok(p))//': expected ''='' after the field name, '// &
                  'found '//after(p)); return
           end if
@@ -270,7 +259,7 @@ contains
           call too_many(r); return
         end if
         if (len(v) > 0) then
-          call check_value(v, tk(p), tl(p), canon)
+          call check_value(v, tk(p), tl(p), x, iv, lv, sv)
           if (ierr /= err_ok) return
           do q = k, k + r - 1
             if (set_line(f, q) /= 0) then
@@ -278,8 +267,11 @@ contains
                    itoa(set_line(f, q))//' and '//itoa(tl(pv))//')'); return
             end if
             set_line(f, q) = tl(pv)
-            nrec = nrec + 1
-            recs(nrec) = 'c%'//trim(element(f, q))//' = '//canon
+            if (.not. set_element(work, f, q, x, iv, lv, sv)) then
+              call fail(tl(pv), 'field '//trim(fields(f)%name)//' has no place in the reader '// &
+                   '(set_element in fortran/case_parse.f90 is out of step with the field table)')
+              return
+            end if
           end do
         end if
         k = k + r
@@ -318,19 +310,19 @@ contains
       call fail(tl(p), why)
     end subroutine too_many
 
-    !> The value v (a token of kind kind) for field f; canon: the value as the namelist input
-    !> gets it (a whole number, a real to 17 digits, .true./.false., a quoted string).
-    subroutine check_value(v, kind, line, canon)
+    !> The value v (a token of kind kind) for field f, as the field's type: x (a real; NaN
+    !> the quiet NaN), i (a whole number), l (a logical) or s (a string's characters).
+    subroutine check_value(v, kind, line, x, i, l, s)
       character(len=*), intent(in) :: v
       integer, intent(in) :: kind, line
-      character(len=:), allocatable, intent(out) :: canon
-      character(len=:), allocatable :: content
-      real(wp) :: x
+      real(wp), intent(out) :: x
+      integer, intent(out) :: i
+      logical, intent(out) :: l
+      character(len=:), allocatable, intent(out) :: s
       integer(8) :: iv
       integer :: ios, n0
       character(len=len(v)) :: u
-      character(len=32) :: buf
-      canon = ''
+      x = 0.0_wp; i = 0; l = .false.; s = ''
       select case (fields(f)%kind)
       case ('i')
         if (kind /= tk_word .or. .not. is_integer(v)) then
@@ -338,20 +330,23 @@ contains
                expected(f)); return
         end if
         n0 = verify(v, '+-0')          ! first significant digit
-        if (n0 == 0) then              ! zero
-          canon = '0'; return
-        end if
+        if (n0 == 0) return            ! zero
+        ios = 0
         if (len(v) - n0 + 1 > 10) then
           ios = 1
         else
-          read(v, *, iostat=ios) iv
-          if (ios == 0 .and. abs(iv) > huge(0)) ios = 1
+          iv = 0
+          do n0 = n0, len(v)           ! at most 10 digits: no overflow of 64 bits
+            iv = 10*iv + (iachar(v(n0:n0)) - iachar('0'))
+          end do
+          if (v(1:1) == '-') iv = -iv
+          if (abs(iv) > huge(0)) ios = 1
         end if
         if (ios /= 0) then
           call fail(line, 'field '//trim(fields(f)%name)//' = '//clip(v)// &
                ' does not fit a 32-bit integer (at most '//itoa(huge(0))//')'); return
         end if
-        canon = itoa(int(iv))
+        i = int(iv)
       case ('r')
         if (kind /= tk_word .or. .not. is_real(v)) then
           call fail(line, 'field '//trim(fields(f)%name)//' = '//clip(v)//': expected '// &
@@ -370,33 +365,24 @@ contains
           call fail(line, 'field '//trim(fields(f)%name)//' = '//clip(v)// &
                ' is beyond the largest number (1.8e308)'); return
         end if
-        if (ieee_is_nan(x)) then
-          canon = 'NaN'                ! (refused by case_validate, naming the field)
-        else if (.not. ieee_is_finite(x)) then
-          canon = trim(merge('+Infinity', '-Infinity', x > 0.0_wp))
-        else
-          write(buf, '(es25.17e3)') x
-          canon = trim(adjustl(buf))
-        end if
+        if (ieee_is_nan(x)) x = ieee_value(x, ieee_quiet_nan)   ! (refused by case_validate)
       case ('l')
         if (kind /= tk_word .or. .not. is_logical(v)) then
           call fail(line, 'field '//trim(fields(f)%name)//' = '//clip(v)//': expected '// &
                expected(f)); return
         end if
-        canon = '.false.'
-        if (index('tT', v(verify(v, '.'):verify(v, '.'))) > 0) canon = '.true.'
+        l = index('tT', v(verify(v, '.'):verify(v, '.'))) > 0
       case ('c')
         if (kind /= tk_string) then
           call fail(line, 'field '//trim(fields(f)%name)//' = '//clip(v)//': expected '// &
                expected(f)//', e.g. '''//clip(v)//''''); return
         end if
-        content = unquote(v)
-        if (len_trim(content) > fields(f)%n) then
+        s = unquote(v)
+        if (len_trim(s) > fields(f)%n) then
           call fail(line, 'field '//trim(fields(f)%name)//' = '//clip(v)//' is longer than '// &
                itoa(fields(f)%n)//' characters'); return
         end if
-        canon = quoted(trim(content))
-        if (f == 1) name_now = content
+        if (f == 1) name_now = s
       end select
     end subroutine check_value
 
@@ -504,6 +490,116 @@ contains
 
   end subroutine parse_unlocked
 
+  !> Position of a field (lower-case name) in the table, 0 if none: spline_case_type's
+  !> field_index, comparing only names of the same length (it runs for every word of a text).
+  pure integer function field_of(name) result(f)
+    character(len=*), intent(in) :: name
+    integer, parameter :: name_len(nfields) = len_trim(fields%name)
+    integer :: n
+    n = len_trim(name)
+    do f = 1, nfields
+      if (name_len(f) /= n) cycle
+      if (fields(f)%name(1:n) == name(1:n)) return
+    end do
+    f = 0
+  end function field_of
+
+  !> Element k of field f (the field table's numbering) of c: x, i, l or s by the field's type.
+  !> One branch per field, in the order of the table (tests/test_input.py sets every element);
+  !> .false. for a field without one.
+  logical function set_element(c, f, k, x, i, l, s) result(known)
+    type(case_t), intent(inout) :: c
+    integer, intent(in) :: f, k
+    real(wp), intent(in) :: x
+    integer, intent(in) :: i
+    logical, intent(in) :: l
+    character(len=*), intent(in) :: s
+    known = .true.
+    select case (fields(f)%name)
+    case ('name'); c%name = s
+    case ('z'); c%z = i
+    case ('module_m'); c%module_m = x
+    case ('alpha_deg'); c%alpha_deg = x
+    case ('b'); c%b = x
+    case ('s'); c%s = x
+    case ('c0'); c%c0 = x
+    case ('e_mod'); c%e_mod = x
+    case ('nu'); c%nu = x
+    case ('lambda_th'); c%lambda_th = x
+    case ('k_cond'); c%k_cond = x
+    case ('rho'); c%rho = x
+    case ('c_heat'); c%c_heat = x
+    case ('j_m'); c%j_m = x
+    case ('j_l'); c%j_l = x
+    case ('j_1'); c%j_1 = x
+    case ('j_2'); c%j_2 = x
+    case ('m_1'); c%m_1 = x
+    case ('m_2'); c%m_2 = x
+    case ('k_p1'); c%k_p1 = x
+    case ('k_p2'); c%k_p2 = x
+    case ('c_p1'); c%c_p1 = x
+    case ('c_p2'); c%c_p2 = x
+    case ('k_t1'); c%k_t1 = x
+    case ('k_t2'); c%k_t2 = x
+    case ('c_t1'); c%c_t1 = x
+    case ('c_t2'); c%c_t2 = x
+    case ('k_m'); c%k_m = x
+    case ('c_m'); c%c_m = x
+    case ('t_d'); c%t_d = x
+    case ('t_l'); c%t_l = x
+    case ('speed_rpm'); c%speed_rpm = x
+    case ('grav'); c%grav = x
+    case ('l_x'); c%l_x = x
+    case ('l_y'); c%l_y = x
+    case ('dof'); c%dof = i
+    case ('thermal'); c%thermal = s
+    case ('t_bulk'); c%t_bulk = x
+    case ('f_m'); c%f_m = x
+    case ('u_flash'); c%u_flash = x
+    case ('eta_hertz'); c%eta_hertz = x
+    case ('method'); c%method = s
+    case ('jacobian'); c%jacobian = s
+    case ('nonlinear'); c%nonlinear = s
+    case ('roots'); c%roots = l
+    case ('stald'); c%stald = l
+    case ('linear_tail'); c%linear_tail = l
+    case ('rtol'); c%rtol = x
+    case ('atol'); c%atol = x
+    case ('max_steps'); c%max_steps = i
+    case ('max_total_steps'); c%max_total_steps = i
+    case ('t0'); c%t0 = x
+    case ('t_end'); c%t_end = x
+    case ('t_transient'); c%t_transient = x
+    case ('n_out'); c%n_out = i
+    case ('start'); c%start = s
+    case ('dq0'); c%dq0(k) = x
+    case ('dv0'); c%dv0(k) = x
+    case ('l_ref'); c%l_ref = x
+    case ('w_ref'); c%w_ref = x
+    case ('fidelity'); c%fidelity = s
+    case ('fidelity_tol'); c%fidelity_tol = x
+    case ('section'); c%section = s
+    case ('lyapunov'); c%lyapunov = l
+    case ('lyapunov_interval'); c%lyapunov_interval = x
+    case ('lyapunov_d0'); c%lyapunov_d0 = x
+    case ('fillet'); c%fillet = l
+    case ('fillet_radius'); c%fillet_radius = x
+    case ('r_bore'); c%r_bore = x
+    case ('r_rim'); c%r_rim = x
+    case ('zeta_m'); c%zeta_m = x
+    case ('ripple_order'); c%ripple_order(k) = x
+    case ('ripple_amp'); c%ripple_amp(k) = x
+    case ('ripple_phase_deg'); c%ripple_phase_deg(k) = x
+    case ('unbalance'); c%unbalance(k) = x
+    case ('unbalance_phase_deg'); c%unbalance_phase_deg(k) = x
+    case ('gamma_x'); c%gamma_x = x
+    case ('gamma_y'); c%gamma_y = x
+    case ('n_slices'); c%n_slices = i
+    case default
+      known = .false.
+    end select
+  end function set_element
+
   !> A case as namelist text (every field, one per line): Python reads the defaults from it.
   subroutine case_write_text(c, text)
     type(case_t), intent(in) :: c
@@ -514,7 +610,7 @@ contains
     lines = ''
     cc = c
     call io_lock()           ! namelist I/O is not thread-safe in libgfortran (iolock.c)
-    call nml_io(cc, ierr, iomsg, out=lines)
+    call nml_write(cc, ierr, iomsg, lines)
     call io_unlock()
     text = ''
     do i = 1, size(lines)
@@ -522,30 +618,24 @@ contains
     end do
   end subroutine case_write_text
 
-  !> The namelist group &spline_case over a local copy of the case (one object, c: the
-  !> records name its components c%NAME): read the records into it, or write it out (the
-  !> 'c%' taken off, so the text names the fields). Callers hold io_lock (case_parse,
-  !> case_write_text): namelist I/O on internal files is not thread-safe in libgfortran.
-  subroutine nml_io(case, ierr, iomsg, lines, out)
-    type(case_t), intent(inout) :: case
+  !> The namelist group &spline_case of a local copy of the case (one object, c: the records
+  !> name its components c%NAME), written out with the 'c%' taken off, so the text names the
+  !> fields. Callers hold io_lock (case_write_text): namelist I/O on internal files is not
+  !> thread-safe in libgfortran.
+  subroutine nml_write(case, ierr, iomsg, out)
+    type(case_t), intent(in) :: case
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: iomsg
-    character(len=*), intent(in), optional :: lines(:)
-    character(len=*), intent(out), optional :: out(:)
+    character(len=*), intent(out) :: out(:)
     type(case_t) :: c
     integer :: i
     namelist /spline_case/ c
     c = case
     iomsg = ''
-    if (present(out)) then
-      write(out, nml=spline_case, iostat=ierr, iomsg=iomsg)
-      do i = 1, size(out)
-        if (out(i)(1:3) == ' C%') out(i) = ' '//out(i)(4:)
-      end do
-      return
-    end if
-    read(lines, nml=spline_case, iostat=ierr, iomsg=iomsg)
-    if (ierr == 0) case = c
-  end subroutine nml_io
+    write(out, nml=spline_case, iostat=ierr, iomsg=iomsg)
+    do i = 1, size(out)
+      if (out(i)(1:3) == ' C%') out(i) = ' '//out(i)(4:)
+    end do
+  end subroutine nml_write
 
 end module spline_case_parse

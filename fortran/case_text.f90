@@ -130,10 +130,15 @@ contains
     dist = d(len(a), len(b))
   end function distance
 
+  !> A character of a word: no blank, control character or namelist punctuation.
   pure logical function word_char(ch)
     character, intent(in) :: ch
-    word_char = .not. (ch == ' ' .or. iachar(ch) < 32 .or. iachar(ch) == 127 .or. &
-         index(',/=()!''"&$;', ch) > 0)
+    select case (ch)
+    case (' ', ',', '/', '=', '(', ')', '!', '''', '"', '&', '$', ';')
+      word_char = .false.
+    case default
+      word_char = .not. (iachar(ch) < 32 .or. iachar(ch) == 127)
+    end select
   end function word_char
 
   pure logical function is_digits(s)

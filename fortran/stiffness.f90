@@ -22,14 +22,17 @@
 !> singularity at the base circle), so plain Gauss-Legendre with nquad points converges
 !> spectrally. This is Tian's angle parametrisation (his alpha = alpha_2 - t) written for either
 !> tooth, so the external integrals are term by term those of Tian 2004 / Chen & Shao 2011.
-!> Gauss-Legendre nodes are generated one at a time (Newton on P_n): no work arrays.
+!> The Gauss-Legendre rule (Newton on P_n; the 32-point rule of a model build from a table) is
+!> made once per call of a public routine and handed to every integral of it
+!> (spline_mesh_stiffness: one rule for both teeth).
 module spline_stiffness
   use spline_kinds, only: wp, pi
   implicit none
   private
   public :: hertz_stiffness, external_tooth_stiffness, internal_tooth_stiffness, &
        spline_mesh_stiffness, sainsot_fillet_compliance, fillet_foundation_stiffness, &
-       fillet_foundation_stiffness_internal, spline_mesh_stiffness_fillet
+       fillet_foundation_stiffness_internal, spline_mesh_stiffness_fillet, gauss_legendre, &
+       gauss_legendre_node
 
   real(wp), parameter :: kappa_shear = 1.2_wp   !< shear correction factor of a rectangular section
   integer, parameter :: ext_tooth = 1, int_tooth = -1
@@ -44,6 +47,34 @@ module spline_stiffness
       -50.952e-5_wp,  185.50e-3_wp,  0.0538e-4_wp,  53.300e-3_wp,  0.2895_wp, 0.9236_wp, &  ! P
       -6.2042e-5_wp,  9.0889e-3_wp, -4.0964e-4_wp,  7.8297e-3_wp, -0.1472_wp, 0.6904_wp], & ! Q
        [6, 4])
+
+  !> The 32-point Gauss-Legendre rule (model_from_case's nquad) as gauss_legendre_node solves it,
+  !> to 18 digits, which read back bit for bit (tests/fortran/test_stiffness.f90 solves it again):
+  !> a model build solves no Newton iteration.
+  real(wp), parameter :: gl32_s(32) = [ &
+       9.97263861849481570E-01_wp, 9.85611511545268382E-01_wp, 9.64762255587506390E-01_wp, &
+       9.34906075937739667E-01_wp, 8.96321155766052091E-01_wp, 8.49367613732569970E-01_wp, &
+       7.94483795967942386E-01_wp, 7.32182118740289711E-01_wp, 6.63044266930215231E-01_wp, &
+       5.87715757240762304E-01_wp, 5.06899908932229359E-01_wp, 4.21351276130635333E-01_wp, &
+       3.31868602282127667E-01_wp, 2.39287362252137065E-01_wp, 1.44471961582796488E-01_wp, &
+       4.83076656877383104E-02_wp, -4.83076656877383104E-02_wp, -1.44471961582796488E-01_wp, &
+       -2.39287362252137065E-01_wp, -3.31868602282127667E-01_wp, -4.21351276130635333E-01_wp, &
+       -5.06899908932229359E-01_wp, -5.87715757240762304E-01_wp, -6.63044266930215231E-01_wp, &
+       -7.32182118740289711E-01_wp, -7.94483795967942386E-01_wp, -8.49367613732569970E-01_wp, &
+       -8.96321155766052091E-01_wp, -9.34906075937739667E-01_wp, -9.64762255587506390E-01_wp, &
+       -9.85611511545268382E-01_wp, -9.97263861849481570E-01_wp]
+  real(wp), parameter :: gl32_w(32) = [ &
+       7.01861000946952130E-03_wp, 1.62743947309057085E-02_wp, 2.53920653092621421E-02_wp, &
+       3.42738629130214176E-02_wp, 4.28358980222266969E-02_wp, 5.09980592623761469E-02_wp, &
+       5.86840934785351279E-02_wp, 6.58222227763617940E-02_wp, 7.23457941088486156E-02_wp, &
+       7.81938957870704360E-02_wp, 8.33119242269467208E-02_wp, 8.76520930044037416E-02_wp, &
+       9.11738786957639047E-02_wp, 9.38443990808044137E-02_wp, 9.56387200792748610E-02_wp, &
+       9.65400885147278537E-02_wp, 9.65400885147278537E-02_wp, 9.56387200792748610E-02_wp, &
+       9.38443990808044137E-02_wp, 9.11738786957639047E-02_wp, 8.76520930044037416E-02_wp, &
+       8.33119242269467208E-02_wp, 7.81938957870704360E-02_wp, 7.23457941088486156E-02_wp, &
+       6.58222227763617940E-02_wp, 5.86840934785351279E-02_wp, 5.09980592623761469E-02_wp, &
+       4.28358980222266969E-02_wp, 3.42738629130214176E-02_wp, 2.53920653092621421E-02_wp, &
+       1.62743947309057085E-02_wp, 7.01861000946952130E-03_wp]
 
 contains
 
@@ -73,10 +104,22 @@ contains
     real(wp), intent(out) :: kb, ks, ka
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
+    real(wp), allocatable :: s(:), w(:)
+    call gauss_legendre(nquad, s, w)
+    call external_tooth_rule(z, m, alpha, b, r_root, e, nu, r_contact, s, w, kb, ks, ka, ierr, errmsg)
+  end subroutine external_tooth_stiffness
+
+  !> external_tooth_stiffness with the Gauss-Legendre rule s, w (gauss_legendre) given.
+  pure subroutine external_tooth_rule(z, m, alpha, b, r_root, e, nu, r_contact, s, w, &
+       kb, ks, ka, ierr, errmsg)
+    real(wp), intent(in) :: z, m, alpha, b, r_root, e, nu, r_contact, s(:), w(:)
+    real(wp), intent(out) :: kb, ks, ka
+    integer, intent(out) :: ierr
+    character(len=*), intent(out) :: errmsg
     real(wp) :: rb, psi0, tc, tlo, psic, xc, hc, beta, g, cb, cs, ca, hb, xb, xr
 
     kb = 0.0_wp; ks = 0.0_wp; ka = 0.0_wp
-    call check_common('external_tooth_stiffness', z, m, alpha, b, e, nu, nquad, ierr, errmsg)
+    call check_common('external_tooth_stiffness', z, m, alpha, b, e, nu, size(s), ierr, errmsg)
     if (ierr /= 0) return
     rb = 0.5_wp*m*z*cos(alpha)
     psi0 = pi/(2.0_wp*z) + involute(alpha)                 ! alpha_2 of Tian
@@ -108,13 +151,13 @@ contains
     xc = r_contact*cos(psic); hc = r_contact*sin(psic)
     beta = atan(tc) - psic
     tlo = roll(max(r_root, rb), rb)
-    call involute_compliance(ext_tooth, rb, psi0, tlo, tc, xc, hc, beta, b, e, g, nquad, cb, cs, ca)
+    call involute_compliance(ext_tooth, rb, psi0, tlo, tc, xc, hc, beta, b, e, g, s, w, cb, cs, ca)
     if (r_root < rb) then
       hb = rb*sin(psi0); xb = rb*cos(psi0); xr = sqrt(r_root**2 - hb**2)
-      call straight_compliance(xr, xb, hb, xc, hc, beta, b, e, g, nquad, cb, cs, ca)
+      call straight_compliance(xr, xb, hb, xc, hc, beta, b, e, g, s, w, cb, cs, ca)
     end if
     kb = 1.0_wp/cb; ks = 1.0_wp/cs; ka = 1.0_wp/ca
-  end subroutine external_tooth_stiffness
+  end subroutine external_tooth_rule
 
   !> Bending, shear and axial-compression stiffness [N/m] of ONE internal (ring) tooth loaded at
   !> radius r_contact. Formulation: slice-beam (variable-section cantilever) integration of the
@@ -140,10 +183,23 @@ contains
     real(wp), intent(out) :: kb, ks, ka
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
+    real(wp), allocatable :: s(:), w(:)
+    call gauss_legendre(nquad, s, w)
+    call internal_tooth_rule(z, m, alpha, b, r_root, r_tip, e, nu, r_contact, s, w, kb, ks, ka, &
+         ierr, errmsg)
+  end subroutine internal_tooth_stiffness
+
+  !> internal_tooth_stiffness with the Gauss-Legendre rule s, w (gauss_legendre) given.
+  pure subroutine internal_tooth_rule(z, m, alpha, b, r_root, r_tip, e, nu, r_contact, s, w, &
+       kb, ks, ka, ierr, errmsg)
+    real(wp), intent(in) :: z, m, alpha, b, r_root, r_tip, e, nu, r_contact, s(:), w(:)
+    real(wp), intent(out) :: kb, ks, ka
+    integer, intent(out) :: ierr
+    character(len=*), intent(out) :: errmsg
     real(wp) :: rb, psi0, tc, tf, psic, xc, hc, beta, g, cb, cs, ca
 
     kb = 0.0_wp; ks = 0.0_wp; ka = 0.0_wp
-    call check_common('internal_tooth_stiffness', z, m, alpha, b, e, nu, nquad, ierr, errmsg)
+    call check_common('internal_tooth_stiffness', z, m, alpha, b, e, nu, size(s), ierr, errmsg)
     if (ierr /= 0) return
     rb = 0.5_wp*m*z*cos(alpha)
     psi0 = pi/(2.0_wp*z) - involute(alpha)     ! ring tooth half angle extrapolated to t = 0
@@ -180,9 +236,9 @@ contains
     xc = r_contact*cos(psic); hc = r_contact*sin(psic)
     beta = atan(tc) + psic
     tf = roll(r_root, rb)
-    call involute_compliance(int_tooth, rb, psi0, tc, tf, xc, hc, beta, b, e, g, nquad, cb, cs, ca)
+    call involute_compliance(int_tooth, rb, psi0, tc, tf, xc, hc, beta, b, e, g, s, w, cb, cs, ca)
     kb = 1.0_wp/cb; ks = 1.0_wp/cs; ka = 1.0_wp/ca
-  end subroutine internal_tooth_stiffness
+  end subroutine internal_tooth_rule
 
   !> docs/model.md Eq. 18 at the pitch point (r_contact = m z / 2 on both teeth):
   !>   1/k_m = 1/k_h + 1/k_b1 + 1/k_s1 + 1/k_a1 + 1/k_b2 + 1/k_s2 + 1/k_a2,
@@ -195,16 +251,17 @@ contains
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
     real(wp) :: rp
+    real(wp), allocatable :: s(:), w(:)
 
     kh = 0.0_wp; km = 0.0_wp
     rp = 0.5_wp*m*z
-    call external_tooth_stiffness(z, m, alpha, b, rf1, e, nu, rp, nquad, kb1, ks1, ka1, ierr, errmsg)
+    call gauss_legendre(nquad, s, w)         ! one rule for both teeth
+    call external_tooth_rule(z, m, alpha, b, rf1, e, nu, rp, s, w, kb1, ks1, ka1, ierr, errmsg)
     if (ierr /= 0) then
       errmsg = 'spline_mesh_stiffness (rf1, pitch point): '//trim(errmsg)
       return
     end if
-    call internal_tooth_stiffness(z, m, alpha, b, rf2, ra2, e, nu, rp, nquad, kb2, ks2, ka2, &
-         ierr, errmsg)
+    call internal_tooth_rule(z, m, alpha, b, rf2, ra2, e, nu, rp, s, w, kb2, ks2, ka2, ierr, errmsg)
     if (ierr /= 0) then
       errmsg = 'spline_mesh_stiffness (rf2, ra2, pitch point): '//trim(errmsg)
       return
@@ -473,39 +530,36 @@ contains
   !> Adds the compliances (1/k per unit face, Section header formulas) of the involute part
   !> t in [ta, tb] of a tooth with half angle psi(t) = psi0 -/+ (t - atan t) (external/internal)
   !> and point r = rb sqrt(1 + t^2), x = r cos(psi), h = r sin(psi). Gauss-Legendre in t.
-  pure subroutine involute_compliance(side, rb, psi0, ta, tb, xc, hc, beta, b, e, g, nquad, &
+  pure subroutine involute_compliance(side, rb, psi0, ta, tb, xc, hc, beta, b, e, g, s, w, &
        cb, cs, ca)
-    integer, intent(in) :: side, nquad
-    real(wp), intent(in) :: rb, psi0, ta, tb, xc, hc, beta, b, e, g
+    integer, intent(in) :: side
+    real(wp), intent(in) :: rb, psi0, ta, tb, xc, hc, beta, b, e, g, s(:), w(:)
     real(wp), intent(out) :: cb, cs, ca
     integer :: i
-    real(wp) :: s, w, t, r, psi, x, h, dxdt, half, mid
+    real(wp) :: t, r, psi, x, h, dxdt, half, mid
     cb = 0.0_wp; cs = 0.0_wp; ca = 0.0_wp
     half = 0.5_wp*(tb - ta); mid = 0.5_wp*(tb + ta)
-    do i = 1, nquad
-      call gauss_legendre_node(nquad, i, s, w)
-      t = mid + half*s
+    do i = 1, size(s)
+      t = mid + half*s(i)
       r = rb*sqrt(1.0_wp + t**2)
       psi = half_angle(side, psi0, t)
       x = r*cos(psi); h = r*sin(psi)
       ! dx/dt = r' cos(psi) - r sin(psi) psi', r' = rb t / sqrt(1+t^2), psi' = -/+ t^2/(1+t^2)
       dxdt = rb*t/sqrt(1.0_wp + t**2)*(cos(psi) + side*t*sin(psi))
-      call add_slice(abs(x - xc), h, abs(dxdt)*w*half, hc, beta, b, e, g, cb, cs, ca)
+      call add_slice(abs(x - xc), h, abs(dxdt)*w(i)*half, hc, beta, b, e, g, cb, cs, ca)
     end do
   end subroutine involute_compliance
 
   !> Adds the compliances of the straight root segment of constant half thickness h (Chen & Shao
   !> 2011: profile between root and base circle taken as a straight line), x in [xa, xb].
-  pure subroutine straight_compliance(xa, xb, h, xc, hc, beta, b, e, g, nquad, cb, cs, ca)
-    real(wp), intent(in) :: xa, xb, h, xc, hc, beta, b, e, g
-    integer, intent(in) :: nquad
+  pure subroutine straight_compliance(xa, xb, h, xc, hc, beta, b, e, g, s, w, cb, cs, ca)
+    real(wp), intent(in) :: xa, xb, h, xc, hc, beta, b, e, g, s(:), w(:)
     real(wp), intent(inout) :: cb, cs, ca
     integer :: i
-    real(wp) :: s, w, half, mid
+    real(wp) :: half, mid
     half = 0.5_wp*(xb - xa); mid = 0.5_wp*(xb + xa)
-    do i = 1, nquad    ! integrand is a quadratic polynomial in x: exact for nquad >= 2
-      call gauss_legendre_node(nquad, i, s, w)
-      call add_slice(abs(mid + half*s - xc), h, w*half, hc, beta, b, e, g, cb, cs, ca)
+    do i = 1, size(s)    ! integrand is a quadratic polynomial in x: exact for nquad >= 2
+      call add_slice(abs(mid + half*s(i) - xc), h, w(i)*half, hc, beta, b, e, g, cb, cs, ca)
     end do
   end subroutine straight_compliance
 
@@ -521,6 +575,22 @@ contains
     cs = cs + kappa_shear*cos(beta)**2/(g*area)*dx
     ca = ca + sin(beta)**2/(e*area)*dx
   end subroutine add_slice
+
+  !> The n-point Gauss-Legendre rule on [-1, 1]: nodes s, weights w (none if n < 1); for n = 32
+  !> the table gl32_s, gl32_w, else solved node by node.
+  pure subroutine gauss_legendre(n, s, w)
+    integer, intent(in) :: n
+    real(wp), allocatable, intent(out) :: s(:), w(:)
+    integer :: i
+    if (n == size(gl32_s)) then
+      s = gl32_s; w = gl32_w
+      return
+    end if
+    allocate(s(max(n, 0)), w(max(n, 0)))
+    do i = 1, n
+      call gauss_legendre_node(n, i, s(i), w(i))
+    end do
+  end subroutine gauss_legendre
 
   !> i-th node s and weight w of the n-point Gauss-Legendre rule on [-1, 1] (Newton on the
   !> three-term recurrence of P_n; initial guess of Tricomi, cos(pi (i - 1/4) / (n + 1/2))).

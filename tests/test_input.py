@@ -436,3 +436,37 @@ def test_values_a_value_array_cannot_carry_get_the_reader_s_message():
         pyspline.load(dict(PAPER, name="big", n_out=2 ** 40))
     with pytest.raises(pyspline.CaseError, match="is longer than 16 characters"):
         pyspline.load(dict(PAPER, name="long", method="adams" * 4))
+
+
+def test_reader_puts_every_element_in_its_field(tmp_path):
+    """The reader assigns each checked value to its own element (fortran/case_parse.f90,
+    set_element): a file giving every element of every field a different value reads back,
+    through the core's value arrays (case_values.f90, an independent walk of case_t), as
+    written. Not validated (stage 1: read only), so the values need not make a model."""
+    from pyspline import case as pc
+    rows, nv, nc = pc._layout()
+    lines, want = ["&spline_case"], {}
+    for k, (name, kind, _, n) in enumerate(rows, start=1):
+        if kind == "c":
+            want[name] = f"s{k}" if name != "name" else "every element"
+            lines.append(f"  {name} = '{want[name]}'")
+        elif kind == "i":
+            want[name] = 100 + k
+            lines.append(f"  {name} = {want[name]}")
+        elif kind == "l":
+            want[name] = k % 2 == 0
+            lines.append(f"  {name} = {'.true.' if want[name] else '.false.'}")
+        else:
+            x = [k + j / 8 for j in range(1, n + 1)]
+            if n == 1:
+                want[name] = x[0]
+                lines.append(f"  {name} = {x[0]!r}")
+            else:
+                want[name] = x
+                lines += [f"  {name}({j}) = {v!r}" for j, v in enumerate(x, start=1)]
+    path = tmp_path / "every.nml"
+    path.write_text("\n".join(lines + ["/", ""]))
+    _, _, values, chars, _, stage, ierr, msg = pc._api.api_load_file(
+        os.fsencode(path), 0, pc._MODEL_BYTES, nv, nc)
+    assert stage == 1 and ierr == 0, msg
+    assert pc._fields_of(values, chars)[0] == want

@@ -8,7 +8,7 @@ program test_stiffness
   use spline_kinds, only: wp, pi
   use spline_stiffness, only: hertz_stiffness, external_tooth_stiffness, internal_tooth_stiffness, &
        spline_mesh_stiffness, fillet_foundation_stiffness, fillet_foundation_stiffness_internal, &
-       spline_mesh_stiffness_fillet
+       spline_mesh_stiffness_fillet, gauss_legendre, gauss_legendre_node
   use spline_case, only: case_t
   use spline_model, only: model_t, ik_m
   use check, only: check_true, check_close, check_done, default_case_model
@@ -27,6 +27,21 @@ program test_stiffness
   type(case_t) :: c
   type(model_t) :: md
   logical :: ok
+  real(wp), allocatable :: gs(:), gw(:)
+  real(wp) :: gsi, gwi
+
+  ! ---- the 32-point Gauss-Legendre rule of a model build is a table: the Newton solve of each
+  !      node gives it bit for bit; it integrates x^62 exactly (2/63)
+  call gauss_legendre(nq, gs, gw)
+  ok = size(gs) == nq .and. size(gw) == nq
+  do n = 1, nq
+    call gauss_legendre_node(nq, n, gsi, gwi)
+    ok = ok .and. gs(n) == gsi .and. gw(n) == gwi
+  end do
+  call check_true('gauss_legendre(32): the table is the solved rule bit for bit', ok)
+  call check_close('gauss_legendre(32) integrates x^62 exactly', sum(gw*gs**62), 2.0_wp/63, 1e-13_wp)
+  call gauss_legendre(5, gs, gw)
+  call check_close('gauss_legendre(5) integrates x^8 exactly', sum(gw*gs**8), 2.0_wp/9, 1e-14_wp)
 
   ! ---- Hertz line contact, Eq. 18: k_h = pi E b / (4 (1 - nu^2))
   kh = hertz_stiffness(e, nu, b)
