@@ -16,7 +16,7 @@ Model (docs/model.md; equation numbers are the paper's):
   Eq. 23 reduced to D1, D2, D3 (Eq. 24, re-derived: the paper's T_L sign slip fixed).
 Thermal levels: 'none' (T_B = 0), 'bulk' (T_B = T_M), 'oneway' (dynamics identical to 'bulk';
 T_f is only reported, which this peer does not do), 'coupled' (T_B = T_M + T_fj with the Blok
-flash temperature, Eqs. 3-7, 12-14, solved per tooth by fixed-point iteration to 2 ulp as the
+flash temperature, Eqs. 3-7, 12-13, solved per tooth by fixed-point iteration to 2 ulp as the
 oracle does, bisection fallback for teeth that do not converge in 60 iterations).
 
 Speed: the phase of tooth j is not re-evaluated with sin/cos per tooth: with a = omega t +
@@ -96,14 +96,14 @@ _NAMES = ("ncalls", "err", "z", "omega", "phase0", "l_x", "l_y", "c", "k_m", "c_
           "l_ref", "w_ref",
           # coupled thermal level
           "coupled", "c0", "th_coef", "t_bulk", "b", "eta_hertz", "hertz", "grc", "uf",
-          "R", "cos_a", "sin_a", "alpha")
+          "R", "cos_a", "r_lo", "r_hi")
 _I = {n: i for i, n in enumerate(_NAMES)}
 _NSCAL = len(_NAMES)
 # slot indices, in the order of _NAMES; after them cos(2 pi j/Z), j = 1..Z, then sin(2 pi j/Z)
 (_NCALLS, _ERR, _Z, _OMEGA, _PHASE0, _L_X, _L_Y, _C, _K_M, _C_M, _R_B, _K_P1, _C_P1, _M_1,
  _K_P2, _C_P2, _M_2, _GRAV, _K_T1, _C_T1, _K_T2, _C_T2, _J_1, _J_M, _J_2, _J_L, _T_D, _T_L,
  _L_REF, _W_REF, _COUPLED, _C0, _TH_COEF, _T_BULK, _B, _ETA_HERTZ, _HERTZ, _GRC, _UF, _R,
- _COS_A, _SIN_A, _ALPHA) = range(_NSCAL)
+ _COS_A, _R_LO, _R_HI) = range(_NSCAL)
 
 _FP_RTOL = 4.5e-16      # as tests/oracle.py: successive iterates within 2 ulp
 _FP_ATOL = 1.0e-300
@@ -135,7 +135,7 @@ def _pack(params, scaled):
              l_ref=l_ref, w_ref=w_ref,
              coupled=1.0 if p.thermal == "coupled" else 0.0, c0=p.c0, th_coef=p.th_coef,
              t_bulk=p.t_bulk, b=p.b, eta_hertz=p.eta_hertz, hertz=p.hertz, grc=p.grc,
-             uf=p.u_flash * p.f_m, R=p.R, cos_a=p.cos_a, sin_a=p.sin_a, alpha=p.alpha)
+             uf=p.u_flash * p.f_m, R=p.R, cos_a=p.cos_a, r_lo=p.r_lo, r_hi=p.r_hi)
     for k, x in v.items():
         d[_I[k]] = x
     ang = p.two_pi_j_over_z                       # 2 pi j / Z, j = 1..Z (Eq. 8)
@@ -148,11 +148,10 @@ def _pack(params, scaled):
 # Compiled pieces
 # --------------------------------------------------------------------------------------------
 @nb.njit(cache=False)
-def _contact_radius(delta, ddelta, R, cos_a, sin_a, alpha):
-    """Eq. 13 (root, dDelta/dt < 0) / Eq. 14 (tip, dDelta/dt >= 0)."""
-    if ddelta < 0.0:
-        return math.sqrt(delta * delta + R * R - 2.0 * R * delta * cos_a)
-    return R * math.sin(math.pi - alpha - math.asin(delta * sin_a / R)) / sin_a
+def _contact_radius(delta, R, cos_a, r_lo, r_hi):
+    """Eq. 13 for both splines (one contact point per tooth pair, docs/model.md s.6), held on the
+    active profile [r_lo, r_hi]."""
+    return min(max(math.sqrt(delta * delta + R * R - 2.0 * R * delta * cos_a), r_lo), r_hi)
 
 
 @nb.njit(cache=False)
@@ -177,16 +176,14 @@ def _coupled_force(d, dn, ddn, sp, cp, X1, Y1, x2, y2, vx1, vy1, vx2, vy2):
     omega = d[_OMEGA]
     R = d[_R]
     cos_a = d[_COS_A]
-    sin_a = d[_SIN_A]
-    alpha = d[_ALPHA]
+    r_lo = d[_R_LO]
+    r_hi = d[_R_HI]
     r_b = d[_R_B]
-    # Eq. 12 (simplified, MODEL s.6) and its total time derivative (branch of Eqs. 13-14)
+    # Eq. 12 (simplified, MODEL s.6)
     d1 = X1 * cp + Y1 * sp
     d2 = x2 * cp + y2 * sp
-    dd1 = vx1 * cp + vy1 * sp + omega * (-X1 * sp + Y1 * cp)
-    dd2 = vx2 * cp + vy2 * sp + omega * (-x2 * sp + y2 * cp)
-    rc1 = _contact_radius(d1, dd1, R, cos_a, sin_a, alpha)
-    rc2 = _contact_radius(d2, dd2, R, cos_a, sin_a, alpha)
+    rc1 = _contact_radius(d1, R, cos_a, r_lo, r_hi)
+    rc2 = _contact_radius(d2, R, cos_a, r_lo, r_hi)
     Rc1 = rc1 * math.sin(math.acos(r_b / rc1))                         # Eqs. 5-6
     Rc2 = rc2 * math.sin(math.acos(r_b / rc2))
     v1 = omega * rc1 * cos_a                                             # Eq. 7

@@ -8,14 +8,14 @@
 program time_rhs
   use spline_kinds, only: wp
   use spline_errors, only: err_ok, err_case, err_exit_code, msglen
-  use spline_model, only: model_t, model_magic, nstate, ndof, thermal_coupled
+  use spline_model, only: model_t, model_magic, nstate, ndof
   use spline_mesh, only: mesh_switch_functions
   use spline_dynamics, only: start_state, rhs_scaled, to_scaled
   use, intrinsic :: iso_fortran_env, only: error_unit, int32
   implicit none
   type(model_t) :: m
   real(wp) :: y(nstate), ys(nstate), f(nstate), acc, dt, t_rhs, t_roots
-  real(wp), allocatable :: g(:), gb(:)
+  real(wp), allocatable :: g(:)
   integer(int32), allocatable :: bytes(:)
   integer :: ierr, k, n, u, nbytes
   integer(8) :: c0, c1, rate
@@ -42,7 +42,7 @@ program time_rhs
   m%dq0 = 0; m%dv0 = 0
   call start_state(m, y, ierr, errmsg)
   if (ierr /= err_ok) call stop_with(ierr, errmsg)
-  allocate(g(2*m%z*m%n_slices), gb(2*m%z))   ! a switch pair per contact (tooth or slice)
+  allocate(g(2*m%z*m%n_slices))   ! a switch pair per contact (tooth or slice)
   call to_scaled(m, y, ys)
   dt = 1.0e-3_wp/n
   acc = 0
@@ -56,11 +56,7 @@ program time_rhs
   if (ierr /= err_ok) call stop_with(ierr, errmsg)
   call system_clock(c0)
   do k = 1, n
-    if (m%thermal == thermal_coupled) then
-      call mesh_switch_functions(m, m%t0 + k*dt, y(1:ndof), g, y(ndof+1:), gb)
-    else
-      call mesh_switch_functions(m, m%t0 + k*dt, y(1:ndof), g)
-    end if
+    call mesh_switch_functions(m, m%t0 + k*dt, y(1:ndof), g)
     acc = acc + g(1)
   end do
   call system_clock(c1)

@@ -26,16 +26,16 @@ contains
   !> Beyond the paper (docs/model.md section 11): T_d is driving_torque(t) (torque ripple), and the
   !> unbalance forces (unbalance_forces) act on the x, y equations of splines 1 and 2.
   !> mode: the frozen contact state of every contact (tooth, or slice of a tooth: mesh_eval).
-  subroutine accelerations(m, t, q, v, a, ierr, errmsg, mode, branch, cstats)
+  subroutine accelerations(m, t, q, v, a, ierr, errmsg, mode, cstats)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(ndof), v(ndof)
     real(wp), intent(out) :: a(ndof)
     integer, intent(out) :: ierr
     character(len=*), intent(inout) :: errmsg
-    integer, intent(in), optional :: mode(m%z*m%n_slices), branch(2, m%z)
+    integer, intent(in), optional :: mode(m%z*m%n_slices)
     type(coupling_stats_t), intent(inout), optional :: cstats
     real(wp) :: fx1, fy1, tm, s1, s3, th1dd, fu(4)
-    call mesh_eval(m, t, q, v, fx1, fy1, tm, ierr, errmsg, mode=mode, branch=branch, cstats=cstats)
+    call mesh_eval(m, t, q, v, fx1, fy1, tm, ierr, errmsg, mode=mode, cstats=cstats)
     if (ierr /= err_ok) return
     a(1) = (fx1 - m%c_p1*v(1) - m%k_p1*q(1))/m%m_1
     a(2) = (fy1 - m%c_p1*v(2) - m%k_p1*q(2))/m%m_1 - m%grav
@@ -97,17 +97,17 @@ contains
   end subroutine from_scaled
 
   !> Eq. 25: d(ys)/d(tau) for the scaled state, ys' = (vs, a / (l w^2)).
-  subroutine rhs_scaled(m, tau, ys, dys, ierr, errmsg, mode, branch, cstats)
+  subroutine rhs_scaled(m, tau, ys, dys, ierr, errmsg, mode, cstats)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: tau, ys(nstate)
     real(wp), intent(out) :: dys(nstate)
     integer, intent(out) :: ierr
     character(len=*), intent(inout) :: errmsg
-    integer, intent(in), optional :: mode(m%z*m%n_slices), branch(2, m%z)
+    integer, intent(in), optional :: mode(m%z*m%n_slices)
     type(coupling_stats_t), intent(inout), optional :: cstats
     real(wp) :: y(nstate), a(ndof)
     call from_scaled(m, ys, y)
-    call accelerations(m, tau/m%w_ref, y(1:ndof), y(ndof+1:), a, ierr, errmsg, mode, branch, cstats)
+    call accelerations(m, tau/m%w_ref, y(1:ndof), y(ndof+1:), a, ierr, errmsg, mode, cstats)
     dys(1:ndof) = ys(ndof+1:)
     dys(ndof+1:) = a/(m%l_ref*m%w_ref**2)
   end subroutine rhs_scaled

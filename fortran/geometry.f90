@@ -1,9 +1,10 @@
-!> Spline geometry: tooth angles (Eqs. 8-9) and the contact-point radius (Eqs. 12-14).
+!> Spline geometry: tooth angles (Eqs. 8-9), the profile shift (Eq. 12) and the contact-point
+!> radius (Eq. 13, one point per tooth pair on the active profile).
 module spline_geometry
   use spline_kinds, only: wp, pi
   implicit none
   private
-  public :: tooth_angles, pitch_rotation, contact_radius, profile_shift, iso4156_radii
+  public :: tooth_angles, pitch_rotation, contact_radius, profile_shift, iso4156_radii, active_profile
 
 contains
 
@@ -49,30 +50,34 @@ contains
   end subroutine pitch_rotation
 
   !> Eq. 12 in its exact simplified form: displacement of spline i in the tooth-profile direction,
-  !> Delta = x cos(phi) + y sin(phi), and its total time derivative (phi' = omega).
-  pure subroutine profile_shift(x, y, vx, vy, omega, sphi, cphi, delta, ddelta)
-    real(wp), intent(in) :: x, y, vx, vy, omega, sphi, cphi
-    real(wp), intent(out) :: delta, ddelta
+  !> Delta = x cos(phi) + y sin(phi).
+  pure real(wp) function profile_shift(x, y, sphi, cphi) result(delta)
+    real(wp), intent(in) :: x, y, sphi, cphi
     delta = x*cphi + y*sphi
-    ddelta = vx*cphi + vy*sphi + omega*(-x*sphi + y*cphi)
-  end subroutine profile_shift
+  end function profile_shift
 
-  !> Eqs. 13-14: radius of the contact point of a spline with pitch radius r (R = m Z / 2) whose
-  !> profile is shifted by delta. Moving towards the root (ddelta < 0): law of cosines (Eq. 13);
-  !> otherwise towards the tip: law of sines (Eq. 14),
-  !>   rc = R sin(pi - alpha - beta) / sin(alpha),  sin(beta) = Delta sin(alpha) / R,
-  !> evaluated in the exact equivalent form rc = R cos(beta) + Delta cos(alpha) (expand
-  !> sin(alpha + beta); |beta| < pi/2), which needs no inverse sine. The pressure angle comes in
-  !> as ca = cos(alpha), sa = sin(alpha) (computed once per case, not per tooth).
-  pure real(wp) function contact_radius(delta, ddelta, r, ca, sa) result(rc)
-    real(wp), intent(in) :: delta, ddelta, r, ca, sa
-    real(wp) :: sb
-    if (ddelta < 0.0_wp) then
-      rc = sqrt(delta**2 + r**2 - 2.0_wp*r*delta*ca)
-    else
-      sb = delta*sa/r
-      rc = r*sqrt(1.0_wp - sb*sb) + delta*ca
-    end if
+  !> The active profile of a spline pair (docs/model.md section 6): the radii where both flanks
+  !> exist, from the internal spline's tip (minor) circle m (Z - 1) / 2 to the external spline's
+  !> tip (major) circle m (Z + 1) / 2. ISO 4156 puts each spline's form circle beyond the mate's
+  !> tip circle (form clearance 0.1 m), so this is the active profile of both splines.
+  pure subroutine active_profile(z, m, r_lo, r_hi)
+    integer, intent(in) :: z
+    real(wp), intent(in) :: m
+    real(wp), intent(out) :: r_lo, r_hi
+    r_lo = 0.5_wp*m*(z - 1.0_wp)
+    r_hi = 0.5_wp*m*(z + 1.0_wp)
+  end subroutine active_profile
+
+  !> Contact-point radius on a spline whose centre is shifted by delta along the tooth profile
+  !> (docs/model.md section 6, the project's rule): the contact point of a tooth pair is one point,
+  !> the pair's pitch point P (|P| = R = m Z / 2 from the undisplaced axis, at angle alpha to the
+  !> profile direction u), the same for both splines; its radius from the shifted centre delta u is
+  !> Eq. 13, r_c = |P - delta u| = sqrt(delta^2 + R^2 - 2 R delta cos(alpha)), held on the active
+  !> profile [r_lo, r_hi]. The paper's Eq. 14 branch is not used: switching between Eqs. 13 and 14
+  !> moves r_c by 2 delta cos(alpha) at once. The pressure angle comes in as ca = cos(alpha).
+  pure real(wp) function contact_radius(delta, r, ca, r_lo, r_hi) result(rc)
+    real(wp), intent(in) :: delta, r, ca, r_lo, r_hi
+    rc = min(max(sqrt(delta**2 + r**2 - 2.0_wp*r*delta*ca), r_lo), r_hi)
   end function contact_radius
 
 end module spline_geometry

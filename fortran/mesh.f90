@@ -1,11 +1,11 @@
 !> Tooth-pair contact and mesh forces: relative displacement along each line of action (Eq. 11),
 !> dead-zone contact with time-varying backlash (Eqs. 2, 15-17), flash-temperature coupling
-!> (Eqs. 1, 3-7, 12-14) and the energy-consistent mesh forces on the bodies (Eqs. 19-22, corrected).
+!> (Eqs. 1, 3-7, 12-13) and the energy-consistent mesh forces on the bodies (Eqs. 19-22, corrected).
 module spline_mesh
   use spline_kinds, only: wp, max_teeth
   use spline_errors, only: err_ok, err_solver, err_thermal
   use spline_model, only: model_t, thermal_oneway, thermal_coupled
-  use spline_geometry, only: tooth_angles, profile_shift, contact_radius
+  use spline_geometry, only: tooth_angles, profile_shift, contact_radius, active_profile
   use spline_thermal, only: thermal_backlash, flash_temperature
   implicit none
   private
@@ -29,8 +29,6 @@ contains
   !> used between the located switches; without it the state decides (|dn_j| > c_j, Eq. 16).
   !> flash (optional, default false): compute T_f and the contact radii even when the thermal
   !> level does not feed them back (one-way post-processing and output).
-  !> branch (optional): frozen root (-1) / tip (+1) branch of Eqs. 13-14 for spline 1 (row 1) and
-  !> 2 (row 2) of every tooth, used between located branch switches; else the sign of dDelta/dt.
   !> cstats (optional): updated with the work of the flash-temperature coupling.
   !> Angular misalignment (docs/model.md section 11): with n_slices > 1 the face is cut into slices
   !> at z_s; slice s of tooth j has its own dn_js (Eq. 11 with spline 1's centre at
@@ -39,7 +37,7 @@ contains
   !> (index (j - 1) n_s + s). fslice(s, j): F_js; mtilt: the tilting moment (M_x, M_y) on spline 1
   !> about the face mid-plane, M_x = -sum z_s F_js cos(phi_j), M_y = -sum z_s F_js sin(phi_j).
   pure subroutine mesh_eval(m, t, q, v, fx1, fy1, tm, ierr, errmsg, mode, flash, dn, c, f, tf, &
-       rc1, rc2, sphi_out, cphi_out, branch, cstats, fslice, mtilt)
+       rc1, rc2, sphi_out, cphi_out, cstats, fslice, mtilt)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(7), v(7)
     real(wp), intent(out) :: fx1, fy1, tm
@@ -47,7 +45,6 @@ contains
     character(len=*), intent(inout) :: errmsg
     integer, intent(in), optional :: mode(m%z*m%n_slices)
     logical, intent(in), optional :: flash
-    integer, intent(in), optional :: branch(2, m%z)
     real(wp), intent(out), optional, dimension(m%z) :: dn, c, f, tf, rc1, rc2, sphi_out, cphi_out
     type(coupling_stats_t), intent(inout), optional :: cstats
     real(wp), intent(out), optional :: fslice(m%n_slices, m%z), mtilt(2)
@@ -112,13 +109,7 @@ contains
       cj = m%c_bulk
       tfj = 0.0_wp
       r1 = m%r_pitch; r2 = m%r_pitch
-      if (want_flash) then
-        if (present(branch)) then
-          call contact_radii(m, q, v, sp(j), cp(j), r1, r2, branch(:, j))
-        else
-          call contact_radii(m, q, v, sp(j), cp(j), r1, r2)
-        end if
-      end if
+      if (want_flash) call contact_radii(m, q, sp(j), cp(j), r1, r2)
       if (mj /= 0) then
         if (coupled) then
           call solve_coupled(m, dnj, ddnj, mj, r1, r2, fj, tfj, iters, resid, ierr)
@@ -177,20 +168,19 @@ contains
     f = m%k_m*(dn - mode*c) + m%c_m*ddn
   end function contact_force
 
-  !> Eqs. 12-14: contact-point radii of tooth pair (sp, cp) on spline 1 (misaligned centre) and 2.
-  !> The branch is the sign of dDelta/dt, or the frozen branch br (-1 root, +1 tip) if given.
-  pure subroutine contact_radii(m, q, v, sp, cp, r1, r2, br)
+  !> Eqs. 12-13: contact-point radii of tooth pair (sp, cp) on spline 1 (misaligned centre) and 2.
+  !> One point per pair (docs/model.md section 6): the pair's pitch point, measured from each
+  !> spline's shifted centre by the same formula (Eq. 13), held on the active profile. Both radii
+  !> are continuous in the state; r1 = r2 whenever Delta_1 = Delta_2 (no sliding).
+  pure subroutine contact_radii(m, q, sp, cp, r1, r2)
     type(model_t), intent(in) :: m
-    real(wp), intent(in) :: q(7), v(7), sp, cp
+    real(wp), intent(in) :: q(7), sp, cp
     real(wp), intent(out) :: r1, r2
-    integer, intent(in), optional :: br(2)
-    real(wp) :: d, dd
-    call profile_shift(q(1) + m%l_x, q(2) + m%l_y, v(1), v(2), m%omega, sp, cp, d, dd)
-    if (present(br)) dd = br(1)
-    r1 = contact_radius(d, dd, m%r_pitch, m%cos_alpha, m%sin_alpha)
-    call profile_shift(q(3), q(4), v(3), v(4), m%omega, sp, cp, d, dd)
-    if (present(br)) dd = br(2)
-    r2 = contact_radius(d, dd, m%r_pitch, m%cos_alpha, m%sin_alpha)
+    real(wp) :: r_lo, r_hi
+    call active_profile(m%z, m%m_n, r_lo, r_hi)
+    r1 = contact_radius(profile_shift(q(1) + m%l_x, q(2) + m%l_y, sp, cp), m%r_pitch, &
+         m%cos_alpha, r_lo, r_hi)
+    r2 = contact_radius(profile_shift(q(3), q(4), sp, cp), m%r_pitch, m%cos_alpha, r_lo, r_hi)
   end subroutine contact_radii
 
   !> Eqs. 3-7 for one tooth with the model's material data.
@@ -271,16 +261,12 @@ contains
 
   !> Root functions for the contact switches of Eq. 16: g_{2k-1} = dn_k - c_k, g_{2k} = dn_k + c_k
   !> for every contact k (a tooth, or slice s of tooth j: k = (j - 1) n_s + s), with the backlash
-  !> at the bulk temperature, which decides the contact state; and, if gb is present, for the
-  !> root/tip branch switches of Eqs. 13-14: gb_{2j-1} = dDelta_1j/dt, gb_{2j} = dDelta_2j/dt
-  !> (needs the velocities v).
-  pure subroutine mesh_switch_functions(m, t, q, g, v, gb)
+  !> at the bulk temperature, which decides the contact state.
+  pure subroutine mesh_switch_functions(m, t, q, g)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(7)
     real(wp), intent(out) :: g(2*m%z*m%n_slices)
-    real(wp), intent(in), optional :: v(7)
-    real(wp), intent(out), optional :: gb(2*m%z)
-    real(wp) :: sp(max_teeth), cp(max_teeth), ex, ey, dnj, d, dns, zs
+    real(wp) :: sp(max_teeth), cp(max_teeth), ex, ey, dnj, dns, zs
     integer :: j, is, k, ns
     call tooth_angles(m%z, m%omega, t, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
     ex = q(1) + m%l_x - q(3)
@@ -298,11 +284,6 @@ contains
         g(2*k - 1) = dns - m%c_bulk
         g(2*k) = dns + m%c_bulk
       end do
-      if (present(gb)) then
-        call profile_shift(q(1) + m%l_x, q(2) + m%l_y, v(1), v(2), m%omega, sp(j), cp(j), d, &
-             gb(2*j - 1))
-        call profile_shift(q(3), q(4), v(3), v(4), m%omega, sp(j), cp(j), d, gb(2*j))
-      end if
     end do
   end subroutine mesh_switch_functions
 

@@ -94,7 +94,7 @@ contains
 
   !> The checks of a finished run: no output may be NaN or infinite (ierr = err_solver with a
   !> message naming the quantity, the tooth or state, and the time: the model left its range,
-  !> e.g. a contact point below the base circle makes the Hertz width 0 and T_f infinite);
+  !> e.g. a runaway state; the contact radii stay on the active profile, so T_f stays finite);
   !> and at the one-way thermal level, the samples where Eq. 2 with the flash temperature,
   !> c0 - kappa (T_M + T_f), is not positive: the coupled level would have stopped there with
   !> thermal interference (closed: their number, t_closed: the first time; a warning, see
@@ -162,7 +162,7 @@ contains
       ierr = err_solver
       errmsg = 'case '//trim(m%name)//': the run produced a non-finite value (NaN or Inf): '// &
            what//which//' at t = '//trim(adjustl(buf))//' s; the model left its range there '// &
-           '(e.g. a contact point below the base circle, or a runaway state)'
+           '(e.g. a runaway state)'
     end subroutine bad
   end subroutine result_checks
 

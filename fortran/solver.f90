@@ -1,6 +1,5 @@
 !> Time integration with CVODE (SUNDIALS 6.4, Fortran 2003 interface) of the scaled system of
-!> Eq. 25, with optional root finding on the contact switches of Eq. 16 (and, at the coupled
-!> thermal level, on the root/tip branch switches of Eqs. 13-14).
+!> Eq. 25, with optional root finding on the contact switches of Eq. 16.
 !>
 !> Reentrant: all run state sits in a solver_ctx_t local to `integrate`, which CVODE hands to
 !> the callbacks as their user data. No module variable changes during a run. The SUNDIALS
@@ -20,7 +19,7 @@ module spline_solver
   use fsunnonlinsol_fixedpoint_mod
   use spline_kinds, only: wp, pi
   use spline_errors, only: err_ok, err_solver, err_interrupted, msglen
-  use spline_model, only: model_t, nstate, ndof, thermal_coupled
+  use spline_model, only: model_t, nstate, ndof
   use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, integrated_states
   use spline_mesh, only: mesh_switch_functions, coupling_stats_t
   use spline_linear, only: tail_t, tail_possible, tail_try, tail_state
@@ -42,7 +41,6 @@ module spline_solver
     logical :: frozen = .false.             !< root finding: contact states frozen between switches
     integer :: nrc = 0                      !< root functions per copy
     integer, allocatable :: modes(:, :)     !< contact state (+1, 0, -1) per contact and copy
-    integer, allocatable :: branches(:, :, :)  !< root (-1) / tip (+1) branch per copy, coupled only
     type(coupling_stats_t) :: cstats        !< work of the flash-temperature coupling
     logical :: watch = .false.              !< stop on SIGINT (callers that can raise it)
     integer(c_int) :: sigint0 = 0           !< SIGINT count when the run began
@@ -162,10 +160,6 @@ contains
       if (ctx%frozen) then
         allocate(ctx%modes(m%z*m%n_slices, ctx%ncopy))
         nroot = 2*m%z*m%n_slices
-        if (m%thermal == thermal_coupled) then
-          allocate(ctx%branches(2, m%z, ctx%ncopy))
-          nroot = 4*m%z
-        end if
       end if
       ctx%nrc = nroot
       nroot = nroot*ctx%ncopy
@@ -529,19 +523,18 @@ contains
     flag = FSUNContext_Create(c_null_ptr, sunctx)
   end function sundials_context_new
 
-  !> Contact states (and branches) from the sign of the switch functions. Counts the switches
+  !> Contact states from the sign of the switch functions. Counts the switches
   !> whose stored state disagreed clearly (beyond round-off) with the state: a missed switch.
   subroutine sync_modes(ctx, c, tau, v, nchanged)
     type(solver_ctx_t), intent(inout) :: ctx
     integer, intent(in) :: c                   !< the copy
     real(c_double), intent(in) :: tau, v(:)    !< v: the integrated states (CVODE's vector)
     integer, intent(inout) :: nchanged
-    real(wp) :: y(nstate), g(2*ctx%m%z*ctx%m%n_slices), gb(2*ctx%m%z), eps, epsv
-    integer :: j, i, want
+    real(wp) :: y(nstate), g(2*ctx%m%z*ctx%m%n_slices), eps
+    integer :: j, want
     call from_scaled(ctx%m, copy_state(ctx, v, c), y)
-    call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), g, y(ndof+1:), gb)
+    call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), g)
     eps = 1.0e-9_wp*ctx%m%c_bulk
-    epsv = eps*ctx%m%w_ref
     do j = 1, ctx%m%z*ctx%m%n_slices         ! every contact: a tooth, or a slice of a tooth
       want = 0
       if (g(2*j - 1) > 0.0_wp) want = 1
@@ -551,29 +544,17 @@ contains
         ctx%modes(j, c) = want
       end if
     end do
-    if (.not. allocated(ctx%branches)) return
-    do j = 1, ctx%m%z
-      do i = 1, 2
-        want = merge(-1, 1, gb(2*j - 2 + i) < 0.0_wp)
-        if (want /= ctx%branches(i, j, c)) then
-          if (abs(gb(2*j - 2 + i)) > epsv) nchanged = nchanged + 1
-          ctx%branches(i, j, c) = want
-        end if
-      end do
-    end do
   end subroutine sync_modes
 
   !> A located root of g_{2j-1} = dn_j - c_j (rising: drive flank engages, falling: it opens)
-  !> or of g_{2j} = dn_j + c_j (falling: back flank engages, rising: it opens); then, in coupled
-  !> mode, of dDelta_ij/dt (rising: the contact point moves to the tip, falling: to the root).
+  !> or of g_{2j} = dn_j + c_j (falling: back flank engages, rising: it opens).
   !> The root functions of copy c are rootsfound((c - 1) nrc + 1 : c nrc).
   subroutine apply_roots(ctx, rootsfound, nroots)
     type(solver_ctx_t), intent(inout) :: ctx
     integer(c_int), intent(in) :: rootsfound(:)
     integer, intent(inout) :: nroots
-    integer :: j, i, z, nc, c, o
-    z = ctx%m%z
-    nc = z*ctx%m%n_slices                      ! contacts: teeth, or slices of teeth
+    integer :: j, nc, c, o
+    nc = ctx%m%z*ctx%m%n_slices                      ! contacts: teeth, or slices of teeth
     do c = 1, ctx%ncopy
       o = (c - 1)*ctx%nrc
       do j = 1, nc
@@ -582,14 +563,6 @@ contains
         if (rootsfound(o + 2*j) == -1) ctx%modes(j, c) = -1
         if (rootsfound(o + 2*j) == 1) ctx%modes(j, c) = 0
       end do
-      if (allocated(ctx%branches)) then        ! coupled level: a whole tooth per contact
-        do j = 1, z
-          do i = 1, 2
-            if (rootsfound(o + 2*nc + 2*j - 2 + i) /= 0) &
-                 ctx%branches(i, j, c) = rootsfound(o + 2*nc + 2*j - 2 + i)
-          end do
-        end do
-      end if
     end do
     nroots = nroots + count(rootsfound /= 0)
   end subroutine apply_roots
@@ -614,9 +587,6 @@ contains
       yf = copy_state(ctx, ys, c)
       if (.not. ctx%frozen) then
         call rhs_scaled(ctx%m, tau, yf, ff, ierr, ctx%cb_msg, cstats=ctx%cstats)
-      else if (allocated(ctx%branches)) then
-        call rhs_scaled(ctx%m, tau, yf, ff, ierr, ctx%cb_msg, ctx%modes(:, c), &
-             ctx%branches(:, :, c), ctx%cstats)
       else
         call rhs_scaled(ctx%m, tau, yf, ff, ierr, ctx%cb_msg, ctx%modes(:, c), cstats=ctx%cstats)
       end if
@@ -640,20 +610,14 @@ contains
     type(solver_ctx_t), pointer :: ctx
     real(c_double), pointer :: ys(:)
     real(wp) :: y(nstate)
-    integer :: z, nc, c, og
+    integer :: nc, c, og
     call c_f_pointer(udata, ctx)
     ys => FN_VGetArrayPointer(sv_y)
-    z = ctx%m%z
-    nc = z*ctx%m%n_slices
+    nc = ctx%m%z*ctx%m%n_slices
     do c = 1, ctx%ncopy
       og = (c - 1)*ctx%nrc
       call from_scaled(ctx%m, copy_state(ctx, ys, c), y)
-      if (allocated(ctx%branches)) then
-        call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), gout(og+1:og+2*nc), &
-             y(ndof+1:), gout(og+2*nc+1:og+2*nc+2*z))
-      else
-        call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), gout(og+1:og+2*nc))
-      end if
+      call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), gout(og+1:og+2*nc))
     end do
     ret = 0
   end function roots_cb

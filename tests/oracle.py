@@ -85,6 +85,9 @@ class Prepared:
         self.omega = self.speed_rpm * 2.0 * math.pi / 60.0          # rad/s
         self.R = self.module_m * self.z / 2.0                        # pitch radius
         self.r_b = self.R * math.cos(self.alpha)                     # base radius
+        # active profile (docs/model.md s.6): internal tip (minor) .. external tip (major) circle
+        self.r_lo = self.module_m * (self.z - 1) / 2.0
+        self.r_hi = self.module_m * (self.z + 1) / 2.0
         self.theta_0 = math.pi / (2.0 * self.z)                      # Eq. 9
         self.cos_a = math.cos(self.alpha)
         self.sin_a = math.sin(self.alpha)
@@ -106,7 +109,7 @@ def prepare(case):
 
 
 # --------------------------------------------------------------------------------------
-# Mesh kinematics (Eqs. 8-11), flash temperature (Eqs. 3-7, 12-14), contact (Eqs. 2, 15-17)
+# Mesh kinematics (Eqs. 8-11), flash temperature (Eqs. 3-7, 12-13), contact (Eqs. 2, 15-17)
 # --------------------------------------------------------------------------------------
 def _phi(t, p):
     """Eqs. 8-9: phi_j = 2 pi j / Z + omega t + theta_0 - alpha."""
@@ -114,13 +117,14 @@ def _phi(t, p):
 
 
 def flash_geometry(t, y, case):
-    """Contact radii and Hertz/velocity quantities of every tooth (Eqs. 5-7, 12-14).
+    """Contact radii and Hertz/velocity quantities of every tooth (Eqs. 5-7, 12-13).
 
     Returns dict with arrays rc1, rc2 (contact-point radii), Rc1, Rc2 (curvature radii
     R_i = r_ci sin(alpha_mi), Eqs. 5-6), v1, v2 (surface velocities, Eq. 7).
     Delta_1j = X1 cos phi + Y1 sin phi, Delta_2j = x2 cos phi + y2 sin phi (Eq. 12, as
-    simplified in docs/model.md s.6); the branch is chosen from the TOTAL time derivative
-    dDelta/dt (including d phi/dt = omega): < 0 -> root (Eq. 13), >= 0 -> tip (Eq. 14).
+    simplified in docs/model.md s.6). One contact point per tooth pair (docs/model.md s.6):
+    the pair's pitch point P, the same for both splines; r_ci is its distance from spline i's
+    centre shifted by Delta_i along the profile, held on the active profile.
     """
     p = prepare(case)
     y = np.asarray(y, dtype=float)
@@ -130,16 +134,13 @@ def flash_geometry(t, y, case):
 
 def _flash_geometry(phi, y, p):
     x1, y1, x2, y2 = y[0], y[1], y[2], y[3]
-    vx1, vy1, vx2, vy2 = y[7], y[8], y[9], y[10]
     X1 = x1 + p.l_x
     Y1 = y1 + p.l_y
     cp, sp = np.cos(phi), np.sin(phi)
     d1 = X1 * cp + Y1 * sp                                          # Eq. 12 (spline 1)
     d2 = x2 * cp + y2 * sp                                          # Eq. 12 (spline 2)
-    dd1 = vx1 * cp + vy1 * sp + p.omega * (-X1 * sp + Y1 * cp)      # d Delta_1j / dt
-    dd2 = vx2 * cp + vy2 * sp + p.omega * (-x2 * sp + y2 * cp)      # d Delta_2j / dt
-    rc1 = _contact_radius(d1, dd1, p)
-    rc2 = _contact_radius(d2, dd2, p)
+    rc1 = _contact_radius(d1, p)
+    rc2 = _contact_radius(d2, p)
     Rc1 = rc1 * np.sin(np.arccos(p.r_b / rc1))                      # Eqs. 5-6
     Rc2 = rc2 * np.sin(np.arccos(p.r_b / rc2))
     v1 = p.omega * rc1 * p.cos_a                                    # Eq. 7
@@ -147,12 +148,11 @@ def _flash_geometry(phi, y, p):
     return {"rc1": rc1, "rc2": rc2, "Rc1": Rc1, "Rc2": Rc2, "v1": v1, "v2": v2}
 
 
-def _contact_radius(delta, ddelta, p):
-    """Eq. 13 (root, dDelta/dt < 0) / Eq. 14 (tip, dDelta/dt >= 0)."""
-    R, a = p.R, p.alpha
-    root = np.sqrt(delta ** 2 + R ** 2 - 2.0 * R * delta * p.cos_a)                # Eq. 13
-    tip = R * np.sin(math.pi - a - np.arcsin(delta * p.sin_a / R)) / p.sin_a         # Eq. 14
-    return np.where(ddelta < 0.0, root, tip)
+def _contact_radius(delta, p):
+    """|P - Delta u|: in the frame (u, its normal) the pitch point is P = R (cos a, sin a) and the
+    shifted centre is (Delta, 0) (Eq. 13 as a distance), clipped to the active profile
+    [internal tip circle, external tip circle]."""
+    return np.clip(np.hypot(p.R * p.cos_a - delta, p.R * p.sin_a), p.r_lo, p.r_hi)
 
 
 def flash_temperature(F, geo, case):
@@ -286,7 +286,7 @@ def mesh(t, y, case):
 
     Returns dict with arrays (length z): phi (Eqs. 8-9), dn (Eq. 11), ddn (its total time
     derivative), c (Eq. 2), F (Eqs. 15-17), Fx = F sin phi, Fy = F cos phi (Eq. 19 with
-    phi_j, docs/model.md s.4), Tf (Eq. 3), rc1, rc2 (Eqs. 12-14); and scalars Tm (Eq. 22),
+    phi_j, docs/model.md s.4), Tf (Eq. 3), rc1, rc2 (Eqs. 12-13); and scalars Tm (Eq. 22),
     kv = |Tm|/T_d, Fx1 = -sum F sin phi, Fy1 = +sum F cos phi (Eqs. 20-21 corrected).
     """
     p = prepare(case)

@@ -30,6 +30,8 @@ CASES = {
     "oneway": dict(PAPER, l_x=1e-4, thermal="oneway", t_bulk=50.0),
     "coupled": dict(PAPER, l_x=1e-4, thermal="coupled", t_bulk=100.0, f_m=0.3),
     "slow_z7": dict(PAPER, z=7, speed_rpm=300.0, l_x=5e-5, l_y=5e-5, grav=0.0),
+    # a shift of up to 1.9 mm moves the contact point past both tip circles: radii held there
+    "oneway_clipped": dict(PAPER, l_x=1.9e-3, thermal="oneway"),
 }
 
 
@@ -40,6 +42,7 @@ def test_rhs_matches_oracle(name):
     p = oracle.prepare(dict(case))
     rng = np.random.default_rng(zlib.crc32(name.encode()))
     n_free = n_contact = 0
+    n_clipped = np.zeros(2, int)
     for y in random_states(case, 40, rng):
         t = rng.uniform(0, 0.05)
         f, mesh, tm = model.rhs_mesh(t, y)
@@ -57,8 +60,11 @@ def test_rhs_matches_oracle(name):
             np.testing.assert_allclose(mesh["rc1"], o["rc1"], rtol=1e-12)
             np.testing.assert_allclose(mesh["rc2"], o["rc2"], rtol=1e-12)
             np.testing.assert_allclose(mesh["Tf"], o["Tf"], rtol=1e-10, atol=1e-12)
+            n_clipped += [(o["rc1"] == p.r_lo).sum(), (o["rc1"] == p.r_hi).sum()]
         contact = np.abs(o["dn"]) > o["c"]
         n_contact += contact.sum()
         n_free += (~contact).sum()
     # the random states exercised both sides of the dead zone
     assert n_contact > 20 and n_free > 20
+    if name == "oneway_clipped":      # ... and both ends of the active profile
+        assert n_clipped.min() > 20

@@ -162,8 +162,8 @@ WHY = {   # what a miss means, where we know (README.md, "The paper's values")
         "aligned with equal supports there is no sliding (r_c1 = r_c2), so T_f is zero to "
         "round-off; the paper's 0.011 degC needs a sliding source the model does not have",
     "paper_flash_lx1e-4/largest flash temperature max T_f":
-        "matched only with f_m = 26, far above any friction coefficient: the paper's flash "
-        "temperatures are about 260 times what Eqs. 3-7 give with f_m = 0.1",
+        "matched only with f_m = 33, far above any friction coefficient: the paper's flash "
+        "temperatures are about 330 times what Eqs. 3-7 give with f_m = 0.1",
 }
 
 
@@ -279,8 +279,8 @@ MEANING = """## What the misses mean
   sliding source the model does not have.
 - **Calibrated values.** k_m = 2.543e5 N/m is 7568 times softer than the potential-energy value of
   the same tooth pair by Eq. 18 (1.924e9 N/m), consistent with N/mm read as N/m, and still 3081
-  times softer than Eq. 18 with the fillet foundation (7.83e8 N/m, docs/stiffness.md); f_m = 26
-  is no friction coefficient: the paper's flash temperatures are about 260 times what Eqs. 3-7
+  times softer than Eq. 18 with the fillet foundation (7.83e8 N/m, docs/stiffness.md); f_m = 33
+  is no friction coefficient: the paper's flash temperatures are about 330 times what Eqs. 3-7
   give with 0.1."""
 
 HELD_TO_ACCOUNT = """## Held to account (independent checks, each a test)

@@ -1,10 +1,10 @@
 !> Module spline_geometry (fortran/geometry.f90) and the geometry model_from_case derives from it,
 !> against docs/model.md sections 2, 6 and 12: ISO 4156 radii, base radius, tooth angles
-!> (Eqs. 8-9), profile shift (Eq. 12) and contact radius (Eqs. 13-14).
+!> (Eqs. 8-9), profile shift (Eq. 12) and contact radius (Eq. 13 on the active profile).
 program test_geometry
   use spline_kinds, only: wp, pi
   use spline_geometry, only: iso4156_radii, tooth_angles, pitch_rotation, profile_shift, &
-       contact_radius
+       contact_radius, active_profile
   use spline_model, only: model_t
   use check, only: check_true, check_close, check_done, default_case_model
   implicit none
@@ -14,7 +14,7 @@ program test_geometry
   type(model_t) :: md
   real(wp) :: rp, rfe, rfi, rai, m, sd, cd, phi, err_s, err_c, worst, alpha
   real(wp) :: sphi(1000), cphi(1000)
-  real(wp) :: x, y, vx, vy, om, h, dl, dd, dp, dm, ddp, ddm, r, delta, rc, want, beta, lo, hi
+  real(wp) :: x, y, dl, r, delta, rc, rc_prev, want, lo, hi
   integer :: i, j, k, z
   character(len=64) :: tag
   logical :: ok
@@ -69,42 +69,39 @@ program test_geometry
     call check_true(trim(tag)//' sin^2 + cos^2 = 1 for every tooth', ok)
   end do
 
-  ! ---- Eq. 12: Delta = x cos(phi) + y sin(phi) and its total time derivative, against a central
-  !      difference in t along x(t) = x + vx t, y(t) = y + vy t, phi(t) = phi + omega t
-  x = 3.0e-5_wp; y = -1.7e-5_wp; vx = 0.21_wp; vy = 0.37_wp; om = 628.3_wp; phi = 0.7_wp
-  call profile_shift(x, y, vx, vy, om, sin(phi), cos(phi), dl, dd)
+  ! ---- Eq. 12: Delta = x cos(phi) + y sin(phi)
+  x = 3.0e-5_wp; y = -1.7e-5_wp; phi = 0.7_wp
+  dl = profile_shift(x, y, sin(phi), cos(phi))
   call check_close('profile_shift Delta = x cos + y sin', dl, x*cos(phi) + y*sin(phi), 4*eps)
-  h = 1.0e-8_wp     ! truncation (omega h)^2 ~ 4e-11, round-off ~ 1e-12
-  call profile_shift(x + vx*h, y + vy*h, vx, vy, om, sin(phi + om*h), cos(phi + om*h), dp, ddp)
-  call profile_shift(x - vx*h, y - vy*h, vx, vy, om, sin(phi - om*h), cos(phi - om*h), dm, ddm)
-  call check_close('profile_shift dDelta/dt = central difference', dd, (dp - dm)/(2*h), 1.0e-9_wp)
 
-  ! ---- Eqs. 13-14 (docs/model.md section 6), R = 16 mm, alpha = 30 deg
+  ! ---- the contact radius (docs/model.md section 6), R = 16 mm, alpha = 30 deg, m = 2 mm, Z = 16
   r = 16.0e-3_wp
-  call check_close('contact_radius Delta = 0, root branch: R', &
-       contact_radius(0.0_wp, -1.0_wp, r, cos(pi/6), sin(pi/6)), r, 2*eps)
-  call check_close('contact_radius Delta = 0, tip branch: R', &
-       contact_radius(0.0_wp, 1.0_wp, r, cos(pi/6), sin(pi/6)), r, 2*eps)
-  ! Eq. 13 is the distance |P - Delta u| with |P| = R, angle(P, u) = alpha; Eq. 14 the law of
-  ! sines with an explicit inverse sine (the code uses an equivalent form without it)
+  call active_profile(16, 2.0e-3_wp, lo, hi)
+  call check_close('active_profile: internal tip circle m (Z - 1) / 2', lo, 15.0e-3_wp, 2*eps)
+  call check_close('active_profile: external tip circle m (Z + 1) / 2', hi, 17.0e-3_wp, 2*eps)
+  call check_close('contact_radius Delta = 0: R', &
+       contact_radius(0.0_wp, r, cos(pi/6), lo, hi), r, 2*eps)
+  ! Eq. 13 is the distance |P - Delta u| with |P| = R, angle(P, u) = alpha; it moves at most as
+  ! fast as Delta (|d r_c / d Delta| <= 1, the triangle inequality) and is held on [lo, hi]
   worst = 0.0_wp
   ok = .true.
-  lo = 0.5_wp*2.0e-3_wp*(16 - 1); hi = 0.5_wp*2.0e-3_wp*(16 + 1)  ! internal tip .. external tip
-  do k = -20, 20
-    delta = k*0.5_wp*2.0e-3_wp/20      ! |Delta| <= m / 2
-    rc = contact_radius(delta, -1.0_wp, r, cos(pi/6), sin(pi/6))
-    want = hypot(r - delta*cos(pi/6), delta*sin(pi/6))
+  rc_prev = 0.0_wp
+  do k = -40, 40
+    delta = k*2.0e-3_wp/20      ! |Delta| <= 2 m: beyond m / 2 the radius reaches the tip circles
+    rc = contact_radius(delta, r, cos(pi/6), lo, hi)
+    want = min(max(hypot(r - delta*cos(pi/6), delta*sin(pi/6)), lo), hi)
     worst = max(worst, abs(rc - want)/(4*eps*r))
-    ok = ok .and. abs(rc - r) <= abs(delta)*(1 + 4*eps) .and. rc >= lo .and. rc <= hi
-    rc = contact_radius(delta, 1.0_wp, r, cos(pi/6), sin(pi/6))
-    beta = asin(delta*sin(pi/6)/r)
-    want = r*sin(pi - pi/6 - beta)/sin(pi/6)
-    worst = max(worst, abs(rc - want)/(8*eps*r))
-    ok = ok .and. abs(rc - r) <= abs(delta)*(1 + 4*eps) .and. rc >= lo .and. rc <= hi
+    ok = ok .and. rc >= lo .and. rc <= hi
+    if (k > -40) ok = ok .and. rc <= rc_prev .and. rc_prev - rc <= 2.0e-3_wp/20*(1 + 4*eps)
+    rc_prev = rc
   end do
-  call check_true('contact_radius Eqs. 13 (|P - Delta u|) and 14 (law of sines), |Delta| <= m/2', &
+  call check_true('contact_radius = Eq. 13 (|P - Delta u|) held on [15, 17] mm, |Delta| <= 2 m', &
        worst <= 1.0_wp)
-  call check_true('contact_radius |r_c - R| <= |Delta|, r_c within the active flank [15, 17] mm', ok)
+  call check_true('contact_radius on the active profile, falling in Delta, |dr_c| <= |dDelta|', ok)
+  call check_close('contact_radius Delta = 2 m: the internal tip circle', &
+       contact_radius(2*2.0e-3_wp, r, cos(pi/6), lo, hi), lo, 0.0_wp)
+  call check_close('contact_radius Delta = -2 m: the external tip circle', &
+       contact_radius(-2*2.0e-3_wp, r, cos(pi/6), lo, hi), hi, 0.0_wp)
 
   call check_done('test_geometry')
 end program test_geometry

@@ -1,8 +1,8 @@
-"""What locating the switches costs and buys, on paper_T100 (coupled flash temperature): CVODE
-with and without root finding (contact switches, and the root/tip branch switches of Eqs. 13-14
-where T_f jumps), at several tolerances, against a reference with root finding at rtol 1e-11.
+"""What locating the contact switches costs and buys, on paper_T100 (coupled flash temperature):
+CVODE with and without root finding, at several tolerances, against a reference with root
+finding at rtol 1e-11.
 
-    python bench/bench_branch_roots.py [--t-end 0.3] [--repeat 3]
+    python bench/bench_switch_roots.py [--t-end 0.3] [--repeat 3]
 """
 import argparse
 import statistics
