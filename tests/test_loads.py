@@ -10,6 +10,7 @@ import pytest
 import oracle
 import pyspline
 from pyspline.core import LOAD_QUANTITIES, TOOTH_LOAD_QUANTITIES
+from pyspline.sweep import SWEEP_LOADS
 from conftest import CASES
 
 REV_OUT = 721       # outputs in one revolution: each tooth's angle sweeps 2 pi in 0.5 deg steps
@@ -165,3 +166,15 @@ def test_executable_writes_the_same_loads(exe, offset_scene, scene, tmp_path):
     assert set(got) == set(res.loads)
     for n, v in res.loads.items():
         np.testing.assert_array_equal(got[n], v, err_msg=n)      # bit for bit
+
+
+def test_sweep_keeps_the_loads(offset_scene):
+    """The sweep dataset's loads are the points' Result.loads (units from the core's table)."""
+    case = offset_scene[0].replace(t_end=0.01, n_out=401, thermal="none")
+    ds = pyspline.sweep(case, progress=False, l_x=[2e-4, 4e-4])
+    for i, lx in enumerate([2e-4, 4e-4]):
+        ld = pyspline.simulate(case.replace(l_x=lx)).loads
+        for n in SWEEP_LOADS + ("Tf_max",):
+            assert ds[n].values[i] == ld[n], n
+    assert ds["closing_speed_max"].attrs["units"] == "m/s"
+    assert ds["load_sharing"].attrs["units"] == "1"
