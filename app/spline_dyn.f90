@@ -163,7 +163,7 @@ program spline_dyn
   call check_interrupt()
   call print_warnings(run_warnings(m, stats))
   allocate(tload(m%z, nload_tooth))
-  call run_loads(m, t, y, tooth, loads, tload)
+  call run_loads(m, t, y, tooth, tm, loads, tload)
 
   write(u, '(a)', iostat=ios) '# spline-dyn output (pyspline): SI units, per-tooth columns Q_j '// &
        'for teeth j = 1..Z'

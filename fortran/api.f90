@@ -245,13 +245,14 @@ contains
     ierr = ie
   end subroutine api_simulate
 
-  !> The loads of a run of a loaded model from its outputs (t, y, tooth as api_simulate returns
-  !> them): loads in the order of api_names('loads'), tload(z, :) in the order of
+  !> The loads of a run of a loaded model from its outputs (t, y, tooth, tm as api_simulate
+  !> returns them): loads in the order of api_names('loads'), tload(z, :) in the order of
   !> api_names('tooth_loads') (spline_loads::run_loads, the numbers spline-dyn writes).
-  subroutine api_loads(model, nb, z, nt, nq, nl, ntl, t, y, tooth, loads, tload, ierr, errmsg)
+  subroutine api_loads(model, nb, z, nt, nq, nl, ntl, t, y, tooth, tm, loads, tload, ierr, &
+       errmsg)
     integer(c_int), intent(in) :: nb, z, nt, nq, nl, ntl
     integer(c_int), intent(in) :: model(nb)
-    real(c_double), intent(in) :: t(nt), y(nt, 14), tooth(nt, z, nq)
+    real(c_double), intent(in) :: t(nt), y(nt, 14), tooth(nt, z, nq), tm(nt)
     real(c_double), intent(out) :: loads(nl), tload(z, ntl)
     integer(c_int), intent(out) :: ierr
     character(len=msglen), intent(out) :: errmsg
@@ -263,7 +264,7 @@ contains
          ntl /= nload_tooth)) then
       ie = err_case; errmsg = 'api_loads: array sizes do not match the loaded case'
     end if
-    if (ie == err_ok) call run_loads(m, t, transpose(y), tooth, loads, tload)
+    if (ie == err_ok) call run_loads(m, t, transpose(y), tooth, tm, loads, tload)
     ierr = ie
   end subroutine api_loads
 

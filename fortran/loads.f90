@@ -12,7 +12,8 @@ module spline_loads
   use spline_quantities, only: iq_tf, nload, nload_tooth, il_f_static, &
        il_load_sharing, il_load_sharing_tooth, il_free_max, il_back_max, il_free_mean, &
        il_unloaded, il_back_teeth, il_impacts_rev, il_closing_speed, il_tf_max, il_tf_max_tooth, &
-       il_tf_max_t, il_revolutions, ilt_f_peak, ilt_load_factor, ilt_free, ilt_back, ilt_onsets
+       il_tf_max_t, il_revolutions, il_batches, il_tm_rms_se, il_sharing_rev, &
+       il_sharing_rev_se, ilt_f_peak, ilt_load_factor, ilt_free, ilt_back, ilt_onsets
   implicit none
   private
   public :: run_loads, tooth_flank, drive_flank, approach_speed
@@ -49,7 +50,7 @@ contains
   end function approach_speed
 
   !> The loads of a run from its outputs (t(k), SI states y(:, k), tooth(k, j, :) in the order
-  !> of spline_quantities tooth_q): loads(nload) in the order of load_q, tload(z, nload_tooth)
+  !> of spline_quantities tooth_q, T_m tm(k)): loads(nload) in the order of load_q, tload(z, nload_tooth)
   !> in the order of load_tooth_q. Over the output times as given (after the transient):
   !> - F_peak_j = max_k |F_j(t_k)|, load factor F_peak_j / F_s with F_s = |T_d| / (Z r_b), the
   !>   load of each tooth when all Z share T_d equally (NaN if T_d = 0); load_sharing = max_j.
@@ -61,9 +62,11 @@ contains
   !>   approach_speed at t_(k-1), the last output before it.
   !> - T_f max over teeth and outputs, the first tooth and time where it occurs (0 and -1 if it
   !>   is 0 throughout: a thermal level without T_f).
-  pure subroutine run_loads(m, t, y, tooth, loads, tload)
+  !> - standard errors by batch means (batch_means): the batches are the whole revolutions of
+  !>   the outputs; per batch the RMS of T_m and the load-sharing factor.
+  pure subroutine run_loads(m, t, y, tooth, tm, loads, tload)
     type(model_t), intent(in) :: m
-    real(wp), intent(in) :: t(:), y(:, :), tooth(:, :, :)
+    real(wp), intent(in) :: t(:), y(:, :), tooth(:, :, :), tm(:)
     real(wp), intent(out) :: loads(nload), tload(m%z, nload_tooth)
     integer :: nt, j, k, fl, prev, drive, onsets
     real(wp) :: fs, tfm, speed
@@ -108,6 +111,7 @@ contains
     onsets = nint(sum(tload(:, ilt_onsets)))
     if (loads(il_revolutions) > 0.0_wp) loads(il_impacts_rev) = onsets/loads(il_revolutions)
     loads(il_closing_speed) = speed
+    call batch_means(m, t, tooth, tm, fs, loads)
     tfm = maxval(tooth(:, :, iq_tf))
     loads(il_tf_max) = tfm
     loads(il_tf_max_tooth) = 0.0_wp
@@ -124,5 +128,52 @@ contains
       end do outer
     end if
   end subroutine run_loads
+
+  !> Standard errors by batch means (e.g. Law & Kelton, Simulation Modeling and Analysis,
+  !> ch. 9.5): output k belongs to revolution b = floor(omega (t_k - t_1) / 2 pi) + 1; the
+  !> nb = floor(revolutions) whole ones are the batches (outputs past them are left out). Per
+  !> batch x_b: the RMS of T_m, sqrt(mean T_m^2), and the load-sharing factor max |F_j| / F_s;
+  !> the standard error of their mean is sd(x_b) / sqrt(nb) (sd with nb - 1). NaN with fewer
+  !> than 2 batches (and for the load sharing when F_s = 0).
+  pure subroutine batch_means(m, t, tooth, tm, fs, loads)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t(:), tooth(:, :, :), tm(:), fs
+    real(wp), intent(inout) :: loads(nload)
+    real(wp), allocatable :: sq(:), fmax(:), cnt(:)
+    real(wp) :: nan
+    integer :: nb, b, k
+    nan = ieee_value(0.0_wp, ieee_quiet_nan)
+    nb = int(loads(il_revolutions))
+    loads(il_batches) = nb
+    loads(il_tm_rms_se) = nan
+    loads(il_sharing_rev) = nan
+    loads(il_sharing_rev_se) = nan
+    if (nb < 2) return
+    allocate(sq(nb), fmax(nb), cnt(nb))
+    sq = 0.0_wp; fmax = 0.0_wp; cnt = 0.0_wp
+    do k = 1, size(t)
+      b = int(m%omega*(t(k) - t(1))/(2.0_wp*pi)) + 1
+      if (b > nb) cycle
+      sq(b) = sq(b) + tm(k)**2
+      cnt(b) = cnt(b) + 1
+      fmax(b) = max(fmax(b), maxval(abs(tooth(k, :, 1))))
+    end do
+    if (any(cnt == 0.0_wp)) return          ! a revolution without outputs: no batches
+    sq = sqrt(sq/cnt)
+    loads(il_tm_rms_se) = std_error(sq)
+    if (fs > 0.0_wp) then
+      fmax = fmax/fs
+      loads(il_sharing_rev) = sum(fmax)/nb
+      loads(il_sharing_rev_se) = std_error(fmax)
+    end if
+  end subroutine batch_means
+
+  !> Standard error of the mean of x: sd(x) / sqrt(n), sd with n - 1 (n >= 2).
+  pure real(wp) function std_error(x) result(se)
+    real(wp), intent(in) :: x(:)
+    real(wp) :: mean
+    mean = sum(x)/size(x)
+    se = sqrt(sum((x - mean)**2)/(size(x) - 1))/sqrt(real(size(x), wp))
+  end function std_error
 
 end module spline_loads

@@ -114,8 +114,9 @@ module spline_quantities
   integer, parameter, public :: il_f_static = 1, il_load_sharing = 2, il_load_sharing_tooth = 3, &
        il_free_max = 4, il_back_max = 5, il_free_mean = 6, il_unloaded = 7, il_back_teeth = 8, &
        il_impacts_rev = 9, il_closing_speed = 10, il_tf_max = 11, il_tf_max_tooth = 12, &
-       il_tf_max_t = 13, il_revolutions = 14
-  integer, parameter :: nload = 14
+       il_tf_max_t = 13, il_revolutions = 14, il_batches = 15, il_tm_rms_se = 16, &
+       il_sharing_rev = 17, il_sharing_rev_se = 18
+  integer, parameter :: nload = 18
   type(quantity_t), parameter :: load_q(nload) = [ &
        quantity_t('F_static', 'N', 'static tooth load of equal load sharing |T_d| / (Z r_b)'), &
        quantity_t('load_sharing', '-', 'load-sharing factor: the largest tooth load factor'), &
@@ -132,6 +133,14 @@ module spline_quantities
        quantity_t('Tf_max', 'degC', 'largest flash temperature T_f over teeth and outputs'), &
        quantity_t('Tf_max_tooth', '', 'the tooth of the largest T_f (0: T_f is 0 throughout)'), &
        quantity_t('Tf_max_t_s', 's', 'the time of the largest T_f (-1: T_f is 0 throughout)'), &
-       quantity_t('revolutions', '', 'shaft revolutions spanned by the outputs')]
+       quantity_t('revolutions', '', 'shaft revolutions spanned by the outputs'), &
+       quantity_t('batches', '', 'whole revolutions of the outputs, the batches of the &
+            &standard errors'), &
+       quantity_t('Tm_rms_se', 'N m', 'standard error of the RMS of T_m by batch means over &
+            &revolutions (NaN: < 2 batches)'), &
+       quantity_t('load_sharing_rev', '-', 'mean over the revolutions of each one''s &
+            &load-sharing factor'), &
+       quantity_t('load_sharing_rev_se', '-', 'standard error of load_sharing_rev by batch means &
+            &(NaN: < 2 batches)')]
 
 end module spline_quantities

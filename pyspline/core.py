@@ -325,16 +325,17 @@ def simulate(case) -> Result:
                   tooth={n: tooth[:, :, i] for i, (n, *_) in enumerate(q)}, Tm=tm, stats=st,
                   section_t=sec_t, section_y=sec_y, lyapunov=lyap,
                   face=face if model.n_slices else None, tilt=tilt if model.n_slices else None,
-                  loads=run_loads(model, t, y, tooth))
+                  loads=run_loads(model, t, y, tooth, tm))
 
 
-def run_loads(model, t, y, tooth) -> dict:
+def run_loads(model, t, y, tooth, tm) -> dict:
     """The loads of a run from its outputs (the core's spline_loads::run_loads; the numbers
     spline-dyn writes): {name: value} for the scalars of LOAD_QUANTITIES (float) and the
-    per-tooth arrays (Z,) of TOOTH_LOAD_QUANTITIES. tooth: (nt, Z, nq) as api_simulate gives it."""
+    per-tooth arrays (Z,) of TOOTH_LOAD_QUANTITIES. tooth: (nt, Z, nq) as api_simulate gives it,
+    tm: T_m (nt,)."""
     model = load(model)
     loads, tload, ierr, msg = _api.api_loads(model.bytes, len(LOAD_QUANTITIES),
-                                             len(TOOTH_LOAD_QUANTITIES), t, y, tooth)
+                                             len(TOOTH_LOAD_QUANTITIES), t, y, tooth, tm)
     raise_for(ierr, msg)
     out = {n: float(v) for n, v in zip(LOAD_QUANTITIES, loads)}
     out.update({n: tload[:, i] for i, n in enumerate(TOOTH_LOAD_QUANTITIES)})

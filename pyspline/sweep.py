@@ -182,7 +182,8 @@ def _template(options: dict, stat_names: Sequence[str]) -> dict:
 #: The loads of a run a sweep keeps per point (Result.loads: the core's, docs/model.md
 #: section 15; Tf_max too), units from the core's table.
 SWEEP_LOADS = ("load_sharing", "free_frac_max", "back_frac_max", "teeth_free_mean", "teeth_back",
-               "impacts_per_rev", "closing_speed_max")
+               "impacts_per_rev", "closing_speed_max", "Tm_rms_se", "load_sharing_rev",
+               "load_sharing_rev_se")
 
 
 @functools.cache
@@ -371,7 +372,8 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     predictability_horizon, chaotic (1 if the exponent exceeds its spread; if lyapunov);
     Tm_/kv_/F_ max, min, rms, Tf_max, D2_max, D2_min; the loads (SWEEP_LOADS: load_sharing,
     free_frac_max, back_frac_max, teeth_free_mean, teeth_back, impacts_per_rev,
-    closing_speed_max; docs/model.md section 15);
+    closing_speed_max, and the batch-means standard errors Tm_rms_se, load_sharing_rev,
+    load_sharing_rev_se; docs/model.md section 15);
     solver statistics (steps, rhs_evals, ..., core_wall_s, wall_s); Tm_spectrum (dim 'order');
     error, error_class ('' if ok), point_hash. A failed point has NaN values and its error.
     attrs: case (namelist text of the base case), pyspline_version, command, swept, section,

@@ -18,9 +18,10 @@ REV_OUT = 721       # outputs in one revolution: each tooth's angle sweeps 2 pi 
 
 def full_contact(**kw):
     """The template drive (Z 16, 30.7 N m, 6000 r/min) without gravity and mesh damping, from
-    its static equilibrium, over one revolution: every tooth stays on its drive flank."""
-    return pyspline.load_case(CASES / "template.nml", name="full", grav=0.0, c_m=0.0,
-                              t_end=0.01, n_out=REV_OUT, **kw)
+    its static equilibrium, over one revolution (unless kw say otherwise): every tooth stays on
+    its drive flank."""
+    kw = {"t_end": 0.01, "n_out": REV_OUT, **kw}
+    return pyspline.load_case(CASES / "template.nml", name="full", grav=0.0, c_m=0.0, **kw)
 
 
 def test_aligned_full_contact_shares_the_load_equally():
@@ -170,11 +171,41 @@ def test_executable_writes_the_same_loads(exe, offset_scene, scene, tmp_path):
 
 def test_sweep_keeps_the_loads(offset_scene):
     """The sweep dataset's loads are the points' Result.loads (units from the core's table)."""
-    case = offset_scene[0].replace(t_end=0.01, n_out=401, thermal="none")
+    case = offset_scene[0].replace(t_end=0.02, n_out=801, thermal="none")
     ds = pyspline.sweep(case, progress=False, l_x=[2e-4, 4e-4])
     for i, lx in enumerate([2e-4, 4e-4]):
         ld = pyspline.simulate(case.replace(l_x=lx)).loads
         for n in SWEEP_LOADS + ("Tf_max",):
-            assert ds[n].values[i] == ld[n], n
+            assert ds[n].values[i] == ld[n] and np.isfinite(ld[n]), n
     assert ds["closing_speed_max"].attrs["units"] == "m/s"
     assert ds["load_sharing"].attrs["units"] == "1"
+
+
+def test_batch_means_against_a_count(offset_scene):
+    """Standard errors by batch means over whole revolutions, recomputed from Result.Tm and
+    Result.F: per revolution the RMS of T_m and the load-sharing factor."""
+    case, res = offset_scene
+    ld = res.loads
+    rev = np.floor(case["speed_rpm"] / 60 * (res.t - res.t[0])).astype(int)
+    nb = int(np.floor(case["speed_rpm"] / 60 * (res.t[-1] - res.t[0])))
+    assert ld["batches"] == nb >= 2
+    fs = ld["F_static"]
+    rms = np.array([np.sqrt(np.mean(res.Tm[rev == b] ** 2)) for b in range(nb)])
+    share = np.array([np.abs(res.F[rev == b]).max() / fs for b in range(nb)])
+    assert ld["Tm_rms_se"] == pytest.approx(rms.std(ddof=1) / np.sqrt(nb), rel=1e-9)
+    assert ld["load_sharing_rev"] == pytest.approx(share.mean(), rel=1e-12)
+    assert ld["load_sharing_rev_se"] == pytest.approx(share.std(ddof=1) / np.sqrt(nb), rel=1e-9)
+    assert ld["load_sharing_rev_se"] > 0
+
+
+def test_batch_means_of_a_periodic_run_vanish():
+    """Full contact with misalignment repeats every revolution: the standard errors are round-off
+    and solver noise, the mean per-revolution load sharing is the run's."""
+    res = pyspline.simulate(full_contact(l_x=1e-4, t_end=0.03, n_out=3 * (REV_OUT - 1) + 1))
+    ld = res.loads
+    assert ld["batches"] == 3
+    assert ld["Tm_rms_se"] < 1e-8 * 30.7                 # T_d
+    assert ld["load_sharing_rev"] == pytest.approx(ld["load_sharing"], rel=1e-6)
+    assert ld["load_sharing_rev_se"] < 1e-6
+    one = pyspline.simulate(full_contact(t_end=0.015, n_out=1081)).loads
+    assert one["batches"] == 1 and np.isnan(one["Tm_rms_se"]) and np.isnan(one["load_sharing_rev"])
