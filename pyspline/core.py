@@ -200,7 +200,8 @@ class Result:
 
     Every quantity is an attribute: the states ``x1 y1 x2 y2 D1 D2 D3`` [m] and their
     velocities ``vx1 ... vD3`` [m/s] (nt,), the per-tooth ``F Fx Fy dn c Tf rc1 rc2`` (nt, Z),
-    ``Tm`` and ``kv`` (nt,). ``to_xarray()`` gives all of it as an xarray.Dataset."""
+    ``Tm`` and ``kv`` (nt,); ``loads``: the load sharing, free and back-flank teeth, impacts
+    and T_f max of the run (the core's). ``to_xarray()`` gives all of it as an xarray.Dataset."""
     case: Case
     t: np.ndarray            #: output times [s]
     y: np.ndarray            #: states (nt, 14): x1, y1, x2, y2, D1, D2, D3 [m], then their velocities [m/s]
