@@ -15,7 +15,10 @@ program spline_dyn
   use spline_case, only: case_t, case_read_file, case_parse, case_name_of
   use spline_model, only: model_t, model_from_case, model_warnings, nstate, nkterms, kterm_names
   use spline_run, only: run_case, run_warnings
-  use spline_quantities, only: nstats, stat_q, ntooth_q, tooth_q, nout_q, output_q
+  use spline_quantities, only: nstats, stat_q, ntooth_q, tooth_q, nout_q, output_q, nload, &
+       load_q, nload_tooth, load_tooth_q, il_load_sharing, il_free_mean, il_back_teeth, &
+       il_impacts_rev, il_closing_speed, il_tf_max, il_tf_max_tooth, il_tf_max_t
+  use spline_loads, only: run_loads
   implicit none
 
   type :: string_t
@@ -67,7 +70,8 @@ program spline_dyn
   type(model_t) :: m
   real(wp), allocatable :: t(:), y(:, :), tooth(:, :, :), tm(:)
   real(c_double), allocatable :: row(:)
-  real(wp) :: stats(nstats)
+  real(wp) :: stats(nstats), loads(nload)
+  real(wp), allocatable :: tload(:, :)
   integer :: ierr, i, j, k, n, q, u, nargs, nsets, ios
   integer(c_int) :: sigint0
   logical :: have_out, options_done
@@ -158,6 +162,8 @@ program spline_dyn
   end if
   call check_interrupt()
   call print_warnings(run_warnings(m, stats))
+  allocate(tload(m%z, nload_tooth))
+  call run_loads(m, t, y, tooth, tm, loads, tload)
 
   write(u, '(a)', iostat=ios) '# spline-dyn output (pyspline): SI units, per-tooth columns Q_j '// &
        'for teeth j = 1..Z'
@@ -169,6 +175,21 @@ program spline_dyn
     write(u, '(1x,a,"=",g0)', advance='no', iostat=ios) trim(stat_q(i)%name), stats(i)
   end do
   write(u, '(a)', iostat=ios) ''
+  ! the loads of the run (spline_loads::run_loads): the scalars, then one line per per-tooth
+  ! quantity with its unit and a value for each tooth j = 1..Z
+  write(u, '(a)', advance='no', iostat=ios) '# loads:'
+  do i = 1, nload
+    write(u, '(1x,a,"=",g0)', advance='no', iostat=ios) trim(load_q(i)%name), loads(i)
+  end do
+  write(u, '(a)', iostat=ios) ''
+  do q = 1, nload_tooth
+    write(u, '(a," [",a,"]:")', advance='no', iostat=ios) '# tooth loads '// &
+         trim(load_tooth_q(q)%name), trim(load_tooth_q(q)%unit)
+    do j = 1, m%z
+      write(u, '(1x,g0)', advance='no', iostat=ios) tload(j, q)
+    end do
+    write(u, '(a)', iostat=ios) ''
+  end do
   ! the header: every column 'NAME [UNIT]' (spline_quantities output_q, its order), per-tooth
   ! quantities as NAME_j for teeth j = 1..Z
   do i = 1, nout_q - ntooth_q
@@ -226,6 +247,12 @@ program spline_dyn
   write(*, '(a,2es12.4)') '  meshing torque T_m min/max [N m]: ', minval(tm), maxval(tm)
   write(*, '(a,2es12.4)') '  tooth force F_j min/max [N]:      ', minval(tooth(:, :, 1)), &
        maxval(tooth(:, :, 1))
+  write(*, '(a,f8.3,a,f6.2,a,i0,a,f8.3,a,es10.3,a)') '  load sharing factor ', &
+       loads(il_load_sharing), ', free teeth (mean) ', loads(il_free_mean), &
+       ', teeth on the back flank ', nint(loads(il_back_teeth)), ', impacts/rev ', &
+       loads(il_impacts_rev), ', closing speed max ', loads(il_closing_speed), ' m/s'
+  write(*, '(a,es11.4,a,i0,a,es11.4,a)') '  flash temperature T_f max [degC]: ', &
+       loads(il_tf_max), ' (tooth ', nint(loads(il_tf_max_tooth)), ', t = ', loads(il_tf_max_t), ' s)'
   do i = 1, nstats
     write(*, '(2x,a24,g0)') stat_q(i)%name, stats(i)
   end do

@@ -24,13 +24,14 @@ module spline_api
   use spline_dynamics, only: accelerations, start_state
   use spline_run, only: run_case, tooth_quantities, output_times, run_warnings
   use spline_quantities, only: quantity_t, nstats, stat_q, ntooth_q, tooth_q, state_q, nout_q, &
-       output_q
+       output_q, nload, load_q, nload_tooth, load_tooth_q
+  use spline_loads, only: run_loads
   use spline_sections, only: section_count
   use spline_lyapunov, only: lyapunov_count
   implicit none
   private
   public :: api_load_file, api_load_fields, api_load_text, api_model_size, api_simulate
-  public :: api_rhs, api_rhs_mesh, api_start_state
+  public :: api_rhs, api_rhs_mesh, api_start_state, api_loads
   public :: api_output_times, api_model_info, api_defaults, api_names, api_tooth_stiffness
   public :: api_field_hint, api_warnings
 
@@ -244,6 +245,29 @@ contains
     ierr = ie
   end subroutine api_simulate
 
+  !> The loads of a run of a loaded model from its outputs (t, y, tooth, tm as api_simulate
+  !> returns them): loads in the order of api_names('loads'), tload(z, :) in the order of
+  !> api_names('tooth_loads') (spline_loads::run_loads, the numbers spline-dyn writes).
+  subroutine api_loads(model, nb, z, nt, nq, nl, ntl, t, y, tooth, tm, loads, tload, ierr, &
+       errmsg)
+    integer(c_int), intent(in) :: nb, z, nt, nq, nl, ntl
+    integer(c_int), intent(in) :: model(nb)
+    real(c_double), intent(in) :: t(nt), y(nt, 14), tooth(nt, z, nq), tm(nt)
+    real(c_double), intent(out) :: loads(nl), tload(z, ntl)
+    integer(c_int), intent(out) :: ierr
+    character(len=msglen), intent(out) :: errmsg
+    type(model_t) :: m
+    integer :: ie
+    loads = 0; tload = 0
+    call unpack(model, m, ie, errmsg)
+    if (ie == err_ok .and. (m%z /= z .or. nq /= ntooth_q .or. nl /= nload .or. &
+         ntl /= nload_tooth)) then
+      ie = err_case; errmsg = 'api_loads: array sizes do not match the loaded case'
+    end if
+    if (ie == err_ok) call run_loads(m, t, transpose(y), tooth, tm, loads, tload)
+    ierr = ie
+  end subroutine api_loads
+
   !> SI right-hand side dy/dt at (t, y) of a loaded model, contact states from the state:
   !> the project's Fortran RHS for solvers driven from Python (the benchmarks' peers).
   subroutine api_rhs(model, nb, t, y, ydot, ierr)
@@ -361,7 +385,8 @@ contains
   !> Units are SI ('-' a ratio, '' none). Lists: 'outputs' (every output quantity in the order
   !> of the executable's CSV columns: t, the states, Tm, kv, the per-tooth quantities),
   !> 'states' (a state vector's), 'tooth' (the per-tooth quantities, order of api_simulate's
-  !> tooth), 'stats' (a run's statistics): the table of spline_quantities; 'fields' (the case
+  !> tooth), 'stats' (a run's statistics), 'loads' and 'tooth_loads' (the loads of a run, its
+  !> scalars and per tooth: api_loads): the table of spline_quantities; 'fields' (the case
   !> fields, case_type.f90's table); 'layout' (the case fields, unit: type i, r, l or c and
   !> the size, e.g. 'r7', 'c16': how api_load_fields lays them out); 'info'
   !> (api_model_info), 'kterms' (Eq. 18 terms), 'errors' (error codes 0..nerr, i = code + 1).
@@ -387,6 +412,10 @@ contains
       if (i >= 1 .and. i <= ntooth_q) call row(tooth_q(i))
     case ('stats')
       if (i >= 1 .and. i <= nstats) call row(stat_q(i))
+    case ('loads')
+      if (i >= 1 .and. i <= nload) call row(load_q(i))
+    case ('tooth_loads')
+      if (i >= 1 .and. i <= nload_tooth) call row(load_tooth_q(i))
     case ('fields')
       call case_field_meta(i, name, ftype, n, unit, descr)
     case ('layout')

@@ -9,7 +9,7 @@ module spline_quantities
   implicit none
   private
   public :: quantity_t, nout_q, output_q, state_q, tooth_q, ntooth_q, iq_tf
-  public :: nsolver_stats, nstats, stat_q
+  public :: nsolver_stats, nstats, stat_q, nload_tooth, load_tooth_q, nload, load_q
 
   type :: quantity_t
     character(len=24) :: name
@@ -95,5 +95,52 @@ module spline_quantities
             &closes the backlash (Eq. 2)'), &
        quantity_t('backlash_closed_t_s', 's', 'first time the one-way flash temperature closes &
             &the backlash (Eq. 2)')]
+
+  !> The loads of a run (spline_loads::run_loads, docs/model.md section 15), per tooth: their
+  !> positions in a run's tooth-load array (ilt_*) and the table.
+  integer, parameter, public :: ilt_f_peak = 1, ilt_load_factor = 2, ilt_free = 3, &
+       ilt_back = 4, ilt_onsets = 5
+  integer, parameter :: nload_tooth = 5
+  type(quantity_t), parameter :: load_tooth_q(nload_tooth) = [ &
+       quantity_t('F_peak', 'N', 'largest tooth load |F_j| over the outputs'), &
+       quantity_t('load_factor', '-', 'tooth load factor F_peak / (T_d / (Z r_b))'), &
+       quantity_t('free_frac', '-', 'fraction of the outputs the tooth is free (F_j = 0)'), &
+       quantity_t('back_frac', '-', 'fraction of the outputs the tooth is in contact on its &
+            &back flank'), &
+       quantity_t('onsets', '', 'contact onsets (impacts): free or on the other flank at one &
+            &output, in contact at the next')]
+
+  !> The loads of a run, the scalars: their positions in a run's load array (il_*) and the table.
+  integer, parameter, public :: il_f_static = 1, il_load_sharing = 2, il_load_sharing_tooth = 3, &
+       il_free_max = 4, il_back_max = 5, il_free_mean = 6, il_unloaded = 7, il_back_teeth = 8, &
+       il_impacts_rev = 9, il_closing_speed = 10, il_tf_max = 11, il_tf_max_tooth = 12, &
+       il_tf_max_t = 13, il_revolutions = 14, il_batches = 15, il_tm_rms_se = 16, &
+       il_sharing_rev = 17, il_sharing_rev_se = 18
+  integer, parameter :: nload = 18
+  type(quantity_t), parameter :: load_q(nload) = [ &
+       quantity_t('F_static', 'N', 'static tooth load of equal load sharing |T_d| / (Z r_b)'), &
+       quantity_t('load_sharing', '-', 'load-sharing factor: the largest tooth load factor'), &
+       quantity_t('load_sharing_tooth', '', 'the tooth of the largest load factor'), &
+       quantity_t('free_frac_max', '-', 'largest fraction of the outputs a tooth is free'), &
+       quantity_t('back_frac_max', '-', 'largest fraction of the outputs a tooth is on its &
+            &back flank'), &
+       quantity_t('teeth_free_mean', '', 'mean number of free teeth at an output'), &
+       quantity_t('teeth_unloaded', '', 'teeth free at every output'), &
+       quantity_t('teeth_back', '', 'teeth on their back flank at some output'), &
+       quantity_t('impacts_per_rev', '', 'contact onsets of all teeth per shaft revolution'), &
+       quantity_t('closing_speed_max', 'm/s', 'largest |d dn_j/dt| at the output before a &
+            &contact onset'), &
+       quantity_t('Tf_max', 'degC', 'largest flash temperature T_f over teeth and outputs'), &
+       quantity_t('Tf_max_tooth', '', 'the tooth of the largest T_f (0: T_f is 0 throughout)'), &
+       quantity_t('Tf_max_t_s', 's', 'the time of the largest T_f (-1: T_f is 0 throughout)'), &
+       quantity_t('revolutions', '', 'shaft revolutions spanned by the outputs'), &
+       quantity_t('batches', '', 'whole revolutions of the outputs, the batches of the &
+            &standard errors'), &
+       quantity_t('Tm_rms_se', 'N m', 'standard error of the RMS of T_m by batch means over &
+            &revolutions (NaN: < 2 batches)'), &
+       quantity_t('load_sharing_rev', '-', 'mean over the revolutions of each one''s &
+            &load-sharing factor'), &
+       quantity_t('load_sharing_rev_se', '-', 'standard error of load_sharing_rev by batch means &
+            &(NaN: < 2 batches)')]
 
 end module spline_quantities

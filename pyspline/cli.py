@@ -27,10 +27,16 @@ from .sweep import MERGED, POINTS_DIR, parse_values, sweep
 def _summary(res) -> str:
     F = res.tooth["F"]
     s = res.stats
+    ld = res.loads      # the core's loads of the run (docs/model.md section 15)
     return (f"{res.case.name:>16s}  F_j [{F.min():8.2f}, {F.max():8.2f}] N  "
             f"T_m [{res.Tm.min():7.2f}, {res.Tm.max():7.2f}] N m  "
             f"k_v [{res.kv.min():.3f}, {res.kv.max():.3f}]  "
             f"D2 [{res.D2.min():.4e}, {res.D2.max():.4e}] m  "
+            f"load sharing {ld['load_sharing']:.3f}  "
+            f"free teeth {ld['teeth_free_mean']:.1f}/{F.shape[1]}  "
+            f"back flank {ld['teeth_back']:.0f}  "
+            f"impacts/rev {ld['impacts_per_rev']:.2f}  "
+            f"T_f max {ld['Tf_max']:.1f} degC  "
             f"{res.level}  "
             f"steps {s['steps']}  {s['wall_s']*1e3:.0f} ms")
 
@@ -94,7 +100,11 @@ def _save_result(res, out: Path, taken: set) -> tuple[Path, str]:
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=out)
     try:
         with os.fdopen(fd, "wb") as f:
-            np.savez_compressed(f, t=res.t, y=res.y, Tm=res.Tm, **res.tooth,
+            extra = {f"stat_{k}": np.array(v) for k, v in res.stats.items()}
+            if res.section_t is not None and len(res.section_t):
+                extra.update(section_t=res.section_t, section_y=res.section_y)
+            np.savez_compressed(f, t=res.t, y=res.y, Tm=res.Tm, kv=res.kv, **res.tooth,
+                                **res.loads, **extra,
                                 **{_RESULT_KEY: np.array(res.case.text())})
         os.replace(tmp, path)
     except BaseException:

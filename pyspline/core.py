@@ -161,11 +161,15 @@ QUANTITIES = {n: (d, u) for n, u, d in _names("outputs")}
 STATE_QUANTITIES = {n: (d, u) for n, u, d in _names("states")}
 TOOTH_QUANTITIES = {n: (d, u) for n, u, d in _names("tooth")}
 STATE_NAMES = tuple(STATE_QUANTITIES)[:len(STATE_QUANTITIES) // 2]   #: x1 .. D3 (positions)
+#: The loads of a run (spline_loads::run_loads, docs/model.md section 15): name -> (description,
+#: unit), the scalars and the per-tooth ones (arrays over the teeth).
+LOAD_QUANTITIES = {n: (d, u) for n, u, d in _names("loads")}
+TOOTH_LOAD_QUANTITIES = {n: (d, u) for n, u, d in _names("tooth_loads")}
 
 
 def _attrs(name: str) -> dict:
     """xarray attrs of an output quantity of the core's table: long_name, units (if any)."""
-    long, unit = QUANTITIES[name]
+    long, unit = QUANTITIES.get(name) or LOAD_QUANTITIES.get(name) or TOOTH_LOAD_QUANTITIES[name]
     return {"long_name": long, "units": cf_units(unit)} if unit else {"long_name": long}
 
 
@@ -196,7 +200,8 @@ class Result:
 
     Every quantity is an attribute: the states ``x1 y1 x2 y2 D1 D2 D3`` [m] and their
     velocities ``vx1 ... vD3`` [m/s] (nt,), the per-tooth ``F Fx Fy dn c Tf rc1 rc2`` (nt, Z),
-    ``Tm`` and ``kv`` (nt,). ``to_xarray()`` gives all of it as an xarray.Dataset."""
+    ``Tm`` and ``kv`` (nt,); ``loads``: the load sharing, free and back-flank teeth, impacts
+    and T_f max of the run (the core's). ``to_xarray()`` gives all of it as an xarray.Dataset."""
     case: Case
     t: np.ndarray            #: output times [s]
     y: np.ndarray            #: states (nt, 14): x1, y1, x2, y2, D1, D2, D3 [m], then their velocities [m/s]
@@ -208,6 +213,11 @@ class Result:
     lyapunov: dict = None    #: Benettin record (case field lyapunov): t [s], log_growth, exponent [1/s]
     face: np.ndarray = None  #: sliced face (n_slices > 1): load of slice s of tooth j, (nt, Z, n_slices) [N]
     tilt: np.ndarray = None  #: sliced face: tilting moment (M_x, M_y) on spline 1, (nt, 2) [N m]
+    #: the loads of the run (the core's, from its outputs: docs/model.md section 15), by name:
+    #: scalars (load_sharing, impacts_per_rev, Tf_max, ...) and per-tooth arrays (Z,)
+    #: (F_peak, load_factor, free_frac, back_frac, onsets); units: LOAD_QUANTITIES,
+    #: TOOTH_LOAD_QUANTITIES
+    loads: dict = None
 
     F = _tooth_quantity("F")
     Fx = _tooth_quantity("Fx")
@@ -248,7 +258,8 @@ class Result:
         dims: time (the output times t [s]), tooth (1..Z), section_point (the Poincare section,
         if the case asked for one), renormalisation (the Benettin record, if lyapunov).
         Variables: the states x1 .. D3 and velocities vx1 .. vD3 (time); Tm, kv (time); the
-        per-tooth F, Fx, Fy, dn, c, Tf, rc1, rc2 (time, tooth); section_t and the states on the
+        per-tooth F, Fx, Fy, dn, c, Tf, rc1, rc2 (time, tooth); the loads (``loads``: per
+        tooth on the tooth dim, the scalars without a dim); section_t and the states on the
         section section_x1 .. section_vD3 (section_point); lyapunov_log_growth
         (renormalisation, with coordinate lyapunov_t [s]). attrs: case (namelist text), name, level, pyspline_version, the
         exponent as lyapunov_exponent [1/s], and the run statistics as stat_<name>."""
@@ -263,6 +274,8 @@ class Result:
         data["kv"] = ("time", self.kv, _attrs("kv"))
         for n, arr in self.tooth.items():
             data[n] = (("time", "tooth"), arr, _attrs(n))
+        for n, v in (self.loads or {}).items():     # per tooth on the tooth dim, scalars 0-d
+            data[n] = (("tooth",) if n in TOOTH_LOAD_QUANTITIES else (), v, _attrs(n))
         if self.section_t is not None and len(self.section_t):
             sec = np.asarray(self.section_y).reshape(-1, 14)
             data["section_t"] = ("section_point", self.section_t,
@@ -310,8 +323,24 @@ def simulate(case) -> Result:
         span = lyap_t - (t[0] if len(t) else 0.0)
         lyap = dict(t=lyap_t, log_growth=lyap_g, exponent=float(lyap_g[-1] / span[-1]))
     return Result(case=model.case, t=t, y=y,
-                  tooth={n: tooth[:, :, i] for i, (n, *_) in enumerate(q)}, Tm=tm, stats=st, section_t=sec_t, section_y=sec_y, lyapunov=lyap,
-                  face=face if model.n_slices else None, tilt=tilt if model.n_slices else None)
+                  tooth={n: tooth[:, :, i] for i, (n, *_) in enumerate(q)}, Tm=tm, stats=st,
+                  section_t=sec_t, section_y=sec_y, lyapunov=lyap,
+                  face=face if model.n_slices else None, tilt=tilt if model.n_slices else None,
+                  loads=run_loads(model, t, y, tooth, tm))
+
+
+def run_loads(model, t, y, tooth, tm) -> dict:
+    """The loads of a run from its outputs (the core's spline_loads::run_loads; the numbers
+    spline-dyn writes): {name: value} for the scalars of LOAD_QUANTITIES (float) and the
+    per-tooth arrays (Z,) of TOOTH_LOAD_QUANTITIES. tooth: (nt, Z, nq) as api_simulate gives it,
+    tm: T_m (nt,)."""
+    model = load(model)
+    loads, tload, ierr, msg = _api.api_loads(model.bytes, len(LOAD_QUANTITIES),
+                                             len(TOOTH_LOAD_QUANTITIES), t, y, tooth, tm)
+    raise_for(ierr, msg)
+    out = {n: float(v) for n, v in zip(LOAD_QUANTITIES, loads)}
+    out.update({n: tload[:, i] for i, n in enumerate(TOOTH_LOAD_QUANTITIES)})
+    return out
 
 
 def rhs(case, t: float, y) -> tuple[np.ndarray, dict, float]:

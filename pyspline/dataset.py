@@ -1,7 +1,7 @@
 """The dataset of a sweep: the per-point summaries gathered into an xarray.Dataset (units and
 descriptions in each variable's attrs: from the core's tables for the swept fields, the
-statistics and the summaries of a result quantity), written to NetCDF-4 (engine h5netcdf)
-atomically, and read back (`open_sweep`)."""
+statistics, the loads and the summaries of a result quantity), written to NetCDF-4 (engine
+h5netcdf) atomically, and read back (`open_sweep`)."""
 from __future__ import annotations
 
 import functools
@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .core import QUANTITIES, TOOTH_QUANTITIES, _names, cf_units
+from .core import LOAD_QUANTITIES, QUANTITIES, TOOTH_QUANTITIES, _names, cf_units
 
 __all__ = ["build_dataset", "field_meta", "open_sweep", "write_netcdf"]
 
@@ -78,6 +78,9 @@ def _stat_attrs(name: str) -> tuple:
         if q in TOOTH_QUANTITIES and what != "section":
             long += " over all teeth"
         return _WHAT[what].format(long), cf_units(unit)
+    if name in LOAD_QUANTITIES:
+        long, unit = LOAD_QUANTITIES[name]
+        return long, cf_units(unit)
     stats = {n: (d, cf_units(u)) for n, u, d in _names("stats")}
     return stats.get(name, (name, ""))
 

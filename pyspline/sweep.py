@@ -171,11 +171,19 @@ def _template(options: dict, stat_names: Sequence[str]) -> dict:
     for q in ("Tm", "kv", "F"):
         s.update({f"{q}_max": nan, f"{q}_min": nan, f"{q}_rms": nan})
     s.update(Tf_max=nan, D2_max=nan, D2_min=nan)
+    s.update({k: nan for k in SWEEP_LOADS})
     s.update({k: nan for k in stat_names})
     if options.get("orders") is not None:
         s["Tm_spectrum"] = np.full(len(options["orders"]), nan)
     s.update(error="", error_class="")
     return s
+
+
+#: The loads of a run a sweep keeps per point (Result.loads: the core's, docs/model.md
+#: section 15; Tf_max too), units from the core's table.
+SWEEP_LOADS = ("load_sharing", "free_frac_max", "back_frac_max", "teeth_free_mean", "teeth_back",
+               "impacts_per_rev", "closing_speed_max", "Tm_rms_se", "load_sharing_rev",
+               "load_sharing_rev_se")
 
 
 @functools.cache
@@ -238,6 +246,7 @@ def summarise(res, options: dict) -> dict:
         st = analysis.stats(arr, quantiles=False)
         s.update({f"{q}_max": st["max"], f"{q}_min": st["min"], f"{q}_rms": st["rms"]})
     s["Tf_max"] = float(np.max(res.tooth["Tf"]))
+    s.update({k: float(res.loads[k]) for k in SWEEP_LOADS})
     s.update(D2_max=float(res.D2.max()), D2_min=float(res.D2.min()))
     for k in _stat_names():
         if k in res.stats:
@@ -361,7 +370,10 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     section_t/section_D2/section_vD2 (dim 'section_point', NaN-padded), period and
     period_residual; lyapunov, lyapunov_spread, lyapunov_rel_spread, lyapunov_slope,
     predictability_horizon, chaotic (1 if the exponent exceeds its spread; if lyapunov);
-    Tm_/kv_/F_ max, min, rms, Tf_max, D2_max, D2_min;
+    Tm_/kv_/F_ max, min, rms, Tf_max, D2_max, D2_min; the loads (SWEEP_LOADS: load_sharing,
+    free_frac_max, back_frac_max, teeth_free_mean, teeth_back, impacts_per_rev,
+    closing_speed_max, and the batch-means standard errors Tm_rms_se, load_sharing_rev,
+    load_sharing_rev_se; docs/model.md section 15);
     solver statistics (steps, rhs_evals, ..., core_wall_s, wall_s); Tm_spectrum (dim 'order');
     error, error_class ('' if ok), point_hash. A failed point has NaN values and its error.
     attrs: case (namelist text of the base case), pyspline_version, command, swept, section,

@@ -19,6 +19,7 @@ TOOTH = [n for n, *_ in _names("tooth")]
 STATES = [n for n, *_ in _names("states")]
 STATS = {n: (u, d) for n, u, d in _names("stats")}
 FIELD_UNITS = {n: u for n, u, _ in _names("fields")}
+LOADS = {n: (u, d) for n, u, d in [*_names("loads"), *_names("tooth_loads")]}
 
 
 @pytest.fixture(scope="module")
@@ -50,7 +51,7 @@ def test_readme_result_table_gives_every_quantity_the_core_unit():
         for code in re.findall(r"`([^`]+)`", cells[0]):
             for name in code.split():
                 listed[name] = cells[1]
-    for n, (u, _) in OUTPUTS.items():
+    for n, (u, _) in {**OUTPUTS, **LOADS}.items():
         assert n in listed, f"README's result table does not list {n}"
         assert listed[n] == u, (n, listed[n], u)
 
@@ -79,6 +80,9 @@ def test_sweep_dataset_takes_the_core_tables(short):
         m = re.fullmatch(r"(\w+?)_(max|min|rms|spectrum)", k)
         if k in STATS:
             expected = STATS[k][0]
+        elif k in LOADS and k != "Tf_max":
+            expected = LOADS[k][0]
+            assert v.attrs["long_name"] == LOADS[k][1], k
         elif m and m.group(1) in OUTPUTS:
             expected = OUTPUTS[m.group(1)][0]
         elif k.startswith("section_") and k[8:] in OUTPUTS:
@@ -90,7 +94,8 @@ def test_sweep_dataset_takes_the_core_tables(short):
         assert unit == cf_units(expected), (k, unit, expected)
         seen.add(k)
     for k in ("Tm_max", "kv_rms", "F_min", "Tf_max", "D2_max", "section_D2", "section_vD2",
-              "Tm_spectrum", "steps", "last_step_s", "coupling_residual_degC", "speed_rpm"):
+              "Tm_spectrum", "steps", "last_step_s", "coupling_residual_degC", "speed_rpm",
+              "load_sharing", "impacts_per_rev", "closing_speed_max", "back_frac_max"):
         assert k in seen, k
     assert ds["speed_rpm"].attrs["long_name"] == "shaft speed"
 

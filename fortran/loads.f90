@@ -1,0 +1,179 @@
+!> The loads of a run, computed once from its outputs (docs/model.md section 15) for the
+!> executable and Python alike: per tooth the peak load and the load factor, the fractions of
+!> the outputs the tooth is free and on its back flank, its contact onsets (impacts); for the
+!> run the load-sharing factor, impacts per revolution, the largest closing speed and the
+!> largest flash temperature with its tooth and time. Names and units: spline_quantities
+!> (load_q, load_tooth_q).
+module spline_loads
+  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+  use spline_kinds, only: wp, pi, max_teeth
+  use spline_model, only: model_t, nstate
+  use spline_geometry, only: tooth_angles
+  use spline_quantities, only: iq_tf, nload, nload_tooth, il_f_static, &
+       il_load_sharing, il_load_sharing_tooth, il_free_max, il_back_max, il_free_mean, &
+       il_unloaded, il_back_teeth, il_impacts_rev, il_closing_speed, il_tf_max, il_tf_max_tooth, &
+       il_tf_max_t, il_revolutions, il_batches, il_tm_rms_se, il_sharing_rev, &
+       il_sharing_rev_se, ilt_f_peak, ilt_load_factor, ilt_free, ilt_back, ilt_onsets
+  implicit none
+  private
+  public :: run_loads, tooth_flank, drive_flank, approach_speed
+
+contains
+
+  !> The flank a tooth is in contact on at one output: 0 free (F_j = 0, Eqs. 15-17: |dn_j| <=
+  !> c_j), else the sign of dn_j (+1: dn_j > c_j, -1: dn_j < -c_j; the sign of the elastic
+  !> force, docs/model.md section 1; for a sliced face the face centre's).
+  pure integer function tooth_flank(f, dn)
+    real(wp), intent(in) :: f, dn
+    tooth_flank = 0
+    if (f /= 0.0_wp) tooth_flank = merge(1, -1, dn > 0.0_wp)
+  end function tooth_flank
+
+  !> The drive flank: the flank every tooth is on at the static equilibrium under T_d (docs/
+  !> model.md section 1): -1 for T_d >= 0 (F_j = -T_d / (Z r_b) < 0), +1 for T_d < 0.
+  pure integer function drive_flank(m)
+    type(model_t), intent(in) :: m
+    drive_flank = merge(1, -1, m%t_d < 0.0_wp)
+  end function drive_flank
+
+  !> |d dn_j/dt| of tooth j at time t in state y (SI): the total rate of Eq. 11 with the turning
+  !> frame (docs/model.md section 2), at the face centre.
+  pure real(wp) function approach_speed(m, t, y, j) result(s)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t, y(nstate)
+    integer, intent(in) :: j
+    real(wp) :: sp(max_teeth), cp(max_teeth), ex, ey
+    call tooth_angles(m%z, m%omega, t, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
+    ex = y(1) + m%l_x - y(3)
+    ey = y(2) + m%l_y - y(4)
+    s = abs((y(8) - y(10))*sp(j) - (y(9) - y(11))*cp(j) + y(13) + m%omega*(ex*cp(j) + ey*sp(j)))
+  end function approach_speed
+
+  !> The loads of a run from its outputs (t(k), SI states y(:, k), tooth(k, j, :) in the order
+  !> of spline_quantities tooth_q, T_m tm(k)): loads(nload) in the order of load_q, tload(z, nload_tooth)
+  !> in the order of load_tooth_q. Over the output times as given (after the transient):
+  !> - F_peak_j = max_k |F_j(t_k)|, load factor F_peak_j / F_s with F_s = |T_d| / (Z r_b), the
+  !>   load of each tooth when all Z share T_d equally (NaN if T_d = 0); load_sharing = max_j.
+  !> - free: F_j = 0; back flank: in contact on the flank opposite to drive_flank (tooth_flank);
+  !>   fractions of the nt outputs.
+  !> - onset of tooth j at t_k: in contact at t_k on another flank than at t_(k-1) (free or the
+  !>   other one). impacts_per_rev = onsets of all teeth / revolutions, revolutions =
+  !>   omega (t_nt - t_1) / (2 pi) (0 if that is 0); the closing speed of an onset is
+  !>   approach_speed at t_(k-1), the last output before it.
+  !> - T_f max over teeth and outputs, the first tooth and time where it occurs (0 and -1 if it
+  !>   is 0 throughout: a thermal level without T_f).
+  !> - standard errors by batch means (batch_means): the batches are the whole revolutions of
+  !>   the outputs; per batch the RMS of T_m and the load-sharing factor.
+  pure subroutine run_loads(m, t, y, tooth, tm, loads, tload)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t(:), y(:, :), tooth(:, :, :), tm(:)
+    real(wp), intent(out) :: loads(nload), tload(m%z, nload_tooth)
+    integer :: nt, j, k, fl, prev, drive, onsets
+    real(wp) :: fs, tfm, speed
+    nt = size(t)
+    loads = 0.0_wp; tload = 0.0_wp
+    if (nt == 0) return
+    drive = drive_flank(m)
+    fs = abs(m%t_d)/(m%z*m%r_b)
+    onsets = 0
+    speed = 0.0_wp
+    do j = 1, m%z
+      prev = 0
+      do k = 1, nt
+        tload(j, ilt_f_peak) = max(tload(j, ilt_f_peak), abs(tooth(k, j, 1)))
+        fl = tooth_flank(tooth(k, j, 1), tooth(k, j, 4))
+        if (fl == 0) tload(j, ilt_free) = tload(j, ilt_free) + 1
+        if (fl == -drive) tload(j, ilt_back) = tload(j, ilt_back) + 1
+        if (k > 1 .and. fl /= 0 .and. fl /= prev) then
+          tload(j, ilt_onsets) = tload(j, ilt_onsets) + 1
+          speed = max(speed, approach_speed(m, t(k - 1), y(:, k - 1), j))
+        end if
+        prev = fl
+      end do
+    end do
+    if (fs > 0.0_wp) then
+      tload(:, ilt_load_factor) = tload(:, ilt_f_peak)/fs
+    else
+      tload(:, ilt_load_factor) = ieee_value(fs, ieee_quiet_nan)
+    end if
+    loads(il_f_static) = fs
+    loads(il_load_sharing) = maxval(tload(:, ilt_load_factor))
+    loads(il_load_sharing_tooth) = maxloc(tload(:, ilt_f_peak), 1)
+    if (fs == 0.0_wp) loads(il_load_sharing) = ieee_value(fs, ieee_quiet_nan)
+    loads(il_free_mean) = sum(tload(:, ilt_free))/nt
+    loads(il_unloaded) = count(tload(:, ilt_free) == nt)
+    loads(il_back_teeth) = count(tload(:, ilt_back) > 0)
+    tload(:, ilt_free) = tload(:, ilt_free)/nt
+    tload(:, ilt_back) = tload(:, ilt_back)/nt
+    loads(il_free_max) = maxval(tload(:, ilt_free))
+    loads(il_back_max) = maxval(tload(:, ilt_back))
+    loads(il_revolutions) = m%omega*(t(nt) - t(1))/(2.0_wp*pi)
+    onsets = nint(sum(tload(:, ilt_onsets)))
+    if (loads(il_revolutions) > 0.0_wp) loads(il_impacts_rev) = onsets/loads(il_revolutions)
+    loads(il_closing_speed) = speed
+    call batch_means(m, t, tooth, tm, fs, loads)
+    tfm = maxval(tooth(:, :, iq_tf))
+    loads(il_tf_max) = tfm
+    loads(il_tf_max_tooth) = 0.0_wp
+    loads(il_tf_max_t) = -1.0_wp
+    if (tfm > 0.0_wp) then
+      outer: do k = 1, nt
+        do j = 1, m%z
+          if (tooth(k, j, iq_tf) == tfm) then
+            loads(il_tf_max_tooth) = j
+            loads(il_tf_max_t) = t(k)
+            exit outer
+          end if
+        end do
+      end do outer
+    end if
+  end subroutine run_loads
+
+  !> Standard errors by batch means (e.g. Law & Kelton, Simulation Modeling and Analysis,
+  !> ch. 9.5): output k belongs to revolution b = floor(omega (t_k - t_1) / 2 pi) + 1; the
+  !> nb = floor(revolutions) whole ones are the batches (outputs past them are left out). Per
+  !> batch x_b: the RMS of T_m, sqrt(mean T_m^2), and the load-sharing factor max |F_j| / F_s;
+  !> the standard error of their mean is sd(x_b) / sqrt(nb) (sd with nb - 1). NaN with fewer
+  !> than 2 batches (and for the load sharing when F_s = 0).
+  pure subroutine batch_means(m, t, tooth, tm, fs, loads)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t(:), tooth(:, :, :), tm(:), fs
+    real(wp), intent(inout) :: loads(nload)
+    real(wp), allocatable :: sq(:), fmax(:), cnt(:)
+    real(wp) :: nan
+    integer :: nb, b, k
+    nan = ieee_value(0.0_wp, ieee_quiet_nan)
+    nb = int(loads(il_revolutions))
+    loads(il_batches) = nb
+    loads(il_tm_rms_se) = nan
+    loads(il_sharing_rev) = nan
+    loads(il_sharing_rev_se) = nan
+    if (nb < 2) return
+    allocate(sq(nb), fmax(nb), cnt(nb))
+    sq = 0.0_wp; fmax = 0.0_wp; cnt = 0.0_wp
+    do k = 1, size(t)
+      b = int(m%omega*(t(k) - t(1))/(2.0_wp*pi)) + 1
+      if (b > nb) cycle
+      sq(b) = sq(b) + tm(k)**2
+      cnt(b) = cnt(b) + 1
+      fmax(b) = max(fmax(b), maxval(abs(tooth(k, :, 1))))
+    end do
+    if (any(cnt == 0.0_wp)) return          ! a revolution without outputs: no batches
+    sq = sqrt(sq/cnt)
+    loads(il_tm_rms_se) = std_error(sq)
+    if (fs > 0.0_wp) then
+      fmax = fmax/fs
+      loads(il_sharing_rev) = sum(fmax)/nb
+      loads(il_sharing_rev_se) = std_error(fmax)
+    end if
+  end subroutine batch_means
+
+  !> Standard error of the mean of x: sd(x) / sqrt(n), sd with n - 1 (n >= 2).
+  pure real(wp) function std_error(x) result(se)
+    real(wp), intent(in) :: x(:)
+    real(wp) :: mean
+    mean = sum(x)/size(x)
+    se = sqrt(sum((x - mean)**2)/(size(x) - 1))/sqrt(real(size(x), wp))
+  end function std_error
+
+end module spline_loads

@@ -1,0 +1,211 @@
+"""The loads of a run (fortran/loads.f90, docs/model.md section 15): load sharing against the
+closed form of static full contact (aligned and with parallel misalignment), free and
+back-flank fractions and contact onsets against a count from Result.F and Result.dn, the closing
+speed against the oracle's d(dn)/dt, and the executable's numbers against Python's."""
+import subprocess
+
+import numpy as np
+import pytest
+
+import oracle
+import pyspline
+from pyspline.core import LOAD_QUANTITIES, TOOTH_LOAD_QUANTITIES
+from pyspline.sweep import SWEEP_LOADS
+from conftest import CASES
+
+REV_OUT = 721       # outputs in one revolution: each tooth's angle sweeps 2 pi in 0.5 deg steps
+
+
+def full_contact(**kw):
+    """The template drive (Z 16, 30.7 N m, 6000 r/min) without gravity and mesh damping, from
+    its static equilibrium, over one revolution (unless kw say otherwise): every tooth stays on
+    its drive flank."""
+    kw = {"t_end": 0.01, "n_out": REV_OUT, **kw}
+    return pyspline.load_case(CASES / "template.nml", name="full", grav=0.0, c_m=0.0, **kw)
+
+
+def test_aligned_full_contact_shares_the_load_equally():
+    """docs/model.md section 15: an aligned drive in static full contact has F_j = -T_d/(Z r_b)
+    on every tooth: load factor 1, no tooth free or on its back flank, no onset."""
+    case = full_contact()
+    res = pyspline.simulate(case)
+    ld, info = res.loads, case.model.info()
+    fs = case["t_d"] / (case["z"] * info["r_b"])
+    assert ld["F_static"] == pytest.approx(fs, rel=1e-14)
+    assert ld["F_static"] == pytest.approx(138.5, abs=0.05)      # the paper's tooth load
+    np.testing.assert_allclose(ld["load_factor"], 1.0, rtol=1e-8)
+    assert ld["load_sharing"] == pytest.approx(1.0, rel=1e-8)
+    for n in ("free_frac", "back_frac", "onsets"):
+        assert not ld[n].any(), n
+    assert ld["impacts_per_rev"] == 0 and ld["teeth_back"] == 0 and ld["teeth_free_mean"] == 0
+    assert ld["revolutions"] == pytest.approx(1.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("l_x, l_y", [(1e-4, 0.0), (6e-5, -8e-5)])
+def test_misaligned_full_contact_load_sharing_closed_form(l_x, l_y):
+    """Parallel misalignment in full contact (Z >= 3, c_m = 0, no gravity): summing
+    F_j = k_m (dn_j + c) over the teeth gives F_j = -F_s + k_m (e_x sin phi_j - e_y cos phi_j)
+    and a mesh that acts on the centre offset e as an isotropic spring K = k_m Z / 2, so the
+    supports hold e = (l_x, l_y) / (1 + K/k_p1 + K/k_p2). As each tooth turns through a
+    revolution its load peaks at F_s + k_m |e|: every load factor is 1 + k_m |e| / F_s."""
+    case = full_contact(l_x=l_x, l_y=l_y, k_p2=8e6)
+    res = pyspline.simulate(case)
+    info = case.model.info()
+    k_m, z = info["k_m"], case["z"]
+    K = k_m * z / 2
+    e = np.hypot(l_x, l_y) / (1 + K / case["k_p1"] + K / case["k_p2"])
+    fs = case["t_d"] / (z * info["r_b"])
+    expected = 1 + k_m * e / fs
+    assert 1.05 < expected < 1.5                           # the misalignment term is seen
+    ld = res.loads
+    assert ld["load_sharing"] == pytest.approx(expected, rel=2e-5)
+    np.testing.assert_allclose(ld["load_factor"], expected, rtol=2e-5)
+    assert not ld["free_frac"].any() and not ld["back_frac"].any() and not ld["onsets"].any()
+
+
+def independent_count(res, drive=-1):
+    """Free, back-flank and onset counts from Result.F and Result.dn (a tooth is free where
+    F_j = 0, else on the flank of the sign of dn_j)."""
+    flank = np.where(res.F == 0, 0, np.sign(res.dn)).astype(int)
+    onset = (flank[1:] != 0) & (flank[1:] != flank[:-1])
+    return flank, onset
+
+
+@pytest.fixture(scope="module")
+def offset_scene():
+    """A light drive (2 N m) whose spline 1 sits 0.4 mm off centre against 0.2 mm backlash,
+    started at rest: teeth hit both flanks, some never touch, with the one-way flash temperature."""
+    case = pyspline.load_case(CASES / "template.nml", name="offset", t_d=2.0, t_l=2.0, l_x=4e-4,
+                              grav=0.0, start="rest", thermal="oneway", t_end=0.03, n_out=1201)
+    return case, pyspline.simulate(case)
+
+
+def test_free_back_flank_and_onsets_against_a_count(offset_scene):
+    case, res = offset_scene
+    ld = res.loads
+    flank, onset = independent_count(res)
+    nt, z = res.F.shape
+    np.testing.assert_array_equal(ld["free_frac"], (flank == 0).sum(0) / nt)
+    np.testing.assert_array_equal(ld["back_frac"], (flank == 1).sum(0) / nt)
+    np.testing.assert_array_equal(ld["onsets"], onset.sum(0))
+    np.testing.assert_array_equal(ld["F_peak"], np.abs(res.F).max(0))
+    assert ld["teeth_back"] == ((flank == 1).any(0)).sum() > 0         # the scene has them
+    assert ld["teeth_unloaded"] == ((flank == 0).all(0)).sum() > 0
+    assert ld["teeth_free_mean"] == pytest.approx((flank == 0).sum(1).mean(), rel=1e-14)
+    revs = case["speed_rpm"] / 60 * (res.t[-1] - res.t[0])
+    assert ld["revolutions"] == pytest.approx(revs, rel=1e-12)
+    assert onset.sum() > 0
+    assert ld["impacts_per_rev"] == pytest.approx(onset.sum() / revs, rel=1e-12)
+    fs = case["t_d"] / (case["z"] * case.model.info()["r_b"])
+    assert ld["load_sharing"] == pytest.approx(np.abs(res.F).max() / fs, rel=1e-14)
+    # the closing speed: |d dn_j/dt| at the output before each onset, from the oracle's Eq. 11
+    p = oracle.prepare({**dict(case), "k_m": case.model.info()["k_m"]})
+    speeds = [abs(oracle.mesh(res.t[k], res.y[k], p)["ddn"][j]) for k, j in zip(*onset.nonzero())]
+    assert ld["closing_speed_max"] == pytest.approx(max(speeds), rel=1e-9)
+    # the flash temperature's peak, its tooth and time
+    k, j = np.unravel_index(np.argmax(res.Tf), res.Tf.shape)
+    assert res.Tf[k, j] > 0
+    assert (ld["Tf_max"], ld["Tf_max_tooth"], ld["Tf_max_t_s"]) == (res.Tf[k, j], j + 1, res.t[k])
+
+
+def test_no_drive_torque_has_no_load_factor():
+    """T_d = 0: the static tooth load is 0, load factors are NaN (undefined), not infinite;
+    the counts remain."""
+    case = pyspline.load_case(CASES / "template.nml", t_d=0.0, t_l=0.0, l_x=4e-4, grav=0.0,
+                              start="rest", t_end=0.005, n_out=201)
+    ld = pyspline.simulate(case).loads
+    assert ld["F_static"] == 0 and np.isnan(ld["load_sharing"])
+    assert np.isnan(ld["load_factor"]).all() and ld["onsets"].sum() > 0
+
+
+def test_loads_in_xarray_and_npz(offset_scene, tmp_path):
+    case, res = offset_scene
+    ds = res.to_xarray()
+    for n, (d, u) in {**LOAD_QUANTITIES, **TOOTH_LOAD_QUANTITIES}.items():
+        v = ds[n]
+        assert v.dims == (("tooth",) if n in TOOTH_LOAD_QUANTITIES else ()), n
+        assert v.attrs["long_name"] == d and v.attrs.get("units", "") == {"-": "1"}.get(u, u), n
+        np.testing.assert_array_equal(v.values, res.loads[n])
+    from pyspline.cli import _summary, main
+    line = _summary(res)
+    assert f"load sharing {res.loads['load_sharing']:.3f}" in line and "impacts/rev" in line
+    nml = tmp_path / "offset.nml"
+    case.replace(section="shaft").to_namelist(nml)
+    assert main(["run", str(nml), "--out", str(tmp_path / "out")]) == 0
+    with np.load(tmp_path / "out" / "offset.npz") as f:
+        for n in ("kv", "section_t", "section_y", "stat_steps", *LOAD_QUANTITIES,
+                  *TOOTH_LOAD_QUANTITIES):
+            assert n in f.files, n
+        np.testing.assert_array_equal(f["kv"], np.abs(f["Tm"]) / case["t_d"])
+
+
+def read_csv_loads(path) -> dict:
+    """The loads spline-dyn writes in its CSV's comment lines."""
+    out = {}
+    for line in open(path):
+        if not line.startswith("#"):
+            break
+        if line.startswith("# loads:"):
+            out.update((k, float(v)) for k, v in (w.split("=") for w in line[8:].split()))
+        elif line.startswith("# tooth loads "):
+            head, values = line[14:].split(":")
+            out[head.split()[0]] = np.array(values.split(), dtype=float)
+    return out
+
+
+@pytest.mark.parametrize("scene", ["offset", "paper_flash_lx1e-4"])
+def test_executable_writes_the_same_loads(exe, offset_scene, scene, tmp_path):
+    case = offset_scene[0] if scene == "offset" else \
+        pyspline.load_case(CASES / f"{scene}.nml", t_end=0.02, n_out=401)
+    nml, out = tmp_path / "c.nml", tmp_path / "c.csv"
+    case.to_namelist(nml)
+    run = subprocess.run([exe, str(nml), "-o", str(out)], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert "load sharing factor" in run.stdout
+    got = read_csv_loads(out)
+    res = pyspline.simulate(case)
+    assert set(got) == set(res.loads)
+    for n, v in res.loads.items():
+        np.testing.assert_array_equal(got[n], v, err_msg=n)      # bit for bit
+
+
+def test_sweep_keeps_the_loads(offset_scene):
+    """The sweep dataset's loads are the points' Result.loads (units from the core's table)."""
+    case = offset_scene[0].replace(t_end=0.02, n_out=801, thermal="none")
+    ds = pyspline.sweep(case, progress=False, l_x=[2e-4, 4e-4])
+    for i, lx in enumerate([2e-4, 4e-4]):
+        ld = pyspline.simulate(case.replace(l_x=lx)).loads
+        for n in SWEEP_LOADS + ("Tf_max",):
+            assert ds[n].values[i] == ld[n] and np.isfinite(ld[n]), n
+    assert ds["closing_speed_max"].attrs["units"] == "m/s"
+    assert ds["load_sharing"].attrs["units"] == "1"
+
+
+def test_batch_means_against_a_count(offset_scene):
+    """Standard errors by batch means over whole revolutions, recomputed from Result.Tm and
+    Result.F: per revolution the RMS of T_m and the load-sharing factor."""
+    case, res = offset_scene
+    ld = res.loads
+    rev = np.floor(case["speed_rpm"] / 60 * (res.t - res.t[0])).astype(int)
+    nb = int(np.floor(case["speed_rpm"] / 60 * (res.t[-1] - res.t[0])))
+    assert ld["batches"] == nb >= 2
+    fs = ld["F_static"]
+    rms = np.array([np.sqrt(np.mean(res.Tm[rev == b] ** 2)) for b in range(nb)])
+    share = np.array([np.abs(res.F[rev == b]).max() / fs for b in range(nb)])
+    assert ld["Tm_rms_se"] == pytest.approx(rms.std(ddof=1) / np.sqrt(nb), rel=1e-9)
+    assert ld["load_sharing_rev"] == pytest.approx(share.mean(), rel=1e-12)
+    assert ld["load_sharing_rev_se"] == pytest.approx(share.std(ddof=1) / np.sqrt(nb), rel=1e-9)
+    assert ld["load_sharing_rev_se"] > 0
+
+
+def test_batch_means_of_a_periodic_run_vanish():
+    """Full contact with misalignment repeats every revolution: the standard errors are round-off
+    and solver noise, the mean per-revolution load sharing is the run's."""
+    res = pyspline.simulate(full_contact(l_x=1e-4, t_end=0.03, n_out=3 * (REV_OUT - 1) + 1))
+    ld = res.loads
+    assert ld["batches"] == 3
+    assert ld["Tm_rms_se"] < 1e-8 * 30.7                 # T_d
+    assert ld["load_sharing_rev"] == pytest.approx(ld["load_sharing"], rel=1e-6)
+    assert ld["load_sharing_rev_se"] < 1e-6
+    one = pyspline.simulate(full_contact(t_end=0.015, n_out=1081)).loads
+    assert one["batches"] == 1 and np.isnan(one["Tm_rms_se"]) and np.isnan(one["load_sharing_rev"])
