@@ -7,8 +7,8 @@
 !>  - torsional only (dof 3) leaves out the lateral motion. Its drivers are the misalignment
 !>    (l_x, l_y), the difference of the gravity sags g |m_1/k_p1 - m_2/k_p2|, a lateral start
 !>    offset, the unbalance (its static deflection m_u e omega^2 / k_p) and the angular
-!>    misalignment (gamma b / 2 at the face ends). Without them every tooth sees the same dn_j, sum_j F_j sin(phi_j) = 0 (Z >= 3) and
-!>    the lateral states never move: dof 3 is then exact.
+!>    misalignment (gamma b / 2 at the face ends). Without them every tooth sees the same dn_j,
+!>    sum_j F_j sin(phi_j) = 0 (Z >= 3) and the lateral states never move: dof 3 is then exact.
 !>  - a temperature dT left out of Eq. 2 moves the backlash by kappa dT, kappa = 2 lambda s cos(alpha).
 module spline_fidelity
   use spline_kinds, only: wp

@@ -42,8 +42,8 @@ module spline_quantities
        quantity_t('dn', 'm', 'relative displacement along the line of action dn_j (Eq. 11)'), &
        quantity_t('c', 'm', 'backlash c_j (Eq. 2)'), &
        quantity_t('Tf', 'degC', 'flash temperature T_f (Eqs. 3-7)'), &
-       quantity_t('rc1', 'm', 'contact-point radius on the external spline (Eqs. 13-14)'), &
-       quantity_t('rc2', 'm', 'contact-point radius on the internal spline (Eqs. 13-14)')]
+       quantity_t('rc1', 'm', 'contact-point radius on the external spline (Eq. 13, one point per tooth pair)'), &
+       quantity_t('rc2', 'm', 'contact-point radius on the internal spline (Eq. 13, one point per tooth pair)')]
 
   !> Every output quantity in the order of the executable's CSV columns: the time, the states,
   !> T_m, k_v, then the per-tooth quantities (one column per tooth each).
