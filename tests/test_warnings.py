@@ -168,3 +168,20 @@ def test_executable_prints_the_same_lines(exe, tmp_path):
     prefix = "spline-dyn: warning: "
     lines = [ln[len(prefix):] for ln in run.stderr.splitlines() if ln.startswith(prefix)]
     assert lines == py
+
+
+def test_reproduce_reports_a_kind_once_for_all_its_cases():
+    """pyspline reproduce runs many cases with the paper's shafts: each kind is one line naming
+    its cases (pyspline.paper.warn_once), not one line per case."""
+    from pyspline.paper import warn_once
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for name in ("a", "b", "a"):
+            ps.load(ps.load_case(dict(name=name)))               # the defaults: the paper's k_T
+        ps.load(ps.load_case(dict(name="c", t_d=60.0)))           # another wind-up
+    with warnings.catch_warnings(record=True) as again:
+        warnings.simplefilter("always")
+        warn_once(caught)
+    msgs = [str(w.message) for w in again]
+    assert len(msgs) == 2 and msgs[0].startswith("case a, b: field k_t1 = 7.8550")
+    assert msgs[1].startswith("case c: field k_t1") and kinds(msgs) == {"windup"}
