@@ -7,7 +7,7 @@ module spline_model
   use spline_errors, only: err_ok, err_case, err_thermal
   use spline_case, only: case_t, case_validate, namelen, option_index, thermal_values, &
        method_values, nonlinear_values, start_values, fidelity_values, section_values, nripple
-  use spline_geometry, only: iso4156_radii, pitch_rotation
+  use spline_geometry, only: iso4156_radii, pitch_rotation, tooth_angles
   use spline_stiffness, only: spline_mesh_stiffness_fillet
   use spline_thermal, only: backlash_coefficient, thermal_backlash
   implicit none
@@ -32,6 +32,13 @@ module spline_model
   !> calibrated 2.54e5 N/m is ~7600 times below for its spline, a deliberate fit; N/mm read
   !> as N/m is 1000 times, on top of such a fit 1e4 is passed.
   real(wp), parameter :: k_m_warn_ratio = 1.0e4_wp
+  !> Plausibility limits of model_warnings (docs/model.md section 12, "Plausibility warnings"):
+  !> the supports' share of the offset beyond the backlash; the static shaft wind-up [rad]
+  !> (a solid steel shaft at 300 MPa shear twists 2 tau L / (G d) = 0.0075 L/d rad: 0.2 rad at
+  !> L/d = 27; an elastomer coupling 5-10 deg at its rated torque); the static tooth deflection
+  !> as a fraction of the module (a tooth at a 1000 MPa root bending stress deflects ~1.6 %).
+  real(wp), parameter :: support_limit = 0.5_wp, windup_limit = 0.2_wp
+  real(wp), parameter :: deflection_limit = 0.05_wp
 
   type :: model_t
     integer  :: magic = 0
@@ -209,8 +216,12 @@ contains
   end subroutine model_from_case
 
   !> Warnings about a valid model (ran, but deserves a second look), one per line ('' if
-  !> none): a given k_m far below the potential-energy stiffness of the geometry (Eq. 18).
-  !> The executable prints them to stderr, Python raises pyspline.SplineWarning (api_warnings).
+  !> none), each naming the fields, the number and the limit (docs/model.md section 12,
+  !> "Plausibility warnings"): a given k_m far below the potential-energy stiffness of the
+  !> geometry (Eq. 18), supports that take most of the offset, a shaft wound up beyond
+  !> windup_limit, a start at rest with teeth overlapping, a tooth deflected beyond
+  !> deflection_limit of the module. The executable prints them to stderr, Python raises
+  !> pyspline.SplineWarning (api_warnings).
   function model_warnings(m) result(text)
     type(model_t), intent(in) :: m
     character(len=:), allocatable :: text
@@ -223,16 +234,129 @@ contains
              'unit slip (N/mm for N/m)? Run as given'//new_line('a')
       end if
     end if
-  contains
-    function fmt(x, f) result(s)
-      real(wp), intent(in) :: x
-      character(len=*), intent(in) :: f
-      character(len=:), allocatable :: s
-      character(len=32) :: buf
-      write(buf, f) x
-      s = trim(adjustl(buf))
-    end function fmt
+    text = text//support_warning(m)//windup_warning(m)//start_warning(m)//load_warning(m)
   end function model_warnings
+
+  !> The offset beyond the backlash, |l| - c, is taken by the mesh and the supports in series
+  !> (not with a floating spline, k_p = 0, or frozen lateral motion, dof = 3): the mesh's lateral
+  !> stiffness with all Z teeth in contact is K = sum_j k_m sin^2(phi_j) = Z k_m / 2 (Eqs. 11,
+  !> 19-21), the supports' k_s = k_p1 k_p2 / (k_p1 + k_p2) (Eq. 23); the supports take the share
+  !> K / (K + k_s). Warned above support_limit.
+  function support_warning(m) result(text)
+    type(model_t), intent(in) :: m
+    character(len=:), allocatable :: text
+    real(wp) :: l, k_mesh, k_s, share
+    text = ''
+    l = hypot(m%l_x, m%l_y)
+    if (m%dof /= 7 .or. l <= m%c_bulk .or. min(m%k_p1, m%k_p2) <= 0.0_wp) return
+    k_mesh = m%z*m%k_m/2.0_wp
+    k_s = 1.0_wp/(1.0_wp/m%k_p1 + 1.0_wp/m%k_p2)
+    share = k_mesh/(k_mesh + k_s)
+    if (share <= support_limit) return
+    text = 'case '//trim(m%name)//': fields k_p1 = '//num(m%k_p1)//', k_p2 = '//num(m%k_p2)// &
+         ' N/m: the supports (in series '//num(k_s)//' N/m, the mesh Z k_m / 2 = '//num(k_mesh)// &
+         ' N/m) take '//num(100.0_wp*share)//' % of the offset beyond the backlash, |l| - c = '// &
+         num(l - m%c_bulk)//' m (limit '//itoa(nint(100.0_wp*support_limit))//' %): the '// &
+         'teeth barely see the misalignment. Run as given'//new_line('a')
+  end function support_warning
+
+  !> Static wind-up of the shafts, T_d / k_t1 and T_L / k_t2, above windup_limit (not for a
+  !> free shaft, k_t = 0).
+  function windup_warning(m) result(text)
+    type(model_t), intent(in) :: m
+    character(len=:), allocatable :: text
+    text = ''
+    call shaft('k_t1', m%k_t1, 't_d', m%t_d)
+    call shaft('k_t2', m%k_t2, 't_l', m%t_l)
+    if (len(text) > 0) text = 'case '//trim(m%name)//': '//text//' (limit '// &
+         fmt(windup_limit, '(f4.2)')//' rad = '//fmt(windup_limit*180.0_wp/pi, '(f4.1)')// &
+         ' deg): shafts this soft? Run as given'//new_line('a')
+  contains
+    subroutine shaft(kname, k, tname, t)
+      character(len=*), intent(in) :: kname, tname
+      real(wp), intent(in) :: k, t
+      if (k <= 0.0_wp .or. abs(t) <= windup_limit*k) return
+      if (len(text) > 0) text = text//'; '
+      text = text//'field '//kname//' = '//num(k)//' N m/rad winds its shaft '//num(abs(t)/k)// &
+           ' rad under '//tname//' = '//num(t)//' N m'
+    end subroutine shaft
+  end function windup_warning
+
+  !> start = 'rest' (plus dq0) with a tooth overlapping beyond its backlash at t0: the largest
+  !> |Delta n_j| - c of Eq. 11 over the teeth (face centre) in the start state.
+  function start_warning(m) result(text)
+    type(model_t), intent(in) :: m
+    character(len=:), allocatable :: text
+    real(wp) :: sp(m%z), cp(m%z), dn(m%z)
+    integer :: j
+    text = ''
+    if (m%start_equilibrium) return
+    call tooth_angles(m%z, m%omega, m%t0, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
+    dn = abs((m%dq0(1) + m%l_x - m%dq0(3))*sp - (m%dq0(2) + m%l_y - m%dq0(4))*cp + m%dq0(6))
+    j = maxloc(dn, 1)
+    if (dn(j) <= m%c_bulk) return
+    text = 'case '//trim(m%name)//': start = ''rest'' with l_x = '//num(m%l_x)//', l_y = '// &
+         num(m%l_y)//' m starts tooth '//itoa(j)//' overlapping its backlash c = '// &
+         num(m%c_bulk)//' m by '//num(dn(j) - m%c_bulk)//' m (Eq. 11 at t0): an impact made '// &
+         'by the start, not the drive; start = ''equilibrium''? Run as given'//new_line('a')
+  end function start_warning
+
+  !> The static tooth load T / (Z r_b) of the larger torque, all teeth sharing it, deflects a
+  !> tooth by that load over the geometry's Eq. 18 stiffness (whatever k_m the case gives):
+  !> above deflection_limit of the module no steel tooth carries it.
+  function load_warning(m) result(text)
+    type(model_t), intent(in) :: m
+    character(len=:), allocatable :: text
+    real(wp) :: t, f, k, d
+    character(len=3) :: tname
+    text = ''
+    k = m%k_terms(ik_m)
+    if (k <= 0.0_wp) return
+    t = m%t_d; tname = 't_d'
+    if (abs(m%t_l) > abs(t)) then
+      t = m%t_l; tname = 't_l'
+    end if
+    f = abs(t)/(m%z*m%r_b)
+    d = f/k
+    if (d <= deflection_limit*m%m_n) return
+    text = 'case '//trim(m%name)//': field '//tname//' = '//num(t)//' N m loads each tooth '// &
+         'with '//num(f)//' N (T / (Z r_b)) and deflects it '//num(d)//' m (Eq. 18: '//num(k)// &
+         ' N/m), '//num(100.0_wp*d/m%m_n)//' % of the module (limit '// &
+         itoa(nint(100.0_wp*deflection_limit))//' %): a torque in N mm? Run as given'//new_line('a')
+  end function load_warning
+
+  !> x without blanks: 4 decimals to 10, then 3, 2, 1 to 1e4 (19.096, 0.2546), else 5.000E+06.
+  function num(x) result(s)
+    real(wp), intent(in) :: x
+    character(len=:), allocatable :: s
+    if (abs(x) >= 1.0e-2_wp .and. abs(x) < 1.0e4_wp) then
+      s = fmt(x, '(f12.4)')
+      if (abs(x) >= 10.0_wp) s = fmt(x, '(f12.3)')
+      if (abs(x) >= 100.0_wp) s = fmt(x, '(f12.2)')
+      if (abs(x) >= 1000.0_wp) s = fmt(x, '(f12.1)')
+    else
+      s = fmt(x, '(es10.3)')
+    end if
+  end function num
+
+  !> i written without blanks.
+  function itoa(i) result(s)
+    integer, intent(in) :: i
+    character(len=:), allocatable :: s
+    character(len=12) :: buf
+    write(buf, '(i0)') i
+    s = trim(buf)
+  end function itoa
+
+  !> x written with format f, without blanks (the warnings' numbers).
+  function fmt(x, f) result(s)
+    real(wp), intent(in) :: x
+    character(len=*), intent(in) :: f
+    character(len=:), allocatable :: s
+    character(len=32) :: buf
+    write(buf, f) x
+    s = trim(adjustl(buf))
+  end function fmt
 
   !> Set the thermal level of a model and the backlash it implies at the bulk temperature:
   !> Eq. 2 with T_B = T_M, or c_0 for the level none.

@@ -18,6 +18,7 @@ import re
 import shutil
 import subprocess
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -26,6 +27,7 @@ import numpy as np
 
 from ..case import load_case
 from ..core import mesh_stiffness, read_csv, simulate
+from ..errors import SplineWarning
 
 # ---------------------------------------------------------------------------------------------
 # Scenarios and the paper's values
@@ -196,18 +198,41 @@ def load_paper_case(name, directory, quick: bool):
 def run_all(directory, quick=False, names=ALL_CASES, progress=True):
     from tqdm import tqdm
     results = {}
-    for name in tqdm(names, desc="paper scenarios", unit="case", disable=not progress):
-        case = load_paper_case(name, directory, quick)
-        res = simulate(case)
-        # The exact Poincare section comes from a second run (section = 'shaft', two outputs).
-        # A section does not stop CVODE, but with root finding the first step after each
-        # restart at a contact switch is sized from the next requested time (a section time or
-        # an output), so that run's steps can differ: the rows that check symmetries to
-        # round-off keep the case's own run.
-        sec = simulate(case.replace(section="shaft", n_out=2, max_steps=case["max_total_steps"]))
-        res.section_t, res.section_y = sec.section_t, sec.section_y
-        results[name] = res
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", SplineWarning)
+        for name in tqdm(names, desc="paper scenarios", unit="case", disable=not progress):
+            case = load_paper_case(name, directory, quick)
+            res = simulate(case)
+            # The exact Poincare section comes from a second run (section = 'shaft', two
+            # outputs). A section does not stop CVODE, but with root finding the first step
+            # after each restart at a contact switch is sized from the next requested time (a
+            # section time or an output), so that run's steps can differ: the rows that check
+            # symmetries to round-off keep the case's own run.
+            sec = simulate(case.replace(section="shaft", n_out=2,
+                                        max_steps=case["max_total_steps"]))
+            res.section_t, res.section_y = sec.section_t, sec.section_y
+            results[name] = res
+    warn_once(caught)
     return results
+
+
+def warn_once(caught) -> None:
+    """Warnings caught over many cases, again, a SplineWarning of the same words (after its
+    'case NAME: ') once, naming its cases: one line per kind instead of one per case."""
+    cases: dict[str, list[str]] = {}
+    for w in caught:
+        if not issubclass(w.category, SplineWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+            continue
+        head, sep, text = str(w.message).partition(": ")
+        if head.startswith("case ") and sep:
+            cases.setdefault(text, []).extend(head[len("case "):].split(", "))
+        else:
+            cases.setdefault(str(w.message), [])
+    for text, names in cases.items():
+        names = list(dict.fromkeys(names))
+        warnings.warn(f"case {', '.join(names)}: {text}" if names else text, SplineWarning,
+                      stacklevel=3)
 
 
 def verification_rows(results):
@@ -331,12 +356,16 @@ def reproduce(out, quick=False, directory=None, progress=True):
     out.mkdir(parents=True, exist_ok=True)
     directory = cases_dir(directory)
     t0 = time.perf_counter()
-    results = run_all(directory, quick, progress=progress)
-    t_run = time.perf_counter() - t0
-    rows = verification_rows(results)
-    write_table(rows, out, quick)
-    drawn = figures.draw_all(results, out, FIGURES)
-    exe = check_executable(directory, ["paper_ideal", "paper_lx1e-4", "paper_T100"], quick=True)
+    with warnings.catch_warnings(record=True) as caught:     # reported once, after the runs
+        warnings.simplefilter("always", SplineWarning)
+        results = run_all(directory, quick, progress=progress)
+        t_run = time.perf_counter() - t0
+        rows = verification_rows(results)
+        write_table(rows, out, quick)
+        drawn = figures.draw_all(results, out, FIGURES)
+        exe = check_executable(directory, ["paper_ideal", "paper_lx1e-4", "paper_T100"],
+                               quick=True)
+    warn_once(caught)
     k = mesh_stiffness(results["paper_lx1e-4"].case)
     summary = dict(
         quick=quick, cases_dir=str(directory), run_time_s=t_run,

@@ -1,0 +1,187 @@
+"""Plausibility warnings of the core (spline_model::model_warnings, docs/model.md section 12,
+"Plausibility warnings"): each fires on the issue's real spline, names the field and the number
+that raised it (checked against a closed form computed here), and is silent once the input is
+made plausible; the shipped cases raise exactly the kinds their fields call for; the
+executable prints the same lines as Python's SplineWarning."""
+from __future__ import annotations
+
+import math
+import subprocess
+import warnings
+
+import pytest
+
+import pyspline as ps
+from conftest import CASES
+
+#: The issue's spline: Z 26, module 1.5875 mm, 30 deg, face 25 mm, 12 000 r/min, 150 N m,
+#: c0 60 um, l_x 80 um, from rest, with the paper's defaults for the rest (k_p, k_t).
+EXAMPLE = dict(name="real_spline", z=26, module_m=1.5875e-3, alpha_deg=30.0, b=0.025,
+               speed_rpm=12000.0, t_d=150.0, t_l=150.0, c0=60e-6, l_x=80e-6, start="rest",
+               t_end=1e-3, n_out=3)
+#: The same made plausible: stiff supports and shafts, the offset within the backlash
+#: (start from rest then overlaps nothing), the torque in N m.
+PLAUSIBLE = dict(EXAMPLE, k_p1=1e12, k_p2=1e12, k_t1=1e5, k_t2=1e5, l_x=50e-6)
+
+KINDS = {"supports": "fields k_p1 =", "windup": "winds its shaft", "start": "start = 'rest'",
+         "load": "loads each tooth", "k_m": "potential-energy mesh stiffness"}
+
+
+def messages(fields) -> list[str]:
+    """The SplineWarning messages of loading a case (dict or file)."""
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        ps.load(ps.load_case(fields))
+    return [str(w.message) for w in rec if issubclass(w.category, ps.SplineWarning)]
+
+
+def kinds(msgs) -> set[str]:
+    return {k for m in msgs for k, key in KINDS.items() if key in m}
+
+
+def one(msgs, kind) -> str:
+    found = [m for m in msgs if KINDS[kind] in m]
+    assert len(found) == 1, (kind, msgs)                  # one line per kind
+    return found[0]
+
+
+def closed_forms(case) -> dict:
+    """The numbers each warning tests, from the case's fields by the formulas of docs/model.md
+    (independent of the core's code): the supports' share of the offset, the shafts' wind-up,
+    the largest tooth overlap at a start from rest, the static tooth deflection / module."""
+    g = case.get
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ps.SplineWarning)
+        stiff = ps.mesh_stiffness(case)
+        c = ps.load(case).info()["c_bulk"]
+    z, alpha = g("z"), math.radians(g("alpha_deg"))
+    k_mesh = z * stiff["k_m_used"] / 2
+    k_s = 1 / (1 / g("k_p1") + 1 / g("k_p2")) if min(g("k_p1"), g("k_p2")) > 0 else 0.0
+    l = math.hypot(g("l_x"), g("l_y"))
+    share = k_mesh / (k_mesh + k_s) if (g("dof") == 7 and l > c and k_s > 0) else 0.0
+    windup = max(abs(g("t_d")) / g("k_t1") if g("k_t1") > 0 else 0.0,
+                 abs(g("t_l")) / g("k_t2") if g("k_t2") > 0 else 0.0)
+    overlap = -1.0
+    if g("start") == "rest":
+        dq = g("dq0")
+        ex, ey = dq[0] + g("l_x") - dq[2], dq[1] + g("l_y") - dq[3]
+        omega = g("speed_rpm") * 2 * math.pi / 60
+        dn = [abs(ex * math.sin(p) - ey * math.cos(p) + dq[5])
+              for p in (2 * math.pi * j / z + omega * g("t0") + math.pi / (2 * z) - alpha
+                        for j in range(1, z + 1))]
+        j = max(range(z), key=lambda i: dn[i])
+        overlap = dn[j] - c
+    r_b = g("module_m") * z / 2 * math.cos(alpha)
+    force = max(abs(g("t_d")), abs(g("t_l"))) / (z * r_b)
+    deflection = force / stiff["k_m"] if stiff["k_m"] > 0 else 0.0
+    return dict(share=share, k_s=k_s, windup=windup, overlap=overlap, c=c, force=force,
+                deflection=deflection, rel=deflection / g("module_m"))
+
+
+def expected_kinds(case) -> set[str]:
+    f = closed_forms(case)
+    return {k for k, on in (("supports", f["share"] > 0.5), ("windup", f["windup"] > 0.2),
+                            ("start", f["overlap"] > 0), ("load", f["rel"] > 0.05)) if on}
+
+
+def test_supports_taking_the_offset():
+    case = ps.load_case(EXAMPLE)
+    f = closed_forms(case)
+    msg = one(messages(EXAMPLE), "supports")
+    assert f["share"] > 0.999                              # 5e6 N/m against Z k_m / 2 ~ 8e9
+    for number in ("k_p1 = 5.000E+06", "k_p2 = 5.000E+06", f"{f['k_s']:.3E} N/m",
+                   f"{100 * f['share']:.3f} %", f"{80e-6 - 60e-6:.3E} m", "(limit 50 %)"):
+        assert number in msg, (number, msg)
+    assert "supports" not in kinds(messages(dict(EXAMPLE, k_p1=1e12, k_p2=1e12)))
+    assert "supports" not in kinds(messages(dict(EXAMPLE, l_x=50e-6)))   # within the backlash
+    assert "supports" not in kinds(messages(dict(EXAMPLE, dof=3)))       # lateral frozen
+
+
+def test_shaft_windup():
+    msg = one(messages(EXAMPLE), "windup")
+    for number in ("k_t1 = 7.8550", f"{150 / 7.855:.3f} rad under t_d = 150.00 N m",
+                   "k_t2 = 7.8560", f"{150 / 7.856:.3f} rad under t_l", "(limit 0.20 rad"):
+        assert number in msg, (number, msg)
+    assert "k_t2" not in one(messages(dict(EXAMPLE, k_t2=1e5)), "windup")
+    assert "windup" not in kinds(messages(dict(EXAMPLE, k_t1=1e5, k_t2=1e5)))
+    assert "windup" not in kinds(messages(dict(EXAMPLE, k_t1=0.0, k_t2=0.0)))   # free shafts
+    # the limit: 0.2 rad
+    assert "windup" in kinds(messages(dict(EXAMPLE, k_t1=149.0, k_t2=1e5, t_d=30.0)))
+    assert "windup" not in kinds(messages(dict(EXAMPLE, k_t1=151.0, k_t2=1e5, t_d=30.0)))
+
+
+def test_start_with_teeth_overlapping():
+    case = ps.load_case(EXAMPLE)
+    f = closed_forms(case)
+    msg = one(messages(EXAMPLE), "start")
+    assert f["overlap"] > 0
+    for number in ("l_x = 8.000E-05", f"backlash c = {f['c']:.3E} m", f"by {f['overlap']:.3E} m"):
+        assert number in msg, (number, msg)
+    assert "start" not in kinds(messages(dict(EXAMPLE, start="equilibrium")))
+    assert "start" not in kinds(messages(dict(EXAMPLE, l_x=50e-6)))
+    # a start kick dq0 that cancels the offset (x1 = -l_x) starts the teeth clear
+    assert "start" not in kinds(messages(dict(EXAMPLE, dq0=[-80e-6, 0, 0, 0, 0, 0, 0])))
+
+
+def test_tooth_load_of_a_torque_in_n_mm():
+    fields = dict(EXAMPLE, t_d=150e3, t_l=150e3)
+    f = closed_forms(ps.load_case(fields))
+    msg = one(messages(fields), "load")
+    assert f["force"] == pytest.approx(3.22e5, rel=0.01) and f["rel"] > 0.3
+    for number in ("t_d = 1.500E+05 N m", f"{f['force']:.3E} N", f"{f['deflection']:.3E} m",
+                   f"{100 * f['rel']:.3f} % of the module", "(limit 5 %)"):
+        assert number in msg, (number, msg)
+    assert "load" not in kinds(messages(EXAMPLE))          # 150 N m: 0.5 um, 0.03 %
+
+
+def test_plausible_input_warns_nothing():
+    assert messages(PLAUSIBLE) == []
+
+
+@pytest.mark.parametrize("path", sorted(CASES.glob("*.nml")), ids=lambda p: p.stem)
+def test_shipped_cases_raise_what_their_fields_call_for(path):
+    """Each shipped case raises exactly the kinds the closed forms predict, one line each. The
+    paper's k_T1 = 7.855 N m/rad winds every shaft that keeps it (paper and physical cases,
+    the template) beyond 0.2 rad; no physical case asks for the tooth-load or k_m warning, and
+    only chaos_z24 (its offset twice the backlash, from rest) for the supports and the start."""
+    case = ps.load_case(path)
+    msgs = messages(path)
+    got = kinds(msgs)
+    assert got - {"k_m"} == expected_kinds(case), msgs
+    for kind in got:
+        one(msgs, kind)
+    if path.stem.startswith(("physical_", "rattle_", "chaos_")):
+        assert not got & {"load", "k_m"}, msgs
+        if path.stem != "chaos_z24":
+            assert not got & {"supports", "start"}, msgs
+
+
+def test_executable_prints_the_same_lines(exe, tmp_path):
+    fields = dict(EXAMPLE, t_d=150e3, t_l=150e3)
+    py = messages(fields)
+    assert kinds(py) == {"supports", "windup", "start", "load"}
+    path = tmp_path / "real_spline.nml"
+    ps.load_case(fields).to_namelist(path)
+    run = subprocess.run([exe, str(path), "-o", str(tmp_path / "out.csv")], capture_output=True,
+                         text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    prefix = "spline-dyn: warning: "
+    lines = [ln[len(prefix):] for ln in run.stderr.splitlines() if ln.startswith(prefix)]
+    assert lines == py
+
+
+def test_reproduce_reports_a_kind_once_for_all_its_cases():
+    """pyspline reproduce runs many cases with the paper's shafts: each kind is one line naming
+    its cases (pyspline.paper.warn_once), not one line per case."""
+    from pyspline.paper import warn_once
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for name in ("a", "b", "a"):
+            ps.load(ps.load_case(dict(name=name)))               # the defaults: the paper's k_T
+        ps.load(ps.load_case(dict(name="c", t_d=60.0)))           # another wind-up
+    with warnings.catch_warnings(record=True) as again:
+        warnings.simplefilter("always")
+        warn_once(caught)
+    msgs = [str(w.message) for w in again]
+    assert len(msgs) == 2 and msgs[0].startswith("case a, b: field k_t1 = 7.8550")
+    assert msgs[1].startswith("case c: field k_t1") and kinds(msgs) == {"windup"}
