@@ -52,7 +52,7 @@ contains
     integer(c_int), intent(in) :: build, nb, nv, nc
     integer(c_int), intent(out) :: model(nb), sizes(nsizes), chars(nc)
     real(c_double), intent(out) :: values(nv)
-    character(len=2048), intent(out) :: warn
+    character(len=4096), intent(out) :: warn
     integer(c_int), intent(out) :: stage, ierr
     character(len=msglen), intent(out) :: errmsg
     type(case_t) :: c
@@ -75,7 +75,7 @@ contains
     real(c_double), intent(in) :: values(nv)
     integer(c_int), intent(in) :: chars(nc)
     integer(c_int), intent(out) :: model(nb), sizes(nsizes)
-    character(len=2048), intent(out) :: warn
+    character(len=4096), intent(out) :: warn
     integer(c_int), intent(out) :: ierr
     character(len=msglen), intent(out) :: errmsg
     type(case_t) :: c
@@ -97,7 +97,7 @@ contains
     character(len=*), intent(in) :: text
     integer(c_int), intent(in) :: nb
     integer(c_int), intent(out) :: model(nb), sizes(nsizes)
-    character(len=2048), intent(out) :: warn
+    character(len=4096), intent(out) :: warn
     integer(c_int), intent(out) :: ierr
     character(len=msglen), intent(out) :: errmsg
     type(case_t) :: c
@@ -166,7 +166,7 @@ contains
     integer(c_int), intent(in) :: nb, ns, stage
     integer(c_int), intent(in) :: model(nb)
     real(c_double), intent(in) :: stats(ns)
-    character(len=2048), intent(out) :: text
+    character(len=4096), intent(out) :: text
     type(model_t) :: m
     character(len=msglen) :: errmsg
     integer :: ie
