@@ -4,7 +4,7 @@
 !> be copied bitwise (the Python layer keeps a loaded case as such a copy: spline_api).
 module spline_model
   use spline_kinds, only: wp, pi
-  use spline_errors, only: err_ok, err_case, err_thermal
+  use spline_errors, only: err_ok, err_case, err_thermal, itoa
   use spline_case, only: case_t, case_validate, namelen, option_index, thermal_values, &
        method_values, nonlinear_values, start_values, fidelity_values, section_values, nripple
   use spline_geometry, only: iso4156_radii, pitch_rotation, tooth_angles
@@ -338,15 +338,6 @@ contains
       s = fmt(x, '(es10.3)')
     end if
   end function num
-
-  !> i written without blanks.
-  function itoa(i) result(s)
-    integer, intent(in) :: i
-    character(len=:), allocatable :: s
-    character(len=12) :: buf
-    write(buf, '(i0)') i
-    s = trim(buf)
-  end function itoa
 
   !> x written with format f, without blanks (the warnings' numbers).
   function fmt(x, f) result(s)
