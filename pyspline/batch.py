@@ -48,6 +48,8 @@ def read_summary(path) -> dict:
         lines = path.read_text(encoding="utf-8").splitlines()
     except (OSError, UnicodeDecodeError) as exc:
         raise CaseError(f"summary {path}: cannot read it: {exc}") from None
+    if f"format = '{FORMAT}'" not in lines[:5]:
+        raise CaseError(f"summary {path}: not a summary of spline-dyn --summary ({FORMAT})")
     values, units, text = {}, {}, {}
     for k, line in enumerate(lines):
         if line.startswith("&"):
@@ -72,8 +74,8 @@ def read_summary(path) -> dict:
         text[m.group(1)] = _unquote(m.group(2))
     else:
         case_text = ""
-    if text.get("format") != FORMAT or not case_text:
-        raise CaseError(f"summary {path}: not a summary of spline-dyn --summary ({FORMAT})")
+    if not case_text:
+        raise CaseError(f"summary {path}: no case (&spline_case) at its end")
     with tempfile.TemporaryDirectory() as tmp:     # the core's reader reads files
         nml = Path(tmp) / "case.nml"
         nml.write_text(case_text, encoding="utf-8")
