@@ -1,7 +1,12 @@
 !> spline-dyn: the standalone (HPC) driver. Reads a case namelist, runs it with the same core
 !> as the Python package, and writes a self-describing CSV (one header row naming every column
 !> with its unit, '#' lines with the case and the solver statistics).
-!>   usage: spline-dyn CASE.nml [-o OUT.csv] [--set FIELD=VALUE]... | --version | --help
+!>   usage: spline-dyn CASE.nml [-o OUT.csv] [--summary FILE] [--set FIELD=VALUE]...
+!>          | --version | --help
+!> --summary FILE writes the per-run summary a sweep point keeps (write_summary: the statistics,
+!> the loads, T_m / k_v / F extremes and RMS, the Poincare section and the Benettin record,
+!> the case), no time series; with --summary and no -o no CSV is written. A run that fails
+!> after its case was read still writes its summary, with the error (pyspline merge).
 !> Errors and usage go to stderr, warnings as 'spline-dyn: warning: ...' lines; the exit status
 !> says what failed (spline_errors err_exit_code): 0 ok, 2 bad input or usage, 3 solver
 !> failure, 4 thermal interference, 130 interrupted (SIGINT). The output is checked before the
@@ -11,14 +16,16 @@ program spline_dyn
   use, intrinsic :: iso_c_binding, only: c_char, c_double, c_int, c_null_char
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use spline_kinds, only: wp
-  use spline_errors, only: err_ok, err_case, err_interrupted, err_exit_code, msglen
-  use spline_case, only: case_t, case_read_file, case_parse, case_name_of
+  use spline_errors, only: err_ok, err_case, err_interrupted, err_exit_code, msglen, err_names
+  use spline_case, only: case_t, case_read_file, case_parse, case_name_of, case_write_text
   use spline_model, only: model_t, model_from_case, model_warnings, nstate, nkterms, kterm_names
   use spline_run, only: run_case, run_warnings
-  use spline_quantities, only: nstats, stat_q, ntooth_q, tooth_q, nout_q, output_q, nload, &
+  use spline_quantities, only: nstats, stat_q, state_q, iq_tf, ntooth_q, tooth_q, nout_q, output_q, nload, &
        load_q, nload_tooth, load_tooth_q, il_load_sharing, il_free_mean, il_back_teeth, &
        il_impacts_rev, il_closing_speed, il_tf_max, il_tf_max_tooth, il_tf_max_t
   use spline_loads, only: run_loads
+  use spline_sections, only: section_count
+  use spline_lyapunov, only: lyapunov_count
   implicit none
 
   type :: string_t
@@ -62,7 +69,7 @@ program spline_dyn
     end function c_csv_record
   end interface
 
-  character(len=:), allocatable :: path, out, arg, tmp, record
+  character(len=:), allocatable :: path, out, arg, tmp, record, summary, stmp
   type(string_t), allocatable :: sets(:)
   character(len=msglen) :: errmsg
   character(len=256) :: iomsg
@@ -71,16 +78,19 @@ program spline_dyn
   real(wp), allocatable :: t(:), y(:, :), tooth(:, :, :), tm(:)
   real(c_double), allocatable :: row(:)
   real(wp) :: stats(nstats), loads(nload)
-  real(wp), allocatable :: tload(:, :)
-  integer :: ierr, i, j, k, n, q, u, nargs, nsets, ios
+  real(wp), allocatable :: tload(:, :), sec_t(:), sec_y(:, :), lyap_t(:), lyap_g(:)
+  real(wp) :: wall
+  integer :: ierr, i, j, k, n, q, u, su, nargs, nsets, ios
+  integer(8) :: c0, c1, rate
   integer(c_int) :: sigint0
-  logical :: have_out, options_done
+  logical :: have_out, have_summary, write_csv, options_done
 
   ! arguments (any length: allocated from get_command_argument's length)
   nargs = command_argument_count()
   allocate(sets(nargs))
   nsets = 0
   have_out = .false.
+  have_summary = .false.
   options_done = .false.
   i = 1
   do while (i <= nargs)
@@ -98,6 +108,11 @@ program spline_dyn
         i = i + 1
         out = argument(i)
         have_out = .true.
+      case ('--summary')
+        if (i == nargs) call usage_error(arg//' needs a file name')
+        i = i + 1
+        summary = argument(i)
+        have_summary = .true.
       case ('--set')
         if (i == nargs) call usage_error('--set needs FIELD=VALUE')
         i = i + 1
@@ -112,6 +127,9 @@ program spline_dyn
         else if (len(arg) > 9 .and. arg(1:min(9, len(arg))) == '--output=') then
           out = arg(10:)
           have_out = .true.
+        else if (len(arg) > 10 .and. arg(1:min(10, len(arg))) == '--summary=') then
+          summary = arg(11:)
+          have_summary = .true.
         else
           call usage_error('unknown option '//arg)
         end if
@@ -125,6 +143,10 @@ program spline_dyn
     i = i + 1
   end do
   if (.not. allocated(path)) call usage_error('no case file given')
+  if (have_summary) then
+    if (len(summary) == 0) call usage_error('--summary needs a file name')
+  end if
+  write_csv = have_out .or. .not. have_summary
   if (have_out) then
     if (len(out) == 0) call usage_error('-o needs a file name')
   else
@@ -143,27 +165,60 @@ program spline_dyn
 
   ! the output, before the run: never the case file, and writable (a temporary name next to
   ! it, renamed when the CSV is complete)
-  if (c_same_file(path//c_null_char, out//c_null_char) /= 0) &
-       call die('the output '//out//' is the case file '//path//': not overwritten '// &
-       '(give another -o)', err_case)
-  tmp = temp_name(out)
-  open(newunit=u, file=tmp, status='replace', action='write', iostat=ios, iomsg=iomsg)
-  if (ios /= 0) call die('cannot write the output '//out//': '//trim(iomsg), err_case)
+  if (write_csv) then
+    if (c_same_file(path//c_null_char, out//c_null_char) /= 0) &
+         call die('the output '//out//' is the case file '//path//': not overwritten '// &
+         '(give another -o)', err_case)
+    tmp = temp_name(out)
+    open(newunit=u, file=tmp, status='replace', action='write', iostat=ios, iomsg=iomsg)
+    if (ios /= 0) call die('cannot write the output '//out//': '//trim(iomsg), err_case)
+  end if
+  if (have_summary) then
+    if (c_same_file(path//c_null_char, summary//c_null_char) /= 0) &
+         call die('the summary '//summary//' is the case file '//path//': not overwritten '// &
+         '(give another --summary)', err_case)
+    if (write_csv) then
+      if (summary == out) call usage_error('the summary and the CSV are the same file '//out)
+    end if
+    stmp = temp_name(summary)
+    open(newunit=su, file=stmp, status='replace', action='write', iostat=ios, iomsg=iomsg)
+    if (ios /= 0) call die('cannot write the summary '//summary//': '//trim(iomsg), err_case)
+  end if
   ! From here a SIGINT is counted, not fatal (fortran/interrupt.c): the run stops at its next
   ! right-hand side, the temporary file is removed, and the exit status is 130.
   sigint0 = c_sigint_watch()
 
   call print_warnings(model_warnings(m))
   allocate(t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q), tm(m%n_out))
-  call run_case(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible=.true.)
+  call system_clock(c0, rate)
+  if (have_summary) then       ! the section and the Benettin record, as Python's api_simulate
+    allocate(sec_t(section_count(m)), sec_y(nstate, section_count(m)), &
+         lyap_t(lyapunov_count(m)), lyap_g(lyapunov_count(m)))
+    call run_case(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible=.true., sec_t=sec_t, &
+         sec_y=sec_y, lyap_t=lyap_t, lyap_g=lyap_g)
+  else
+    call run_case(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible=.true.)
+  end if
+  call system_clock(c1)
+  wall = real(c1 - c0, wp)/rate
   if (ierr /= err_ok) then
-    close(u, status='delete', iostat=ios)
+    if (write_csv) close(u, status='delete', iostat=ios)
+    if (have_summary .and. ierr /= err_interrupted) then    ! a failed point is a result
+      call write_summary(.false.)
+    else if (have_summary) then
+      close(su, status='delete', iostat=ios)
+    end if
     call die(errmsg, ierr)
   end if
   call check_interrupt()
   call print_warnings(run_warnings(m, stats))
   allocate(tload(m%z, nload_tooth))
   call run_loads(m, t, y, tooth, tm, loads, tload)
+  if (have_summary) call write_summary(.true.)
+  if (.not. write_csv) then
+    write(*, '(a)') 'case '//trim(m%name)//': '//summary
+    stop 0, quiet=.true.
+  end if
 
   write(u, '(a)', iostat=ios) '# spline-dyn output (pyspline): SI units, per-tooth columns Q_j '// &
        'for teeth j = 1..Z'
@@ -309,11 +364,108 @@ contains
     call die('cannot write the output '//to//': '//trim(why), err_case)
   end subroutine rename_into
 
-  !> A SIGINT since the watch began: remove the temporary file, exit 130.
+  !> The summary of the run (what a sweep point keeps; pyspline merge reads it, pyspline/
+  !> batch.py): '#' comments; lines NAME [UNIT] = VALUES, the numbers comma-separated with 17
+  !> significant digits (every double reads back exactly; units of spline_quantities); lines
+  !> NAME = 'TEXT'; then the case as a namelist (every field). ok: the run finished, else the
+  !> summary has the case and the error (ierr, errmsg) only. Written to a temporary name and
+  !> renamed when complete.
+  subroutine write_summary(ok)
+    logical, intent(in) :: ok
+    character(len=:), allocatable :: text
+    integer, parameter :: itm = 2 + nstate, ikv = 3 + nstate, id2 = 6, ivd2 = 13
+    integer :: i2, nt
+    ios = 0
+    write(su, '(a)', iostat=ios) '# spline-dyn summary (pyspline '//version()//'): one run, '// &
+         'SI units; NAME [UNIT] = VALUES (17 significant digits), then the case'
+    write(su, '(a)', iostat=ios) "format = 'pyspline-summary 1'"
+    write(su, '(a)', iostat=ios) 'case_file = '//quoted(path)
+    if (.not. ok) then
+      write(su, '(a)', iostat=ios) 'error = '//quoted(trim(errmsg))
+      write(su, '(a)', iostat=ios) 'error_kind = '//quoted(trim(err_names(ierr)))
+    else
+      do i2 = 1, nstats
+        call put('stats.'//stat_q(i2)%name, stat_q(i2)%unit, [stats(i2)])
+      end do
+      call put('run.wall_s', 's', [wall])
+      do i2 = 1, nload
+        call put('loads.'//load_q(i2)%name, load_q(i2)%unit, [loads(i2)])
+      end do
+      do i2 = 1, nload_tooth
+        call put('tooth_loads.'//load_tooth_q(i2)%name, load_tooth_q(i2)%unit, tload(:, i2))
+      end do
+      nt = m%n_out
+      call put('run.t_first', 's', t(1:min(1, nt)))
+      call extremes('Tm', output_q(itm)%unit, tm)
+      call extremes('kv', output_q(ikv)%unit, abs(tm)/m%t_d)
+      call extremes('F', tooth_q(1)%unit, reshape(tooth(:, :, 1), [nt*m%z]))
+      call extremes('Tf', tooth_q(iq_tf)%unit, reshape(tooth(:, :, iq_tf), [nt*m%z]))
+      call extremes('D2', state_q(id2)%unit, y(id2, :))
+      call extremes('vD2', state_q(ivd2)%unit, y(ivd2, :))
+      call put('section.t', 's', sec_t)
+      call put('section.D2', state_q(id2)%unit, sec_y(id2, :))
+      call put('section.vD2', state_q(ivd2)%unit, sec_y(ivd2, :))
+      call put('lyapunov.t', 's', lyap_t)
+      call put('lyapunov.log_growth', '', lyap_g)
+    end if
+    call case_write_text(c, text)
+    if (ios == 0) write(su, '(a)', advance='no', iostat=ios, iomsg=iomsg) text
+    if (ios == 0) close(su, iostat=ios, iomsg=iomsg)
+    if (ios /= 0) then
+      close(su, status='delete', iostat=i2)
+      call c_unlink(stmp//c_null_char)
+      call die('cannot write the summary '//summary//': '//trim(iomsg), err_case)
+    end if
+    call rename_into(stmp, summary)
+  end subroutine write_summary
+
+  !> Summary lines run.Q_max, run.Q_min, run.Q_rms (sqrt(mean(x**2))) of the values x.
+  subroutine extremes(q, unit, x)
+    character(len=*), intent(in) :: q, unit
+    real(wp), intent(in) :: x(:)
+    if (size(x) == 0) return
+    call put('run.'//q//'_max', unit, [maxval(x)])
+    call put('run.'//q//'_min', unit, [minval(x)])
+    call put('run.'//q//'_rms', unit, [sqrt(sum(x**2)/size(x))])
+  end subroutine extremes
+
+  !> One summary line: NAME [UNIT] = x(1),x(2),... (app/csvrow.c: 17 significant digits).
+  subroutine put(name, unit, x)
+    character(len=*), intent(in) :: name, unit
+    real(wp), intent(in) :: x(:)
+    character(len=:), allocatable :: buf
+    integer :: nb
+    if (ios /= 0) return
+    allocate(character(len=26*size(x) + 1) :: buf)
+    nb = c_csv_record(real(x, c_double), size(x), buf, len(buf))
+    write(su, '(a)', iostat=ios, iomsg=iomsg) trim(name)//' ['//trim(unit)//'] = '// &
+         buf(1:max(nb, 0))
+  end subroutine put
+
+  !> Text in single quotes, a quote doubled and a line break written as \n.
+  function quoted(text) result(s)
+    character(len=*), intent(in) :: text
+    character(len=:), allocatable :: s
+    integer :: i2
+    s = "'"
+    do i2 = 1, len(text)
+      if (text(i2:i2) == "'") then
+        s = s//"''"
+      else if (text(i2:i2) == new_line('a')) then
+        s = s//'\n'
+      else
+        s = s//text(i2:i2)
+      end if
+    end do
+    s = s//"'"
+  end function quoted
+
+  !> A SIGINT since the watch began: remove the temporary files, exit 130.
   subroutine check_interrupt()
     integer :: ios2
     if (c_sigint_count() == sigint0) return
-    close(u, status='delete', iostat=ios2)
+    if (write_csv) close(u, status='delete', iostat=ios2)
+    if (have_summary) close(su, status='delete', iostat=ios2)
     call die('case '//trim(m%name)//': interrupted (SIGINT)', err_interrupted)
   end subroutine check_interrupt
 
@@ -335,10 +487,12 @@ contains
 
   subroutine usage(unit)
     integer, intent(in) :: unit
-    write(unit, '(a)') 'usage: spline-dyn CASE.nml [-o OUT.csv] [--set FIELD=VALUE]...'
+    write(unit, '(a)') 'usage: spline-dyn CASE.nml [-o OUT.csv] [--summary FILE] [--set FIELD=VALUE]...'
     write(unit, '(a)') '       spline-dyn --version | --help'
     write(unit, '(a)') '  runs one pyspline case (namelist &spline_case) and writes a CSV (default: '// &
          'the case file''s stem .csv)'
+    write(unit, '(a)') '  --summary FILE     writes the run''s summary (no time series; no CSV '// &
+         'without -o): pyspline merge'
     write(unit, '(a)') '  --set FIELD=VALUE  replaces a field of the case file (repeatable; '// &
          'strings in quotes)'
     write(unit, '(a)') '  exit status: 0 ok, 2 bad input or usage, 3 solver failure, '// &

@@ -1,6 +1,7 @@
 """pyspline: nonlinear dynamics of an involute spline coupling with parallel misalignment and
 flash temperature (Xue, Shen & Xue 2025). The physics lives in the Fortran core (fortran/);
 this package reads cases, runs them and plots them."""
+from .batch import merge
 from .case import Case, defaults, load_case
 from .cluster import local_dask_client
 from .core import Model, Result, load, mesh_stiffness, rhs, simulate, start_state, tooth_stiffness
@@ -10,7 +11,7 @@ from .sweep import sweep  # pyspline.sweep: the function
 
 __all__ = ["Case", "CaseError", "Model", "Result", "SolverError", "SplineError", "SplineWarning",
            "ThermalInterferenceError", "defaults", "load", "load_case", "local_dask_client",
-           "mesh_stiffness", "open_sweep", "rhs", "simulate", "start_state", "sweep", "tooth_stiffness"]
+           "merge", "mesh_stiffness", "open_sweep", "rhs", "simulate", "start_state", "sweep", "tooth_stiffness"]
 from importlib.metadata import PackageNotFoundError, version as _version
 
 try:

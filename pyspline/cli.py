@@ -4,7 +4,8 @@ commands (each --help says what it writes and where):
   cases list | copy NAME [DEST]   the shipped cases; copy one to start your own (template)
   run CASE...                     run cases, print a summary line each (--out DIR: NAME.npz)
   plot CASE... [--out DIR]        one scene as a figure: DIR/NAME.png
-  sweep CASE --set F=a:b:n ...    sweep one or two fields: DIR/sweep.nc and figures
+  sweep CASE --set F=a:b:n ...    sweep one or two fields (or --table design.csv): DIR/sweep.nc
+  merge SUMMARY... --out DIR      spline-dyn --summary files into DIR/sweep.nc
   reproduce [--out DIR]           the paper's scenarios: figures, verification table, summary
   calibrate, check-exe            fit the paper's unknowns; executable against Python
 Also `python -m pyspline`. The standalone executable is spline-dyn (spline-dyn --help)."""
@@ -21,6 +22,7 @@ import numpy as np
 
 from .case import load_case
 from .errors import CaseError, SolverError, SplineError, SplineWarning, ThermalInterferenceError
+from .batch import add_merge
 from .sweep import MERGED, POINTS_DIR, parse_values, sweep
 
 
@@ -297,7 +299,9 @@ def _make_executor(args):
 def _command(args) -> str:
     """The command line of a parsed `pyspline sweep`, for attrs['command']."""
     parts = ["pyspline", "sweep", args.case]
-    parts += [f"--set={v}" for v in args.set] + [f"--fix={v}" for v in args.fix or ()]
+    parts += [f"--set={v}" for v in args.set or ()] + [f"--fix={v}" for v in args.fix or ()]
+    if args.table:
+        parts.append(f"--table={args.table}")
     parts += [f"--section={args.section}", f"--out={args.out}"]
     if args.lyapunov:
         parts.append("--lyapunov")
@@ -311,7 +315,11 @@ def _command(args) -> str:
 def cmd_sweep(args) -> int:
     try:
         grid = {k: parse_values(k, v) for k, v in _assignments(args.set, "--set").items()}
-        if not 1 <= len(grid) <= 2:
+        if args.table:
+            if grid:
+                raise CaseError("give --table or --set FIELD=VALUES, not both")
+            grid = dict(table=args.table)
+        elif not 1 <= len(grid) <= 2:
             raise CaseError("give one or two --set FIELD=VALUES to sweep")
         case = load_case(args.case, **_fixed(args.fix))
     except SplineError as exc:
@@ -343,6 +351,8 @@ def cmd_sweep(args) -> int:
         print(f"first error: {errors[0]}", file=sys.stderr)
     print(f"wrote {out / MERGED} (xarray.open_dataset(path, engine='h5netcdf') or "
           "pyspline.open_sweep)")
+    if "point" in ds.dims:    # a design table: no line or grid to draw
+        return 1 if a["n_missing"] or a["n_executor_errors"] else 0
     from .plots import sweep_figures
     for path in sweep_figures(ds, out):
         print(f"wrote {path}")
@@ -395,6 +405,8 @@ to a summary: Poincare section of D2 and dD2/dt, its period, the largest Lyapuno
 failed point, and for a speed_rpm sweep the spectrum of T_m in shaft orders.
 
 VALUES: start:stop:num (numpy.linspace, both ends included) or a comma list (10,20,30).
+--table design.csv instead: one point per row of a CSV of case fields (header: the fields),
+dim 'point' with the fields as coordinates (no figures).
 
 Writes into --out DIR:
   DIR/points/<index>.<hash>.npz   one file per finished point, written as it finishes
@@ -441,8 +453,10 @@ def _add_sweep_and_plot(sub) -> None:
                        "Lyapunov and waterfall figures in --out", description=SWEEP_HELP,
                        formatter_class=fmt)
     r.add_argument("case", metavar="CASE", help="case file (namelist)")
-    r.add_argument("--set", action="append", required=True, metavar="FIELD=VALUES",
+    r.add_argument("--set", action="append", metavar="FIELD=VALUES",
                    help="a swept field: start:stop:num or v1,v2,...; give one or two")
+    r.add_argument("--table", metavar="CSV",
+                   help="a design table instead of --set: one point per row, fields as columns")
     r.add_argument("--fix", action="append", metavar="FIELD=VALUE",
                    help="change a field of the case for every point (e.g. t_end=0.5)")
     r.add_argument("--out", required=True, metavar="DIR", help="output directory")
@@ -468,6 +482,7 @@ def _add_sweep_and_plot(sub) -> None:
     r.add_argument("--fix", action="append", metavar="FIELD=VALUE",
                    help="change a field of the case (e.g. t_end=0.5)")
     r.set_defaults(func=cmd_plot)
+    add_merge(sub)
 
 
 def main(argv=None) -> int:

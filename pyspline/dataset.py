@@ -86,11 +86,12 @@ def _stat_attrs(name: str) -> tuple:
 
 
 def build_dataset(grid: dict, keys: list, summaries: dict, hashes: dict, options: dict,
-                  attrs: dict):
+                  attrs: dict, point_fields: dict | None = None):
     """The Dataset of a sweep over `grid` ({field: values}): `keys` are the keys every summary
     has, `summaries` and `hashes` are by grid index (a point without a summary is marked
     NotComputed), `options` the summary options, `attrs` the Dataset's attrs (the counts
-    n_points, n_ok, n_failed, n_missing are added)."""
+    n_points, n_ok, n_failed, n_missing are added). A design table: grid {'point': row
+    numbers} and point_fields {field: values per point}, coordinates along 'point'."""
     import xarray as xr
 
     names = list(grid)
@@ -139,6 +140,11 @@ def build_dataset(grid: dict, keys: list, summaries: dict, hashes: dict, options
             a["units"] = units
         variables[k] = (dims, v, a)
     coords = {n: (n, np.asarray(grid[n]), _field_attrs(n)) for n in names}
+    if point_fields is not None:
+        coords["point"] = ("point", np.asarray(grid["point"]),
+                           {"long_name": "design point (row of the design table)"})
+        coords.update({f: ("point", np.asarray(v), _field_attrs(f))
+                       for f, v in point_fields.items()})
     if options.get("orders") is not None:
         coords["order"] = ("order", np.asarray(options["orders"], dtype=float),
                            {"long_name": "shaft order (frequency / shaft rotation frequency)",

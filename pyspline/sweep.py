@@ -34,8 +34,8 @@ from .core import STATE_NAMES
 from .dataset import MERGED, build_dataset, open_sweep, write_netcdf
 from .errors import CaseError
 
-__all__ = ["local_dask_client", "open_sweep", "parse_values", "point_cases", "run_point",
-           "summarise", "sweep", "task_points", "write_netcdf"]
+__all__ = ["local_dask_client", "open_sweep", "parse_values", "point_cases", "read_table",
+           "run_point", "summarise", "sweep", "table_cases", "task_points", "write_netcdf"]
 
 #: Bump when the content of a point summary changes: older point files are then recomputed.
 #: 2: the default Benettin separation (lyapunov_d0 = 0: 1e4 rtol, was 1e-8) changed exponents.
@@ -135,6 +135,56 @@ def point_cases(case, grid: Mapping) -> dict:
     return out
 
 
+def read_table(table) -> dict:
+    """A design table as {field: 1-D array of values, one per point}: a CSV file (a header row
+    of case fields, then one row per point, values as in a case file: 1e-4, 16, true, 'adams'),
+    a mapping {field: sequence} or a pandas DataFrame. Typed like the fields' defaults."""
+    if isinstance(table, (str, os.PathLike)):
+        import csv
+        try:
+            with open(table, newline="", encoding="utf-8") as f:
+                rows = [r for r in csv.reader(f) if r and any(x.strip() for x in r)]
+        except (OSError, UnicodeDecodeError) as exc:
+            raise CaseError(f"design table {os.fspath(table)}: cannot read it: {exc}") from None
+        if len(rows) < 2:
+            raise CaseError(f"design table {os.fspath(table)}: needs a header row of case "
+                            "fields and at least one row of values")
+        header = [h.strip().lower() for h in rows[0]]
+        for k, r in enumerate(rows[1:], start=2):
+            if len(r) != len(header):
+                raise CaseError(f"design table {os.fspath(table)}: row {k} has {len(r)} values "
+                                f"for {len(header)} fields")
+        columns = {h: [r[i] for r in rows[1:]] for i, h in enumerate(header)}
+        if len(columns) != len(header):
+            raise CaseError(f"design table {os.fspath(table)}: a field is given twice")
+        for h in columns:
+            if h not in defaults():
+                raise CaseError(f"design table {os.fspath(table)}: unknown field '{h}' (see "
+                                "cases/template.nml)")
+        return {h: np.asarray([_typed(h, x) for x in v]) for h, v in columns.items()}
+    if hasattr(table, "columns") and hasattr(table, "to_dict"):      # a pandas DataFrame
+        table = {str(c): table[c].to_numpy() for c in table.columns}
+    if not isinstance(table, Mapping):
+        raise TypeError(f"a design table is a CSV path, a mapping or a DataFrame, not "
+                        f"{type(table).__name__}")
+    out = {str(k).lower(): _as_values(k, v) for k, v in table.items()}
+    if len({len(v) for v in out.values()}) > 1:
+        raise ValueError("the columns of a design table must have the same length")
+    return out
+
+
+def table_cases(case, columns: Mapping) -> dict:
+    """{(row,): Case or CaseError} for every row of a design table (columns: read_table)."""
+    n = len(next(iter(columns.values())))
+    out = {}
+    for i in range(n):
+        try:
+            out[(i,)] = case.replace(**{f: _py(v[i]) for f, v in columns.items()})
+        except CaseError as exc:
+            out[(i,)] = exc
+    return out
+
+
 def _options_key(options: dict) -> str:
     o = dict(options)
     if o.get("orders") is not None:
@@ -212,36 +262,43 @@ def _binned_spectrum(t, x, speed_rpm, orders_axis) -> np.ndarray:
     return out
 
 
+def section_summary(s: dict, case, section_t, D2s, vD2s, rms: tuple) -> None:
+    """Put the Poincare section (times, D2, dD2/dt) and its period into summary `s`; rms: the
+    RMS of D2 and of dD2/dt over the run's outputs."""
+    s.update(section_t=np.asarray(section_t, dtype=float), section_D2=D2s, section_vD2=vD2s)
+    if len(D2s) >= 4:     # classify_period needs 2 points in the tail (the last half)
+        # what the solver's tolerance is relative to: the trajectory's RMS, but at least
+        # the scales of Eq. 25 (its atol acts on states scaled by them), so that a fixed
+        # point whose dD2/dt is zero up to solver noise counts as period 1
+        info = case.model.info()
+        scale = [max(rms[0], info["l_ref"]), max(rms[1], info["l_ref"] * info["w_ref"])]
+        period, info = analysis.classify_period(np.c_[D2s, vD2s], case["rtol"], scale=scale)
+        s["period"] = float(period)
+        r = info["residual"]
+        s["period_residual"] = r[period] if period else (min(r.values()) if r else np.nan)
+
+
+def lyapunov_summary(s: dict, lyap_t, log_growth, exponent: float, t0: float) -> None:
+    """Put the Lyapunov exponent and the fit of its Benettin record (times lyap_t, cumulative
+    log growth; t0 the first output time) into summary `s`."""
+    s.update(lyapunov=exponent, predictability_horizon=analysis.predictability_horizon(exponent))
+    if len(lyap_t) >= 3 and np.isfinite(log_growth).all():
+        fit = analysis.largest_lyapunov_fit(lyap_t, log_growth, t0=t0)
+        s.update(lyapunov_spread=fit.spread, lyapunov_rel_spread=fit.rel_spread,
+                 lyapunov_slope=fit.slope, chaotic=float(analysis.is_chaotic(exponent, fit.spread)))
+
+
 def summarise(res, options: dict) -> dict:
     """The summary of one Result (see `sweep` for the keys), all numbers in SI units."""
     s = _template(options, _stat_names())
     case = res.case
     if options["section"] != "none" and res.section_y is not None:
         sy = np.asarray(res.section_y, dtype=float).reshape(-1, 14)
-        D2s, vD2s = sy[:, _I_D2], sy[:, 7 + _I_D2]
-        s.update(section_t=np.asarray(res.section_t, dtype=float), section_D2=D2s,
-                 section_vD2=vD2s)
-        if len(D2s) >= 4:     # classify_period needs 2 points in the tail (the last half)
-            # what the solver's tolerance is relative to: the trajectory's RMS, but at least
-            # the scales of Eq. 25 (its atol acts on states scaled by them), so that a fixed
-            # point whose dD2/dt is zero up to solver noise counts as period 1
-            info = res.case.model.info()
-            scale = [max(np.sqrt(np.mean(res.D2**2)), info["l_ref"]),
-                     max(np.sqrt(np.mean(res.vD2**2)), info["l_ref"] * info["w_ref"])]
-            period, info = analysis.classify_period(np.c_[D2s, vD2s], case["rtol"],
-                                                    scale=scale)
-            s["period"] = float(period)
-            r = info["residual"]
-            s["period_residual"] = r[period] if period else (min(r.values()) if r else np.nan)
+        section_summary(s, case, res.section_t, sy[:, _I_D2], sy[:, 7 + _I_D2],
+                        (np.sqrt(np.mean(res.D2**2)), np.sqrt(np.mean(res.vD2**2))))
     if options["lyapunov"] and res.lyapunov is not None:
         ly = res.lyapunov
-        lam = float(ly["exponent"])
-        s.update(lyapunov=lam, predictability_horizon=analysis.predictability_horizon(lam))
-        if len(ly["t"]) >= 3 and np.isfinite(ly["log_growth"]).all():
-            fit = analysis.largest_lyapunov_fit(ly["t"], ly["log_growth"], t0=float(res.t[0]))
-            s.update(lyapunov_spread=fit.spread, lyapunov_rel_spread=fit.rel_spread,
-                     lyapunov_slope=fit.slope,
-                     chaotic=float(analysis.is_chaotic(lam, fit.spread)))
+        lyapunov_summary(s, ly["t"], ly["log_growth"], float(ly["exponent"]), float(res.t[0]))
     for q, arr in (("Tm", res.Tm), ("kv", res.kv), ("F", res.tooth["F"])):
         st = analysis.stats(arr, quantiles=False)
         s.update({f"{q}_max": st["max"], f"{q}_min": st["min"], f"{q}_rms": st["rms"]})
@@ -337,12 +394,16 @@ def _version() -> str:
 
 
 def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapunov=False, *,
-          spectrum=None, orders=None, command=None, chunk=None, workers=None, **fields):
-    """Run `case` (a Case, dict of fields or namelist path) over one or two swept fields and
-    return an xarray.Dataset of the per-point summaries.
+          spectrum=None, orders=None, command=None, chunk=None, workers=None, table=None,
+          **fields):
+    """Run `case` (a Case, dict of fields or namelist path) over one or two swept fields, or
+    over the rows of a design table, and return an xarray.Dataset of the per-point summaries.
 
     ``sweep(case, l_x=np.linspace(0, 3e-4, 61))`` sweeps one field; two keywords sweep their
     grid (first field varies slowest; dims in keyword order). Values: any 1-D sequence.
+    ``sweep(case, table="design.csv")`` runs one point per row of a table of case fields
+    (read_table: CSV path, mapping or DataFrame): dim 'point' (the row), the fields as
+    coordinates along it.
 
     executor : None (serial, in this process) or a concurrent.futures.Executor
         (ThreadPoolExecutor, ProcessPoolExecutor, ``distributed.Client(...).get_executor()``).
@@ -385,9 +446,15 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     base = load_case(case)
     if section not in SECTIONS:
         raise CaseError(f"section must be one of {', '.join(SECTIONS)}, got {section!r}")
-    if not fields:
+    if table is not None:
+        if fields:
+            raise TypeError("give a design table or fields to sweep, not both")
+        fields = read_table(table)
+        if not fields or not len(next(iter(fields.values()))):
+            raise CaseError("the design table has no fields or no rows")
+    elif not fields:
         raise TypeError("sweep needs at least one field to sweep, e.g. l_x=[0, 1e-4, 2e-4]")
-    if len(fields) > 2:
+    elif len(fields) > 2:
         raise TypeError(f"sweep takes one or two fields, got {len(fields)}: {', '.join(fields)}")
     known = defaults()
     grid = {}
@@ -403,9 +470,14 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     if len(grid) != len(fields):
         raise TypeError("the same field is swept twice")
     base = base.replace(section=section, lyapunov=bool(lyapunov))
-    cases = point_cases(base, grid)
+    point_fields = None
+    if table is not None:     # one dim 'point', the table's fields as its coordinates
+        point_fields, grid = grid, {"point": np.arange(len(next(iter(grid.values()))))}
+        cases = table_cases(base, point_fields)
+    else:
+        cases = point_cases(base, grid)
     if spectrum is None:
-        spectrum = "speed_rpm" in grid
+        spectrum = "speed_rpm" in (point_fields or grid)
     if spectrum and orders is None:
         orders = _default_orders(cases.values())
     options = dict(section=section, lyapunov=bool(lyapunov),
@@ -435,10 +507,12 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
 
     if command is None:
         spec = ", ".join(f"{k}=[{len(v)} values]" for k, v in grid.items())
+        if point_fields is not None:
+            spec = f"table=[{len(grid['point'])} rows of {', '.join(point_fields)}]"
         command = f"pyspline.sweep({base.name!r}, {spec}, section={section!r}, " \
                   f"lyapunov={bool(lyapunov)})"
     attrs = dict(case=base.text(), pyspline_version=_version(), command=command,
-                 swept=" ".join(grid), section=section, lyapunov=int(bool(lyapunov)),
+                 swept=" ".join(point_fields or grid), section=section, lyapunov=int(bool(lyapunov)),
                  created=datetime.datetime.now(datetime.timezone.utc).isoformat(
                      timespec="seconds"),
                  n_reused=n_reused, out="" if out is None else str(out))
@@ -520,7 +594,7 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
             bar.close()
         attrs.update(n_computed=computed, n_executor_errors=executor_errors)
         try:
-            ds = build_dataset(grid, keys, summaries, hashes, options, attrs)
+            ds = build_dataset(grid, keys, summaries, hashes, options, attrs, point_fields)
             if out is not None:
                 write_netcdf(ds, out / MERGED)
         except Exception as merge_exc:     # noqa: BLE001 -- keep the original exception
@@ -529,7 +603,7 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
         raise
     bar.close()
     attrs.update(n_computed=computed, n_executor_errors=executor_errors)
-    ds = build_dataset(grid, keys, summaries, hashes, options, attrs)
+    ds = build_dataset(grid, keys, summaries, hashes, options, attrs, point_fields)
     if out is not None:
         write_netcdf(ds, out / MERGED)
     return ds

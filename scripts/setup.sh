@@ -30,8 +30,10 @@ python3 -m pip install -q --disable-pip-version-check \
 
 # Test-only cross-checks and benchmark peers (never imported by the package): ROSS (an
 # independent potential-energy stiffness; 2.3 needs plotly < 6), numba + numbalsoda (the
-# compiled-LSODA peer of bench/numba_peer.py).
-python3 -m pip install -q --disable-pip-version-check ross-rotordynamics "plotly<6" numba numbalsoda
+# compiled-LSODA peer of bench/numba_peer.py), dask-jobqueue (tests/test_batch.py renders the
+# SLURMCluster job script of docs/building.md).
+python3 -m pip install -q --disable-pip-version-check ross-rotordynamics "plotly<6" numba numbalsoda \
+  dask-jobqueue
 
 # The source of exactly the installed version: same interface, same numbers.
 version="$(dpkg-query -W -f='${Version}' libsundials-dev)"
