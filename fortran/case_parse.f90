@@ -110,7 +110,7 @@ contains
     p = 2
 
     ! the items, each checked element assigned to the copy (kept if the whole text passes)
-    allocate(set_line(nfields, ndof_case))
+    allocate(set_line(nfields, maxval(fields%n, mask=fields%kind /= 'c')))   ! lists: to max_teeth
     set_line = 0
     do
       if (p > ntok) then
@@ -595,6 +595,7 @@ contains
     case ('gamma_x'); c%gamma_x = x
     case ('gamma_y'); c%gamma_y = x
     case ('n_slices'); c%n_slices = i
+    case ('spacing_error'); c%spacing_error(k) = x
     case default
       known = .false.
     end select

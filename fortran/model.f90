@@ -3,7 +3,7 @@
 !> module (geometry, stiffness, thermal). A model_t holds no pointers or allocatables, so it can
 !> be copied bitwise (the Python layer keeps a loaded case as such a copy: spline_api).
 module spline_model
-  use spline_kinds, only: wp, pi
+  use spline_kinds, only: wp, pi, max_teeth
   use spline_errors, only: err_ok, err_case, err_thermal
   use spline_case, only: case_t, case_validate, namelen, option_index, thermal_values, &
        method_values, nonlinear_values, start_values, fidelity_values, section_values, nripple
@@ -27,7 +27,7 @@ module spline_model
   integer, parameter :: stiffness_nquad = 32   !< Gauss points: converged to 1e-15 from 16 on
   !> Marks a model_t built by this build's constructor (layout version in the last digits):
   !> a copy handed back from outside is checked against it.
-  integer, parameter :: model_magic = 517730005
+  integer, parameter :: model_magic = 517730006
   !> A given k_m this many times below Eq. 18 draws a warning (model_warnings): the paper's
   !> calibrated 2.54e5 N/m is ~7600 times below for its spline, a deliberate fit; N/mm read
   !> as N/m is 1000 times, on top of such a fit 1e4 is passed.
@@ -81,6 +81,9 @@ module spline_model
     real(wp) :: unbalance_phase(2) = 0.0_wp !< [rad]
     real(wp) :: gamma_x = 0.0_wp, gamma_y = 0.0_wp  !< angular misalignment of spline 1 [rad]
     integer  :: n_slices = 1                !< face-width slices
+    !> tooth spacing (index) errors e_j of spline 1 [m] (0 beyond z), and whether any is nonzero
+    real(wp) :: spacing_error(max_teeth) = 0.0_wp
+    logical  :: spacing = .false.
   end type model_t
 
 contains
@@ -194,6 +197,19 @@ contains
       write(errmsg, '(a,es10.3,a,es10.3,a)') 'case '//trim(m%name)//': thermal interference: '// &
            't_bulk = ', m%t_bulk, ' degC closes the backlash (c = ', m%c_bulk, ' m, Eq. 2)'
       ierr = err_thermal
+      return
+    end if
+
+    ! tooth spacing errors (docs/model.md section 11): |e_j| < c0 is checked with the case;
+    ! the bulk temperature shrinks the backlash to c_bulk, which must keep both gaps too
+    m%spacing_error = c%spacing_error
+    m%spacing = any(c%spacing_error /= 0.0_wp)
+    if (maxval(abs(m%spacing_error(1:m%z))) >= m%c_bulk) then
+      write(errmsg, '(a,i0,a,es10.3,a,es10.3,a)') 'case '//trim(m%name)//': field spacing_error(', &
+           maxloc(abs(m%spacing_error(1:m%z)), dim=1), ') is not smaller in magnitude than the '// &
+           'backlash at the bulk temperature: |e_j| = ', maxval(abs(m%spacing_error(1:m%z))), &
+           ' m, c = ', m%c_bulk, ' m (Eq. 2)'
+      ierr = err_case
       return
     end if
 

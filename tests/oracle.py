@@ -80,6 +80,12 @@ class Prepared:
         self.f_m = g("f_m")
         self.u_flash = g("u_flash")          # u = 0.83   (Eq. 3)
         self.eta_hertz = g("eta_hertz")      # eta = 1.127 (Eq. 4)
+        # tooth spacing (index) errors e_j (docs/model.md s.11): tooth j of spline 1 sits e_j
+        # ahead of its place along +dn, so its dead zone is met at dn_j + e_j; teeth not listed: 0
+        e = np.zeros(self.z)
+        given = np.asarray(case.get("spacing_error", []), dtype=float)[:self.z]
+        e[:given.size] = given
+        self.e = e
 
         # Derived (convention 1 of the brief / docs/model.md s.2, s.8)
         self.omega = self.speed_rpm * 2.0 * math.pi / 60.0          # rad/s
@@ -269,13 +275,14 @@ def _solve_coupled(dn, ddn, geo, p):
 
 
 def _kinematics(t, y, p):
-    """Eqs. 8-11: phi_j, dn_j and its total time derivative ddn_j."""
+    """Eqs. 8-11: phi_j, dn_j (with the spacing error e_j) and its total time derivative ddn_j
+    (e_j is fixed on the tooth: no rate)."""
     phi = _phi(t, p)
     sp, cp = np.sin(phi), np.cos(phi)
     X1 = y[0] + p.l_x
     Y1 = y[1] + p.l_y
     ex, ey = X1 - y[2], Y1 - y[3]
-    dn = ex * sp - ey * cp + y[5]                                         # Eq. 11
+    dn = ex * sp - ey * cp + y[5] + p.e                 # Eq. 11, tooth j shifted by e_j
     ddn = ((y[7] - y[9]) * sp - (y[8] - y[10]) * cp + y[12]
            + p.omega * (ex * cp + ey * sp))                               # d/dt of Eq. 11
     return phi, sp, cp, dn, ddn
