@@ -183,3 +183,13 @@ def test_a_shorter_list_gives_the_first_teeth_and_a_file_reads_the_same(tmp_path
     path = tmp_path / "short.nml"
     path.write_text("&spline_case\n  k_m = 2.3e5\n  spacing_error = 1e-6, -2e-6\n/\n")
     assert pyspline.load_case(path)["spacing_error"] == case["spacing_error"]
+
+
+@pytest.mark.parametrize("shape,dof", [(NO_FIRST, 3), (WITH_FIRST, 7)])
+def test_auto_fidelity_counts_the_errors_eccentricity(shape, dof):
+    """fidelity = 'auto' keeps the lateral motion when the errors' first harmonic moves the
+    centres, and drops it when they have none (every tooth then pushes the centres equally)."""
+    e = list(3e-6 * shape / np.abs(shape).max())
+    res = pyspline.simulate(dict(PAPER, name="auto", k_m=1e8, grav=0.0, spacing_error=e,
+                                 fidelity="auto", t_end=0.002, n_out=3))
+    assert res.stats["dof"] == dof
