@@ -28,7 +28,7 @@ contains
          c%t_transient, c%dq0, c%dv0, c%l_ref, c%w_ref, c%fidelity_tol, c%lyapunov_interval, &
          c%lyapunov_d0, c%fillet_radius, c%r_bore, c%r_rim, c%zeta_m, c%ripple_order, &
          c%ripple_amp, c%ripple_phase_deg, c%unbalance, c%unbalance_phase_deg, c%gamma_x, &
-         c%gamma_y, c%spacing_error]
+         c%gamma_y, c%spacing_error, c%spacing_error_amp]
   end function real_values
 
   !> Check every field (see the module's comment). ierr = err_case with a message naming
@@ -163,6 +163,7 @@ contains
 
     ! beyond the paper
     if (.not. finite(field_index('spacing_error'))) return
+    if (.not. finite(field_index('spacing_error_amp'))) return
     if (.not. all(ieee_is_finite(x(at(beyond):)))) then
       call fail('fillet_radius', '.. gamma_y (the fields beyond the paper) must be finite numbers')
       return
@@ -210,6 +211,13 @@ contains
              ' would close a flank''s gap (|e_j| < c_j)'); return
       end if
     end do
+    if (.not. (c%spacing_error_amp >= 0.0_wp .and. c%spacing_error_amp < c%c0)) then
+      call fail('spacing_error_amp', '= '//num(c%spacing_error_amp)//' m is outside 0 .. c0 = '// &
+           num(c%c0)//' m (the largest random spacing error; both flanks keep a gap)'); return
+    end if
+    if (c%spacing_error_seed < 1 .or. c%spacing_error_seed > 2147483646) then
+      call fail('spacing_error_seed', '= '//itoa(c%spacing_error_seed)//' is outside 1 .. 2147483646'); return
+    end if
 
     ! memory, before anything is allocated
     bytes = case_output_bytes(c)

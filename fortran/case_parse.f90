@@ -601,6 +601,8 @@ contains
     case ('gamma_y'); c%gamma_y = x
     case ('n_slices'); c%n_slices = i
     case ('spacing_error'); c%spacing_error(k) = x
+    case ('spacing_error_amp'); c%spacing_error_amp = x
+    case ('spacing_error_seed'); c%spacing_error_seed = i
     case default
       known = .false.
     end select

@@ -26,7 +26,7 @@ import math
 import numpy as np
 
 __all__ = ["Prepared", "prepare", "mesh", "rhs", "energy", "static_torsion",
-           "flash_geometry", "flash_temperature", "coupled_residual"]
+           "flash_geometry", "flash_temperature", "coupled_residual", "random_spacing_errors"]
 
 THERMAL_MODES = ("none", "bulk", "oneway", "coupled")
 
@@ -85,6 +85,9 @@ class Prepared:
         e = np.zeros(self.z)
         given = np.asarray(case.get("spacing_error", []), dtype=float)[:self.z]
         e[:given.size] = given
+        amp = float(case.get("spacing_error_amp", 0.0))
+        if amp > 0.0:
+            e = e + random_spacing_errors(self.z, amp, int(case.get("spacing_error_seed", 1)))
         self.e = e
 
         # Derived (convention 1 of the brief / docs/model.md s.2, s.8)
@@ -107,6 +110,24 @@ class Prepared:
         self.hertz = 2.0 * (1.0 - self.nu ** 2) / self.e_mod
         # Eq. 3 thermal contact coefficient g rho c (same steel for both splines)
         self.grc = self.k_cond * self.rho * self.c_heat
+
+
+def random_spacing_errors(z, amp, seed):
+    """docs/model.md s.11: MINSTD x <- 48271 x mod (2^31 - 1) from x = seed, 8 draws discarded,
+    u_j = x / (2^31 - 1) for teeth 1..z, d_j = 2 u_j - 1, mean removed, scaled to max |e_j| = amp."""
+    m31, x = 2 ** 31 - 1, seed
+    for _ in range(8):
+        x = 48271 * x % m31
+    d = []
+    for _ in range(z):
+        x = 48271 * x % m31
+        d.append(2.0 * (x / m31) - 1.0)
+    mean = 0.0
+    for v in d:
+        mean += v
+    mean /= z
+    d = np.array(d) - mean
+    return d * (amp / np.abs(d).max())
 
 
 def prepare(case):

@@ -139,7 +139,8 @@ def test_run_keeps_the_torque_and_the_executable_agrees(exe, tmp_path):
     """A run with spacing errors (from rest, rattling into contact) settles to T_m = -T_d and
     the static loads of the closed form; spline-dyn gives Python's numbers bit for bit."""
     case = pyspline.load_case(dict(PAPER, name="sp", k_m=1e7, grav=0.0, c_m=0.0,
-                                   spacing_error=scaled(WITH_FIRST, 1e7), t_end=0.02, n_out=41))
+                                   spacing_error=scaled(WITH_FIRST, 1e7), spacing_error_amp=2e-6,
+                                   spacing_error_seed=99, t_end=0.02, n_out=41))
     res = pyspline.simulate(case)
     assert res.stats["linear_tail_t_s"] == -1.0          # the tail is off with errors
     path = tmp_path / "sp.nml"
@@ -167,7 +168,14 @@ def test_run_keeps_the_torque_and_the_executable_agrees(exe, tmp_path):
     (dict(spacing_error=1e-6), ["field spacing_error", "1 to 1000 numbers"]),
     # the bulk temperature shrinks the backlash below the error (Eq. 2)
     (dict(spacing_error=[1.9e-4], thermal="bulk", t_bulk=200.0),
-     ["field spacing_error(1)", "backlash at the bulk temperature"]),
+     ["field spacing_error(1)", "at the bulk temperature"]),
+    (dict(spacing_error_amp=2e-4), ["field spacing_error_amp", "outside 0 .. c0"]),
+    (dict(spacing_error_amp=-1e-6), ["field spacing_error_amp", "outside 0 .. c0"]),
+    (dict(spacing_error_amp=math.nan), ["field spacing_error_amp", "finite"]),
+    (dict(spacing_error_seed=0), ["field spacing_error_seed", "outside 1 .. 2147483646"]),
+    # each part below c0, their sum not (the seeded tooth 1 of seed 1 is positive)
+    (dict(spacing_error=[1.5e-4] * 16, spacing_error_amp=1.5e-4),
+     ["field spacing_error(", "with spacing_error_amp"]),
 ])
 def test_bad_spacing_errors_are_case_errors(fields, words):
     with pytest.raises(pyspline.CaseError) as exc:
@@ -193,3 +201,28 @@ def test_auto_fidelity_counts_the_errors_eccentricity(shape, dof):
     res = pyspline.simulate(dict(PAPER, name="auto", k_m=1e8, grav=0.0, spacing_error=e,
                                  fidelity="auto", t_end=0.002, n_out=3))
     assert res.stats["dof"] == dof
+
+
+def seeded_errors(**fields):
+    """e_j of a case as the core built them: dn_j at the rest state of an aligned case."""
+    case = pyspline.load_case(dict(PAPER, name="seeded", **fields))
+    return pyspline.rhs(case, 0.0, np.zeros(14))[1]["dn"]
+
+
+@pytest.mark.parametrize("z,seed", [(16, 1), (7, 123456789), (1000, 2147483646)])
+def test_seeded_errors_are_reproducible_with_mean_zero(z, seed):
+    """spacing_error_amp, spacing_error_seed: MINSTD as docs/model.md states it (tests/oracle.py
+    from the document), mean 0, largest |e_j| the amplitude; the same seed the same numbers."""
+    amp = 3e-5
+    e = seeded_errors(z=z, spacing_error_amp=amp, spacing_error_seed=seed)
+    np.testing.assert_array_equal(e, seeded_errors(z=z, spacing_error_amp=amp,
+                                                   spacing_error_seed=seed))
+    np.testing.assert_allclose(e, oracle.random_spacing_errors(z, amp, seed), rtol=0,
+                               atol=4e-16 * amp)
+    assert abs(e.mean()) < 1e-15 * amp
+    np.testing.assert_allclose(np.abs(e).max(), amp, rtol=1e-15)
+    assert np.unique(e).size == z                      # no repeats, no constant run
+    other = seeded_errors(z=z, spacing_error_amp=amp, spacing_error_seed=seed % 1000 + 1)
+    assert not np.allclose(e, other)
+    if z == 1000:                                      # uniform: about half the teeth past amp/2
+        assert 0.3 < (np.abs(e) > 0.5 * amp).mean() < 0.7
