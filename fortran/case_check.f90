@@ -28,7 +28,7 @@ contains
          c%t_transient, c%dq0, c%dv0, c%l_ref, c%w_ref, c%fidelity_tol, c%lyapunov_interval, &
          c%lyapunov_d0, c%fillet_radius, c%r_bore, c%r_rim, c%zeta_m, c%ripple_order, &
          c%ripple_amp, c%ripple_phase_deg, c%unbalance, c%unbalance_phase_deg, c%gamma_x, &
-         c%gamma_y]
+         c%gamma_y, c%spacing_error, c%spacing_error_amp]
   end function real_values
 
   !> Check every field (see the module's comment). ierr = err_case with a message naming
@@ -162,6 +162,8 @@ contains
     end if
 
     ! beyond the paper
+    if (.not. finite(field_index('spacing_error'))) return
+    if (.not. finite(field_index('spacing_error_amp'))) return
     if (.not. all(ieee_is_finite(x(at(beyond):)))) then
       call fail('fillet_radius', '.. gamma_y (the fields beyond the paper) must be finite numbers')
       return
@@ -195,6 +197,26 @@ contains
     if (c%n_slices > 1 .and. option_index(thermal_values, c%thermal) > 2) then
       call fail('n_slices', '> 1 needs thermal = none or bulk: the flash temperature (oneway, '// &
            'coupled) is modelled for a whole tooth'); return
+    end if
+    ! spacing errors: both flanks of every tooth keep a gap, |e_j| < c0 (the backlash at the
+    ! bulk temperature is checked by spline_model::model_from_case); none beyond tooth z
+    do i = 1, max_teeth
+      if (i > c%z .and. c%spacing_error(i) /= 0.0_wp) then
+        call fail('spacing_error('//itoa(i)//')', '= '//num(c%spacing_error(i))//' m is given '// &
+             'for a tooth beyond z = '//itoa(c%z)//': list one error per tooth, teeth 1 .. z'); return
+      end if
+      if (.not. abs(c%spacing_error(i)) < c%c0) then
+        call fail('spacing_error('//itoa(i)//')', '= '//num(c%spacing_error(i))//' m is not '// &
+             'smaller in magnitude than the backlash c0 = '//num(c%c0)//' m: tooth '//itoa(i)// &
+             ' would close a flank''s gap (|e_j| < c_j)'); return
+      end if
+    end do
+    if (.not. (c%spacing_error_amp >= 0.0_wp .and. c%spacing_error_amp < c%c0)) then
+      call fail('spacing_error_amp', '= '//num(c%spacing_error_amp)//' m is outside 0 .. c0 = '// &
+           num(c%c0)//' m (the largest random spacing error; both flanks keep a gap)'); return
+    end if
+    if (c%spacing_error_seed < 1 .or. c%spacing_error_seed > 2147483646) then
+      call fail('spacing_error_seed', '= '//itoa(c%spacing_error_seed)//' is outside 1 .. 2147483646'); return
     end if
 
     ! memory, before anything is allocated

@@ -66,7 +66,8 @@ contains
     character(len=*), intent(in), optional :: origin
     logical, intent(in), optional :: show_lines
     integer, allocatable :: tk(:), ta(:), tb(:), tl(:)
-    integer, allocatable :: set_line(:, :)
+    integer, allocatable :: set_line(:)     ! line that set each element: field f's at(f) + q
+    integer :: at(nfields + 1)
     character(len=:), allocatable :: from
     integer :: ntok, p, f, i0, i1, group_line
     logical :: lines_on
@@ -110,7 +111,11 @@ contains
     p = 2
 
     ! the items, each checked element assigned to the copy (kept if the whole text passes)
-    allocate(set_line(nfields, ndof_case))
+    at(1) = 0
+    do f = 1, nfields
+      at(f + 1) = at(f) + merge(1, fields(f)%n, fields(f)%kind == 'c')
+    end do
+    allocate(set_line(at(nfields + 1)))
     set_line = 0
     do
       if (p > ntok) then
@@ -262,11 +267,11 @@ contains
           call check_value(v, tk(p), tl(p), x, iv, lv, sv)
           if (ierr /= err_ok) return
           do q = k, k + r - 1
-            if (set_line(f, q) /= 0) then
+            if (set_line(at(f) + q) /= 0) then
               call fail(tl(pv), 'field '//trim(element(f, q))//' is given twice (lines '// &
-                   itoa(set_line(f, q))//' and '//itoa(tl(pv))//')'); return
+                   itoa(set_line(at(f) + q))//' and '//itoa(tl(pv))//')'); return
             end if
-            set_line(f, q) = tl(pv)
+            set_line(at(f) + q) = tl(pv)
             if (.not. set_element(work, f, q, x, iv, lv, sv)) then
               call fail(tl(pv), 'field '//trim(fields(f)%name)//' has no place in the reader '// &
                    '(set_element in fortran/case_parse.f90 is out of step with the field table)')
@@ -595,6 +600,9 @@ contains
     case ('gamma_x'); c%gamma_x = x
     case ('gamma_y'); c%gamma_y = x
     case ('n_slices'); c%n_slices = i
+    case ('spacing_error'); c%spacing_error(k) = x
+    case ('spacing_error_amp'); c%spacing_error_amp = x
+    case ('spacing_error_seed'); c%spacing_error_seed = i
     case default
       known = .false.
     end select

@@ -3,7 +3,7 @@
 !> simple allowed range that spline_case_check applies). Every field is in SI units (angles in
 !> degrees only where the name ends in _deg).
 module spline_case_type
-  use spline_kinds, only: wp, pi
+  use spline_kinds, only: wp, pi, max_teeth
   implicit none
   private
   public :: case_t, field_t, fields, nfields, field_index, case_field, case_field_meta, &
@@ -78,6 +78,9 @@ module spline_case_type
     real(wp) :: unbalance(2) = 0.0_wp, unbalance_phase_deg(2) = 0.0_wp
     real(wp) :: gamma_x = 0.0_wp, gamma_y = 0.0_wp
     integer  :: n_slices = 1
+    real(wp) :: spacing_error(max_teeth) = 0.0_wp
+    real(wp) :: spacing_error_amp = 0.0_wp
+    integer  :: spacing_error_seed = 1
   end type case_t
 
   !> A field of the namelist: name; type (i integer, r real, l logical, c character); size
@@ -98,7 +101,7 @@ module spline_case_type
     real(wp) :: lo = 0.0_wp, hi = 0.0_wp
     character(len=80) :: note = ''
   end type field_t
-  integer, parameter :: nfields = 79
+  integer, parameter :: nfields = 82
   real(wp), parameter :: inf_ = huge(1.0_wp)
   type(field_t), parameter :: fields(nfields) = [ &
        field_t('name', 'c', namelen, '', 'case name, used in messages (default: the file name)'), &
@@ -221,7 +224,11 @@ module spline_case_type
        field_t('unbalance_phase_deg', 'r', 2, 'deg', 'phase beta_i of the unbalance'), &
        field_t('gamma_x', 'r', 1, 'rad', 'angular misalignment of spline 1 about x'), &
        field_t('gamma_y', 'r', 1, 'rad', 'angular misalignment of spline 1 about y'), &
-       field_t('n_slices', 'i', 1, '-', 'face-width slices (angular misalignment)')]
+       field_t('n_slices', 'i', 1, '-', 'face-width slices (angular misalignment)'), &
+       field_t('spacing_error', 'r', max_teeth, 'm', 'tooth spacing (index) error e_j of spline 1, '// &
+               'teeth 1 .. z'), &
+       field_t('spacing_error_amp', 'r', 1, 'm', 'largest seeded random spacing error (mean 0); 0: none'), &
+       field_t('spacing_error_seed', 'i', 1, '-', 'seed of the random spacing errors, 1 .. 2147483646')]
 
 contains
 

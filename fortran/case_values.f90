@@ -95,7 +95,8 @@ contains
     call r(c%fillet_radius); call r(c%r_bore); call r(c%r_rim); call r(c%zeta_m)
     call ra(c%ripple_order); call ra(c%ripple_amp); call ra(c%ripple_phase_deg)
     call ra(c%unbalance); call ra(c%unbalance_phase_deg); call r(c%gamma_x); call r(c%gamma_y)
-    call i(c%n_slices)
+    call i(c%n_slices); call ra(c%spacing_error)
+    call r(c%spacing_error_amp); call i(c%spacing_error_seed)
     if (ierr == err_ok .and. (iv /= size(v) .or. is /= len(s))) call mismatch()
     if (ierr == err_ok) call field(' ', 0)       ! no field beyond the last
   contains

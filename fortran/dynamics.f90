@@ -173,6 +173,7 @@ contains
     q(5) = -m%r_b*m%t_d/max(m%k_t1, tiny(1.0_wp))
     q(7) = m%r_b*m%t_l/max(m%k_t2, tiny(1.0_wp))
     q(6) = -sign(m%c_bulk, m%t_d) - m%t_d/(m%z*m%k_m*m%r_b)
+    if (m%spacing) q(6) = q(6) - sum(m%spacing_error(1:m%z))/m%z   ! full contact: dn_j + e_j
     lam_prev = 0.0_wp; q_prev = 0.0_wp; dq_prev = 0.0_wp
     call residual(q, r)
     if (ierr /= err_ok) return

@@ -7,11 +7,13 @@
 !>  - torsional only (dof 3) leaves out the lateral motion. Its drivers are the misalignment
 !>    (l_x, l_y), the difference of the gravity sags g |m_1/k_p1 - m_2/k_p2|, a lateral start
 !>    offset, the unbalance (its static deflection m_u e omega^2 / k_p) and the angular
-!>    misalignment (gamma b / 2 at the face ends). Without them every tooth sees the same dn_j,
-!>    sum_j F_j sin(phi_j) = 0 (Z >= 3) and the lateral states never move: dof 3 is then exact.
+!>    misalignment (gamma b / 2 at the face ends), and the first harmonic of the tooth spacing
+!>    errors, an eccentricity (2/Z) |sum_j e_j exp(2 pi i j/Z)| (docs/model.md section 11).
+!>    Without them every tooth sees the same dn_j, sum_j F_j sin(phi_j) = 0 (Z >= 3) and the
+!>    lateral states never move: dof 3 is then exact.
 !>  - a temperature dT left out of Eq. 2 moves the backlash by kappa dT, kappa = 2 lambda s cos(alpha).
 module spline_fidelity
-  use spline_kinds, only: wp
+  use spline_kinds, only: wp, pi
   use spline_model, only: model_t, thermal_none, thermal_bulk, thermal_oneway, thermal_coupled, &
        set_thermal_level
   implicit none
@@ -67,7 +69,8 @@ contains
   !> lateral start velocity, a free lateral body (k_p = 0) or no load.
   pure real(wp) function lateral_estimate(m) result(eps)
     type(model_t), intent(in) :: m
-    real(wp) :: e, f0
+    real(wp) :: e, f0, es, ec
+    integer :: j
     f0 = static_tooth_load(m)
     eps = huge(1.0_wp)
     if (f0 == 0.0_wp .or. m%k_p1 == 0.0_wp .or. m%k_p2 == 0.0_wp) return
@@ -75,6 +78,14 @@ contains
     e = hypot(m%l_x, m%l_y) + m%grav*abs(m%m_1/m%k_p1 - m%m_2/m%k_p2) + norm2(m%dq0(1:4)) &
          + m%omega**2*(m%unbalance(1)/m%k_p1 + m%unbalance(2)/m%k_p2) &
          + 0.5_wp*m%b*hypot(m%gamma_x, m%gamma_y)
+    if (m%spacing) then
+      es = 0.0_wp; ec = 0.0_wp
+      do j = 1, m%z
+        es = es + m%spacing_error(j)*sin(2.0_wp*pi*j/m%z)
+        ec = ec + m%spacing_error(j)*cos(2.0_wp*pi*j/m%z)
+      end do
+      e = e + 2.0_wp/m%z*hypot(es, ec)
+    end if
     eps = m%k_m*e/f0
   end function lateral_estimate
 

@@ -64,11 +64,13 @@ contains
 
   !> Whether the model's right-hand side can be affine and time-invariant in full contact:
   !> the case allows it (linear_tail), Z >= 3, no face slices, no coupled flash temperature,
-  !> no torque ripple, no unbalance.
+  !> no torque ripple, no unbalance, no tooth spacing errors (their first harmonic turns with
+  !> the shaft, a time-varying lateral force, and the contact bound above has no e_j).
   pure logical function tail_possible(m)
     type(model_t), intent(in) :: m
     tail_possible = m%linear_tail .and. m%z >= 3 .and. m%n_slices == 1 .and. &
-         m%thermal /= thermal_coupled .and. m%n_ripple == 0 .and. all(m%unbalance == 0.0_wp)
+         m%thermal /= thermal_coupled .and. m%n_ripple == 0 .and. all(m%unbalance == 0.0_wp) &
+         .and. .not. m%spacing
   end function tail_possible
 
   !> Try to start the tail at scaled time tau from the full scaled state ys (integrated states

@@ -68,8 +68,10 @@ contains
     mx = 0.0_wp; my = 0.0_wp
     ns = m%n_slices
     do j = 1, m%z
-      ! Eq. 11 and its total time derivative (phi_j' = omega), at the face centre
-      dnj = ex*sp(j) - ey*cp(j) + q(6)
+      ! Eq. 11 and its total time derivative (phi_j' = omega), at the face centre; tooth j of
+      ! spline 1 sits e_j ahead along +dn (spacing error, docs/model.md section 11): it meets
+      ! the dead zone at dn_j + e_j, the rate is unchanged
+      dnj = ex*sp(j) - ey*cp(j) + q(6) + m%spacing_error(j)
       ddnj = evx*sp(j) - evy*cp(j) + v(6) + m%omega*(ex*cp(j) + ey*sp(j))
       if (ns > 1) then
         ! slices of the face (angular misalignment; thermal none or bulk: c_j = c_bulk)
@@ -261,7 +263,8 @@ contains
 
   !> Root functions for the contact switches of Eq. 16: g_{2k-1} = dn_k - c_k, g_{2k} = dn_k + c_k
   !> for every contact k (a tooth, or slice s of tooth j: k = (j - 1) n_s + s), with the backlash
-  !> at the bulk temperature, which decides the contact state.
+  !> at the bulk temperature, which decides the contact state; dn_k includes the tooth's spacing
+  !> error e_j (|dn_j + e_j| = c_j, docs/model.md section 11).
   pure subroutine mesh_switch_functions(m, t, q, g)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(7)
@@ -273,7 +276,7 @@ contains
     ey = q(2) + m%l_y - q(4)
     ns = m%n_slices
     do j = 1, m%z
-      dnj = ex*sp(j) - ey*cp(j) + q(6)
+      dnj = ex*sp(j) - ey*cp(j) + q(6) + m%spacing_error(j)   ! Eq. 11 with the spacing error
       do is = 1, ns
         dns = dnj
         if (ns > 1) then

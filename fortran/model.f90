@@ -3,7 +3,8 @@
 !> module (geometry, stiffness, thermal). A model_t holds no pointers or allocatables, so it can
 !> be copied bitwise (the Python layer keeps a loaded case as such a copy: spline_api).
 module spline_model
-  use spline_kinds, only: wp, pi
+  use spline_kinds, only: wp, pi, max_teeth
+  use, intrinsic :: iso_fortran_env, only: int64
   use spline_errors, only: err_ok, err_case, err_thermal, itoa
   use spline_case, only: case_t, case_validate, namelen, option_index, thermal_values, &
        method_values, nonlinear_values, start_values, fidelity_values, section_values, nripple
@@ -27,7 +28,7 @@ module spline_model
   integer, parameter :: stiffness_nquad = 32   !< Gauss points: converged to 1e-15 from 16 on
   !> Marks a model_t built by this build's constructor (layout version in the last digits):
   !> a copy handed back from outside is checked against it.
-  integer, parameter :: model_magic = 517730005
+  integer, parameter :: model_magic = 517730006
   !> A given k_m this many times below Eq. 18 draws a warning (model_warnings): the paper's
   !> calibrated 2.54e5 N/m is ~7600 times below for its spline, a deliberate fit; N/mm read
   !> as N/m is 1000 times, on top of such a fit 1e4 is passed.
@@ -88,6 +89,9 @@ module spline_model
     real(wp) :: unbalance_phase(2) = 0.0_wp !< [rad]
     real(wp) :: gamma_x = 0.0_wp, gamma_y = 0.0_wp  !< angular misalignment of spline 1 [rad]
     integer  :: n_slices = 1                !< face-width slices
+    !> tooth spacing (index) errors e_j of spline 1 [m] (0 beyond z), and whether any is nonzero
+    real(wp) :: spacing_error(max_teeth) = 0.0_wp
+    logical  :: spacing = .false.
   end type model_t
 
 contains
@@ -204,6 +208,23 @@ contains
       return
     end if
 
+    ! tooth spacing errors (docs/model.md section 11): the list plus the seeded random ones;
+    ! each part is below c0 (case check), the sum must keep both gaps at c0 and at the bulk
+    ! temperature's backlash c_bulk (Eq. 2) too
+    m%spacing_error = c%spacing_error
+    if (c%spacing_error_amp > 0.0_wp) m%spacing_error(1:m%z) = m%spacing_error(1:m%z) + &
+         random_spacing_errors(m%z, c%spacing_error_amp, c%spacing_error_seed)
+    m%spacing = any(m%spacing_error /= 0.0_wp)
+    if (maxval(abs(m%spacing_error(1:m%z))) >= min(m%c0, m%c_bulk)) then
+      write(errmsg, '(a,i0,a,es10.3,a,es10.3,a)') 'case '//trim(m%name)//': field spacing_error(', &
+           maxloc(abs(m%spacing_error(1:m%z)), dim=1), ') is not smaller in magnitude than the '// &
+           'backlash (c0, or at the bulk temperature): |e_j| = ', &
+           maxval(abs(m%spacing_error(1:m%z))), ' m (with spacing_error_amp), c = ', &
+           min(m%c0, m%c_bulk), ' m (Eq. 2)'
+      ierr = err_case
+      return
+    end if
+
     ! scales of Eq. 25
     m%l_ref = c%l_ref
     if (m%l_ref == 0.0_wp) m%l_ref = m%c0
@@ -213,6 +234,31 @@ contains
     m%magic = model_magic
     errmsg = ''
     ierr = err_ok
+
+  contains
+
+    !> Random tooth spacing errors, the same numbers on every compiler (docs/model.md section
+    !> 11): MINSTD (Park & Miller 1993), x <- 48271 x mod (2^31 - 1) from x = seed, in 64-bit
+    !> integers (no overflow); 8 draws discarded, then u_j = x/(2^31 - 1) for teeth 1 .. z,
+    !> d_j = 2 u_j - 1, the mean taken off, scaled so that the largest |e_j| is amp.
+    pure function random_spacing_errors(z, amp, seed) result(e)
+      integer, intent(in) :: z, seed
+      real(wp), intent(in) :: amp
+      real(wp) :: e(z)
+      integer(int64), parameter :: mod31 = 2147483647_int64
+      integer(int64) :: x
+      integer :: j
+      x = int(seed, int64)
+      do j = 1, 8
+        x = mod(48271_int64*x, mod31)
+      end do
+      do j = 1, z
+        x = mod(48271_int64*x, mod31)
+        e(j) = 2.0_wp*(real(x, wp)/real(mod31, wp)) - 1.0_wp
+      end do
+      e = e - sum(e)/z
+      e = e*(amp/maxval(abs(e)))
+    end function random_spacing_errors
   end subroutine model_from_case
 
   !> Warnings about a valid model (ran, but deserves a second look), one per line ('' if

@@ -32,6 +32,9 @@ from .errors import CaseError, decode
 GROUP = "spline_case"
 _CONTROL = re.compile(rb"[\x00-\x1f\x7f]")
 NAME_BYTES = 128   #: longest case name (UTF-8 bytes; fortran/case.f90 namelen)
+#: list fields with one number per tooth (as many as the most teeth): a shorter list gives the
+#: first teeth, as in a namelist file
+PER_TOOTH = frozenset({"spacing_error"})
 _api = _core.spline_api
 _MODEL_BYTES = int(_api.api_model_size())
 
@@ -249,6 +252,10 @@ def _coerce(label, key, value, default):
             raise bad("holds a control character (e.g. a newline)")
         return value.strip()
     if isinstance(default, list):
+        if key in PER_TOOTH:            # teeth 1 .. len(value); the others keep their defaults
+            if not isinstance(value, (list, tuple)) or not 0 < len(value) <= len(default):
+                raise bad(f"must be a list of 1 to {len(default)} numbers (one per tooth)")
+            return [_coerce(label, key, v, d) for v, d in zip(value, default)] + default[len(value):]
         if not isinstance(value, (list, tuple)) or len(value) != len(default):
             raise bad(f"must be a list of {len(default)} numbers")
         return [_coerce(label, key, v, d) for v, d in zip(value, default)]

@@ -26,7 +26,7 @@ import math
 import numpy as np
 
 __all__ = ["Prepared", "prepare", "mesh", "rhs", "energy", "static_torsion",
-           "flash_geometry", "flash_temperature", "coupled_residual"]
+           "flash_geometry", "flash_temperature", "coupled_residual", "random_spacing_errors"]
 
 THERMAL_MODES = ("none", "bulk", "oneway", "coupled")
 
@@ -80,6 +80,15 @@ class Prepared:
         self.f_m = g("f_m")
         self.u_flash = g("u_flash")          # u = 0.83   (Eq. 3)
         self.eta_hertz = g("eta_hertz")      # eta = 1.127 (Eq. 4)
+        # tooth spacing (index) errors e_j (docs/model.md s.11): tooth j of spline 1 sits e_j
+        # ahead of its place along +dn, so its dead zone is met at dn_j + e_j; teeth not listed: 0
+        e = np.zeros(self.z)
+        given = np.asarray(case.get("spacing_error", []), dtype=float)[:self.z]
+        e[:given.size] = given
+        amp = float(case.get("spacing_error_amp", 0.0))
+        if amp > 0.0:
+            e = e + random_spacing_errors(self.z, amp, int(case.get("spacing_error_seed", 1)))
+        self.e = e
 
         # Derived (convention 1 of the brief / docs/model.md s.2, s.8)
         self.omega = self.speed_rpm * 2.0 * math.pi / 60.0          # rad/s
@@ -101,6 +110,24 @@ class Prepared:
         self.hertz = 2.0 * (1.0 - self.nu ** 2) / self.e_mod
         # Eq. 3 thermal contact coefficient g rho c (same steel for both splines)
         self.grc = self.k_cond * self.rho * self.c_heat
+
+
+def random_spacing_errors(z, amp, seed):
+    """docs/model.md s.11: MINSTD x <- 48271 x mod (2^31 - 1) from x = seed, 8 draws discarded,
+    u_j = x / (2^31 - 1) for teeth 1..z, d_j = 2 u_j - 1, mean removed, scaled to max |e_j| = amp."""
+    m31, x = 2 ** 31 - 1, seed
+    for _ in range(8):
+        x = 48271 * x % m31
+    d = []
+    for _ in range(z):
+        x = 48271 * x % m31
+        d.append(2.0 * (x / m31) - 1.0)
+    mean = 0.0
+    for v in d:
+        mean += v
+    mean /= z
+    d = np.array(d) - mean
+    return d * (amp / np.abs(d).max())
 
 
 def prepare(case):
@@ -269,13 +296,14 @@ def _solve_coupled(dn, ddn, geo, p):
 
 
 def _kinematics(t, y, p):
-    """Eqs. 8-11: phi_j, dn_j and its total time derivative ddn_j."""
+    """Eqs. 8-11: phi_j, dn_j (with the spacing error e_j) and its total time derivative ddn_j
+    (e_j is fixed on the tooth: no rate)."""
     phi = _phi(t, p)
     sp, cp = np.sin(phi), np.cos(phi)
     X1 = y[0] + p.l_x
     Y1 = y[1] + p.l_y
     ex, ey = X1 - y[2], Y1 - y[3]
-    dn = ex * sp - ey * cp + y[5]                                         # Eq. 11
+    dn = ex * sp - ey * cp + y[5] + p.e                 # Eq. 11, tooth j shifted by e_j
     ddn = ((y[7] - y[9]) * sp - (y[8] - y[10]) * cp + y[12]
            + p.omega * (ex * cp + ey * sp))                               # d/dt of Eq. 11
     return phi, sp, cp, dn, ddn

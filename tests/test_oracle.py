@@ -30,6 +30,13 @@ CASES = {
     "oneway": dict(PAPER, l_x=1e-4, thermal="oneway", t_bulk=50.0),
     "coupled": dict(PAPER, l_x=1e-4, thermal="coupled", t_bulk=100.0, f_m=0.3),
     "slow_z7": dict(PAPER, z=7, speed_rpm=300.0, l_x=5e-5, l_y=5e-5, grav=0.0),
+    # tooth spacing errors up to 0.9 c0 of either sign (docs/model.md s.11)
+    "spacing": dict(PAPER, l_x=1e-4, thermal="bulk", t_bulk=20.0,
+                    spacing_error=list(0.9e-4 * np.sin(np.arange(1, 17) * 2.3))),
+    "spacing_seeded": dict(PAPER, l_y=5e-5, spacing_error=[3e-5, -2e-5],
+                           spacing_error_amp=1.2e-4, spacing_error_seed=20261124),
+    "spacing_oneway": dict(PAPER, z=7, thermal="oneway", t_bulk=50.0,
+                           spacing_error=[1.5e-4, -1.2e-4, 0.0, 5e-5, -1e-5, 1.8e-4, -1.9e-4]),
     # a shift of up to 1.9 mm moves the contact point past both tip circles: radii held there
     "oneway_clipped": dict(PAPER, l_x=1.9e-3, thermal="oneway"),
 }
