@@ -6,7 +6,7 @@
 module spline_case_values
   use spline_kinds, only: wp
   use spline_errors, only: err_ok, err_case
-  use spline_case_type, only: case_t, case_field, fields
+  use spline_case_type, only: case_t, fields, nfields
   implicit none
   private
   public :: case_value_sizes, case_to_values, case_from_values, case_value_offset, case_put_value
@@ -16,19 +16,8 @@ contains
   !> Entries of the real array (nv) and characters of the string (nc) of a case.
   subroutine case_value_sizes(nv, nc)
     integer, intent(out) :: nv, nc
-    character(len=32) :: name
-    character(len=1) :: kind
-    integer :: i, n
-    nv = 0; nc = 0
-    do i = 1, huge(i)
-      call case_field(i, name, kind, n)
-      if (len_trim(name) == 0) exit
-      if (kind == 'c') then
-        nc = nc + n
-      else
-        nv = nv + n
-      end if
-    end do
+    nv = sum(fields%n, mask=fields%kind /= 'c')
+    nc = sum(fields%n, mask=fields%kind == 'c')
   end subroutine case_value_sizes
 
   !> Where field f (the table's numbering) starts in its array, by walk's layout: the entries
@@ -134,12 +123,12 @@ contains
     subroutine field(kind, n)
       character(len=1), intent(in) :: kind
       integer, intent(in) :: n
-      character(len=32) :: name
-      character(len=1) :: fk
-      integer :: fn
       k = k + 1
-      call case_field(k, name, fk, fn)
-      if (fk /= kind .or. fn /= n) call mismatch()
+      if (k > nfields) then               ! past the last: kind ' ', size 0 (as case_field)
+        if (kind /= ' ' .or. n /= 0) call mismatch()
+      else if (fields(k)%kind /= kind .or. fields(k)%n /= n) then
+        call mismatch()
+      end if
     end subroutine field
     subroutine mismatch()
       ierr = err_case
