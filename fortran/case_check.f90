@@ -41,7 +41,7 @@ contains
     integer :: at(nfields + 1)    ! field f's values: x(at(f) : at(f + 1) - 1)
     real(wp) :: r_pitch, depth, involute, e, ta, dt_out, bytes
     type(case_t) :: dflt          ! the defaults (component defaults of case_t)
-    integer :: i, f, beyond
+    integer :: i, f, beyond, i_dq0, i_dv0
 
     ierr = err_case
     errmsg = ''
@@ -54,14 +54,15 @@ contains
       errmsg = 'spline_case_check: real_values does not list the real fields of the table'; return
     end if
     beyond = field_index('fillet')       ! the fields beyond the paper: from fillet on
+    i_dq0 = field_index('dq0'); i_dv0 = field_index('dv0')
     ! the paper's fields finite, in the table's order but for dq0 and dv0, after w_ref (the
     ! order the messages have always had); an array by the sum of its magnitudes
     do f = 1, beyond - 1
-      if (fields(f)%kind /= 'r' .or. fields(f)%name == 'dq0' .or. fields(f)%name == 'dv0') cycle
+      if (fields(f)%kind /= 'r' .or. f == i_dq0 .or. f == i_dv0) cycle
       if (.not. finite(f)) return
       if (fields(f)%name /= 'w_ref') cycle
-      if (.not. finite(field_index('dq0'))) return
-      if (.not. finite(field_index('dv0'))) return
+      if (.not. finite(i_dq0)) return
+      if (.not. finite(i_dv0)) return
     end do
 
     ! geometry (ISO 4156 and beyond it, with margin)
@@ -258,22 +259,21 @@ contains
     end function ranges
 
     !> The table's rule of field g on the value v (see spline_case_type's field_t).
+    !> (The name and note are trimmed for a message only: this runs for every element.)
     logical function field_rule(g, v)
       integer, intent(in) :: g
       real(wp), intent(in) :: v
-      character(len=:), allocatable :: name, note
-      name = trim(fields(g)%name); note = trim(fields(g)%note)
       field_rule = .true.
       select case (fields(g)%rule)
       case ('p')                            ! positive, within lo .. hi
         field_rule = v > 0.0_wp
         if (.not. field_rule) then
-          call fail(name, 'must be positive'); return
+          call fail(fields(g)%name, 'must be positive'); return
         end if
       case ('n')                            ! 0 ('none' or 'computed') or within lo .. hi
         field_rule = v >= 0.0_wp
         if (.not. field_rule) then
-          call fail(name, 'must not be negative'); return
+          call fail(fields(g)%name, 'must not be negative'); return
         end if
         if (v == 0.0_wp) return
       case ('z')                            ! 0 (chosen by the model) or within lo .. hi
@@ -281,7 +281,9 @@ contains
       case (' ')
         return
       end select
-      field_rule = in_range(v, fields(g)%lo, fields(g)%hi, name, note)
+      field_rule = v >= fields(g)%lo .and. v <= fields(g)%hi
+      if (.not. field_rule) field_rule = in_range(v, fields(g)%lo, fields(g)%hi, fields(g)%name, &
+           trim(fields(g)%note))
     end function field_rule
 
     subroutine fail(field, why)

@@ -2,13 +2,16 @@
 !> Python alike (pyspline hands the bytes of a case file to api_parse). The text is tokenised
 !> (spline_case_lex) and checked here, every error naming the line, the field and what was
 !> expected (unknown fields get the nearest field name as a suggestion). Each checked value is
-!> converted once and assigned to its element of a local copy (set_element), kept only if the
+!> converted once and put at its element's place in the case's flat value arrays (local copies,
+!> spline_case_values: the one list of the fields, walk), which become the case only if the
 !> whole text passed, so reading a case changes no module variable (reentrant). Writing a case
 !> as namelist text (case_write_text) uses the compiler's namelist output.
 module spline_case_parse
   use spline_kinds, only: wp
   use spline_errors, only: err_ok, err_case, itoa
-  use spline_case_type, only: case_t, fields, nfields, namelen, ndof_case
+  use spline_case_type, only: case_t, fields, nfields, namelen, field_index
+  use spline_case_values, only: case_value_sizes, case_to_values, case_from_values, &
+       case_value_offset, case_put_value
   use spline_case_text, only: lower, unquote, shown, clip, hint, is_digits, is_integer, &
        is_real, is_logical, is_value, expected, kind_word, element
   use spline_case_lex, only: tokenize, tk_word, tk_string, tk_equals, tk_comma, tk_slash, &
@@ -69,10 +72,14 @@ contains
     integer, allocatable :: set_line(:)     ! line that set each element: field f's at(f) + q
     integer :: at(nfields + 1)
     character(len=:), allocatable :: from
-    integer :: ntok, p, f, i0, i1, group_line
+    integer :: ntok, p, f, off, i0, i1, group_line
+    character(len=:), allocatable :: why
     logical :: lines_on
     type(case_t) :: work
     character(len=namelen) :: name_now
+    real(wp), allocatable :: vals(:)        ! the case's values (spline_case_values' layout)
+    character(len=:), allocatable :: chars
+    integer :: nv, nc
 
     ierr = err_ok
     errmsg = ''
@@ -81,7 +88,6 @@ contains
     lines_on = len(from) > 0
     if (present(show_lines)) lines_on = lines_on .and. show_lines
     name_now = c%name
-    work = c
 
     call tokenize(text, tk, ta, tb, tl, ntok, i0, i1)
     if (i0 > 0) then
@@ -110,12 +116,17 @@ contains
     group_line = tl(1)
     p = 2
 
-    ! the items, each checked element assigned to the copy (kept if the whole text passes)
+    ! the items, each checked element put into the value arrays of c (kept if the whole text
+    ! passes)
     at(1) = 0
     do f = 1, nfields
       at(f + 1) = at(f) + merge(1, fields(f)%n, fields(f)%kind == 'c')
     end do
     allocate(set_line(at(nfields + 1)))
+    call case_value_sizes(nv, nc)
+    allocate(vals(nv))
+    allocate(character(len=nc) :: chars)
+    call case_to_values(c, vals, chars)
     set_line = 0
     do
       if (p > ntok) then
@@ -142,8 +153,12 @@ contains
       call fail(tl(p + 1), 'text after the end of the group &spline_case: '''// &
            clip(tok(p + 1))//''''); return
     end if
+    call case_from_values(vals, chars, work, ierr, errmsg)
+    if (ierr /= err_ok) then
+      why = trim(errmsg)
+      call fail(0, why); return
+    end if
     c = work
-    ierr = err_ok
 
   contains
 
@@ -167,11 +182,12 @@ contains
         return
       end if
       name = lower(tok(p))
-      f = field_of(name)
+      f = field_index(name)
       if (f == 0) then
         call fail(line, 'unknown field '''//clip(tok(p))//''''//hint(name)); return
       end if
       p = p + 1
+      off = case_value_offset(f)
       lo = 1; hi = fields(f)%n
       if (fields(f)%kind == 'c') hi = 1
       if (p <= ntok) then
@@ -222,7 +238,7 @@ contains
         ! a word that names a field, or begins a line and is no value of this field: the
         ! '=' after a field name is missing
         if (tk(p) == tk_word) then
-          if (field_of(lower(tok(p))) > 0) then
+          if (field_index(lower(tok(p))) > 0) then
             call fail(tl(p), 'field '//lower(tok(p))//': expected ''='' after the field name, '// &
                  'found '//after(p)); return
           end if
@@ -272,11 +288,7 @@ contains
                    itoa(set_line(at(f) + q))//' and '//itoa(tl(pv))//')'); return
             end if
             set_line(at(f) + q) = tl(pv)
-            if (.not. set_element(work, f, q, x, iv, lv, sv)) then
-              call fail(tl(pv), 'field '//trim(fields(f)%name)//' has no place in the reader '// &
-                   '(set_element in fortran/case_parse.f90 is out of step with the field table)')
-              return
-            end if
+            call case_put_value(vals, chars, f, off, q, x, iv, lv, sv)
           end do
         end if
         k = k + r
@@ -494,119 +506,6 @@ contains
     end subroutine fail
 
   end subroutine parse_unlocked
-
-  !> Position of a field (lower-case name) in the table, 0 if none: spline_case_type's
-  !> field_index, comparing only names of the same length (it runs for every word of a text).
-  pure integer function field_of(name) result(f)
-    character(len=*), intent(in) :: name
-    integer, parameter :: name_len(nfields) = len_trim(fields%name)
-    integer :: n
-    n = len_trim(name)
-    do f = 1, nfields
-      if (name_len(f) /= n) cycle
-      if (fields(f)%name(1:n) == name(1:n)) return
-    end do
-    f = 0
-  end function field_of
-
-  !> Element k of field f (the field table's numbering) of c: x, i, l or s by the field's type.
-  !> One branch per field, in the order of the table (tests/test_input.py sets every element);
-  !> .false. for a field without one.
-  logical function set_element(c, f, k, x, i, l, s) result(known)
-    type(case_t), intent(inout) :: c
-    integer, intent(in) :: f, k
-    real(wp), intent(in) :: x
-    integer, intent(in) :: i
-    logical, intent(in) :: l
-    character(len=*), intent(in) :: s
-    known = .true.
-    select case (fields(f)%name)
-    case ('name'); c%name = s
-    case ('z'); c%z = i
-    case ('module_m'); c%module_m = x
-    case ('alpha_deg'); c%alpha_deg = x
-    case ('b'); c%b = x
-    case ('s'); c%s = x
-    case ('c0'); c%c0 = x
-    case ('e_mod'); c%e_mod = x
-    case ('nu'); c%nu = x
-    case ('lambda_th'); c%lambda_th = x
-    case ('k_cond'); c%k_cond = x
-    case ('rho'); c%rho = x
-    case ('c_heat'); c%c_heat = x
-    case ('j_m'); c%j_m = x
-    case ('j_l'); c%j_l = x
-    case ('j_1'); c%j_1 = x
-    case ('j_2'); c%j_2 = x
-    case ('m_1'); c%m_1 = x
-    case ('m_2'); c%m_2 = x
-    case ('k_p1'); c%k_p1 = x
-    case ('k_p2'); c%k_p2 = x
-    case ('c_p1'); c%c_p1 = x
-    case ('c_p2'); c%c_p2 = x
-    case ('k_t1'); c%k_t1 = x
-    case ('k_t2'); c%k_t2 = x
-    case ('c_t1'); c%c_t1 = x
-    case ('c_t2'); c%c_t2 = x
-    case ('k_m'); c%k_m = x
-    case ('c_m'); c%c_m = x
-    case ('t_d'); c%t_d = x
-    case ('t_l'); c%t_l = x
-    case ('speed_rpm'); c%speed_rpm = x
-    case ('grav'); c%grav = x
-    case ('l_x'); c%l_x = x
-    case ('l_y'); c%l_y = x
-    case ('dof'); c%dof = i
-    case ('thermal'); c%thermal = s
-    case ('t_bulk'); c%t_bulk = x
-    case ('f_m'); c%f_m = x
-    case ('u_flash'); c%u_flash = x
-    case ('eta_hertz'); c%eta_hertz = x
-    case ('method'); c%method = s
-    case ('jacobian'); c%jacobian = s
-    case ('nonlinear'); c%nonlinear = s
-    case ('roots'); c%roots = l
-    case ('stald'); c%stald = l
-    case ('linear_tail'); c%linear_tail = l
-    case ('rtol'); c%rtol = x
-    case ('atol'); c%atol = x
-    case ('max_steps'); c%max_steps = i
-    case ('max_total_steps'); c%max_total_steps = i
-    case ('t0'); c%t0 = x
-    case ('t_end'); c%t_end = x
-    case ('t_transient'); c%t_transient = x
-    case ('n_out'); c%n_out = i
-    case ('start'); c%start = s
-    case ('dq0'); c%dq0(k) = x
-    case ('dv0'); c%dv0(k) = x
-    case ('l_ref'); c%l_ref = x
-    case ('w_ref'); c%w_ref = x
-    case ('fidelity'); c%fidelity = s
-    case ('fidelity_tol'); c%fidelity_tol = x
-    case ('section'); c%section = s
-    case ('lyapunov'); c%lyapunov = l
-    case ('lyapunov_interval'); c%lyapunov_interval = x
-    case ('lyapunov_d0'); c%lyapunov_d0 = x
-    case ('fillet'); c%fillet = l
-    case ('fillet_radius'); c%fillet_radius = x
-    case ('r_bore'); c%r_bore = x
-    case ('r_rim'); c%r_rim = x
-    case ('zeta_m'); c%zeta_m = x
-    case ('ripple_order'); c%ripple_order(k) = x
-    case ('ripple_amp'); c%ripple_amp(k) = x
-    case ('ripple_phase_deg'); c%ripple_phase_deg(k) = x
-    case ('unbalance'); c%unbalance(k) = x
-    case ('unbalance_phase_deg'); c%unbalance_phase_deg(k) = x
-    case ('gamma_x'); c%gamma_x = x
-    case ('gamma_y'); c%gamma_y = x
-    case ('n_slices'); c%n_slices = i
-    case ('spacing_error'); c%spacing_error(k) = x
-    case ('spacing_error_amp'); c%spacing_error_amp = x
-    case ('spacing_error_seed'); c%spacing_error_seed = i
-    case default
-      known = .false.
-    end select
-  end function set_element
 
   !> A case as namelist text (every field, one per line): Python reads the defaults from it.
   subroutine case_write_text(c, text)

@@ -254,11 +254,16 @@ contains
     unit = fields(i)%unit; descr = fields(i)%descr
   end subroutine case_field_meta
 
-  !> Position of a field (lower-case name) in the table; 0: no such field.
+  !> Position of a field (lower-case name) in the table; 0: no such field. Only names of the
+  !> same length are compared (it runs for every word of a case's text, and in validation).
   pure integer function field_index(name) result(f)
     character(len=*), intent(in) :: name
+    integer, parameter :: name_len(nfields) = len_trim(fields%name)
+    integer :: n
+    n = len_trim(name)
     do f = 1, nfields
-      if (fields(f)%name == name) return
+      if (name_len(f) /= n) cycle
+      if (fields(f)%name(1:n) == name(1:n)) return
     end do
     f = 0
   end function field_index

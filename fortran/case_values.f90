@@ -1,34 +1,54 @@
 !> A case's fields as two flat arrays, laid out by the field table (case_field, the order of
 !> case_t): every number and logical (an integer as its value, a logical as 1 or 0) in one
 !> real array, every character field (blank-padded to its size) in one string. This is how a
-!> case crosses to Python and back (fortran/api.f90), with no text to tokenise or re-read.
+!> case crosses to Python and back (fortran/api.f90), with no text to tokenise or re-read, and
+!> how the reader (fortran/case_parse.f90) assigns each checked value (case_put_value).
 module spline_case_values
   use spline_kinds, only: wp
   use spline_errors, only: err_ok, err_case
-  use spline_case, only: case_t, case_field
+  use spline_case_type, only: case_t, fields, nfields
   implicit none
   private
-  public :: case_value_sizes, case_to_values, case_from_values
+  public :: case_value_sizes, case_to_values, case_from_values, case_value_offset, case_put_value
 
 contains
 
   !> Entries of the real array (nv) and characters of the string (nc) of a case.
   subroutine case_value_sizes(nv, nc)
     integer, intent(out) :: nv, nc
-    character(len=32) :: name
-    character(len=1) :: kind
-    integer :: i, n
-    nv = 0; nc = 0
-    do i = 1, huge(i)
-      call case_field(i, name, kind, n)
-      if (len_trim(name) == 0) exit
-      if (kind == 'c') then
-        nc = nc + n
-      else
-        nv = nv + n
-      end if
-    end do
+    nv = sum(fields%n, mask=fields%kind /= 'c')
+    nc = sum(fields%n, mask=fields%kind == 'c')
   end subroutine case_value_sizes
+
+  !> Where field f (the table's numbering) starts in its array, by walk's layout: the entries
+  !> of the real array (types i, r, l) or the characters of the string (type c) that the fields
+  !> before it in the same array take.
+  pure integer function case_value_offset(f) result(off)
+    integer, intent(in) :: f
+    integer :: g
+    off = 0
+    do g = 1, f - 1
+      if ((fields(g)%kind == 'c') .eqv. (fields(f)%kind == 'c')) off = off + fields(g)%n
+    end do
+  end function case_value_offset
+
+  !> Element k of field f, whose entries start after off (case_value_offset), into v or s as
+  !> walk encodes it: x a real, i an integer, l a logical (1 or 0), str a string (blank-padded
+  !> to the field's size), taken by the field's type.
+  pure subroutine case_put_value(v, s, f, off, k, x, i, l, str)
+    real(wp), intent(inout) :: v(:)
+    character(len=*), intent(inout) :: s
+    integer, intent(in) :: f, off, k, i
+    real(wp), intent(in) :: x
+    logical, intent(in) :: l
+    character(len=*), intent(in) :: str
+    select case (fields(f)%kind)
+    case ('c'); s(off+1:off+fields(f)%n) = str
+    case ('i'); v(off+k) = real(i, wp)
+    case ('l'); v(off+k) = merge(1.0_wp, 0.0_wp, l)
+    case default; v(off+k) = x
+    end select
+  end subroutine case_put_value
 
   !> The fields of c into v and s (sized by case_value_sizes).
   subroutine case_to_values(c, v, s)
@@ -104,12 +124,12 @@ contains
     subroutine field(kind, n)
       character(len=1), intent(in) :: kind
       integer, intent(in) :: n
-      character(len=32) :: name
-      character(len=1) :: fk
-      integer :: fn
       k = k + 1
-      call case_field(k, name, fk, fn)
-      if (fk /= kind .or. fn /= n) call mismatch()
+      if (k > nfields) then               ! past the last: kind ' ', size 0 (as case_field)
+        if (kind /= ' ' .or. n /= 0) call mismatch()
+      else if (fields(k)%kind /= kind .or. fields(k)%n /= n) then
+        call mismatch()
+      end if
     end subroutine field
     subroutine mismatch()
       ierr = err_case

@@ -1,6 +1,6 @@
 /* One process-wide lock around the core's I/O on internal files (fortran/case_parse.f90: taken by
- * case_parse, for its list-directed and namelist reads, and by case_write_text, for its
- * namelist write; no routine that holds it takes it again).
+ * case_parse, for its list-directed internal reads of reals, subscripts and repeat counts, and by
+ * case_write_text, for its namelist write; no routine that holds it takes it again).
  *
  * Why: libgfortran (GCC 12, Debian 12) is not safe when two threads read internal units at
  * once. Two threads parsing cases (api_load, called with the GIL released) then corrupt each

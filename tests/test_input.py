@@ -441,10 +441,10 @@ def test_values_a_value_array_cannot_carry_get_the_reader_s_message():
 
 
 def test_reader_puts_every_element_in_its_field(tmp_path):
-    """The reader assigns each checked value to its own element (fortran/case_parse.f90,
-    set_element): a file giving every element of every field a different value reads back,
-    through the core's value arrays (case_values.f90, an independent walk of case_t), as
-    written. Not validated (stage 1: read only), so the values need not make a model."""
+    """The reader puts each checked value at its own element's place (fortran/case_parse.f90,
+    by case_value_offset and case_put_value of case_values.f90, computed from the field table):
+    a file giving every element of every field a different value reads back, through the
+    core's value arrays (walk, the list of case_t's components), as written. Not validated (stage 1: read only), so the values need not make a model."""
     from pyspline import case as pc
     rows, nv, nc = pc._layout()
     lines, want = ["&spline_case"], {}
