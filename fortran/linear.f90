@@ -203,7 +203,7 @@ contains
     real(wp), intent(out) :: ys(:, :)
     integer, parameter :: nanchor = 32
     complex(wp) :: vh(tl%n, tl%n)
-    real(wp) :: p(tl%n, tl%n), x(tl%n), h
+    real(wp) :: p(tl%n, tl%n), x(tl%n), xn(tl%n), h
     integer :: i, j, n, nt
     logical :: uniform
     n = tl%n
@@ -221,7 +221,11 @@ contains
     end if
     do i = 1, nt
       if (uniform .and. mod(i - 1, nanchor) /= 0) then
-        x = matmul(p, x)
+        xn = 0.0_wp
+        do j = 1, n                    ! P x by columns (n ~ 14: no library call)
+          xn = xn + p(:, j)*x(j)
+        end do
+        x = xn
       else
         x = real(matmul(tl%v, tl%c*exp(tl%lam*(taus(i) - tl%tau0))))
       end if

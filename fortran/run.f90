@@ -209,11 +209,22 @@ contains
     integer, allocatable :: modes(:, :)
     errmsg = ''
     stats = 0.0_wp
-    t = 0.0_wp; y = 0.0_wp; tooth = 0.0_wp; tm = 0.0_wp
+    t = 0.0_wp; y = 0.0_wp
     allocate(modes(m%z*m%n_slices, m%n_out))
     call output_times(m, t)
     call start_state(m, y0, ierr, errmsg)
-    if (ierr /= err_ok) return
+    if (ierr == err_ok) call integrate_level()
+    ! tooth and tm are zero where the run did not reach (every output is written otherwise)
+    if (ierr /= err_ok) then
+      tooth = 0.0_wp; tm = 0.0_wp
+      return
+    end if
+    call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt)
+    if (ierr /= err_ok) then
+      tooth = 0.0_wp; tm = 0.0_wp
+    end if
+  contains
+    subroutine integrate_level()
     ! A section does not stop CVODE, but with root finding the first step after each restart
     ! depends on the next requested time, which may be a section time (spline_solver::integrate):
     ! a run that asks for a section takes its times whether or not the caller keeps the points
@@ -228,8 +239,7 @@ contains
       call integrate(m, y0, m%n_out, t, y, modes, stats(1:nsolver_stats), ierr, errmsg, &
            interruptible, ts, ysec)
     end if
-    if (ierr /= err_ok) return
-    call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt)
+    end subroutine integrate_level
   end subroutine run_level
 
   !> Per-tooth quantities at the output times, with the contact states the integration used
