@@ -7,6 +7,9 @@ demand with f2py into bench/build/); then one run's time per step and its shares
 integrator's calls), Jacobian (difference-quotient calls), roots (root-function evaluations,
 where the case locates switches), solver (CVODE's own work and the per-tooth outputs: the rest
 of the core time) and Python (wall time outside the core: case file, f2py, result arrays).
+Then the cost of the outputs (output_cost): the wall time of a run with its n_out output times
+less that of the same run with 2 (same span and tolerances), per output time, against the
+target OUTPUT_TARGET_US (0.1 us at Z = 16).
 """
 from __future__ import annotations
 
@@ -76,6 +79,32 @@ def time_rhs(model, n):
 
 
 CASES = ("paper_lx1e-4", "paper_T100", "physical_lx1e-4")
+OUTPUT_TARGET_US = 0.1     # per output time at Z = 16 (issue "Ahead of the strongest peer")
+
+
+def output_cost(case, repeat=15):
+    """Wall seconds per output time: runs with the case's n_out and with 2 output times (same
+    span, same tolerances), alternating, repeat times each. Returns (median, min, max) of the
+    per-pair differences over n_out - 2, and the medians of the two runs (s)."""
+    few = case.replace(n_out=2)
+    simulate(case), simulate(few)     # warm-up (page faults of the output arrays, caches)
+    many_s, few_s = [], []
+    for _ in range(repeat):
+        for c, acc in ((case, many_s), (few, few_s)):
+            t0 = time.perf_counter()
+            simulate(c)
+            acc.append(time.perf_counter() - t0)
+    per = sorted((a - b)/(case["n_out"] - 2) for a, b in zip(many_s, few_s))
+    return (statistics.median(per), per[0], per[-1], statistics.median(many_s),
+            statistics.median(few_s))
+
+
+def format_output_cost(name, case, cost) -> str:
+    med, lo, hi, many, few = cost
+    return (f"outputs {name} (Z = {case['z']}, n_out = {case['n_out']}): {med*1e6:.3f} us per "
+            f"output time (range {lo*1e6:.3f}..{hi*1e6:.3f}; runs {many*1e3:.2f} ms against "
+            f"{few*1e3:.2f} ms with 2), target {OUTPUT_TARGET_US} us: ratio "
+            f"{med*1e6/OUTPUT_TARGET_US:.1f}")
 
 
 def rhs_cost(case, n=200_000, repeat=5):

@@ -56,6 +56,13 @@ def cmd_bench(args) -> int:
         rows = anatomy.anatomy(out, quick=args.quick)
         print("\n".join(anatomy.format_rows(rows)))
         print(f"wrote {out}/anatomy.png and anatomy.csv")
+        from pyspline import load_case
+        from pyspline.paper import cases_dir
+        case = load_case(cases_dir() / "paper_lx1e-4.nml")
+        if args.quick:
+            case = case.replace(t_end=0.1, n_out=641)
+        cost = anatomy.output_cost(case, repeat=5 if args.quick else 15)
+        print(anatomy.format_output_cost(case.name, case, cost))
     else:
         rows = bench.stability_map(out, quick=args.quick)
         for r in rows:

@@ -221,7 +221,7 @@ contains
     type(model_t) :: m
     real(wp), allocatable :: ycol(:, :), scol(:, :)
     integer :: ie
-    t = 0; y = 0; tooth = 0; tm = 0; stats = 0; sec_t = 0; sec_y = 0; lyap_t = 0; lyap_g = 0
+    stats = 0; sec_t = 0; sec_y = 0; lyap_t = 0; lyap_g = 0   ! t, y, tooth, tm: below
     face = 0; tilt = 0
     call unpack(model, m, ie, errmsg)
     if (ie == err_ok .and. (m%z /= z .or. m%n_out /= nt .or. nq /= ntooth_q .or. ns /= nstats &
@@ -241,6 +241,8 @@ contains
       end if
       y = transpose(ycol)
       sec_y = transpose(scol)
+    else
+      t = 0; y = 0; tooth = 0; tm = 0       ! run_case defines them whenever it runs
     end if
     ierr = ie
   end subroutine api_simulate

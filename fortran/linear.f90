@@ -25,7 +25,7 @@ module spline_linear
   use spline_mesh, only: mesh_switch_functions
   implicit none
   private
-  public :: tail_t, tail_possible, tail_try, tail_state
+  public :: tail_t, tail_possible, tail_try, tail_state, tail_states
 
   !> The closed-form tail of one run (held by the solver's context).
   type :: tail_t
@@ -191,5 +191,49 @@ contains
     ys = tl%held
     ys(tl%idx(1:tl%n)) = tl%ystar + real(matmul(tl%v, tl%c*exp(tl%lam*(tau - tl%tau0))))
   end subroutine tail_state
+
+  !> The tail at the ascending scaled times taus(i) (>= its start) into ys(:, i), as tail_state
+  !> (bit for bit) at every nanchor-th time; between those, when the times are uniformly spaced
+  !> (h, to the round-off of their computation), the motion about the equilibrium,
+  !> x = ys - y*, advanced by the real step matrix P = Re(V diag(exp(lambda h)) V^-1):
+  !> one real n x n product per time instead of n complex exponentials and an n x n complex
+  !> product. Each step adds round-off of order n eps |P| |x|, at most nanchor - 1 steps from
+  !> an exact anchor (about 1e-13 of the motion; tests/fortran/test_linear.f90).
+  subroutine tail_states(tl, taus, ys)
+    type(tail_t), intent(in) :: tl
+    real(wp), intent(in) :: taus(:)
+    real(wp), intent(out) :: ys(:, :)
+    integer, parameter :: nanchor = 32
+    complex(wp) :: vh(tl%n, tl%n)
+    real(wp) :: p(tl%n, tl%n), x(tl%n), xn(tl%n), h
+    integer :: i, j, n, nt
+    logical :: uniform
+    n = tl%n
+    nt = size(taus)
+    uniform = nt > 2
+    if (uniform) then
+      h = (taus(nt) - taus(1))/(nt - 1)
+      uniform = all(abs(taus(2:) - taus(:nt-1) - h) <= 16*epsilon(h)*abs(taus(nt)))
+    end if
+    if (uniform) then
+      do j = 1, n
+        vh(:, j) = tl%v(:, j)*exp(tl%lam(j)*h)
+      end do
+      p = real(matmul(vh, tl%w))
+    end if
+    do i = 1, nt
+      if (uniform .and. mod(i - 1, nanchor) /= 0) then
+        xn = 0.0_wp
+        do j = 1, n                    ! P x by columns (n ~ 14: no library call)
+          xn = xn + p(:, j)*x(j)
+        end do
+        x = xn
+      else
+        x = real(matmul(tl%v, tl%c*exp(tl%lam*(taus(i) - tl%tau0))))
+      end if
+      ys(:, i) = tl%held
+      ys(tl%idx(1:n), i) = tl%ystar + x
+    end do
+  end subroutine tail_states
 
 end module spline_linear

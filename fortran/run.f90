@@ -4,7 +4,7 @@
 !> of spline_lyapunov when the case asks), the per-tooth quantities (Eqs. 11, 15-22 and, for the
 !> thermal levels that have it, Eqs. 1-7) at every output time, and the checks of the result.
 module spline_run
-  use spline_kinds, only: wp
+  use spline_kinds, only: wp, pi
   use spline_errors, only: err_ok, err_solver, itoa
   use spline_model, only: model_t, nstate, ndof, thermal_oneway, thermal_coupled, set_thermal_level
   use spline_dynamics, only: start_state
@@ -107,9 +107,16 @@ contains
     integer, intent(inout) :: ierr
     character(len=*), intent(inout) :: errmsg
     real(wp), intent(in), optional :: sec_t(:), sec_y(:, :), lyap_t(:), lyap_g(:)
-    integer :: k, j, q, i
+    integer :: k, j, q, i, k1
     closed = 0.0_wp; t_closed = 0.0_wp
-    do k = 1, size(t)
+    ! one contiguous pass over each array; the output-by-output search only to name a failure
+    if (all(ieee_is_finite(t)) .and. all(ieee_is_finite(y)) .and. all(ieee_is_finite(tm)) .and. &
+         all(ieee_is_finite(tooth))) then
+      k1 = size(t) + 1
+    else
+      k1 = 1
+    end if
+    do k = k1, size(t)
       if (.not. ieee_is_finite(t(k))) call bad('the output time', '', k)
       do i = 1, nstate
         if (.not. ieee_is_finite(y(i, k))) call bad('the state '//trim(state_q(i)%name), '', k)
@@ -138,14 +145,16 @@ contains
       end do
     end if
     if (m%thermal == thermal_oneway) then
-      do k = 1, size(t)
-        do j = 1, size(tooth, 2)
+      i = size(t) + 1      ! the first output where a tooth closes it
+      do j = 1, size(tooth, 2)
+        do k = 1, size(t)
           if (m%c_bulk - m%kappa*tooth(k, j, iq_tf) <= 0.0_wp) then
-            if (closed == 0.0_wp) t_closed = t(k)
+            i = min(i, k)
             closed = closed + 1.0_wp
           end if
         end do
       end do
+      if (closed > 0.0_wp) t_closed = t(i)
     end if
   contains
     subroutine bad(what, which, k, tk)
@@ -199,11 +208,22 @@ contains
     integer, allocatable :: modes(:, :)
     errmsg = ''
     stats = 0.0_wp
-    t = 0.0_wp; y = 0.0_wp; tooth = 0.0_wp; tm = 0.0_wp
+    t = 0.0_wp; y = 0.0_wp
     allocate(modes(m%z*m%n_slices, m%n_out))
     call output_times(m, t)
     call start_state(m, y0, ierr, errmsg)
-    if (ierr /= err_ok) return
+    if (ierr == err_ok) call integrate_level()
+    ! tooth and tm are zero where the run did not reach (every output is written otherwise)
+    if (ierr /= err_ok) then
+      tooth = 0.0_wp; tm = 0.0_wp
+      return
+    end if
+    call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt)
+    if (ierr /= err_ok) then
+      tooth = 0.0_wp; tm = 0.0_wp
+    end if
+  contains
+    subroutine integrate_level()
     ! A section does not stop CVODE, but with root finding the first step after each restart
     ! depends on the next requested time, which may be a section time (spline_solver::integrate):
     ! a run that asks for a section takes its times whether or not the caller keeps the points
@@ -218,14 +238,16 @@ contains
       call integrate(m, y0, m%n_out, t, y, modes, stats(1:nsolver_stats), ierr, errmsg, &
            interruptible, ts, ysec)
     end if
-    if (ierr /= err_ok) return
-    call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt)
+    end subroutine integrate_level
   end subroutine run_level
 
   !> Per-tooth quantities at the output times, with the contact states the integration used
   !> (2: decided by the state).
   !> face(k, j, s), tilt(k, :) (optional): the load of slice s of tooth j along the face and the
   !> tilting moment (M_x, M_y) on spline 1 (mesh_eval), for sliced faces.
+  !> Without flash temperature or slices, bulk_tooth_outputs forms them in one pass per tooth; it
+  !> must agree with tooth_quantities (mesh_eval, the definition) to the bit at the first and the
+  !> last output, else (a change to one and not the other) every output is formed by mesh_eval.
   subroutine tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t(:), y(:, :)
@@ -237,18 +259,97 @@ contains
     real(wp) :: row(m%z, ntooth_q), fs(m%n_slices, m%z), mt(2)
     integer :: k
     ierr = err_ok
+    if (.not. present(face) .and. m%n_slices == 1 .and. m%thermal < thermal_oneway) then
+      call bulk_tooth_outputs(m, t, y, modes, tooth, tm)
+      if (same_as_mesh(1) .and. same_as_mesh(size(t))) return
+    end if
     do k = 1, size(t)
-      if (modes(1, k) == 2) then
-        call tooth_quantities(m, t(k), y(:, k), row, tm(k), ierr, errmsg, fslice=fs, mtilt=mt)
-      else
-        call tooth_quantities(m, t(k), y(:, k), row, tm(k), ierr, errmsg, modes(:, k), fs, mt)
-      end if
+      call quantities_at(k)
       if (ierr /= err_ok) return
       tooth(k, :, :) = row
       if (present(face)) face(k, :, :) = transpose(fs)
       if (present(tilt)) tilt(k, :) = mt
     end do
+  contains
+    !> tooth_quantities at output k into row, tm(k).
+    subroutine quantities_at(k)
+      integer, intent(in) :: k
+      if (modes(1, k) == 2) then
+        call tooth_quantities(m, t(k), y(:, k), row, tm(k), ierr, errmsg, fslice=fs, mtilt=mt)
+      else
+        call tooth_quantities(m, t(k), y(:, k), row, tm(k), ierr, errmsg, modes(:, k), fs, mt)
+      end if
+    end subroutine quantities_at
+    !> Whether output k of bulk_tooth_outputs is tooth_quantities' to the bit.
+    logical function same_as_mesh(k) result(same)
+      integer, intent(in) :: k
+      real(wp) :: tmk
+      same = .true.
+      if (k < 1) return
+      tmk = tm(k)
+      call quantities_at(k)
+      same = ierr == err_ok .and. all(row == tooth(k, :, :)) .and. tm(k) == tmk
+      ierr = err_ok
+    end function same_as_mesh
   end subroutine tooth_outputs
+
+  !> The per-tooth quantities of tooth_quantities at every output time, for a model without
+  !> flash temperature (thermal none or bulk: T_f = 0, both contact radii on the pitch circle,
+  !> c_j = c_bulk) or face slices: Eqs. 8-9, 11, 15-17 and 19-22 as tooth_angles and mesh_eval
+  !> evaluate them, operation for operation, in blocks of nblk outputs, one pass per tooth
+  !> (tooth(k, j, q) is contiguous in k: a row per output would touch z ntooth_q cache lines;
+  !> the pitch rotation of tooth_angles runs over the block's outputs at once).
+  subroutine bulk_tooth_outputs(m, t, y, modes, tooth, tm)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t(:), y(:, :)
+    integer, intent(in) :: modes(:, :)
+    real(wp), intent(out) :: tooth(:, :, :), tm(:)
+    integer, parameter :: nblk = 64
+    real(wp), allocatable :: sp(:, :), cp(:, :)
+    real(wp) :: ex(nblk), ey(nblk), evx(nblk), evy(nblk), sumf(nblk), phi, dnj, ddnj, fj, cb
+    integer :: k0, nk, i, j, k, mj
+    allocate(sp(nblk, m%z), cp(nblk, m%z))
+    cb = m%c_bulk
+    tooth(:, :, 5) = cb                ! c_j
+    tooth(:, :, 6) = 0.0_wp            ! T_f
+    tooth(:, :, 7:8) = m%r_pitch       ! r_c1, r_c2
+    do k0 = 0, size(t) - 1, nblk
+      nk = min(nblk, size(t) - k0)
+      do i = 1, nk
+        k = k0 + i
+        phi = 2.0_wp*pi/m%z + m%omega*t(k) + m%theta0 - m%alpha     ! tooth_angles, tooth 1
+        sp(i, 1) = sin(phi)
+        cp(i, 1) = cos(phi)
+        ex(i) = y(1, k) + m%l_x - y(3, k)
+        ey(i) = y(2, k) + m%l_y - y(4, k)
+        evx(i) = y(ndof+1, k) - y(ndof+3, k)
+        evy(i) = y(ndof+2, k) - y(ndof+4, k)
+      end do
+      do j = 2, m%z             ! tooth_angles' rotation by the pitch, for nk outputs at once
+        sp(1:nk, j) = sp(1:nk, j-1)*m%cos_pitch + cp(1:nk, j-1)*m%sin_pitch
+        cp(1:nk, j) = cp(1:nk, j-1)*m%cos_pitch - sp(1:nk, j-1)*m%sin_pitch
+      end do
+      sumf = 0.0_wp
+      do j = 1, m%z
+        do i = 1, nk
+          k = k0 + i
+          dnj = ex(i)*sp(i, j) - ey(i)*cp(i, j) + y(6, k)
+          ddnj = evx(i)*sp(i, j) - evy(i)*cp(i, j) + y(ndof+6, k) + m%omega*(ex(i)*cp(i, j) + &
+               ey(i)*sp(i, j))
+          mj = modes(j, k)
+          if (mj == 2) mj = merge(1, merge(-1, 0, dnj < -cb), dnj > cb)
+          fj = 0.0_wp
+          if (mj /= 0) fj = m%k_m*(dnj - mj*cb) + m%c_m*ddnj
+          tooth(k, j, 1) = fj
+          tooth(k, j, 2) = fj*sp(i, j)
+          tooth(k, j, 3) = fj*cp(i, j)
+          tooth(k, j, 4) = dnj
+          sumf(i) = sumf(i) + fj
+        end do
+      end do
+      tm(k0+1:k0+nk) = m%r_b*sumf(1:nk)
+    end do
+  end subroutine bulk_tooth_outputs
 
   !> Every per-tooth quantity (order of spline_quantities tooth_q) and the meshing torque at one state y (SI):
   !> Eqs. 11, 15-17, 19-22 and, where the thermal level has them, Eqs. 1-7 and 12-14.

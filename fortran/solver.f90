@@ -22,7 +22,7 @@ module spline_solver
   use spline_model, only: model_t, nstate, ndof
   use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, integrated_states
   use spline_mesh, only: mesh_switch_functions, coupling_stats_t
-  use spline_linear, only: tail_t, tail_possible, tail_try, tail_state
+  use spline_linear, only: tail_t, tail_possible, tail_try, tail_state, tail_states
   use spline_quantities, only: nstats => nsolver_stats, ist_steps, ist_rhs_evals, ist_jac_evals, &
        ist_lin_rhs_evals, ist_err_test_fails, ist_nonlin_conv_fails, ist_roots_found, &
        ist_root_fn_evals, ist_last_step, ist_mode_resyncs, ist_coupling_residual, &
@@ -310,15 +310,17 @@ contains
     logical function take_linear_tail(k0) result(taken)
       integer, intent(in) :: k0
       real(c_double) :: yt(nstate)
+      real(c_double), allocatable :: yts(:, :)
       integer :: j
       taken = .false.
       if (.not. use_tail) return
       taken = tail_try(tail, m, ctx%idx, ctx%n, tau, copy_state(ctx, yr, 1))
       if (.not. taken) return
       stats(ist_linear_tail_t) = tau/m%w_ref
+      allocate(yts(nstate, k0 + 1:nt))
+      call tail_states(tail, tout(k0+1:nt)*m%w_ref, yts)
       do j = k0 + 1, nt
-        call tail_state(tail, tout(j)*m%w_ref, yt)
-        call from_scaled(m, yt, yout(:, j))
+        call from_scaled(m, yts(:, j), yout(:, j))
         if (ctx%frozen) modes_out(:, j) = tail%flank
       end do
       do j = ks, nsec

@@ -80,6 +80,9 @@ def test_anatomy_quick(tmp_path):
     case = pyspline.load_case(CASES / "paper_lx1e-4.nml")
     assert anatomy.rhs_cost(case.replace(z=32), n=10, repeat=1)[2] > \
         anatomy.rhs_cost(case, n=10, repeat=1)[2]
+    cost = anatomy.output_cost(case.replace(t_end=0.05, n_out=321), repeat=1)
+    assert cost[1] <= cost[0] <= cost[2] and cost[3] > 0 and cost[4] > 0
+    assert "target 0.1 us" in anatomy.format_output_cost("paper_lx1e-4", case, cost)
 
 
 def test_bifurcation_accuracy_quick(tmp_path):
