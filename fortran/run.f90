@@ -333,7 +333,7 @@ contains
       do j = 1, m%z
         do i = 1, nk
           k = k0 + i
-          dnj = ex(i)*sp(i, j) - ey(i)*cp(i, j) + y(6, k)
+          dnj = ex(i)*sp(i, j) - ey(i)*cp(i, j) + y(6, k) + m%spacing_error(j)   ! as mesh_eval
           ddnj = evx(i)*sp(i, j) - evy(i)*cp(i, j) + y(ndof+6, k) + m%omega*(ex(i)*cp(i, j) + &
                ey(i)*sp(i, j))
           mj = modes(j, k)

@@ -14,6 +14,8 @@ from conftest import CASES
     ("physical_z24", dict(t_end=0.05, n_out=201, thermal="bulk")),         # bulk backlash, Z = 24
     ("paper_flash_lx1e-4", dict(t_end=0.05, n_out=201)),                   # one-way: flash path
     ("paper_T100", dict(t_end=0.05, n_out=201, thermal="bulk", roots=False)),
+    ("paper_lx1e-4", dict(t_end=0.05, n_out=201, spacing_error_amp=5e-5,   # spacing errors
+                          spacing_error_seed=3)),
 ])
 def test_tooth_outputs_are_the_mesh_at_the_stored_states(name, kw):
     res = pyspline.simulate(pyspline.load_case(CASES / f"{name}.nml", **kw))
