@@ -159,8 +159,11 @@ contains
     nout_name = trim(merge('outputs_per_revolution', 'n_out                 ', &
          c%outputs_per_revolution > 0.0_wp))
     nout_is = '= '//itoa(n_out)
-    if (c%outputs_per_revolution > 0.0_wp) &
-         nout_is = '= '//num(c%outputs_per_revolution)//' gives n_out = '//itoa(n_out)
+    if (c%outputs_per_revolution > 0.0_wp) then
+      nout_is = '= '//num(c%outputs_per_revolution)//' gives n_out = '//itoa(n_out)
+      if (n_out > 2000000000) nout_is = '= '//num(c%outputs_per_revolution)//' gives more '// &
+           'than 2e9 output times (n_out)'
+    end if
     if (n_out < 1) then; call fail('n_out', 'must be at least 1'); return; end if
     if (n_out > 1) then
       if (.not. (ta < t_end)) then
