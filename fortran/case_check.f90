@@ -7,7 +7,7 @@ module spline_case_check
   use spline_kinds, only: wp, pi, max_teeth
   use spline_errors, only: err_ok, err_case, itoa
   use spline_case_type, only: case_t, fields, nfields, field_index, ndof_case, nripple, &
-       option_index, case_output_bytes, max_output_bytes, thermal_values, method_values, &
+       option_index, case_output_bytes, case_run_times, max_output_bytes, thermal_values, method_values, &
        nonlinear_values, start_values, fidelity_values, jacobian_values, section_values
   use spline_case_text, only: num, size_text
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -25,8 +25,9 @@ contains
          c%c_heat, c%j_m, c%j_l, c%j_1, c%j_2, c%m_1, c%m_2, c%k_p1, c%k_p2, c%c_p1, c%c_p2, &
          c%k_t1, c%k_t2, c%c_t1, c%c_t2, c%k_m, c%c_m, c%t_d, c%t_l, c%speed_rpm, c%grav, &
          c%l_x, c%l_y, c%t_bulk, c%f_m, c%u_flash, c%eta_hertz, c%rtol, c%atol, c%t0, c%t_end, &
-         c%t_transient, c%dq0, c%dv0, c%l_ref, c%w_ref, c%fidelity_tol, c%lyapunov_interval, &
-         c%lyapunov_d0, c%fillet_radius, c%r_bore, c%r_rim, c%zeta_m, c%ripple_order, &
+         c%t_transient, c%revolutions, c%transient_revolutions, c%outputs_per_revolution, &
+         c%dq0, c%dv0, c%l_ref, c%w_ref, c%fidelity_tol, c%lyapunov_interval, c%lyapunov_d0, &
+         c%fillet_radius, c%r_bore, c%r_rim, c%zeta_m, c%ripple_order, &
          c%ripple_amp, c%ripple_phase_deg, c%unbalance, c%unbalance_phase_deg, c%gamma_x, &
          c%gamma_y, c%spacing_error, c%spacing_error_amp]
   end function real_values
@@ -39,9 +40,11 @@ contains
     character(len=*), intent(out) :: errmsg
     real(wp), allocatable :: x(:)
     integer :: at(nfields + 1)    ! field f's values: x(at(f) : at(f + 1) - 1)
-    real(wp) :: r_pitch, depth, involute, e, ta, dt_out, bytes
+    real(wp) :: r_pitch, depth, involute, e, ta, dt_out, bytes, t_end, t_transient
+    character(len=:), allocatable :: nout_name
+    character(len=120) :: nout_is
     type(case_t) :: dflt          ! the defaults (component defaults of case_t)
-    integer :: i, f, beyond, i_dq0, i_dv0
+    integer :: i, f, beyond, i_dq0, i_dv0, n_out
 
     ierr = err_case
     errmsg = ''
@@ -108,30 +111,70 @@ contains
       call fail('max_total_steps', 'must be at least 1'); return
     end if
 
-    ! times
+    ! times, given in seconds and n_out or in shaft revolutions (case_run_times: a revolution
+    ! field wins over its time field; its messages name it)
     if (.not. ranges('t0', 't0')) return
-    if (.not. (c%t_end > c%t0)) then; call fail('t_end', 'must be greater than t0'); return; end if
-    if (.not. ranges('t_end', 't_end')) return
-    if (.not. (c%t_end - c%t0 >= 1.0e-9_wp)) then
-      call fail('t_end', '- t0 = '//num(c%t_end - c%t0)//' s: a run lasts at least 1e-9 s'); return
+    if (.not. ranges('revolutions', 'outputs_per_revolution')) return
+    do f = field_index('revolutions'), field_index('outputs_per_revolution')
+      if (x(at(f)) > 0.0_wp .and. .not. (c%speed_rpm > 0.0_wp)) then
+        call fail(trim(fields(f)%name), '= '//num(x(at(f)))//' needs a positive speed_rpm '// &
+             '(it counts shaft revolutions); give the run in seconds at speed_rpm = 0'); return
+      end if
+    end do
+    call case_run_times(c, t_end, t_transient, n_out)
+    if (c%revolutions > 0.0_wp) then
+      if (.not. (t_end <= fields(field_index('t_end'))%hi)) then
+        call fail('revolutions', '= '//num(c%revolutions)//' at speed_rpm = '//num(c%speed_rpm)// &
+             ' ends at t_end = '//num(t_end)//' s, beyond '// &
+             num(fields(field_index('t_end'))%hi)//' s (the tooth angle omega t keeps its '// &
+             'digits within 1e6 s)'); return
+      end if
+      if (.not. (t_end - c%t0 >= 1.0e-9_wp)) then
+        call fail('revolutions', '= '//num(c%revolutions)//' at speed_rpm = '// &
+             num(c%speed_rpm)//' lasts '//num(t_end - c%t0)//' s: a run lasts at least 1e-9 s')
+        return
+      end if
+    else
+      if (.not. (c%t_end > c%t0)) then; call fail('t_end', 'must be greater than t0'); return; end if
+      if (.not. ranges('t_end', 't_end')) return
+      if (.not. (c%t_end - c%t0 >= 1.0e-9_wp)) then
+        call fail('t_end', '- t0 = '//num(c%t_end - c%t0)//' s: a run lasts at least 1e-9 s'); return
+      end if
     end if
     if (.not. ranges('t_transient', 't_transient')) return
-    ta = c%t0 + c%t_transient
-    if (.not. (ta <= c%t_end)) then
+    ta = c%t0 + t_transient
+    if (.not. (ta <= t_end)) then
+      if (c%transient_revolutions > 0.0_wp) then
+        call fail('transient_revolutions', '= '//num(c%transient_revolutions)//' ends after '// &
+             't_end = '//num(t_end)//' s: the transient must not pass the end of the run'); return
+      else if (c%revolutions > 0.0_wp) then
+        call fail('t_transient', '= '//num(c%t_transient)//' s ends after t_end = '// &
+             num(t_end)//' s (revolutions = '//num(c%revolutions)//'): t0 + t_transient '// &
+             'must not pass t_end'); return
+      end if
       call fail('t_transient', '= '//num(c%t_transient)//' s ends after t_end: t0 + t_transient '// &
            'must not pass t_end'); return
     end if
-    if (c%n_out < 1) then; call fail('n_out', 'must be at least 1'); return; end if
-    if (c%n_out > 1) then
-      if (.not. (ta < c%t_end)) then
-        call fail('t_transient', '= '//num(c%t_transient)//' s leaves no output window: '// &
-             itoa(c%n_out)//' output times would all be t_end (use n_out = 1, or a shorter '// &
+    ! n_out, or outputs_per_revolution where it gives n_out: nout_name, nout_is name it
+    nout_name = trim(merge('outputs_per_revolution', 'n_out                 ', &
+         c%outputs_per_revolution > 0.0_wp))
+    nout_is = '= '//itoa(n_out)
+    if (c%outputs_per_revolution > 0.0_wp) then
+      nout_is = '= '//num(c%outputs_per_revolution)//' gives n_out = '//itoa(n_out)
+      if (n_out > 2000000000) nout_is = '= '//num(c%outputs_per_revolution)//' gives more '// &
+           'than 2e9 output times (n_out)'
+    end if
+    if (n_out < 1) then; call fail('n_out', 'must be at least 1'); return; end if
+    if (n_out > 1) then
+      if (.not. (ta < t_end)) then
+        call fail('t_transient', '= '//num(t_transient)//' s leaves no output window: '// &
+             itoa(n_out)//' output times would all be t_end (use n_out = 1, or a shorter '// &
              't_transient)'); return
       end if
-      dt_out = (c%t_end - ta)/real(c%n_out - 1, wp)
-      if (.not. (dt_out > 1.0e3_wp*spacing_of(max(abs(ta), abs(c%t_end))))) then
-        call fail('n_out', '= '//itoa(c%n_out)//' puts the output times '//num(dt_out)//' s '// &
-             'apart, closer than the time resolution at t = '//num(c%t_end)//' s'); return
+      dt_out = (t_end - ta)/real(n_out - 1, wp)
+      if (.not. (dt_out > 1.0e3_wp*spacing_of(max(abs(ta), abs(t_end))))) then
+        call fail(nout_name, trim(nout_is)//' puts the output times '//num(dt_out)//' s '// &
+             'apart, closer than the time resolution at t = '//num(t_end)//' s'); return
       end if
     end if
     do i = 1, ndof_case
@@ -224,14 +267,14 @@ contains
     bytes = case_output_bytes(c)
     if (bytes > max_output_bytes) then
       if (c%lyapunov .or. option_index(section_values, c%section) > 1) then
-        call fail('n_out', '= '//itoa(c%n_out)//' with z = '//itoa(c%z)//' teeth, the Poincare '// &
+        call fail(nout_name, trim(nout_is)//' with z = '//itoa(c%z)//' teeth, the Poincare '// &
              'section and the Lyapunov record need '//size_text(bytes)//' of memory for the '// &
-             'outputs, more than the limit of '//size_text(max_output_bytes)//': lower n_out '// &
-             '(or shorten the run)'); return
+             'outputs, more than the limit of '//size_text(max_output_bytes)//': lower '// &
+             nout_name//' (or shorten the run)'); return
       end if
-      call fail('n_out', '= '//itoa(c%n_out)//' with z = '//itoa(c%z)//' teeth needs '// &
+      call fail(nout_name, trim(nout_is)//' with z = '//itoa(c%z)//' teeth needs '// &
            size_text(bytes)//' of memory for the outputs, more than the limit of '// &
-           size_text(max_output_bytes)//': lower n_out'); return
+           size_text(max_output_bytes)//': lower '//nout_name); return
     end if
     ierr = err_ok
 

@@ -72,7 +72,7 @@ contains
   function hint(word) result(s)
     character(len=*), intent(in) :: word
     character(len=:), allocatable :: s
-    character(len=20) :: best
+    character(len=24) :: best
     best = case_suggest(word)
     if (len_trim(best) > 0) then
       s = ': did you mean '//trim(best)//'?'
@@ -85,7 +85,7 @@ contains
   !> the word's length; or the one field the word begins), else blank.
   function case_suggest(word) result(best)
     character(len=*), intent(in) :: word
-    character(len=20) :: best
+    character(len=24) :: best
     character(len=:), allocatable :: w
     integer :: i, d, dbest, nprefix, iprefix
     w = lower(trim(adjustl(word)))

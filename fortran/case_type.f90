@@ -7,7 +7,7 @@ module spline_case_type
   implicit none
   private
   public :: case_t, field_t, fields, nfields, field_index, case_field, case_field_meta, &
-       case_name_of, option_index, case_output_bytes
+       case_name_of, option_index, case_output_bytes, case_run_times
   public :: namelen, optlen, nripple, ndof_case, max_case_bytes, max_output_bytes
   public :: thermal_values, method_values, nonlinear_values, start_values, fidelity_values, &
        jacobian_values, section_values
@@ -62,6 +62,9 @@ module spline_case_type
     integer  :: max_steps = 100000, max_total_steps = 20000000
     real(wp) :: t0 = 0.0_wp, t_end = 0.1_wp, t_transient = 0.0_wp
     integer  :: n_out = 1001
+    !> The run in shaft revolutions (0: t_end, t_transient, n_out as given); case_run_times.
+    real(wp) :: revolutions = 0.0_wp, transient_revolutions = 0.0_wp
+    real(wp) :: outputs_per_revolution = 0.0_wp
     character(len=optlen) :: start = 'equilibrium'
     real(wp) :: dq0(ndof_case) = 0.0_wp, dv0(ndof_case) = 0.0_wp
     real(wp) :: l_ref = 0.0_wp, w_ref = 0.0_wp
@@ -92,7 +95,7 @@ module spline_case_type
   !> order; tests/test_input.py checks the table against the defaults and its units against
   !> cases/template.nml; Python reads names, units and descriptions through api_names('fields')).
   type :: field_t
-    character(len=20) :: name
+    character(len=24) :: name
     character(len=1) :: kind
     integer :: n
     character(len=20) :: unit = ''
@@ -101,7 +104,7 @@ module spline_case_type
     real(wp) :: lo = 0.0_wp, hi = 0.0_wp
     character(len=80) :: note = ''
   end type field_t
-  integer, parameter :: nfields = 82
+  integer, parameter :: nfields = 85
   real(wp), parameter :: inf_ = huge(1.0_wp)
   type(field_t), parameter :: fields(nfields) = [ &
        field_t('name', 'c', namelen, '', 'case name, used in messages (default: the file name)'), &
@@ -192,6 +195,14 @@ module spline_case_type
                's (the tooth angle omega t keeps its digits within 1e6 s)'), &
        field_t('t_transient', 'r', 1, 's', 'integrated after t0 but not output', 'n', 0.0_wp, inf_), &
        field_t('n_out', 'i', 1, '', 'number of uniform output times'), &
+       field_t('revolutions', 'r', 1, 'rev', 'run after t0 in shaft revolutions; 0 = t_end', 'n', &
+               0.0_wp, inf_, 'shaft revolutions, not negative; 0 for t_end'), &
+       field_t('transient_revolutions', 'r', 1, 'rev', &
+               'transient in shaft revolutions; 0 = t_transient', 'n', 0.0_wp, inf_, &
+               'shaft revolutions, not negative; 0 for t_transient'), &
+       field_t('outputs_per_revolution', 'r', 1, '1/rev', &
+               'output times per shaft revolution; 0 = n_out', 'n', 0.0_wp, inf_, &
+               'outputs per shaft revolution, not negative; 0 for n_out'), &
        field_t('start', 'c', optlen, '', 'equilibrium (static, computed) | rest'), &
        field_t('dq0', 'r', ndof_case, 'm', 'added to the start displacements x1 y1 x2 y2 D1 D2 D3'), &
        field_t('dv0', 'r', ndof_case, 'm/s', 'added to the start velocities'), &
@@ -295,9 +306,11 @@ contains
   !> record (2 numbers per renormalisation).
   pure real(wp) function case_output_bytes(c) result(bytes)
     type(case_t), intent(in) :: c
-    real(wp) :: nt, nsec, nlyap, window, omega
-    nt = real(c%n_out, wp)
-    window = max(c%t_end - c%t0 - c%t_transient, 0.0_wp)
+    real(wp) :: nt, nsec, nlyap, window, omega, t_end, t_transient
+    integer :: n_out
+    call case_run_times(c, t_end, t_transient, n_out)
+    nt = real(n_out, wp)
+    window = max(t_end - c%t0 - t_transient, 0.0_wp)
     omega = c%speed_rpm*2.0_wp*pi/60.0_wp
     nsec = 0.0_wp
     if (option_index(section_values, c%section) == 2) nsec = window*omega/(2.0_wp*pi) + 2.0_wp
@@ -309,5 +322,36 @@ contains
          + 2.0_wp*8.0_wp*2.0_wp*nlyap
     if (c%n_slices > 1) bytes = bytes + nt*2.0_wp*8.0_wp*(c%z*c%n_slices + 2.0_wp)
   end function case_output_bytes
+
+  !> The run's end time t_end, transient t_transient [s] and number of output times n_out:
+  !> the fields themselves, or, where the case gives them in shaft revolutions (a period
+  !> 60 / speed_rpm s), t_end = t0 + revolutions period, t_transient = transient_revolutions
+  !> period and n_out = outputs_per_revolution R + 1 to the nearest whole number, R the
+  !> revolutions of the output window [t0 + t_transient, t_end] (outputs 1/outputs_per_revolution
+  !> of a revolution apart when R outputs_per_revolution is whole; capped at 2e9 outputs, which
+  !> the memory check refuses). A revolution field wins over its time field. Assumes
+  !> speed_rpm > 0 where a revolution field is set (spline_case_check).
+  pure subroutine case_run_times(c, t_end, t_transient, n_out)
+    type(case_t), intent(in) :: c
+    real(wp), intent(out) :: t_end, t_transient
+    integer, intent(out) :: n_out
+    real(wp) :: period, rev_run, rev_transient
+    t_end = c%t_end; t_transient = c%t_transient; n_out = c%n_out
+    if (.not. (c%revolutions > 0.0_wp .or. c%transient_revolutions > 0.0_wp .or. &
+         c%outputs_per_revolution > 0.0_wp)) return
+    period = 60.0_wp/c%speed_rpm
+    rev_run = (c%t_end - c%t0)/period
+    rev_transient = c%t_transient/period
+    if (c%revolutions > 0.0_wp) then
+      rev_run = c%revolutions
+      t_end = c%t0 + c%revolutions*period
+    end if
+    if (c%transient_revolutions > 0.0_wp) then
+      rev_transient = c%transient_revolutions
+      t_transient = c%transient_revolutions*period
+    end if
+    if (c%outputs_per_revolution > 0.0_wp) &
+         n_out = nint(min(c%outputs_per_revolution*max(rev_run - rev_transient, 0.0_wp), 2.0e9_wp)) + 1
+  end subroutine case_run_times
 
 end module spline_case_type

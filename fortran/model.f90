@@ -6,7 +6,7 @@ module spline_model
   use spline_kinds, only: wp, pi, max_teeth
   use, intrinsic :: iso_fortran_env, only: int64
   use spline_errors, only: err_ok, err_case, err_thermal, itoa
-  use spline_case, only: case_t, case_validate, namelen, option_index, thermal_values, &
+  use spline_case, only: case_t, case_validate, case_run_times, namelen, option_index, thermal_values, &
        method_values, nonlinear_values, start_values, fidelity_values, section_values, nripple
   use spline_geometry, only: iso4156_radii, pitch_rotation, tooth_angles
   use spline_stiffness, only: spline_mesh_stiffness_fillet
@@ -120,9 +120,10 @@ contains
     m%k_m = c%k_m; m%c_m = c%c_m; m%t_d = c%t_d; m%t_l = c%t_l
     m%omega = c%speed_rpm*2.0_wp*pi/60.0_wp; m%grav = c%grav; m%l_x = c%l_x; m%l_y = c%l_y
     m%t_bulk = c%t_bulk; m%f_m = c%f_m; m%u_flash = c%u_flash; m%eta_hertz = c%eta_hertz
-    m%rtol = c%rtol; m%atol = c%atol; m%max_steps = c%max_steps; m%n_out = c%n_out
+    m%rtol = c%rtol; m%atol = c%atol; m%max_steps = c%max_steps
     m%max_total_steps = c%max_total_steps
-    m%t0 = c%t0; m%t_end = c%t_end; m%t_transient = c%t_transient
+    m%t0 = c%t0      ! t_end, t_transient, n_out: as given, or from the shaft revolutions
+    call case_run_times(c, m%t_end, m%t_transient, m%n_out)
     m%roots = c%roots; m%stald = c%stald; m%linear_tail = c%linear_tail; m%dq0 = c%dq0; m%dv0 = c%dv0
     m%dof = c%dof; m%fidelity_tol = c%fidelity_tol
     m%auto = option_index(fidelity_values, c%fidelity) == 2

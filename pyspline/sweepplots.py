@@ -486,9 +486,11 @@ def _fmt(v) -> str:
 
 
 def _duration(ds) -> float | None:
-    """t_end - t0 - t_transient of the sweep's case [s] (None if one of them is swept)."""
+    """t_end - t0 - t_transient of the sweep's case [s] (None if one of them is swept, or if
+    the case gives the run in shaft revolutions: then it differs with the speed)."""
     keys = ("t_end", "t0", "t_transient")
-    if any(k in ds["error"].dims for k in keys):
+    revs = ("revolutions", "transient_revolutions")
+    if any(k in ds["error"].dims for k in keys + revs) or any(_case_value(ds, k) for k in revs):
         return None
     t_end, t0, t_tr = (_case_value(ds, k) for k in keys)
     return t_end - t0 - t_tr
