@@ -22,8 +22,9 @@ program spline_dyn
   use spline_run, only: run_case, run_warnings
   use spline_quantities, only: nstats, stat_q, state_q, iq_tf, ntooth_q, tooth_q, nout_q, output_q, nload, &
        load_q, nload_tooth, load_tooth_q, il_load_sharing, il_free_mean, il_back_teeth, &
-       il_impacts_rev, il_closing_speed, il_tf_max, il_tf_max_tooth, il_tf_max_t
-  use spline_loads, only: run_loads
+       il_impacts_rev, il_closing_speed, il_tf_max, il_tf_max_tooth, il_tf_max_t, il_sigma_root, &
+       il_sigma_flank, il_tau_pitch
+  use spline_loads, only: run_loads, stress_warnings
   use spline_sections, only: section_count
   use spline_lyapunov, only: lyapunov_count
   implicit none
@@ -214,6 +215,7 @@ program spline_dyn
   call print_warnings(run_warnings(m, stats))
   allocate(tload(m%z, nload_tooth))
   call run_loads(m, t, y, tooth, tm, loads, tload)
+  call print_warnings(stress_warnings(m, loads))
   if (have_summary) call write_summary(.true.)
   if (.not. write_csv) then
     write(*, '(a)') 'case '//trim(m%name)//': '//summary
@@ -308,6 +310,8 @@ program spline_dyn
        loads(il_impacts_rev), ', closing speed max ', loads(il_closing_speed), ' m/s'
   write(*, '(a,es11.4,a,i0,a,es11.4,a)') '  flash temperature T_f max [degC]: ', &
        loads(il_tf_max), ' (tooth ', nint(loads(il_tf_max_tooth)), ', t = ', loads(il_tf_max_t), ' s)'
+  write(*, '(a,3f10.2)') '  tooth stresses root bending / flank bearing / shear at pitch [MPa]:', &
+       1.0e-6_wp*loads([il_sigma_root, il_sigma_flank, il_tau_pitch])
   do i = 1, nstats
     write(*, '(2x,a24,g0)') stat_q(i)%name, stats(i)
   end do

@@ -25,7 +25,7 @@ module spline_api
   use spline_run, only: run_case, tooth_quantities, output_times, run_warnings
   use spline_quantities, only: quantity_t, nstats, stat_q, ntooth_q, tooth_q, state_q, nout_q, &
        output_q, nload, load_q, nload_tooth, load_tooth_q
-  use spline_loads, only: run_loads
+  use spline_loads, only: run_loads, stress_warnings
   use spline_sections, only: section_count
   use spline_lyapunov, only: lyapunov_count
   implicit none
@@ -161,7 +161,8 @@ contains
   end subroutine api_field_hint
 
   !> Warnings about a loaded model (stage 0: model_warnings) or about a run of it (stage 1:
-  !> run_warnings, from the run's statistics), one per line; blank if none.
+  !> run_warnings, from the run's statistics in stats; stage 2: stress_warnings, from the run's
+  !> loads in stats, as api_loads returns them), one per line; blank if none.
   subroutine api_warnings(model, nb, stats, ns, stage, text)
     integer(c_int), intent(in) :: nb, ns, stage
     integer(c_int), intent(in) :: model(nb)
@@ -175,8 +176,10 @@ contains
     if (ie /= err_ok) return
     if (stage == 0) then
       text = model_warnings(m)
-    else if (ns == nstats) then
+    else if (stage == 1 .and. ns == nstats) then
       text = run_warnings(m, stats)
+    else if (stage == 2 .and. ns == nload) then
+      text = stress_warnings(m, stats)
     end if
   end subroutine api_warnings
 

@@ -4,7 +4,8 @@ module spline_geometry
   use spline_kinds, only: wp, pi
   implicit none
   private
-  public :: tooth_angles, pitch_rotation, contact_radius, profile_shift, iso4156_radii, active_profile
+  public :: tooth_angles, pitch_rotation, contact_radius, profile_shift, iso4156_radii, active_profile, &
+       root_section
 
 contains
 
@@ -20,6 +21,22 @@ contains
     rf_int = 0.5_wp*m*(z + 1.5_wp)
     ra_int = 0.5_wp*m*(z - 1.0_wp)
   end subroutine iso4156_radii
+
+  !> The external tooth's root section for the bending stress estimate (docs/model.md section
+  !> 15, "Tooth stresses"): the load at the pitch circle R = m Z / 2 (the contact point of docs/
+  !> model.md section 6) stands h_f = R - r_f = 0.75 m above the critical section at the root
+  !> (minor) circle r_f = m (Z - 1.5) / 2 (iso4156_radii); the flanks of ISO 4156's basic rack
+  !> are straight at the pressure angle, so the tooth there is t_f = s + 2 h_f tan(alpha) thick
+  !> (s: the tooth thickness at the pitch circle).
+  pure subroutine root_section(z, m, s, alpha, h_f, t_f)
+    integer, intent(in) :: z
+    real(wp), intent(in) :: m, s, alpha
+    real(wp), intent(out) :: h_f, t_f
+    real(wp) :: r, rf, rfi, rai
+    call iso4156_radii(z, m, r, rf, rfi, rai)
+    h_f = r - rf
+    t_f = s + 2.0_wp*h_f*tan(alpha)
+  end subroutine root_section
 
   !> Eqs. 8-9: line-of-action angle of every tooth pair, phi_j = 2 pi j / Z + omega t + theta_0 - alpha,
   !> returned as sin and cos (what the mesh needs). Two sin/cos pairs per call instead of Z: the

@@ -2,21 +2,33 @@
 !> executable and Python alike: per tooth the peak load and the load factor, the fractions of
 !> the outputs the tooth is free and on its back flank, its contact onsets (impacts); for the
 !> run the load-sharing factor, impacts per revolution, the largest closing speed and the
-!> largest flash temperature with its tooth and time. Names and units: spline_quantities
-!> (load_q, load_tooth_q).
+!> largest flash temperature with its tooth and time; the nominal stresses of the most loaded
+!> tooth at its peak load and their warnings (tooth_stresses, stress_warnings). Names and units:
+!> spline_quantities (load_q, load_tooth_q).
 module spline_loads
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use spline_kinds, only: wp, pi, max_teeth
   use spline_model, only: model_t, nstate
-  use spline_geometry, only: tooth_angles
+  use spline_geometry, only: tooth_angles, root_section, active_profile
+  use spline_errors, only: itoa
   use spline_quantities, only: iq_tf, nload, nload_tooth, il_f_static, &
        il_load_sharing, il_load_sharing_tooth, il_free_max, il_back_max, il_free_mean, &
        il_unloaded, il_back_teeth, il_impacts_rev, il_closing_speed, il_tf_max, il_tf_max_tooth, &
        il_tf_max_t, il_revolutions, il_batches, il_tm_rms_se, il_sharing_rev, &
-       il_sharing_rev_se, ilt_f_peak, ilt_load_factor, ilt_free, ilt_back, ilt_onsets
+       il_sharing_rev_se, il_sigma_root, il_sigma_flank, il_tau_pitch, ilt_f_peak, ilt_load_factor, ilt_free, ilt_back, ilt_onsets
   implicit none
   private
-  public :: run_loads, tooth_flank, drive_flank, approach_speed
+  public :: run_loads, tooth_flank, drive_flank, approach_speed, tooth_stresses, stress_warnings
+
+  !> Limits of stress_warnings [Pa] (docs/model.md section 15, "Tooth stresses"): typical
+  !> allowables of case-hardened steel splines (58-63 HRC) at full load, 10^4 torque cycles,
+  !> uniform drive: shear 50,000 psi (Dudley, "When splines need stress control", Product
+  !> Engineering 1957, as in Machinery's Handbook's involute-spline stress tables); flank
+  !> compression of a fixed spline 9 x 5,000 psi (same tables); root bending 400 MPa, ISO
+  !> 6336-5's nominal bending endurance of case-hardened steel, about 1000 MPa with its fillet
+  !> concentration, over a spline fillet's concentration of about 2 and a safety of 1.25.
+  real(wp), parameter :: sigma_root_limit = 400.0e6_wp, sigma_flank_limit = 310.0e6_wp, &
+       tau_pitch_limit = 345.0e6_wp
 
 contains
 
@@ -97,6 +109,8 @@ contains
       tload(:, ilt_load_factor) = ieee_value(fs, ieee_quiet_nan)
     end if
     loads(il_f_static) = fs
+    call tooth_stresses(m, maxval(tload(:, ilt_f_peak)), loads(il_sigma_root), &
+         loads(il_sigma_flank), loads(il_tau_pitch))
     loads(il_load_sharing) = maxval(tload(:, ilt_load_factor))
     loads(il_load_sharing_tooth) = maxloc(tload(:, ilt_f_peak), 1)
     if (fs == 0.0_wp) loads(il_load_sharing) = ieee_value(fs, ieee_quiet_nan)
@@ -128,6 +142,77 @@ contains
       end do outer
     end if
   end subroutine run_loads
+
+  !> Nominal stresses of a tooth carrying the load f along its line of action (docs/model.md
+  !> section 15, "Tooth stresses"), from its tangential part at the pitch circle
+  !> f_t = f cos(alpha) spread evenly over the face width b:
+  !> - root bending sigma_root = 6 f_t h_f / (b t_f^2): the tooth a cantilever loaded at the
+  !>   pitch circle, h_f above its root section t_f thick (spline_geometry::root_section);
+  !> - flank bearing sigma_flank = f_t / (b h_w) over the working depth h_w = m (the active
+  !>   profile, spline_geometry::active_profile);
+  !> - shear at the pitch circle tau_pitch = f_t / (b s), s the tooth thickness there.
+  pure subroutine tooth_stresses(m, f, sigma_root, sigma_flank, tau_pitch)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: f
+    real(wp), intent(out) :: sigma_root, sigma_flank, tau_pitch
+    real(wp) :: ft, h_f, t_f, r_lo, r_hi
+    ft = abs(f)*m%cos_alpha
+    call root_section(m%z, m%m_n, m%s, m%alpha, h_f, t_f)
+    call active_profile(m%z, m%m_n, r_lo, r_hi)
+    sigma_root = 6.0_wp*ft*h_f/(m%b*t_f**2)
+    sigma_flank = ft/(m%b*(r_hi - r_lo))
+    tau_pitch = ft/(m%b*m%s)
+  end subroutine tooth_stresses
+
+  !> Warnings about a run's loads (loads in the order of load_q, as run_loads makes them), one
+  !> line each (blank if none): a nominal stress of tooth_stresses beyond its limit
+  !> (sigma_root_limit, sigma_flank_limit, tau_pitch_limit). The executable prints them to
+  !> stderr, Python raises pyspline.SplineWarning (api_warnings stage 2): the same words.
+  function stress_warnings(m, loads) result(text)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: loads(nload)
+    character(len=:), allocatable :: text
+    text = over('root bending stress 6 F cos(alpha) h_f / (b t_f^2)', loads(il_sigma_root), &
+         sigma_root_limit)//over('flank bearing stress F cos(alpha) / (b h_w)', &
+         loads(il_sigma_flank), sigma_flank_limit)//over('shear stress at the pitch circle '// &
+         'F cos(alpha) / (b s)', loads(il_tau_pitch), tau_pitch_limit)
+  contains
+    function over(what, x, limit) result(line)
+      character(len=*), intent(in) :: what
+      real(wp), intent(in) :: x, limit
+      character(len=:), allocatable :: line
+      line = ''
+      if (.not. x > limit) return
+      line = 'case '//trim(m%name)//': '//what//' = '//fmt(x*1.0e-6_wp, '(f0.1)')// &
+           ' MPa at the peak load of tooth '//itoa(nint(loads(il_load_sharing_tooth)))// &
+           ' (t_d = '//fmt(m%t_d, '(es10.3)')//' N m) exceeds '//itoa(nint(limit*1.0e-6_wp))// &
+           ' MPa, a typical allowable of case-hardened steel (an estimate, docs/model.md '// &
+           'section 15)'//hint(x, limit)//'. Run as given'//new_line('a')
+    end function over
+    !> Why: the static load alone (F_static, the peak over the load-sharing factor) beyond the
+    !> limit points to the torque's unit, else the run's dynamic peak.
+    function hint(x, limit) result(h)
+      real(wp), intent(in) :: x, limit
+      character(len=:), allocatable :: h
+      h = ': a dynamic peak (no drive torque)'
+      if (.not. loads(il_f_static) > 0.0_wp) return
+      if (x/loads(il_load_sharing) > limit) then
+        h = ': the static load alone is beyond it, a torque in N mm?'
+      else
+        h = ': a dynamic peak, load-sharing factor '//fmt(loads(il_load_sharing), '(f0.2)')
+      end if
+    end function hint
+  end function stress_warnings
+
+  !> x written with format f, without blanks.
+  function fmt(x, f) result(s)
+    real(wp), intent(in) :: x
+    character(len=*), intent(in) :: f
+    character(len=:), allocatable :: s
+    character(len=40) :: buf
+    write(buf, f) x
+    s = trim(adjustl(buf))
+  end function fmt
 
   !> Standard errors by batch means (e.g. Law & Kelton, Simulation Modeling and Analysis,
   !> ch. 9.5): output k belongs to revolution b = floor(omega (t_k - t_1) / 2 pi) + 1; the

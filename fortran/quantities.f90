@@ -115,8 +115,9 @@ module spline_quantities
        il_free_max = 4, il_back_max = 5, il_free_mean = 6, il_unloaded = 7, il_back_teeth = 8, &
        il_impacts_rev = 9, il_closing_speed = 10, il_tf_max = 11, il_tf_max_tooth = 12, &
        il_tf_max_t = 13, il_revolutions = 14, il_batches = 15, il_tm_rms_se = 16, &
-       il_sharing_rev = 17, il_sharing_rev_se = 18
-  integer, parameter :: nload = 18
+       il_sharing_rev = 17, il_sharing_rev_se = 18, il_sigma_root = 19, il_sigma_flank = 20, &
+       il_tau_pitch = 21
+  integer, parameter :: nload = 21
   type(quantity_t), parameter :: load_q(nload) = [ &
        quantity_t('F_static', 'N', 'static tooth load of equal load sharing |T_d| / (Z r_b)'), &
        quantity_t('load_sharing', '-', 'load-sharing factor: the largest tooth load factor'), &
@@ -141,6 +142,12 @@ module spline_quantities
        quantity_t('load_sharing_rev', '-', 'mean over the revolutions of each one''s &
             &load-sharing factor'), &
        quantity_t('load_sharing_rev_se', '-', 'standard error of load_sharing_rev by batch means &
-            &(NaN: < 2 batches)')]
+            &(NaN: < 2 batches)'), &
+       quantity_t('sigma_root', 'Pa', 'nominal root bending stress of the most loaded tooth at &
+            &its peak load, 6 F cos(alpha) h_f / (b t_f^2)'), &
+       quantity_t('sigma_flank', 'Pa', 'nominal flank bearing (compressive) stress at that load, &
+            &F cos(alpha) / (b h_w)'), &
+       quantity_t('tau_pitch', 'Pa', 'nominal tooth shear stress at the pitch circle at that load, &
+            &F cos(alpha) / (b s)')]
 
 end module spline_quantities

@@ -39,6 +39,8 @@ def _summary(res) -> str:
             f"back flank {ld['teeth_back']:.0f}  "
             f"impacts/rev {ld['impacts_per_rev']:.2f}  "
             f"T_f max {ld['Tf_max']:.1f} degC  "
+            f"stress root/flank/shear {ld['sigma_root'] * 1e-6:.1f}/"
+            f"{ld['sigma_flank'] * 1e-6:.1f}/{ld['tau_pitch'] * 1e-6:.1f} MPa  "
             f"{res.level}  "
             f"steps {s['steps']}  {s['wall_s']*1e3:.0f} ms")
 

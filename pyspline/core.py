@@ -338,6 +338,7 @@ def run_loads(model, t, y, tooth, tm) -> dict:
     loads, tload, ierr, msg = _api.api_loads(model.bytes, len(LOAD_QUANTITIES),
                                              len(TOOTH_LOAD_QUANTITIES), t, y, tooth, tm)
     raise_for(ierr, msg)
+    _warn(_api.api_warnings(model.bytes, loads, 2))      # nominal stresses beyond their limits
     out = {n: float(v) for n, v in zip(LOAD_QUANTITIES, loads)}
     out.update({n: tload[:, i] for i, n in enumerate(TOOTH_LOAD_QUANTITIES)})
     return out

@@ -233,7 +233,7 @@ def _template(options: dict, stat_names: Sequence[str]) -> dict:
 #: section 15; Tf_max too), units from the core's table.
 SWEEP_LOADS = ("load_sharing", "free_frac_max", "back_frac_max", "teeth_free_mean", "teeth_back",
                "impacts_per_rev", "closing_speed_max", "Tm_rms_se", "load_sharing_rev",
-               "load_sharing_rev_se")
+               "load_sharing_rev_se", "sigma_root", "sigma_flank", "tau_pitch")
 
 
 @functools.cache

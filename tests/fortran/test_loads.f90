@@ -2,7 +2,8 @@
 !> hand, whose loads are known: a tooth always on its drive flank, one never loaded, one that
 !> cycles free -> back flank -> drive flank (two onsets every three outputs), a flash
 !> temperature at one tooth and time, a closing speed set by dD2/dt, and a T_m whose RMS per
-!> revolution is 30, 32, 34 N m (its batch-means standard error 2/sqrt(3)).
+!> revolution is 30, 32, 34 N m (its batch-means standard error 2/sqrt(3)); the nominal
+!> stresses of the most loaded tooth (3 F_s) by the formulas of section 15 and their warnings.
 program test_loads
   use spline_kinds, only: wp, pi
   use spline_model, only: model_t, nstate
@@ -10,13 +11,15 @@ program test_loads
        il_load_sharing, il_load_sharing_tooth, il_free_max, il_back_max, il_free_mean, &
        il_unloaded, il_back_teeth, il_impacts_rev, il_closing_speed, il_tf_max, il_tf_max_tooth, &
        il_tf_max_t, il_revolutions, il_batches, il_tm_rms_se, il_sharing_rev, il_sharing_rev_se, &
-       ilt_f_peak, ilt_load_factor, ilt_free, ilt_back, ilt_onsets
-  use spline_loads, only: run_loads
+       ilt_f_peak, ilt_load_factor, ilt_free, ilt_back, ilt_onsets, il_sigma_root, &
+       il_sigma_flank, il_tau_pitch
+  use spline_loads, only: run_loads, stress_warnings
   use check, only: check_true, check_close, check_done, default_case_model
   implicit none
   integer, parameter :: nt = 30
   type(model_t) :: m
-  real(wp) :: t(nt), y(nstate, nt), tm(nt), loads(nload), fs, period, revs
+  real(wp) :: t(nt), y(nstate, nt), tm(nt), loads(nload), fs, period, revs, ft, h_f, t_f
+  character(len=:), allocatable :: text
   real(wp), allocatable :: tooth(:, :, :), tl(:, :)
   integer :: k, fl, rev
 
@@ -69,6 +72,22 @@ program test_loads
   call check_close('load sharing per revolution 3, SE 0', loads(il_sharing_rev), 3.0_wp, &
        1.0e-15_wp)
   call check_true('load sharing SE 0', loads(il_sharing_rev_se) == 0)
+  ! section 15: f_t = 3 F_s cos(alpha); the load at R = m Z / 2, the root at m (Z - 1.5) / 2,
+  ! straight flanks; working depth m; shear over the tooth thickness s
+  ft = 3*fs*cos(m%alpha)
+  h_f = 0.75_wp*m%m_n
+  t_f = m%s + 2*h_f*tan(m%alpha)
+  call check_close('root bending 6 f_t h_f / (b t_f^2)', loads(il_sigma_root), &
+       6*ft*h_f/(m%b*t_f**2), 1.0e-14_wp)
+  call check_close('flank bearing f_t / (b m)', loads(il_sigma_flank), ft/(m%b*m%m_n), 1.0e-14_wp)
+  call check_close('shear f_t / (b s)', loads(il_tau_pitch), ft/(m%b*m%s), 1.0e-14_wp)
+  call check_true('no stress warning at 3 F_s', stress_warnings(m, loads) == '')
+  loads(il_sigma_flank) = 311.0e6_wp
+  text = stress_warnings(m, loads)
+  call check_true('bearing stress beyond 310 MPa: one line', index(text, 'flank bearing stress &
+       &F cos(alpha) / (b h_w) = 311.0 MPa at the peak load of tooth 3') > 0 .and. &
+       index(text, 'exceeds 310 MPa') > 0 .and. count([(text(k:k) == new_line('a'), &
+       k = 1, len(text))]) == 1)
   call check_true('every load has a name', all(len_trim(load_q%name) > 0))
   call check_done('test_loads')
 end program test_loads
