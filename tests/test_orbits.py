@@ -126,3 +126,23 @@ def test_newton_failure_says_what_was_tried():
                        r"Newton step\(s\); scaled residual .*wanted 1e-09"):
         pyspline.periodic_orbit(case, guess=y_eq, max_iter=0)
     assert issubclass(pyspline.OrbitError, pyspline.SplineError)
+
+
+def test_newton_converges_quadratically_on_a_switching_orbit():
+    """cases/chaos_z24.nml with 10 times its mesh damping (zeta_m = 0.1) settles on a period-1
+    orbit on which teeth leave contact and strike the back flank every revolution: a nonlinear,
+    piecewise-smooth map. From the end of a 0.1 s run, Newton's residual falls quadratically,
+    r_(k+1) <= 100 r_k^2, down to the tolerance (a linear rate would stall above it)."""
+    case = pyspline.load_case(CASES / "chaos_z24.nml", zeta_m=0.1, t_transient=0.0, t_end=0.1,
+                              n_out=101, section="none", lyapunov=False)
+    orbit = pyspline.periodic_orbit(case, tol=1e-6)
+    r = orbit.residuals
+    assert len(r) >= 3 and r[-1] <= 1e-6, r
+    for a, b in zip(r, r[1:]):
+        assert b <= 100 * a**2, r
+    tr = orbit.trajectory
+    free = (np.abs(tr.dn) <= tr.c).mean()
+    assert 0.5 < free < 1 and (tr.dn > tr.c).any()       # free flights and back-flank strikes
+    s = scale_of(case)
+    assert np.abs((tr.y[-1] - tr.y[0]) / s).max() < 10 * orbit.residual + 10 * case["rtol"]
+    assert orbit.stable
