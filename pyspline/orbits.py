@@ -120,7 +120,7 @@ def periodic_orbit(case, n: int = 1, guess=None, t0: float | None = None, tol: f
     tol = 100 * rtol if tol is None else float(tol)
     scale = np.r_[np.full(7, info["l_ref"]), np.full(7, info["l_ref"] * info["w_ref"])]
     if guess is None:
-        y = _settled_state(case, t0, period)
+        y = _settled_state(model, t0, period)
     else:
         y = np.asarray(guess, dtype=float)
         if y.shape != (NSTATE,):
@@ -188,20 +188,33 @@ def _fail(case, n, period, t0, it, hist, tol, why):
         "looser tol")
 
 
-def _settled_state(case: Case, t0: float, period: float) -> np.ndarray:
+#: run-length fields given in shaft revolutions win over t_end, t_transient, n_out: zeroed
+#: where a run's times are set here (when the case has them)
+_REVOLUTION_FIELDS = ("revolutions", "transient_revolutions", "outputs_per_revolution")
+
+
+def _run(case: Case, **times) -> Case:
+    """The case with its run times set (t_end, t_transient, n_out, ...), no section, no
+    Lyapunov exponent."""
+    times.update({k: 0.0 for k in _REVOLUTION_FIELDS if k in case})
+    return case.replace(section="none", lyapunov=False, **times)
+
+
+def _settled_state(model, t0: float, period: float) -> np.ndarray:
     """The state at the first t0 + k period (k >= 1) at or after the case's t_end, from a run of
     the case from its start (the default guess)."""
-    k = max(int(np.ceil((case["t_end"] - t0) / period - 1e-9)),
+    case = model.case
+    t_end = float(model.output_times()[-1])      # the case's t_end, however it was given
+    k = max(int(np.ceil((t_end - t0) / period - 1e-9)),
             int(np.floor((case["t0"] - t0) / period)) + 1)
-    res = simulate(case.replace(t_end=t0 + k * period, t_transient=0.0, n_out=2,
-                                section="none", lyapunov=False))
+    res = simulate(_run(case, t_end=t0 + k * period, t_transient=0.0, n_out=2))
     return res.y[-1].copy()
 
 
 def _trajectory(case: Case, t0: float, t1: float, y0: np.ndarray) -> Result:
     """simulate from (t0, y0) to t1: start at rest plus the state as dq0, dv0 (exact: 0 + y)."""
-    run = case.replace(start="rest", dq0=list(y0[:7]), dv0=list(y0[7:]), t0=t0, t_end=t1,
-                       t_transient=0.0, section="none", lyapunov=False)
+    run = _run(case, start="rest", dq0=list(y0[:7]), dv0=list(y0[7:]), t0=t0, t_end=t1,
+               t_transient=0.0)
     with warnings.catch_warnings():
         # the orbit may start in contact: the start-at-rest overlap warning says nothing here
         warnings.filterwarnings("ignore", message=r".*start = 'rest' with", category=SplineWarning)
