@@ -28,12 +28,13 @@ module spline_api
   use spline_loads, only: run_loads, stress_warnings
   use spline_sections, only: section_count
   use spline_lyapunov, only: lyapunov_count
+  use spline_orbits, only: period_map
   implicit none
   private
   public :: api_load_file, api_load_fields, api_load_text, api_model_size, api_simulate
   public :: api_rhs, api_rhs_mesh, api_start_state, api_loads
   public :: api_output_times, api_model_info, api_defaults, api_names, api_tooth_stiffness
-  public :: api_field_hint, api_warnings
+  public :: api_field_hint, api_warnings, api_period_map
 
   integer, parameter :: ninfo = 12   !< entries of api_model_info
   integer, parameter :: nsizes = 5   !< entries of a load's sizes (load_model)
@@ -331,6 +332,27 @@ contains
     if (ie == err_ok) call start_state(m, y, ie, errmsg)
     ierr = ie
   end subroutine api_start_state
+
+  !> The period map of a loaded model (spline_orbits::period_map): y1(:, k) the SI state at
+  !> t1 of the run from y0(:, k) at t0; mask(i) = 1 for the states its level integrates.
+  !> Called without the GIL; a SIGINT stops it (ierr 4).
+  subroutine api_period_map(model, nb, t0, t1, nc, y0, y1, mask, ierr, errmsg)
+    integer(c_int), intent(in) :: nb, nc
+    integer(c_int), intent(in) :: model(nb)
+    real(c_double), intent(in) :: t0, t1, y0(14, nc)
+    real(c_double), intent(out) :: y1(14, nc)
+    integer(c_int), intent(out) :: mask(14), ierr
+    character(len=msglen), intent(out) :: errmsg
+    type(model_t) :: m
+    integer :: ie, mk(14)
+    y1 = 0; mask = 0
+    call unpack(model, m, ie, errmsg)
+    if (ie == err_ok) then
+      call period_map(m, t0, t1, y0, y1, mk, ie, errmsg, interruptible=.true.)
+      mask = mk
+    end if
+    ierr = ie
+  end subroutine api_period_map
 
   !> The output times of a loaded model (uniform after the transient).
   subroutine api_output_times(model, nb, nt, t, ierr, errmsg)

@@ -1,0 +1,53 @@
+!> The period map of a forced run, for periodic orbits (docs/orbits.md): from a state y0 at
+!> time t0, integrate to t1 = t0 + n T and return the state there (spline_solver::integrate,
+!> with the case's tolerances, contact switches and linear tail). Python's
+!> pyspline.periodic_orbit solves P^n(y0) = y0 with it and differences it for the monodromy.
+module spline_orbits
+  use spline_kinds, only: wp
+  use spline_errors, only: err_ok
+  use spline_model, only: model_t, nstate
+  use spline_dynamics, only: integrated_states
+  use spline_solver, only: integrate
+  use spline_fidelity, only: auto_level
+  use spline_quantities, only: nsolver_stats
+  implicit none
+  private
+  public :: period_map
+
+contains
+
+  !> y1(:, k): the SI state at t1 of the run that starts from y0(:, k) (SI) at t0, one column at
+  !> a time (each its own CVODE run). The model level is the case's, or for fidelity = 'auto'
+  !> the one spline_fidelity::auto_level picks first (a coupled case's one-way level: the re-run
+  !> coupled of spline_run::run_case is not made here). mask(i) = 1 for the states that level
+  !> integrates (dof 3: the torsional ones; the lateral ones stay at their start displacement,
+  !> at rest). ierr /= err_ok: the first column that failed stops the map (errmsg says why).
+  subroutine period_map(m, t0, t1, y0, y1, mask, ierr, errmsg, interruptible)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t0, t1, y0(:, :)
+    real(wp), intent(out) :: y1(:, :)
+    integer, intent(out) :: mask(nstate), ierr
+    character(len=*), intent(out) :: errmsg
+    logical, intent(in), optional :: interruptible
+    type(model_t) :: run
+    real(wp) :: eps_lat, eps_th, tout(1), st(nsolver_stats)
+    integer :: k, idx(nstate), n
+    integer, allocatable :: modes(:, :)
+    call auto_level(m, run, eps_lat, eps_th)
+    run%t0 = t0
+    run%t_end = t1
+    call integrated_states(run, idx, n)
+    mask = 0
+    mask(idx(1:n)) = 1
+    allocate(modes(run%z*run%n_slices, 1))
+    tout = t1
+    y1 = 0.0_wp
+    ierr = err_ok
+    errmsg = ''
+    do k = 1, size(y0, 2)
+      call integrate(run, y0(:, k), 1, tout, y1(:, k:k), modes, st, ierr, errmsg, interruptible)
+      if (ierr /= err_ok) return
+    end do
+  end subroutine period_map
+
+end module spline_orbits

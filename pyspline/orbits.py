@@ -1,0 +1,221 @@
+"""Periodic orbits of a forced run and their Floquet multipliers (docs/orbits.md).
+
+The shaft turns at constant omega, so a run is forced with the shaft period T = 2 pi / omega
+(torque ripple of a fractional order n_k repeats after the revolutions that make n n_k whole).
+A period-n orbit is a fixed point of the n-fold period map, P^n(y0) = y0, where P^n takes the
+state at the section time t0 to the state at t0 + n T (the core integrates it:
+spline_orbits::period_map, with the case's tolerances, root-located contact switches and
+linear tail). Nothing here computes physics: the map is the core's, Newton and the
+eigenvalues are linear algebra on its values.
+"""
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+from fractions import Fraction
+
+import numpy as np
+
+from .case import Case
+from .core import STATE_QUANTITIES, Result, _api, load, raise_for, simulate
+from .errors import CaseError, SolverError, SplineError, SplineWarning
+
+NSTATE = 14
+
+
+class OrbitError(SplineError):
+    """Newton on P^n(y) - y = 0 did not converge (the message says what was tried and the
+    residual reached)."""
+
+
+@dataclass
+class Orbit:
+    """A periodic orbit: its section point y0 at t0 and its Floquet multipliers.
+
+    ``monodromy`` is M = dP^n/dy0 over the integrated states ``states`` (the torsional ones at
+    dof 3), in the scaled states of Eq. 25 (same eigenvalues as in SI units)."""
+    case: Case
+    n: int                   #: shaft periods of the map
+    period: float            #: n T = 2 pi n / omega [s]
+    t0: float                #: section time [s]
+    y0: np.ndarray           #: the orbit's state at t0 (14,), SI
+    trajectory: Result       #: simulate from (t0, y0) over one period (case's n_out points)
+    monodromy: np.ndarray    #: M (k, k), central differences of the core's map
+    states: tuple            #: names of the k states M acts on
+    multipliers: np.ndarray  #: eigenvalues of M, largest modulus first
+    stable: bool             #: every |mu| < 1 - margin
+    margin: float            #: the margin of ``stable``
+    residual: float          #: max |P^n(y0) - y0| in the scaled states of Eq. 25
+    iterations: int          #: Newton steps taken
+    residuals: list = field(default_factory=list)   #: the scaled residual before each step and at the end
+    fd_step: float = 0.0     #: the central-difference step (scaled states)
+
+
+def _period_map(model, t0: float, t1: float, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The core's map of the columns of ys (14, k), SI: (their states at t1, the mask of the
+    integrated states)."""
+    y1, mask, ierr, msg = _api.api_period_map(model.bytes, t0, t1, np.asfortranarray(ys))
+    raise_for(ierr, msg)
+    if not np.isfinite(y1).all():
+        raise SolverError(f"case {model.case.name}: the period map from t = {t0} s to {t1} s "
+                          "gave a non-finite state (the model left its range)")
+    return y1, mask.astype(bool)
+
+
+def forcing_periods(case: Case, n: int) -> None:
+    """Check that the forcing repeats after n shaft revolutions: omega > 0 and every torque
+    ripple term of non-zero amplitude has an order n_k with n n_k whole. CaseError otherwise,
+    naming the field and the n that would do."""
+    if not case["speed_rpm"] > 0:
+        raise CaseError(f"case {case.name}: speed_rpm = {case['speed_rpm']}: the shaft does not "
+                        "turn, so there is no forcing period T = 2 pi/omega for a periodic orbit")
+    for order, amp in zip(case["ripple_order"], case["ripple_amp"]):
+        if amp == 0 or float(order * n).is_integer():
+            continue
+        frac = Fraction(order).limit_denominator(1000)
+        hint = (f"; n = {frac.denominator} revolutions would repeat it"
+                if abs(float(frac) - order) <= 1e-12 * abs(order) else
+                " (no whole number of revolutions up to 1000 repeats it)")
+        raise CaseError(f"case {case.name}: ripple_order = {order:g} (ripple_amp = {amp:g}) does "
+                        f"not repeat within n = {n} shaft revolution(s): n * ripple_order must be "
+                        f"a whole number{hint}")
+
+
+def periodic_orbit(case, n: int = 1, guess=None, t0: float | None = None, tol: float | None = None,
+                   max_iter: int = 12, margin: float = 1e-4) -> Orbit:
+    """The period-n orbit of a forced case near a guess, and its Floquet multipliers.
+
+    Newton on F(y) = P^n(y) - y = 0, with P^n the core's map over n shaft periods from the
+    section time t0 (default: the case's t0) and the Jacobian M - I, where the monodromy
+    M = dP^n/dy0 comes from central differences of the map: state i (scaled by Eq. 25: l_ref
+    for the displacements, l_ref w_ref for the velocities) stepped by h = rtol^(1/3), rtol the
+    case's (the truncation error h^2 balances the map's noise of order rtol / h). All 2k
+    differenced runs go to the core in one call. A step that does not lower the residual is
+    halved (up to 6 times). The variational equations with the saltation matrices at the
+    contact switches (exact M, docs/orbits.md) are the next step; no continuation yet, and an
+    orbit that grazes a contact switch is not detected (its map is not differentiable there).
+
+    guess: a state (14,), SI, at t0; default: the state at t0 + k n T that ends (or first
+    follows) the case's own run from its start (its t_end settles it).
+    tol: the scaled residual max_i |P^n(y0) - y0|_i to reach; default 100 rtol.
+    margin: stable means every |mu| < 1 - margin (the multipliers carry the error of the
+    differences, about h^2 + rtol / h: 1e-7 to 4e-7 measured at rtol 1e-11; keep margin well
+    above it).
+
+    Returns an Orbit. Raises CaseError for bad input (n, guess, a case without a forcing
+    period), OrbitError when Newton does not converge (what was tried, the residual reached),
+    SolverError when a run of the map fails."""
+    model = load(case)
+    case = model.case
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise CaseError(f"case {case.name}: n = {n!r}: the number of shaft periods of the "
+                        "orbit must be a whole number >= 1")
+    n = int(n)
+    forcing_periods(case, n)
+    info = model.info()
+    omega, period = info["omega"], 2 * np.pi * n / info["omega"]
+    t0 = float(case["t0"] if t0 is None else t0)
+    t1 = t0 + period
+    rtol = case["rtol"]
+    tol = 100 * rtol if tol is None else float(tol)
+    scale = np.r_[np.full(7, info["l_ref"]), np.full(7, info["l_ref"] * info["w_ref"])]
+    if guess is None:
+        y = _settled_state(model, t0, period)
+    else:
+        y = np.asarray(guess, dtype=float)
+        if y.shape != (NSTATE,):
+            raise CaseError(f"case {case.name}: guess has shape {y.shape}: a state has {NSTATE} "
+                            f"entries ({', '.join(STATE_QUANTITIES)}), SI")
+        if not np.isfinite(y).all():
+            raise CaseError(f"case {case.name}: guess is not finite")
+    h = rtol ** (1 / 3)
+
+    def residual(y):
+        y1, mask = _period_map(model, t0, t1, y[:, None])
+        return (y1[:, 0] - y) / scale, mask
+
+    def monodromy(y, free):
+        idx = np.flatnonzero(free)
+        steps = h * np.maximum(1.0, np.abs(y[idx] / scale[idx]))
+        cols = np.repeat(y[:, None], 2 * len(idx), axis=1)
+        for c, (i, s) in enumerate(zip(idx, steps)):
+            cols[i, 2 * c] += s * scale[i]
+            cols[i, 2 * c + 1] -= s * scale[i]
+        y1, _ = _period_map(model, t0, t1, cols)
+        z1 = y1[idx] / scale[idx, None]
+        return (z1[:, 0::2] - z1[:, 1::2]) / (2 * steps)
+
+    r, free = residual(y)
+    hist = [float(np.abs(r[free]).max())]
+    it = 0
+    while hist[-1] > tol:
+        if it == max_iter:
+            _fail(case, n, period, t0, it, hist, tol, "the iteration limit max_iter was reached")
+        M = monodromy(y, free)
+        try:
+            dz = np.linalg.solve(M - np.eye(len(M)), -r[free])
+        except np.linalg.LinAlgError:
+            _fail(case, n, period, t0, it, hist, tol, "M - I is singular (a multiplier at 1)")
+        it += 1
+        for _ in range(7):
+            y_new = y.copy()
+            y_new[free] += dz * scale[free]
+            r_new, _ = residual(y_new)
+            if np.abs(r_new[free]).max() < hist[-1]:
+                break
+            dz = dz / 2
+        else:
+            _fail(case, n, period, t0, it, hist, tol,
+                  "the Newton step, halved 6 times, did not lower the residual")
+        y, r = y_new, r_new
+        hist.append(float(np.abs(r[free]).max()))
+    M = monodromy(y, free)
+    mu = np.linalg.eigvals(M)
+    mu = mu[np.argsort(-np.abs(mu), kind="stable")]
+    names = tuple(str(s) for s, f in zip(STATE_QUANTITIES, free) if f)
+    return Orbit(case=case, n=n, period=period, t0=t0, y0=y, trajectory=_trajectory(case, t0, t1, y),
+                 monodromy=M, states=names, multipliers=mu,
+                 stable=bool(np.all(np.abs(mu) < 1 - margin)), margin=margin,
+                 residual=hist[-1], iterations=it, residuals=hist, fd_step=h)
+
+
+def _fail(case, n, period, t0, it, hist, tol, why):
+    raise OrbitError(
+        f"case {case.name}: no period-{n} orbit found (Newton on P^n(y) - y = 0, period "
+        f"{period:.6g} s from t0 = {t0:.6g} s): {why} after {it} Newton step(s); scaled residual "
+        f"{hist[-1]:.3g} (wanted {tol:.3g}), history {', '.join(f'{v:.2g}' for v in hist)}. "
+        "Try a guess nearer the orbit (a longer settling run: t_end), another n, or a "
+        "looser tol")
+
+
+#: run-length fields given in shaft revolutions win over t_end, t_transient, n_out: zeroed
+#: where a run's times are set here (when the case has them)
+_REVOLUTION_FIELDS = ("revolutions", "transient_revolutions", "outputs_per_revolution")
+
+
+def _run(case: Case, **times) -> Case:
+    """The case with its run times set (t_end, t_transient, n_out, ...), no section, no
+    Lyapunov exponent."""
+    times.update({k: 0.0 for k in _REVOLUTION_FIELDS if k in case})
+    return case.replace(section="none", lyapunov=False, **times)
+
+
+def _settled_state(model, t0: float, period: float) -> np.ndarray:
+    """The state at the first t0 + k period (k >= 1) at or after the case's t_end, from a run of
+    the case from its start (the default guess)."""
+    case = model.case
+    t_end = float(model.output_times()[-1])      # the case's t_end, however it was given
+    k = max(int(np.ceil((t_end - t0) / period - 1e-9)),
+            int(np.floor((case["t0"] - t0) / period)) + 1)
+    res = simulate(_run(case, t_end=t0 + k * period, t_transient=0.0, n_out=2))
+    return res.y[-1].copy()
+
+
+def _trajectory(case: Case, t0: float, t1: float, y0: np.ndarray) -> Result:
+    """simulate from (t0, y0) to t1: start at rest plus the state as dq0, dv0 (exact: 0 + y)."""
+    run = _run(case, start="rest", dq0=list(y0[:7]), dv0=list(y0[7:]), t0=t0, t_end=t1,
+               t_transient=0.0)
+    with warnings.catch_warnings():
+        # the orbit may start in contact: the start-at-rest overlap warning says nothing here
+        warnings.filterwarnings("ignore", message=r".*start = 'rest' with", category=SplineWarning)
+        return simulate(run)
