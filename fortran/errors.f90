@@ -3,10 +3,11 @@
 !> field, or the CVODE flag and the time. Python maps them to exceptions (pyspline.errors),
 !> the executable to exit codes (err_exit_code).
 module spline_errors
+  use spline_kinds, only: wp
   implicit none
   private
   public :: err_ok, err_case, err_solver, err_thermal, err_interrupted, nerr, err_names
-  public :: msglen, err_exit_code, itoa
+  public :: msglen, err_exit_code, itoa, ftoa
 
   integer, parameter :: err_ok = 0           !< success
   integer, parameter :: err_case = 1         !< bad case: field missing, ill-typed, out of range
@@ -45,5 +46,15 @@ contains
     write(buf, '(i0)') i
     s = trim(buf)
   end function itoa
+
+  !> A real as text in the format f, without blanks, for messages (e.g. '(es10.3)', '(f0.2)').
+  function ftoa(x, f) result(s)
+    real(wp), intent(in) :: x
+    character(len=*), intent(in) :: f
+    character(len=:), allocatable :: s
+    character(len=40) :: buf
+    write(buf, f) x
+    s = trim(adjustl(buf))
+  end function ftoa
 
 end module spline_errors

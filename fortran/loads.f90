@@ -10,7 +10,7 @@ module spline_loads
   use spline_kinds, only: wp, pi, max_teeth
   use spline_model, only: model_t, nstate
   use spline_geometry, only: tooth_angles, root_section, active_profile
-  use spline_errors, only: itoa
+  use spline_errors, only: itoa, ftoa
   use spline_quantities, only: iq_tf, nload, nload_tooth, il_f_static, &
        il_load_sharing, il_load_sharing_tooth, il_free_max, il_back_max, il_free_mean, &
        il_unloaded, il_back_teeth, il_impacts_rev, il_closing_speed, il_tf_max, il_tf_max_tooth, &
@@ -183,9 +183,9 @@ contains
       character(len=:), allocatable :: line
       line = ''
       if (.not. x > limit) return
-      line = 'case '//trim(m%name)//': '//what//' = '//fmt(x*1.0e-6_wp, '(f0.1)')// &
+      line = 'case '//trim(m%name)//': '//what//' = '//ftoa(x*1.0e-6_wp, '(f0.1)')// &
            ' MPa at the peak load of tooth '//itoa(nint(loads(il_load_sharing_tooth)))// &
-           ' (t_d = '//fmt(m%t_d, '(es10.3)')//' N m) exceeds '//itoa(nint(limit*1.0e-6_wp))// &
+           ' (t_d = '//ftoa(m%t_d, '(es10.3)')//' N m) exceeds '//itoa(nint(limit*1.0e-6_wp))// &
            ' MPa, a typical allowable of case-hardened steel (an estimate, docs/model.md '// &
            'section 15)'//hint(x, limit)//'. Run as given'//new_line('a')
     end function over
@@ -199,20 +199,10 @@ contains
       if (x/loads(il_load_sharing) > limit) then
         h = ': the static load alone is beyond it, a torque in N mm?'
       else
-        h = ': a dynamic peak, load-sharing factor '//fmt(loads(il_load_sharing), '(f0.2)')
+        h = ': a dynamic peak, load-sharing factor '//ftoa(loads(il_load_sharing), '(f0.2)')
       end if
     end function hint
   end function stress_warnings
-
-  !> x written with format f, without blanks.
-  function fmt(x, f) result(s)
-    real(wp), intent(in) :: x
-    character(len=*), intent(in) :: f
-    character(len=:), allocatable :: s
-    character(len=40) :: buf
-    write(buf, f) x
-    s = trim(adjustl(buf))
-  end function fmt
 
   !> Standard errors by batch means (e.g. Law & Kelton, Simulation Modeling and Analysis,
   !> ch. 9.5): output k belongs to revolution b = floor(omega (t_k - t_1) / 2 pi) + 1; the

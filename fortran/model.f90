@@ -5,7 +5,7 @@
 module spline_model
   use spline_kinds, only: wp, pi, max_teeth
   use, intrinsic :: iso_fortran_env, only: int64
-  use spline_errors, only: err_ok, err_case, err_thermal, itoa
+  use spline_errors, only: err_ok, err_case, err_thermal, itoa, ftoa
   use spline_case, only: case_t, case_validate, case_run_times, namelen, option_index, thermal_values, &
        method_values, nonlinear_values, start_values, fidelity_values, section_values, nripple
   use spline_geometry, only: iso4156_radii, pitch_rotation, tooth_angles
@@ -275,9 +275,9 @@ contains
     text = ''
     if (.not. m%k_m_computed .and. m%k_m_nofillet > 0.0_wp) then
       if (m%k_m*k_m_warn_ratio < m%k_m_nofillet) then
-        text = text//'case '//trim(m%name)//': field k_m = '//fmt(m%k_m, '(es10.3)')//' N/m is '// &
-             fmt(m%k_m_nofillet/m%k_m, '(es8.1)')//' times below the potential-energy mesh '// &
-             'stiffness of this geometry (Eq. 18: '//fmt(m%k_m_nofillet, '(es10.3)')//' N/m): a '// &
+        text = text//'case '//trim(m%name)//': field k_m = '//ftoa(m%k_m, '(es10.3)')//' N/m is '// &
+             ftoa(m%k_m_nofillet/m%k_m, '(es8.1)')//' times below the potential-energy mesh '// &
+             'stiffness of this geometry (Eq. 18: '//ftoa(m%k_m_nofillet, '(es10.3)')//' N/m): a '// &
              'unit slip (N/mm for N/m)? Run as given'//new_line('a')
       end if
     end if
@@ -316,7 +316,7 @@ contains
     call shaft('k_t1', m%k_t1, 't_d', m%t_d)
     call shaft('k_t2', m%k_t2, 't_l', m%t_l)
     if (len(text) > 0) text = 'case '//trim(m%name)//': '//text//' (limit '// &
-         fmt(windup_limit, '(f4.2)')//' rad = '//fmt(windup_limit*180.0_wp/pi, '(f4.1)')// &
+         ftoa(windup_limit, '(f4.2)')//' rad = '//ftoa(windup_limit*180.0_wp/pi, '(f4.1)')// &
          ' deg): shafts this soft? Run as given'//new_line('a')
   contains
     subroutine shaft(kname, k, tname, t)
@@ -377,24 +377,14 @@ contains
     real(wp), intent(in) :: x
     character(len=:), allocatable :: s
     if (abs(x) >= 1.0e-2_wp .and. abs(x) < 1.0e4_wp) then
-      s = fmt(x, '(f12.4)')
-      if (abs(x) >= 10.0_wp) s = fmt(x, '(f12.3)')
-      if (abs(x) >= 100.0_wp) s = fmt(x, '(f12.2)')
-      if (abs(x) >= 1000.0_wp) s = fmt(x, '(f12.1)')
+      s = ftoa(x, '(f12.4)')
+      if (abs(x) >= 10.0_wp) s = ftoa(x, '(f12.3)')
+      if (abs(x) >= 100.0_wp) s = ftoa(x, '(f12.2)')
+      if (abs(x) >= 1000.0_wp) s = ftoa(x, '(f12.1)')
     else
-      s = fmt(x, '(es10.3)')
+      s = ftoa(x, '(es10.3)')
     end if
   end function num
-
-  !> x written with format f, without blanks (the warnings' numbers).
-  function fmt(x, f) result(s)
-    real(wp), intent(in) :: x
-    character(len=*), intent(in) :: f
-    character(len=:), allocatable :: s
-    character(len=32) :: buf
-    write(buf, f) x
-    s = trim(adjustl(buf))
-  end function fmt
 
   !> Set the thermal level of a model and the backlash it implies at the bulk temperature:
   !> Eq. 2 with T_B = T_M, or c_0 for the level none.
