@@ -74,8 +74,9 @@ contains
   !>   approach_speed at t_(k-1), the last output before it.
   !> - T_f max over teeth and outputs, the first tooth and time where it occurs (0 and -1 if it
   !>   is 0 throughout: a thermal level without T_f).
-  !> - standard errors by batch means (batch_means): the batches are the whole revolutions of
-  !>   the outputs; per batch the RMS of T_m and the load-sharing factor.
+  !> - standard errors by batch means (batch_means): per whole revolution of the outputs the
+  !>   RMS of T_m and the load-sharing factor, their standard errors by overlapping batches of
+  !>   floor(sqrt(revolutions)) revolutions (std_error).
   pure subroutine run_loads(m, t, y, tooth, tm, loads, tload)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t(:), y(:, :), tooth(:, :, :), tm(:)
@@ -208,7 +209,8 @@ contains
   !> ch. 9.5): output k belongs to revolution b = floor(omega (t_k - t_1) / 2 pi) + 1; the
   !> nb = floor(revolutions) whole ones are the batches (outputs past them are left out). Per
   !> batch x_b: the RMS of T_m, sqrt(mean T_m^2), and the load-sharing factor max |F_j| / F_s;
-  !> the standard error of their mean is sd(x_b) / sqrt(nb) (sd with nb - 1). NaN with fewer
+  !> the standard error of their mean by std_error (overlapping batches of floor(sqrt(nb))
+  !> revolutions: in a chaotic run consecutive revolutions are correlated). NaN with fewer
   !> than 2 batches (and for the load sharing when F_s = 0).
   pure subroutine batch_means(m, t, tooth, tm, fs, loads)
     type(model_t), intent(in) :: m
@@ -243,12 +245,24 @@ contains
     end if
   end subroutine batch_means
 
-  !> Standard error of the mean of x: sd(x) / sqrt(n), sd with n - 1 (n >= 2).
+  !> Standard error of the mean of x(1..n) (n >= 2), consecutive and possibly correlated, by
+  !> overlapping batch means (Meketon & Schmeiser 1984; docs/model.md section 15): batches of
+  !> m = floor(sqrt(n)) consecutive values, one starting at each of i = 1..n-m+1, with means
+  !> xb_i; variance of the mean n m / ((n - m)(n - m + 1)) sum_i (xb_i - mean)^2 / n.
+  !> m = 1 (n < 4) is sd(x) / sqrt(n).
   pure real(wp) function std_error(x) result(se)
     real(wp), intent(in) :: x(:)
-    real(wp) :: mean
-    mean = sum(x)/size(x)
-    se = sqrt(sum((x - mean)**2)/(size(x) - 1))/sqrt(real(size(x), wp))
+    real(wp) :: mean, xb, ss
+    integer :: n, m, i
+    n = size(x)
+    m = int(sqrt(real(n, wp)))
+    mean = sum(x)/n
+    ss = 0.0_wp
+    do i = 1, n - m + 1
+      xb = sum(x(i:i + m - 1))/m
+      ss = ss + (xb - mean)**2
+    end do
+    se = sqrt(real(m, wp)*ss/(real(n - m, wp)*real(n - m + 1, wp)))
   end function std_error
 
 end module spline_loads

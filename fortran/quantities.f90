@@ -135,14 +135,14 @@ module spline_quantities
        quantity_t('Tf_max_tooth', '', 'the tooth of the largest T_f (0: T_f is 0 throughout)'), &
        quantity_t('Tf_max_t_s', 's', 'the time of the largest T_f (-1: T_f is 0 throughout)'), &
        quantity_t('revolutions', '', 'shaft revolutions spanned by the outputs'), &
-       quantity_t('batches', '', 'whole revolutions of the outputs, the batches of the &
-            &standard errors'), &
-       quantity_t('Tm_rms_se', 'N m', 'standard error of the RMS of T_m by batch means over &
-            &revolutions (NaN: < 2 batches)'), &
+       quantity_t('batches', '', 'whole revolutions of the outputs, the values the &
+            &standard errors are taken over'), &
+       quantity_t('Tm_rms_se', 'N m', 'standard error of the RMS of T_m by overlapping batch &
+            &means of sqrt(batches) revolutions (NaN: < 2 batches)'), &
        quantity_t('load_sharing_rev', '-', 'mean over the revolutions of each one''s &
             &load-sharing factor'), &
-       quantity_t('load_sharing_rev_se', '-', 'standard error of load_sharing_rev by batch means &
-            &(NaN: < 2 batches)'), &
+       quantity_t('load_sharing_rev_se', '-', 'standard error of load_sharing_rev by overlapping &
+            &batch means (NaN: < 2 batches)'), &
        quantity_t('sigma_root', 'Pa', 'nominal root bending stress of the most loaded tooth at &
             &its peak load, 6 F cos(alpha) h_f / (b t_f^2)'), &
        quantity_t('sigma_flank', 'Pa', 'nominal flank bearing (compressive) stress at that load, &
