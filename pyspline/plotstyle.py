@@ -145,6 +145,13 @@ def roundoff_span(x, scale=0.0, rtol=1e-8) -> float | None:
     return span if span <= bar else None
 
 
+def roundoff_amplitude(amplitude, scale, rtol=1e-8) -> bool:
+    """A spectrum whose largest amplitude is round-off by the rule of `roundoff_span`: a tone
+    of amplitude A spans 2 A, judged against the signal's size `scale` (e.g. its RMS)."""
+    bar = max(ROUNDOFF_REL, ROUNDOFF_RTOLS * rtol) * float(scale)
+    return bool(scale > 0 and np.isfinite(amplitude) and 2.0 * amplitude <= bar)
+
+
 def flat_limits(centre, scale) -> tuple[float, float]:
     """Limits around a constant value: +-1 % of max(|centre|, scale) (+-1 if both are 0)."""
     half = 0.01 * max(abs(centre), scale) or 1.0

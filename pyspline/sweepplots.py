@@ -273,7 +273,8 @@ def lyapunov_vs_param(ds, param: str, var: str = "lyapunov", path=None,
 def waterfall(ds, speed: str = "speed_rpm", freq: str = "freq_hz", amp: str = "amplitude",
               z: int | None = None, max_order: float | None = None, path=None,
               style: str = "map", floor: float = 1e-4, title: str | None = None,
-              units: dict | None = None, duration: float | None = None) -> Figure:
+              units: dict | None = None, duration: float | None = None,
+              scale: float | None = None, rtol: float = 1e-8) -> Figure:
     """Spectra against speed: frequency [Hz] on x, speed [rpm] on y.
 
     ``ds[amp]`` has dims (speed, freq); ``ds[freq]`` is 1-D (one frequency grid for all) or
@@ -287,7 +288,9 @@ def waterfall(ds, speed: str = "speed_rpm", freq: str = "freq_hz", amp: str = "a
     frequency of any speed with a finite amplitude (its Nyquist frequency; amplitudes beyond it
     are NaN). A tooth pass Z x |rpm| / 60 above the data of its speed is named on the figure
     and warned about (SplineWarning); given `duration`, the sampled time [s] of each run
-    (t_end - t0 - t_transient), with the n_out that resolves it."""
+    (t_end - t0 - t_transient), with the n_out that resolves it. Given `scale`, the signal's
+    size (e.g. the largest RMS of T_m), a map whose largest amplitude is round-off by the rule
+    of the run plots (`plotstyle.roundoff_amplitude`, with the runs' `rtol`) says so on it."""
     rpm = ps.array(ds, speed)
     a = ps.array(ds, amp, dims=(speed, freq) if hasattr(ds, "dims") else None)
     f = ps.array(ds, freq)
@@ -345,6 +348,8 @@ def waterfall(ds, speed: str = "speed_rpm", freq: str = "freq_hz", amp: str = "a
     ax.set_ylim(y_lo, y_hi)
     if words:
         ps.note(ax, words, loc="lower right")
+    if scale is not None and ps.roundoff_amplitude(top, scale, rtol):
+        ps.note(ax, ps.no_content(2.0 * top, amp_unit) + ":\nthese amplitudes are round-off")
     ax.set_xlabel(ps.label(ds, freq, units=units) if ps.unit_of(ds, freq, "", units)
                   else "frequency [Hz]")
     ax.set_ylabel(ps.label(ds, speed, units=units) if ps.unit_of(ds, speed, "", units)
@@ -460,9 +465,14 @@ def _waterfalls(ds, out, title_case) -> list[Path]:
     names = list(ds["error"].dims)
     z = None if "z" in names else _z(ds)
     duration = _duration(ds)
+    rtol = _case_value(ds, "rtol")
+
+    def size(d):                       # T_m's size, against which round-off is judged
+        return float(np.nanmax(np.abs(d["Tm_rms"].values))) if "Tm_rms" in d else None
     if len(names) == 1:
         path = out / "waterfall.png"
-        waterfall(_waterfall_ds(ds), z=z, path=path, duration=duration,
+        waterfall(_waterfall_ds(ds), z=z, path=path, duration=duration, scale=size(ds),
+                  rtol=rtol,
                   title=f"{title_case}: spectrum of T_m vs speed (dashed: shaft and "
                         "tooth-pass orders)")
         return [path]
@@ -474,7 +484,8 @@ def _waterfalls(ds, out, title_case) -> list[Path]:
         v = values[i]
         sub = ds.isel({other: i})
         path = out / f"waterfall_{other}={_fmt(v)}.png"
-        waterfall(_waterfall_ds(sub), z=z, path=path, duration=duration,
+        waterfall(_waterfall_ds(sub), z=z, path=path, duration=duration, scale=size(sub),
+                  rtol=rtol,
                   title=f"{title_case}, {other} = {_fmt(v)}: spectrum of T_m vs speed")
         paths.append(path)
     return paths

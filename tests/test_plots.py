@@ -129,6 +129,18 @@ def test_waterfall_stops_at_nyquist_and_warns_about_tooth_pass():
     assert (1922 - 1) / (2 * 0.3) > 3200.0 >= (1921 - 1) / (2 * 0.3)
 
 
+def test_waterfall_of_round_off_says_so():
+    """Amplitudes of 1e-7 of a signal's size are round-off (the run plots' rule): the map says
+    so; at 1e-5 of it they are content and it does not."""
+    ds = _nyquist_spectra([3000, 6000], f_nyq=4000.0)
+    top = float(np.nanmax(ds["amplitude"]))
+    flat = pl.waterfall(ds, z=16, scale=top / 1e-7, rtol=1e-8)
+    assert "these amplitudes are round-off" in _texts(flat.axes[0])
+    real = pl.waterfall(ds, z=16, scale=top / 1e-5, rtol=1e-8)
+    assert "round-off" not in _texts(real.axes[0])
+    assert ps.roundoff_amplitude(1.0, 1e7, rtol=1e-8) and not ps.roundoff_amplitude(1.0, 1e6)
+
+
 def test_waterfall_within_nyquist_does_not_warn():
     ds = _nyquist_spectra([3000, 6000], f_nyq=4000.0)
     with warnings.catch_warnings():
