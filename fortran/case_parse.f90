@@ -7,7 +7,7 @@
 !> whole text passed, so reading a case changes no module variable (reentrant). Writing a case
 !> as namelist text (case_write_text) uses the compiler's namelist output.
 module spline_case_parse
-  use spline_kinds, only: wp
+  use spline_kinds, only: wp, max_teeth
   use spline_errors, only: err_ok, err_case, itoa
   use spline_case_type, only: case_t, fields, nfields, namelen, field_index
   use spline_case_values, only: case_value_sizes, case_to_values, case_from_values, &
@@ -508,12 +508,16 @@ contains
   end subroutine parse_unlocked
 
   !> A case as namelist text (every field, one per line): Python reads the defaults from it.
+  !> The records: about 90 for the scalar fields and the short lists, and at least one for
+  !> every 5 values of a list as long as max_teeth (spacing_error with distinct values).
   subroutine case_write_text(c, text)
     type(case_t), intent(in) :: c
     character(len=:), allocatable, intent(out) :: text
     type(case_t) :: cc
-    character(len=256) :: lines(120), iomsg
+    character(len=256), allocatable :: lines(:)
+    character(len=256) :: iomsg
     integer :: i, ierr
+    allocate(lines(200 + max_teeth))
     lines = ''
     cc = c
     call io_lock()           ! namelist I/O is not thread-safe in libgfortran (iolock.c)

@@ -126,6 +126,22 @@ def test_summary_reads_back_the_core_numbers(tmp_path, exe):
                if k.split(".")[-1] not in TIMINGS)
 
 
+def test_summary_keeps_a_long_spacing_error_list(tmp_path, exe):
+    """The case at a summary's end is the whole case: 400 distinct spacing errors (about 80
+    namelist records, which overflowed the 120-record buffer the case text was written into
+    before) read back equal, bit for bit."""
+    e = np.random.default_rng(7).normal(0.0, 1e-7, 400)
+    base = pyspline.load_case(CASE, z=400, spacing_error=list(e), t_end=2e-4, n_out=3)
+    nml = tmp_path / "z400.nml"
+    nml.write_text(base.text(), encoding="utf-8")
+    run = subprocess.run([exe, str(nml), "--summary", "z.summary"], cwd=tmp_path,
+                         capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    case = read_summary(tmp_path / "z.summary")["case"]
+    assert case["z"] == 400 and np.array_equal(case["spacing_error"][:400], e)
+    assert case.text() == base.text()
+
+
 def test_failed_run_summary_and_refusals(tmp_path, exe):
     """A run that fails writes a summary with the error and keeps its exit code; merge shows it
     as the sweep shows a failed point. A summary is never the case file."""
