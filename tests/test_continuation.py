@@ -136,3 +136,69 @@ def test_follow_sweeps_jump_at_the_folds(resonance_branch):
     below = (speeds > speeds[0]) & (speeds < folds[0] - 15)
     want = np.interp(speeds[below], p[lower], y[lower])
     assert np.allclose(pp[:, below], want, rtol=0.02)
+
+
+def cli(tmp_path, *args):
+    # cwd: not the checkout, whose source tree would shadow the installed package
+    return subprocess.run([sys.executable, "-m", "pyspline", *args], capture_output=True,
+                          text=True, timeout=300, cwd=tmp_path)
+
+
+def test_cli_end_to_end(tmp_path):
+    """`pyspline continue` on the linear scene: continuation.nc holds the branch (the same
+    numbers as the Python call), frequency_response.png is drawn, exit 0; a field that
+    cannot be continued is a CaseError naming it, exit 2."""
+    import xarray as xr
+    case, *_ = linear_scene(2.0)
+    path = tmp_path / "scene.nml"
+    path.write_text(case.text())
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2600",
+              "--stop", "3800", "--ds", "0.1", "--out", "out", "--quiet")
+    assert run.returncode == 0, run.stderr
+    assert "wrote out/continuation.nc" in run.stdout and "points on 1 branch(es)" in run.stdout
+    ds = xr.open_dataset(tmp_path / "out" / "continuation.nc", engine="h5netcdf")
+    want = pyspline.continuation(case, "speed_rpm", 2600, 3800, ds=0.1, progress=False)
+    assert np.array_equal(ds.speed_rpm, want.speed_rpm) and np.array_equal(ds.y0, want.y0)
+    assert ds.attrs["command"].startswith("pyspline continue")
+    assert (tmp_path / "out" / "frequency_response.png").stat().st_size > 10_000
+    run = cli(tmp_path, "continue", str(path), "--field", "z", "--start", "16", "--stop", "20")
+    assert run.returncode == 2 and "field z cannot be continued" in run.stderr, run.stderr
+    # a follow sweep from the command line: both directions in sweep.nc, one overlaid figure
+    run = cli(tmp_path, "sweep", str(path), "--set", "speed_rpm=2600:3000:3", "--follow", "both",
+              "--fix", "t_end=0.04", "--out", "sw", "--quiet")
+    assert run.returncode == 0, run.stderr
+    sw = pyspline.open_sweep(tmp_path / "sw")
+    assert list(sw.direction.values) == ["up", "down"] and sw.attrs["follow"] == "both"
+    assert "--follow=both" in sw.attrs["command"] and (sw.error == "").all()
+    assert (tmp_path / "sw" / "bifurcation.png").exists()
+
+
+@pytest.mark.parametrize("field, match", [
+    ("method", "field method cannot be continued"),
+    ("rtol", "field rtol cannot be continued"),
+    ("nonsense", "unknown field 'nonsense'"),
+    ("speed_rpm(2)", "field speed_rpm is not an array"),
+    ("ripple_amp(5)", r"ripple_amp\(5\): index out of 1..4")])
+def test_bad_field(field, match):
+    with pytest.raises(pyspline.CaseError, match=match):
+        pyspline.continuation(RESONANCE, field, 0.1, 0.2, progress=False)
+
+
+def test_bad_range_and_follow():
+    with pytest.raises(pyspline.CaseError, match="start and stop must be finite and differ"):
+        pyspline.continuation(RESONANCE, "t_d", 30, 30, progress=False)
+    with pytest.raises(pyspline.CaseError, match="follow= needs exactly one swept field"):
+        pyspline.sweep(RESONANCE, speed_rpm=[1, 2], t_d=[1, 2], follow="up", progress=False)
+    with pytest.raises(pyspline.CaseError, match="follow must be one of up, down, both"):
+        pyspline.sweep(RESONANCE, speed_rpm=[1, 2], follow="sideways", progress=False)
+
+
+def test_corrector_failure_says_where():
+    """A corrector allowed no Newton step cannot converge off the start: the step halves
+    down to ds_min, then OrbitError names where, the residual reached and its history."""
+    case, *_ = linear_scene(2.0)
+    with pytest.raises(pyspline.OrbitError, match=r"continuation in speed_rpm: the corrector did "
+                       r"not converge after point 1 of branch 0, near speed_rpm = 26.*arclength step down to "
+                       r".*scaled residual .*wanted 1e-09\), history"):
+        pyspline.continuation(case, "speed_rpm", 2600, 3800, progress=False, max_corrector=0,
+                              ds_min=0.01)
