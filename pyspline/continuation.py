@@ -281,7 +281,7 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
                         sp["branch"] = len(branches) - 1
                         specials.append(sp)
                         if (sp["type"] == "period_doubling" and switch and len(branches) < 4
-                                and nb <= 4 * n):
+                                and nb <= 4 * n and _smooth(sp)):
                             todo.append(_doubled_start(sp, nb, y_fixed))
     finally:
         bar.close()
@@ -534,6 +534,10 @@ def continuation_dataset(case, prob, label, branches, specials, margin, k, attrs
         "special_n": (("special",), np.array([s["n"] for s in specials], int)),
         "special_mu_real": (("special",), crit.real, {"long_name": "critical multiplier, real part"}),
         "special_mu_imag": (("special",), crit.imag, {"long_name": "critical multiplier, imaginary part"}),
+        "special_smooth": (("special",), np.array([_smooth(s) for s in specials], np.int8),
+                           {"long_name": "1: the critical multiplier is at +1, -1 or on the unit "
+                                         "circle (within 0.01); 0: it jumped across (a "
+                                         "non-smooth bifurcation, e.g. at a grazing)"}),
         "special_y0": (("special", "state"), np.array([s["y"] for s in specials]).reshape(nsp, 14),
                        {"long_name": "section state at t0 (SI)"}),
     })
@@ -546,6 +550,16 @@ def continuation_dataset(case, prob, label, branches, specials, margin, k, attrs
                     pyspline_version=_version(), n_points=npt, n_special=nsp,
                     n_branches=len(branches), **attrs)
     return ds
+
+
+def _smooth(sp) -> bool:
+    mu = sp["critical"]
+    target = {"fold": 1.0, "period_doubling": -1.0}.get(sp["type"])
+    if target is not None:
+        return abs(mu - target) < 1e-2
+    if sp["type"] == "neimark_sacker":
+        return abs(abs(mu) - 1) < 1e-2
+    return True
 
 
 def _version():
@@ -606,16 +620,22 @@ def cmd_continue(args, fixed, exit_code) -> int:
     print(f"{ds.attrs['n_points']} points on {ds.attrs['n_branches']} branch(es), "
           f"{int(ds.stable.sum())} stable, in {ds.attrs['wall_s']:.1f} s")
     for i in range(ds.sizes["special"]):
+        kind = str(ds.special_type.values[i])
         mu = complex(ds.special_mu_real[i], ds.special_mu_imag[i])
-        print(f"{str(ds.special_type.values[i]):16s} {label} = {float(ds[f'special_{label}'][i]):.6g}"
-              f"  period {int(ds.special_n[i])}  critical multiplier {mu:.4f}  "
-              f"{MEASURES['Tm_pp'][0]} {float(ds.special_Tm_pp[i]):.4g} N m")
+        what = (f"closest approach {float(ds.special_closest_approach[i]):.3g} m" if kind ==
+                "grazing" else f"critical multiplier {mu:.4f}")
+        print(f"{kind:16s} {label} = {float(ds[f'special_{label}'][i]):.6g}  period "
+              f"{int(ds.special_n[i])}  {what}  {MEASURES['Tm_pp'][0]} "
+              f"{float(ds.special_Tm_pp[i]):.4g} N m"
+              + ("" if ds.special_smooth[i] else "  (non-smooth: the multiplier jumped across)"))
     print(f"wrote {out / 'continuation.nc'}")
     if sw is not None:
         write_netcdf(sw, out / "sweep.nc")
         print(f"wrote {out / 'sweep.nc'}")
     path = out / "frequency_response.png"
-    frequency_response(ds, args.measure, sweep=sw, path=path)
+    frequency_response(ds, args.measure, sweep=sw, path=path,
+                       title=f"{case.name}: {MEASURES[args.measure][0]} of the periodic orbits "
+                             f"vs {label}" + (", follow sweeps up and down" if sw else ""))
     print(f"wrote {path}")
     return 0
 

@@ -99,6 +99,7 @@ def test_folds_have_a_multiplier_at_one(resonance_branch):
     assert len(folds) == 2
     mu = ds.special_mu_real.values[folds] + 1j * ds.special_mu_imag.values[folds]
     assert np.abs(mu - 1).max() < 1e-3, mu
+    assert (ds.special_smooth.values[folds] == 1).all()
     p_hi, p_lo = ds.special_speed_rpm.values[folds]
     assert 2400 < p_lo < p_hi < 2530
     # the field turns back at the folds and only there; stable, unstable, stable between them
