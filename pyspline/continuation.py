@@ -22,7 +22,7 @@ import numpy as np
 from .case import Case, defaults, load_case
 from .core import STATE_QUANTITIES, load
 from .errors import CaseError, SolverError, SplineWarning
-from .orbits import (OrbitError, _scale, _trajectory, forcing_periods, map_and_monodromy,
+from .orbits import (OrbitError, _period_map, _trajectory, forcing_periods, map_and_monodromy,
                      periodic_orbit)
 
 __all__ = ["continuation", "SPECIAL_TYPES"]
@@ -121,17 +121,22 @@ class _Problem:
         Fq = []
         for pp in (p + hp, p - hp):
             mm = self.model(pp)
-            y1p, _, _ = map_and_monodromy_map_only(mm, self.t0, self.t1(pp, n), y)
+            y1p, _, _ = _map_only(mm, self.t0, self.t1(pp, n), y)
             Fq.append((y1p - y)[free] / self.d0[free])
         J = np.c_[M - np.eye(len(M)), (Fq[0] - Fq[1]) / (2 * hp / self.pscale)]
         return F, J, M, y
 
 
-def map_and_monodromy_map_only(model, t0, t1, y):
-    """The map alone (no monodromy) through the same core entry."""
-    from .orbits import _period_map
+def _map_only(model, t0, t1, y):
+    """The core's map alone (no monodromy): (y1, None, free)."""
     y1, free = _period_map(model, t0, t1, np.asarray(y, float)[:, None])
     return y1[:, 0], None, free
+
+
+def _scale(info: dict) -> np.ndarray:
+    """The scales of Eq. 25 of the 14 states (l_ref; l_ref w_ref for the velocities): those
+    of orbits.map_and_monodromy's M."""
+    return np.r_[np.full(7, info["l_ref"]), np.full(7, info["l_ref"] * info["w_ref"])]
 
 
 # --------------------------------------------------------------------------- test functions
@@ -261,7 +266,7 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     forcing_periods(c0, n)
     tol = 100 * base["rtol"] if tol is None else float(tol)
     orbit = periodic_orbit(c0, n=n, guess=guess, tol=tol)
-    prob.free = map_and_monodromy_map_only(prob.model(start), t0, prob.t1(start, n), orbit.y0)[2]
+    prob.free = _map_only(prob.model(start), t0, prob.t1(start, n), orbit.y0)[2]
     k = int(prob.free.sum())
     branches, specials = [], []
     bar = tqdm(total=max_points, desc=f"continue {label}", unit="point", disable=not progress,
@@ -362,7 +367,7 @@ def _new_orbit(br, y, u):
     """The doubled branch's point is not the period-n orbit again: P^(n/2)(y) != y."""
     prob = br.prob
     p = prob.p_of(u[-1])
-    y1, _, free = map_and_monodromy_map_only(prob.model(p), prob.t0, prob.t1(p, br.n // 2), y)
+    y1, _, free = _map_only(prob.model(p), prob.t0, prob.t1(p, br.n // 2), y)
     return np.abs((y1 - y)[free] / prob.d0[free]).max() > 1e3 * br.tol
 
 
@@ -541,7 +546,7 @@ def continuation_dataset(case, prob, label, branches, specials, margin, k, attrs
         "special_y0": (("special", "state"), np.array([s["y"] for s in specials]).reshape(nsp, 14),
                        {"long_name": "section state at t0 (SI)"}),
     })
-    for key in ("Tm_pp", "F_max", "closest_approach"):
+    for key in ("Tm_pp", "F_max", "D2_pp", "closest_approach"):
         long, unit = _POINT_VARS[key]
         data[f"special_{key}"] = (("special",), np.array([s[key] for s in specials], float),
                                   {"long_name": long, "units": unit})
