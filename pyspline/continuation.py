@@ -98,7 +98,10 @@ class _Problem:
         if m is None:
             if len(self.models) > 8:
                 self.models.clear()
-            m = self.models[p] = load(self.case_at(p))
+            with warnings.catch_warnings():     # the case's notes: said once, at the start
+                if self.models or hasattr(self, "d0"):
+                    warnings.simplefilter("ignore", SplineWarning)
+                m = self.models[p] = load(self.case_at(p))
         return m
 
     def t1(self, p: float, n: int) -> float:
