@@ -203,3 +203,29 @@ def test_corrector_failure_says_where():
                        r".*scaled residual .*wanted 1e-09\), history"):
         pyspline.continuation(case, "speed_rpm", 2600, 3800, progress=False, max_corrector=0,
                               ds_min=0.01)
+
+
+def test_neimark_sacker_pair_on_the_unit_circle():
+    """With a = 0.5 the upper branch, past its fold, loses stability to a torus and regains
+    it: two Neimark-Sacker points, each with a complex pair located on the unit circle
+    (secant on |mu|^2 - 1), and between them a complex pair outside it."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds = pyspline.continuation(RESONANCE.replace(ripple_amp=[0.5, 0, 0, 0]), "speed_rpm",
+                                   2000, 2400, ds_max=0.5, progress=False)
+    ns = np.flatnonzero(ds.special_type.values == "neimark_sacker")
+    assert len(ns) == 2
+    mu = ds.special_mu_real.values[ns] + 1j * ds.special_mu_imag.values[ns]
+    assert np.abs(np.abs(mu) - 1).max() < 1e-3, mu
+    assert (np.abs(np.angle(mu)) > 0.1).all() and (np.abs(np.angle(mu)) < np.pi - 0.1).all()
+    assert (ds.special_smooth.values[ns] == 1).all()
+    # between them (on the branch, after the first) the pair is outside: unstable
+    first, second = ds.special_speed_rpm.values[ns]
+    p = ds.speed_rpm.values
+    i1, i2 = np.flatnonzero(np.diff(np.sign(np.diff(p)))) + 1     # the two folds
+    after_fold = np.arange(len(p)) > i2
+    inside = after_fold & (p > min(first, second) + 1) & (p < max(first, second) - 1)
+    assert inside.sum() >= 2
+    pair = np.abs(ds.mu_imag.values[inside]) > 1e-6
+    outside = (ds.mu_abs.values[inside] > 1) & pair
+    assert outside.any(axis=1).all() and not ds.stable.values[inside].any()
