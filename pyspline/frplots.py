@@ -12,7 +12,8 @@ from . import plotstyle as ps
 
 #: measures of a branch point and of a sweep point: name -> (label, unit, sweep expression)
 MEASURES = {"Tm_pp": ("T_m peak-to-peak", "N m", lambda d: d["Tm_max"] - d["Tm_min"]),
-            "F_max": ("largest tooth load", "N", lambda d: d["F_max"]),
+            "F_max": ("largest tooth load", "N",      # abs: F_j's sign is the flank's
+                      lambda d: np.maximum(np.abs(d["F_max"]), np.abs(d["F_min"]))),
             "D2_pp": ("D_2 peak-to-peak", "m", lambda d: d["D2_max"] - d["D2_min"])}
 SPECIAL_MARKS = {"fold": ("o", "#D55E00", "fold (mu = +1)"),
                  "period_doubling": ("s", "#009E73", "period doubling (mu = -1)"),
@@ -71,14 +72,16 @@ def frequency_response(branch, measure: str = "Tm_pp", sweep=None, path=None,
         sx = sweep.attrs.get("swept", "").split()
         key = sx[-1] if sx else field
         dirs = list(sweep["direction"].values) if "direction" in sweep.dims else \
-            [sweep.attrs.get("follow") or "up"]
+            [sweep.attrs.get("follow") or "runs"]
         for d in dirs:
             sub = sweep.sel(direction=d) if "direction" in sweep.dims else sweep
-            mk, colour, label = DIRECTION_MARKS.get(str(d), ("o", "0.4", str(d)))
+            mk, colour, label = DIRECTION_MARKS.get(str(d), ("o", "0.4", "runs"))
+            label += (" (runs, each from the one before)" if str(d) in DIRECTION_MARKS else
+                      " (each from the case's start)")
             ax.plot(np.asarray(sub[key], float) / fx, np.asarray(from_sweep(sub), float) / fy,
                     ls="", marker=mk, ms=6, mfc="none", mec=colour, mew=1.2, zorder=4)
             handles.append(Line2D([], [], ls="", marker=mk, ms=6, mfc="none", mec=colour,
-                                  mew=1.2, label=f"{label} (runs, each from the one before)"))
+                                  mew=1.2, label=label))
     ax.set_xlabel(ps.label(branch, field, factor_unit=ux))
     ax.set_ylabel(f"{name} [{uy}]" if uy else name)
     ax.grid(alpha=0.3, lw=0.5)
