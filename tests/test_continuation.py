@@ -229,3 +229,26 @@ def test_neimark_sacker_pair_on_the_unit_circle():
     pair = np.abs(ds.mu_imag.values[inside]) > 1e-6
     outside = (ds.mu_abs.values[inside] > 1) & pair
     assert outside.any(axis=1).all() and not ds.stable.values[inside].any()
+
+
+def test_follow_chains_on_processes_are_the_serial_ones():
+    """An executor runs one chain per direction: the same numbers as serially; 'up' and
+    'down' alone are the directions of 'both' (down listed in either order of the values)."""
+    import concurrent.futures as cf
+    case = RESONANCE.replace(t_end=0.3, t_transient=0.2, n_out=101)
+    speeds = np.linspace(2400, 2520, 5)
+    kw = dict(progress=False, spectrum=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        both = pyspline.sweep(case, speed_rpm=speeds, follow="both", **kw)
+        with cf.ProcessPoolExecutor(2) as ex:
+            par = pyspline.sweep(case, speed_rpm=speeds, follow="both", executor=ex, **kw)
+        up = pyspline.sweep(case, speed_rpm=speeds, follow="up", **kw)
+        down = pyspline.sweep(case, speed_rpm=speeds[::-1], follow="down", **kw)
+    assert np.array_equal(both.Tm_max, par.Tm_max)
+    assert np.array_equal(both.section_D2, par.section_D2, equal_nan=True)
+    assert "direction" not in up.dims and up.attrs["follow"] == "up"
+    assert np.array_equal(up.Tm_max, both.Tm_max.sel(direction="up"))
+    assert np.array_equal(down.Tm_max.values[::-1], both.Tm_max.sel(direction="down"))
+    # the directions differ here (2400-2520 r/min spans the folds' hysteresis)
+    assert not np.allclose(both.Tm_max.sel(direction="up"), both.Tm_max.sel(direction="down"))
