@@ -5,6 +5,7 @@ commands (each --help says what it writes and where):
   run CASE...                     run cases, print a summary line each (--out DIR: NAME.npz)
   plot CASE... [--out DIR]        one scene as a figure: DIR/NAME.png
   sweep CASE --set F=a:b:n ...    sweep one or two fields (or --table design.csv): DIR/sweep.nc
+  continue CASE --field F ...     follow a periodic orbit in F: DIR/continuation.nc, figure
   merge SUMMARY... --out DIR      spline-dyn --summary files into DIR/sweep.nc
   reproduce [--out DIR]           the paper's scenarios: figures, verification table, summary
   calibrate, check-exe            fit the paper's unknowns; executable against Python
@@ -307,6 +308,8 @@ def _command(args) -> str:
     parts += [f"--section={args.section}", f"--out={args.out}"]
     if args.lyapunov:
         parts.append("--lyapunov")
+    if args.follow:
+        parts.append(f"--follow={args.follow}")
     if args.scheduler:
         parts.append(f"--scheduler={args.scheduler}")
     elif args.workers > 1:
@@ -332,7 +335,10 @@ def cmd_sweep(args) -> int:
     try:
         ds = sweep(case, executor=executor, workers=workers, progress=not args.quiet, out=out,
                    section=args.section, lyapunov=args.lyapunov, command=_command(args),
-                   **grid)
+                   follow=args.follow, **grid)
+    except SplineError as exc:        # follow= on a grid or a table
+        print(f"error: {exc}", file=sys.stderr)
+        return exit_code(exc)
     except KeyboardInterrupt:
         print(f"\ninterrupted: the finished points are in {out / POINTS_DIR}/ and merged into "
               f"{out / MERGED}; run the same command again to compute the rest",
@@ -474,6 +480,10 @@ def _add_sweep_and_plot(sub) -> None:
     r.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on a Dask cluster (distributed scheduler at ADDRESS, e.g. "
                         "tcp://host:8786)")
+    r.add_argument("--follow", choices=("up", "down", "both"),
+                   help="one field: run the points in order, each from the previous point's "
+                        "final state (hysteresis, coexisting attractors); both: a dim "
+                        "'direction'. Serial per direction (--workers: one chain each)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     r.set_defaults(func=cmd_sweep)
     r = sub.add_parser("plot", help="one page of figures per case: DIR/CASENAME.png",
@@ -485,6 +495,8 @@ def _add_sweep_and_plot(sub) -> None:
                    help="change a field of the case (e.g. t_end=0.5)")
     r.set_defaults(func=cmd_plot)
     add_merge(sub)
+    from .continuation import add_continue
+    add_continue(sub, _fixed, exit_code)
 
 
 def main(argv=None) -> int:

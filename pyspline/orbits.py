@@ -81,6 +81,33 @@ def forcing_periods(case: Case, n: int) -> None:
                         f"a whole number{hint}")
 
 
+def _scale(info: dict) -> np.ndarray:
+    """The scales of Eq. 25 of the 14 states: l_ref for displacements, l_ref w_ref for velocities."""
+    return np.r_[np.full(7, info["l_ref"]), np.full(7, info["l_ref"] * info["w_ref"])]
+
+
+def map_and_monodromy(model, t0: float, t1: float, y: np.ndarray):
+    """(y1, M, free): the core's map of the state y (14,), SI, at t0 to y1 (14,), SI, at t1;
+    the monodromy M = dP/dy0 (k, k) over the k integrated states, in the scaled states of
+    Eq. 25; free (14,) bool, the mask of the integrated states.
+
+    M by central differences of the map: state i (scaled) stepped by h = rtol^(1/3)
+    max(1, |y_i|), rtol the case's; all 2k differenced runs go to the core in one call."""
+    scale = _scale(model.info())
+    h = model.case["rtol"] ** (1 / 3)
+    y = np.asarray(y, dtype=float)
+    y1, free = _period_map(model, t0, t1, y[:, None])
+    idx = np.flatnonzero(free)
+    steps = h * np.maximum(1.0, np.abs(y[idx] / scale[idx]))
+    cols = np.repeat(y[:, None], 2 * len(idx), axis=1)
+    for c, (i, s) in enumerate(zip(idx, steps)):
+        cols[i, 2 * c] += s * scale[i]
+        cols[i, 2 * c + 1] -= s * scale[i]
+    yc, _ = _period_map(model, t0, t1, cols)
+    z1 = yc[idx] / scale[idx, None]
+    return y1[:, 0], (z1[:, 0::2] - z1[:, 1::2]) / (2 * steps), free
+
+
 def periodic_orbit(case, n: int = 1, guess=None, t0: float | None = None, tol: float | None = None,
                    max_iter: int = 12, margin: float = 1e-4) -> Orbit:
     """The period-n orbit of a forced case near a guess, and its Floquet multipliers.
@@ -135,15 +162,7 @@ def periodic_orbit(case, n: int = 1, guess=None, t0: float | None = None, tol: f
         return (y1[:, 0] - y) / scale, mask
 
     def monodromy(y, free):
-        idx = np.flatnonzero(free)
-        steps = h * np.maximum(1.0, np.abs(y[idx] / scale[idx]))
-        cols = np.repeat(y[:, None], 2 * len(idx), axis=1)
-        for c, (i, s) in enumerate(zip(idx, steps)):
-            cols[i, 2 * c] += s * scale[i]
-            cols[i, 2 * c + 1] -= s * scale[i]
-        y1, _ = _period_map(model, t0, t1, cols)
-        z1 = y1[idx] / scale[idx, None]
-        return (z1[:, 0::2] - z1[:, 1::2]) / (2 * steps)
+        return map_and_monodromy(model, t0, t1, y)[1]
 
     r, free = residual(y)
     hist = [float(np.abs(r[free]).max())]

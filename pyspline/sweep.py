@@ -395,7 +395,7 @@ def _version() -> str:
 
 def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapunov=False, *,
           spectrum=None, orders=None, command=None, chunk=None, workers=None, table=None,
-          **fields):
+          follow=None, **fields):
     """Run `case` (a Case, dict of fields or namelist path) over one or two swept fields, or
     over the rows of a design table, and return an xarray.Dataset of the per-point summaries.
 
@@ -426,6 +426,11 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
         speed_rpm is swept.
     orders : shaft-order axis of the spectrum (default 0 .. 2Z+2 in steps of 0.05).
     command : text stored in attrs['command'] (default: this call, abbreviated).
+    follow : None, 'up', 'down' or 'both' (one swept field): run the points in order of the
+        value (up: increasing), each from the previous point's final state (pyspline.follow),
+        so hysteresis and coexisting attractors show; 'both' adds a dim 'direction' (up,
+        down). Chains are serial: an executor runs one chain per direction; `out` gets
+        sweep.nc only (no point files: a point depends on the one before).
 
     Dataset: coordinates = the swept values (units from the core's field table); per point
     section_t/section_D2/section_vD2 (dim 'section_point', NaN-padded), period and
@@ -484,6 +489,9 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
                    orders=None if not spectrum else [float(o) for o in np.asarray(orders)])
     keys = list(_template(options, _stat_names()))
 
+    if follow is not None:
+        return _follow(base, grid, cases, keys, options, follow, point_fields, executor, progress,
+                       out, command, section, lyapunov)
     hashes, summaries, todo, n_reused = {}, {}, [], 0
     points_dir = None
     if out is not None:
@@ -606,4 +614,42 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     ds = build_dataset(grid, keys, summaries, hashes, options, attrs, point_fields)
     if out is not None:
         write_netcdf(ds, out / MERGED)
+    return ds
+
+
+def _follow(base, grid, cases, keys, options, follow, point_fields, executor, progress, out,
+            command, section, lyapunov):
+    """sweep(..., follow=...): chains of points (pyspline.follow), one Dataset per direction
+    ('both': concatenated along 'direction')."""
+    from tqdm import tqdm
+    from .follow import DIRECTIONS, follow_sweep
+    if follow not in DIRECTIONS:
+        raise CaseError(f"follow must be one of {', '.join(DIRECTIONS)} or None, got {follow!r}")
+    if point_fields is not None or len(grid) != 1:
+        raise CaseError("follow= needs exactly one swept field (a line of values), not a grid "
+                        "or a design table")
+    (name, values), = grid.items()
+    hashes = {i: point_hash(c, options) for i, c in cases.items() if isinstance(c, Case)}
+    if command is None:
+        command = f"pyspline.sweep({base.name!r}, {name}=[{len(values)} values], " \
+                  f"section={section!r}, lyapunov={bool(lyapunov)}, follow={follow!r})"
+    attrs = dict(case=base.text(), pyspline_version=_version(), command=command, swept=name,
+                 section=section, lyapunov=int(bool(lyapunov)), follow=follow,
+                 created=datetime.datetime.now(datetime.timezone.utc).isoformat(
+                     timespec="seconds"), n_reused=0, out="" if out is None else str(out),
+                 n_executor_errors=0)
+    total = len(values) * (2 if follow == "both" else 1)
+    with tqdm(total=total, desc=f"sweep {name} (follow {follow})", unit="run",
+              disable=not progress, dynamic_ncols=True) as bar:
+        runs = follow_sweep(cases, values, follow, options, executor, bar)
+    if follow == "both":     # one grid (direction, field): the dataset builder pads sections
+        dgrid = {"direction": np.array(["up", "down"]), **grid}
+        summaries = {(k,) + i: s for k, d in enumerate(("up", "down")) for i, s in runs[d].items()}
+        hashes = {(k,) + i: h for k in range(2) for i, h in hashes.items()}
+    else:
+        dgrid, summaries = grid, runs[follow]
+    attrs.update(n_computed=len(summaries))
+    ds = build_dataset(dgrid, keys, summaries, hashes, options, attrs)
+    if out is not None:
+        write_netcdf(ds, Path(out) / MERGED)
     return ds

@@ -405,7 +405,15 @@ def sweep_figures(ds, out) -> list[Path]:
         return written
     x = numeric[0]
     other = [n for n in names if n != x]
-    if "section_D2" in ds:
+    if "direction" in other and "section_D2" in ds:     # follow='both': overlay the two
+        from .frplots import bifurcation_follow
+        path = out / "bifurcation.png"
+        bifurcation_follow(ds, x, path=path, title=f"{title_case}: D_2 on the {section} "
+                           f"section vs {x}, followed up and down")
+        written.append(path)
+        other = []
+        ds = ds.sel(direction="up")        # the other figures: the up direction
+    if "section_D2" in ds and not written:
         path = out / "bifurcation.png"
         if not other:
             bifurcation(ds, x, path=path,

@@ -1,0 +1,675 @@
+"""Pseudo-arclength continuation of a periodic orbit in one case field (docs/continuation.md).
+
+The unknowns are u = (z, q): z the section state of the orbit over the integrated states,
+scaled by Eq. 25 with the scales of the start point (l_ref, l_ref w_ref), q = (p - start) /
+|stop - start| the field. The residual F(z, p) = P^n_p(y) - y and its monodromy M come from
+the core through orbits.map_and_monodromy (the case rebuilt at p, the map over the period
+2 pi n / omega(p)); dF/dp by central differences of the map at p +- h. Predictor along the
+tangent of the branch, corrector Newton on [F; tangent . (u - u_pred)] with the bordered
+Jacobian [[M - I, dF/dq], [tangent^T]]. Special points are located by the Illinois secant on
+a test function of the multipliers (folds, period doublings, Neimark-Sacker points) or by
+bisection on the contact sequence of the orbit's trajectory (grazing). Nothing here computes
+physics: the map, M and the trajectories are the core's.
+"""
+from __future__ import annotations
+
+import re
+import time
+import warnings
+
+import numpy as np
+
+from .case import Case, defaults, load_case
+from .core import STATE_QUANTITIES, load
+from .errors import CaseError, SolverError, SplineWarning
+from .orbits import (OrbitError, _period_map, _trajectory, forcing_periods, map_and_monodromy,
+                     periodic_orbit)
+
+__all__ = ["continuation", "SPECIAL_TYPES"]
+
+#: special points and what each test function watches
+SPECIAL_TYPES = {"fold": "a real multiplier through +1 (det(M - I) changes sign)",
+                 "period_doubling": "a real multiplier through -1 (det(M + I) changes sign)",
+                 "neimark_sacker": "a complex pair of multipliers through the unit circle",
+                 "grazing": "the contact sequence of a tooth over the period changes (a "
+                            "closest approach |dn_j| - c_j reaches zero)"}
+
+#: run-control and identity fields: not physical parameters of the orbit
+_NOT_CONTINUABLE = {"t0", "t_end", "t_transient", "rtol", "atol", "revolutions",
+                    "transient_revolutions", "outputs_per_revolution", "dq0", "dv0",
+                    "lyapunov_d0", "h_max", "h0", "max_step", "h_min"}
+
+
+def parse_field(case: Case, field: str) -> tuple[str, int | None]:
+    """'speed_rpm' -> ('speed_rpm', None); 'ripple_amp' or 'ripple_amp(2)' -> (name, index 0
+    or 1): an array field is continued in one element (1-based in the text, first by default).
+    CaseError naming the field when it is unknown, not a real number or a run setting."""
+    m = re.fullmatch(r"\s*([a-z_][a-z0-9_]*)\s*(?:\(\s*(\d+)\s*\))?\s*", str(field).lower())
+    if not m:
+        raise CaseError(f"case {case.name}: field {field!r}: expected NAME or NAME(i)")
+    name, idx = m.group(1), m.group(2)
+    known = defaults()
+    if name not in known:
+        raise CaseError(f"case {case.name}: unknown field '{name}' to continue (see "
+                        "cases/template.nml)")
+    value = known[name]
+    arr = isinstance(value, (list, tuple))
+    elem = value[0] if arr and len(value) else value
+    if name in _NOT_CONTINUABLE or isinstance(elem, (bool, str, int)) or not isinstance(elem, float):
+        raise CaseError(f"case {case.name}: field {name} cannot be continued: a periodic orbit "
+                        "is continued in a real-valued physical field (speed_rpm, t_d, l_x, "
+                        "ripple_amp, unbalance, ...), not a whole number, an option or a run "
+                        "setting")
+    if idx is not None and not arr:
+        raise CaseError(f"case {case.name}: field {name} is not an array: no index ({field})")
+    if arr:
+        i = 0 if idx is None else int(idx) - 1
+        if not 0 <= i < len(value):
+            raise CaseError(f"case {case.name}: field {field}: index out of 1..{len(value)}")
+        return name, i
+    return name, None
+
+
+def field_label(name: str, index) -> str:
+    return name if index is None else f"{name}({index + 1})"
+
+
+class _Problem:
+    """The case at a value p of the field, its map and monodromy in the start's scales."""
+
+    def __init__(self, case, name, index, n, start, stop, t0):
+        self.case, self.name, self.index, self.n = case, name, index, n
+        self.p0, self.pscale = float(start), abs(float(stop) - float(start))
+        self.t0 = t0
+        self.models = {}
+        self.d0 = _scale(self.model(self.p0).info())
+        self.rtol = case["rtol"]
+        self.h = self.rtol ** (1 / 3)
+
+    def case_at(self, p: float) -> Case:
+        if self.index is None:
+            return self.case.replace(**{self.name: float(p)})
+        v = list(self.case[self.name])
+        v[self.index] = float(p)
+        return self.case.replace(**{self.name: v})
+
+    def model(self, p: float):
+        m = self.models.get(p)
+        if m is None:
+            if len(self.models) > 8:
+                self.models.clear()
+            with warnings.catch_warnings():     # the case's notes: said once, at the start
+                if self.models or hasattr(self, "d0"):
+                    warnings.simplefilter("ignore", SplineWarning)
+                m = self.models[p] = load(self.case_at(p))
+        return m
+
+    def t1(self, p: float, n: int) -> float:
+        return self.t0 + 2 * np.pi * n / self.model(p).info()["omega"]
+
+    def p_of(self, q: float) -> float:
+        return self.p0 + q * self.pscale
+
+    def evaluate(self, y_fixed, u, n):
+        """At u = (z, q): F (k,), J = [M - I, dF/dq] (k, k+1), M (k, k), the state y (14,)."""
+        p = self.p_of(u[-1])
+        y = y_fixed.copy()
+        y[self.free] = u[:-1] * self.d0[self.free]
+        model = self.model(p)
+        y1, Mp, free = map_and_monodromy(model, self.t0, self.t1(p, n), y)
+        d = _scale(model.info())[free] / self.d0[free]     # M in the start's scales
+        M = d[:, None] * Mp / d[None, :]
+        F = (y1 - y)[free] / self.d0[free]
+        hp = self.h * max(abs(p), self.pscale)
+        Fq = []
+        for pp in (p + hp, p - hp):
+            mm = self.model(pp)
+            y1p, _, _ = _map_only(mm, self.t0, self.t1(pp, n), y)
+            Fq.append((y1p - y)[free] / self.d0[free])
+        J = np.c_[M - np.eye(len(M)), (Fq[0] - Fq[1]) / (2 * hp / self.pscale)]
+        return F, J, M, y
+
+
+def _map_only(model, t0, t1, y):
+    """The core's map alone (no monodromy): (y1, None, free)."""
+    y1, free = _period_map(model, t0, t1, np.asarray(y, float)[:, None])
+    return y1[:, 0], None, free
+
+
+def _scale(info: dict) -> np.ndarray:
+    """The scales of Eq. 25 of the 14 states (l_ref; l_ref w_ref for the velocities): those
+    of orbits.map_and_monodromy's M."""
+    return np.r_[np.full(7, info["l_ref"]), np.full(7, info["l_ref"] * info["w_ref"])]
+
+
+# --------------------------------------------------------------------------- test functions
+
+def _multipliers(M) -> np.ndarray:
+    mu = np.linalg.eigvals(M)
+    return mu[np.argsort(-np.abs(mu), kind="stable")]
+
+
+def _tests(mu) -> dict:
+    """Test functions of the multipliers (their sign changes between points mark a point)."""
+    pairs = mu[mu.imag > 1e-9 * np.maximum(1, np.abs(mu))]
+    return {"fold": float(np.prod(mu - 1).real), "period_doubling": float(np.prod(mu + 1).real),
+            "neimark_sacker": float(np.prod(np.abs(pairs) ** 2 - 1)) if len(pairs) else np.nan,
+            "_pairs": len(pairs)}
+
+
+def contact_measures(tr) -> dict:
+    """From one period of the orbit's trajectory (a Result): s_j(t) = |dn_j| - c_j, the contact
+    deflection of tooth j (> 0 in contact on either flank, < 0 its gap): the signature of the
+    contact sequence (per tooth: the sign at t0 and the number of sign changes over the period,
+    at the case's output samples), and the closest approach: the smallest |s_j| over the
+    teeth whose contact does not change over the period (NaN if every tooth switches)."""
+    s = np.abs(tr.dn) - tr.c
+    pos = s > 0
+    changes = (pos[1:] != pos[:-1]).sum(axis=0)
+    steady = changes == 0
+    closest = float(np.abs(s[:, steady]).min()) if steady.any() else np.nan
+    return {"signature": tuple(map(int, np.r_[pos[0], changes])), "closest_approach": closest,
+            "switches": int(changes.sum())}
+
+
+# --------------------------------------------------------------------------- the branch
+
+class _Branch:
+    def __init__(self, prob: _Problem, n: int, y_fixed, tol, max_corr):
+        self.prob, self.n, self.y_fixed, self.tol, self.max_corr = prob, n, y_fixed, tol, max_corr
+
+    def correct(self, u_pred, row, target):
+        """Newton on [F(u); row . u - target] from u_pred. (u, F, J, M, y, iterations,
+        residual history) or None when it does not converge."""
+        u = u_pred.copy()
+        hist = []
+        for it in range(self.max_corr + 1):
+            try:
+                F, J, M, y = self.prob.evaluate(self.y_fixed, u, self.n)
+            except SolverError as exc:      # a run of the map failed: this step fails
+                self.last_hist = hist + [np.nan]
+                self.last_error = str(exc)
+                return None
+            r = float(np.abs(F).max())
+            hist.append(r)
+            if r <= self.tol and it > 0 or (r <= self.tol and abs(row @ u - target) < 1e-12):
+                return u, F, J, M, y, it, hist
+            if it == self.max_corr or (it >= 2 and r > hist[-2]) or not np.isfinite(r):
+                break
+            A = np.vstack([J, row])
+            try:
+                du = np.linalg.solve(A, -np.r_[F, row @ u - target])
+            except np.linalg.LinAlgError:
+                break
+            u = u + du
+        self.last_hist = hist
+        return None
+
+    def point(self, u, J, M, y, it, hist, tau_prev):
+        """The record of a converged point and its tangent (oriented along tau_prev)."""
+        k = len(u)
+        try:
+            tau = np.linalg.solve(np.vstack([J, tau_prev]), np.eye(k)[-1])
+        except np.linalg.LinAlgError:
+            tau = tau_prev.copy()
+        tau /= np.linalg.norm(tau)
+        mu = _multipliers(M)
+        prob = self.prob
+        p = prob.p_of(u[-1])
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SplineWarning)
+            tr = _trajectory(prob.case_at(p), prob.t0, prob.t1(p, self.n), y)
+        return dict(u=u, tau=tau, p=p, y=y, M=M, mu=mu, tests=_tests(mu),
+                    contact=contact_measures(tr), Tm_pp=float(np.ptp(tr.Tm)),
+                    F_max=float(np.abs(tr.tooth["F"]).max()), D2_pp=float(np.ptp(tr.D2)),
+                    residual=hist[-1], iterations=it, n=self.n)
+
+
+def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=None, *,
+                 ds: float = 0.05, ds_min: float = 1e-4, ds_max: float = 0.25, max_angle: float = 0.15,
+                 max_points: int = 200, tol: float | None = None, max_corrector: int = 6,
+                 margin: float = 1e-4, switch: bool = True, detect: bool = True,
+                 progress: bool = True, command: str | None = None):
+    """Pseudo-arclength continuation of the period-n orbit of `case` in `field` from `start`
+    to `stop`, through stable and unstable parts; returns an xarray.Dataset.
+
+    field : a real case field ('speed_rpm', 't_d', 'l_x', 'ripple_amp' (its first element),
+        'ripple_amp(2)', 'unbalance(1)', ...). CaseError naming it otherwise.
+    guess : the orbit's state (14,), SI, at t0 for `start` (default: periodic_orbit's, the end
+        of a settled run of the case at `start`).
+    ds, ds_min, ds_max : arclength steps in the units of u = (z, q): the section state scaled
+        by Eq. 25 and q the field over |stop - start|. A step whose corrector needs <= 2
+        iterations grows 1.5x, one that needs >= 4 shrinks; a failed one halves; below ds_min:
+        OrbitError saying where and the residual reached. max_angle [rad]: a step whose
+        tangent turns more than twice it is halved; the next step is scaled to turn by about it.
+    tol : the corrector's scaled residual max |P^n(y) - y| (default 100 rtol).
+    margin : stable means every |mu| < 1 - margin.
+    switch : at a period doubling continue the doubled branch (n -> 2n) from it along the
+        critical eigenvector.
+    detect : locate folds, period doublings, Neimark-Sacker points and grazing.
+
+    Dataset: dim 'point' (the branch points in order; variable 'branch' numbers the branches,
+    'n' their periods): the field's value, y0 (point, state), Tm_pp, F_max, D2_pp, the
+    multipliers (mu_real, mu_imag, mu_abs; dim 'multiplier', largest modulus first), stable,
+    closest_approach, switches, residual, iterations; dim 'special': type, the field's value,
+    branch, the critical multiplier, Tm_pp, F_max, y0. attrs: case, field, start, stop, n,
+    timing."""
+    from tqdm import tqdm
+    base = load_case(case)
+    name, index = parse_field(base, field)
+    label = field_label(name, index)
+    start, stop = float(start), float(stop)
+    if not (np.isfinite(start) and np.isfinite(stop)) or start == stop:
+        raise CaseError(f"case {base.name}: field {label}: start and stop must be finite and "
+                        f"differ, got {start:g}, {stop:g}")
+    wall0 = time.perf_counter()
+    t0 = float(base["t0"])
+    prob = _Problem(base, name, index, n, start, stop, t0)
+    c0 = prob.case_at(start)
+    forcing_periods(c0, n)
+    tol = 100 * base["rtol"] if tol is None else float(tol)
+    orbit = periodic_orbit(c0, n=n, guess=guess, tol=tol)
+    prob.free = _map_only(prob.model(start), t0, prob.t1(start, n), orbit.y0)[2]
+    k = int(prob.free.sum())
+    branches, specials = [], []
+    bar = tqdm(total=max_points, desc=f"continue {label}", unit="point", disable=not progress,
+               dynamic_ncols=True)
+    try:
+        u0 = np.r_[orbit.y0[prob.free] / prob.d0[prob.free], 0.0]
+        todo = [(n, u0, None, orbit.y0.copy())]
+        while todo and sum(len(b) for b in branches) < max_points:
+            nb, u_start, tau0, y_fixed = todo.pop(0)
+            br = _Branch(prob, nb, y_fixed, tol, max_corrector)
+            pts = _follow(br, u_start, tau0, np.sign(stop - start), ds, ds_min, ds_max, max_angle,
+                          max_points - sum(len(b) for b in branches), len(branches), bar)
+            branches.append(pts)
+            if detect:
+                for a, b in zip(pts, pts[1:]):
+                    for sp in _locate_all(br, a, b, k):
+                        sp["branch"] = len(branches) - 1
+                        specials.append(sp)
+                        if (sp["type"] == "period_doubling" and switch and len(branches) < 4
+                                and nb <= 4 * n and _smooth(sp)):
+                            todo.append(_doubled_start(sp, nb, y_fixed))
+    finally:
+        bar.close()
+    wall = time.perf_counter() - wall0
+    return continuation_dataset(base, prob, label, branches, specials, margin, k, dict(
+        start=start, stop=stop, n=n, tol=tol, wall_s=wall,
+        command=command or f"pyspline.continuation({base.name!r}, {label!r}, {start:g}, "
+                           f"{stop:g}, n={n})"))
+
+
+def _doubled_start(sp, nb, y_fixed):
+    """The start of the doubled branch at a period doubling: the point, with a tangent along
+    the eigenvector of the multiplier at -1 (in z; the field fixed)."""
+    w, V = np.linalg.eig(sp["M"])
+    v = np.real(V[:, np.argmin(np.abs(w + 1))])
+    tau = np.r_[v / np.linalg.norm(v), 0.0]
+    return (2 * nb, sp["u"], tau, y_fixed)
+
+
+def _follow(br, u0, tau0, direction, ds, ds_min, ds_max, max_angle, max_points, ibranch, bar):
+    """The points of one branch from u0: predictor-corrector until the field leaves
+    [start, stop] (the last point put on its end), max_points, or a failure below ds_min."""
+    prob = br.prob
+    k = len(u0)
+    e_q = np.eye(k)[-1]
+    if tau0 is None:                  # the first branch: start on the orbit, head to stop
+        first = br.correct(u0, e_q, u0[-1])
+        if first is None:
+            _fail(br, u0, ds, "at the start")
+        u, F, J, M, y, it, hist = first
+        tau0 = direction * e_q
+        pts = [br.point(u, J, M, y, it, hist, tau0)]
+        tau = pts[0]["tau"]
+    else:                             # a doubled branch: off the point along tau0
+        tau = tau0
+        res = br.correct(u0 + ds * tau, tau, tau @ (u0 + ds * tau))
+        if res is None or not _new_orbit(br, res[4], res[0]):
+            warnings.warn(f"case {prob.case.name}: no period-{br.n} branch found next to the "
+                          f"period doubling at {prob.name} = {prob.p_of(u0[-1]):.6g}",
+                          SplineWarning, stacklevel=3)
+            return []
+        u, F, J, M, y, it, hist = res
+        pts = [br.point(u, J, M, y, it, hist, tau)]
+        tau = pts[0]["tau"]
+    bar.update(1)
+    lo, hi = min(0.0, np.sign(direction)), max(0.0, np.sign(direction))   # q in [0, 1]
+    while len(pts) < max_points:
+        a = pts[-1]
+        pred = a["u"] + ds * a["tau"]
+        end = None
+        if not lo - 1e-12 <= pred[-1] <= hi + 1e-12:
+            end = hi if pred[-1] > hi else lo
+            res = br.correct(a["u"] + a["tau"] * (end - a["u"][-1]) / a["tau"][-1], e_q, end) \
+                if abs(a["tau"][-1]) > 1e-3 else None
+        else:
+            res = br.correct(pred, a["tau"], a["tau"] @ pred)
+        if res is None:
+            ds /= 2
+            if ds < ds_min:
+                _fail(br, pred, ds, f"after point {len(pts)} of branch {ibranch}")
+            continue
+        u, F, J, M, y, it, hist = res
+        new = br.point(u, J, M, y, it, hist, a["tau"])
+        angle = np.arccos(np.clip(new["tau"] @ a["tau"], -1, 1))
+        if angle > 2 * max_angle and ds > ds_min:      # the branch turns: a shorter step
+            ds = max(ds_min, ds / 2)
+            continue
+        pts.append(new)
+        bar.update(1)
+        if end is not None:
+            break
+        grow = 1.5 if it <= 2 else (0.6 if it >= 4 else 1.0)
+        ds = max(ds_min, min(ds_max, ds * grow, ds * max_angle / max(angle, 1e-12)))
+    return pts
+
+
+def _new_orbit(br, y, u):
+    """The doubled branch's point is not the period-n orbit again: P^(n/2)(y) != y."""
+    prob = br.prob
+    p = prob.p_of(u[-1])
+    y1, _, free = _map_only(prob.model(p), prob.t0, prob.t1(p, br.n // 2), y)
+    return np.abs((y1 - y)[free] / prob.d0[free]).max() > 1e3 * br.tol
+
+
+def _fail(br, u, ds, where):
+    prob = br.prob
+    hist = getattr(br, "last_hist", [np.nan])
+    raise OrbitError(
+        f"case {prob.case.name}: continuation in {prob.name}: the corrector did not converge "
+        f"{where}, near {prob.name} = {prob.p_of(u[-1]):.6g} (period-{br.n} orbit), with the "
+        f"arclength step down to {ds:.3g}: scaled residual {hist[-1]:.3g} (wanted "
+        f"{br.tol:.3g}), history {', '.join(f'{v:.2g}' for v in hist)}"
+        + (f" (last failure: {br.last_error})" if getattr(br, "last_error", "") else "")
+        + ". Try a smaller ds or "
+        "ds_min, a looser tol, or a range that stops short of it")
+
+
+# --------------------------------------------------------------------------- special points
+
+def _at(br, a, sigma):
+    """The branch point at arclength sigma from point a (along a's tangent)."""
+    tau = a["tau"]
+    pred = a["u"] + sigma * tau
+    res = br.correct(pred, tau, tau @ pred)
+    if res is None:
+        return None
+    u, F, J, M, y, it, hist = res
+    return br.point(u, J, M, y, it, hist, tau)
+
+
+def _locate_all(br, a, b, k):
+    """The special points between branch points a and b."""
+    out = []
+    sigma_b = float(a["tau"] @ (b["u"] - a["u"]))
+    if sigma_b <= 0:
+        return out
+    ta, tb = a["tests"], b["tests"]
+    for kind in ("fold", "period_doubling", "neimark_sacker"):
+        fa, fb = ta[kind], tb[kind]
+        if kind == "neimark_sacker" and ta["_pairs"] != tb["_pairs"]:
+            continue
+        if np.isfinite(fa) and np.isfinite(fb) and np.sign(fa) != np.sign(fb) and fa != 0:
+            sp = _secant(br, a, b, sigma_b, kind)
+            if sp is not None:
+                out.append(sp)
+    if a["contact"]["signature"] != b["contact"]["signature"]:
+        sp = _bisect_grazing(br, a, b, sigma_b)
+        if sp is not None:
+            out.append(sp)
+    return sorted(out, key=lambda s: s["sigma"])
+
+
+def _secant(br, a, b, sigma_b, kind, iters=12):
+    """Illinois secant on sigma for a test function's zero between a (sigma 0) and b."""
+    lo, hi, flo, fhi = 0.0, sigma_b, a["tests"][kind], b["tests"][kind]
+    best, side = (a if abs(flo) < abs(fhi) else b), 0
+    for _ in range(iters):
+        s = hi - fhi * (hi - lo) / (fhi - flo)
+        if not lo < s < hi:
+            s = (lo + hi) / 2
+        pt = _at(br, a, s)
+        if pt is None:
+            break
+        f = pt["tests"][kind]
+        best = pt
+        best["sigma"] = s
+        if np.sign(f) == np.sign(fhi):
+            hi, fhi = s, f
+            if side == -1:
+                flo /= 2
+            side = -1
+        else:
+            lo, flo = s, f
+            if side == 1:
+                fhi /= 2
+            side = 1
+        if hi - lo < 1e-6 * sigma_b:
+            break
+    best.setdefault("sigma", 0.0)
+    return _special(best, kind)
+
+
+def _bisect_grazing(br, a, b, sigma_b, iters=8):
+    lo, hi = 0.0, sigma_b
+    sig_a = a["contact"]["signature"]
+    best = b
+    best.setdefault("sigma", sigma_b)
+    for _ in range(iters):
+        s = (lo + hi) / 2
+        pt = _at(br, a, s)
+        if pt is None:
+            break
+        if pt["contact"]["signature"] == sig_a:
+            lo = s
+        else:
+            hi, best = s, pt
+            best["sigma"] = s
+    # the last point with a's contact sequence: its closest approach is the one that closes
+    last = _at(br, a, lo) if lo > 0 else a
+    sp = _special(best, "grazing")
+    sp["closest_approach"] = (last or a)["contact"]["closest_approach"]
+    return sp
+
+
+def _special(pt, kind):
+    mu = pt["mu"]
+    target = {"fold": 1.0, "period_doubling": -1.0}.get(kind)
+    if target is not None:
+        crit = mu[np.argmin(np.abs(mu - target))]
+    elif kind == "neimark_sacker":
+        pairs = mu[np.abs(mu.imag) > 1e-9]
+        crit = pairs[np.argmin(np.abs(np.abs(pairs) - 1))] if len(pairs) else np.nan
+    else:
+        crit = mu[0]
+    return dict(pt, type=kind, critical=complex(crit),
+                closest_approach=pt["contact"]["closest_approach"])
+
+
+# --------------------------------------------------------------------------- the dataset
+
+_POINT_VARS = {"Tm_pp": ("T_m peak-to-peak over the period", "N m"),
+               "F_max": ("largest tooth load over the period", "N"),
+               "D2_pp": ("D2 peak-to-peak over the period", "m"),
+               "closest_approach": ("closest approach to a contact boundary: smallest |dn_j| - "
+                                    "c_j of the teeth whose contact does not change", "m"),
+               "switches": ("contact changes of all teeth over the period", "1"),
+               "residual": ("corrector residual max |P^n(y) - y| (scaled, Eq. 25)", "1"),
+               "iterations": ("corrector iterations", "1")}
+
+
+def continuation_dataset(case, prob, label, branches, specials, margin, k, attrs):
+    """The branches and special points as an xarray.Dataset (docs/continuation.md)."""
+    import xarray as xr
+    from .dataset import _field_attrs
+    pts = [(ib, p) for ib, b in enumerate(branches) for p in b]
+    npt, nsp = len(pts), len(specials)
+    mu = np.full((npt, k), np.nan, complex)
+    for i, (_, p) in enumerate(pts):
+        mu[i, :len(p["mu"])] = p["mu"]
+    fa = _field_attrs(prob.name)
+    state = [str(s) for s in STATE_QUANTITIES]
+
+    def col(key, rows):
+        return np.array([r["contact"][key] if key in ("closest_approach", "switches")
+                         else r[key] for r in rows], dtype=float)
+    rows = [p for _, p in pts]
+    data = {label: (("point",), col("p", rows), fa),
+            "branch": (("point",), np.array([ib for ib, _ in pts], int),
+                       {"long_name": "branch number (0: from start; later: doubled branches)"}),
+            "n": (("point",), np.array([p["n"] for p in rows], int),
+                  {"long_name": "shaft revolutions of the orbit's period"}),
+            "y0": (("point", "state"), np.array([p["y"] for p in rows]).reshape(npt, 14),
+                   {"long_name": "section state at t0 (SI: m, rad; m/s, rad/s)"}),
+            "mu_real": (("point", "multiplier"), mu.real, {"long_name": "Floquet multiplier, real part"}),
+            "mu_imag": (("point", "multiplier"), mu.imag, {"long_name": "Floquet multiplier, imaginary part"}),
+            "mu_abs": (("point", "multiplier"), np.abs(mu), {"long_name": "Floquet multiplier, modulus"}),
+            "stable": (("point",), np.array([bool(np.all(np.abs(p["mu"]) < 1 - margin))
+                                            for p in rows], np.int8),
+                       {"long_name": f"1: every |mu| < 1 - {margin:g}"})}
+    for key, (long, unit) in _POINT_VARS.items():
+        data[key] = (("point",), col(key, rows), {"long_name": long, "units": unit})
+    crit = np.array([s["critical"] for s in specials], complex).reshape(nsp)
+    data.update({
+        "special_type": (("special",), np.array([s["type"] for s in specials], dtype=object
+                                                ).astype(str) if nsp else np.zeros(0, "<U1"),
+                         {"long_name": "special point: " + "; ".join(
+                             f"{t}: {d}" for t, d in SPECIAL_TYPES.items())}),
+        f"special_{label}": (("special",), col("p", specials), fa),
+        "special_branch": (("special",), np.array([s["branch"] for s in specials], int)),
+        "special_n": (("special",), np.array([s["n"] for s in specials], int)),
+        "special_mu_real": (("special",), crit.real, {"long_name": "critical multiplier, real part"}),
+        "special_mu_imag": (("special",), crit.imag, {"long_name": "critical multiplier, imaginary part"}),
+        "special_smooth": (("special",), np.array([_smooth(s) for s in specials], np.int8),
+                           {"long_name": "1: the critical multiplier is at +1, -1 or on the unit "
+                                         "circle (within 0.01); 0: it jumped across (a "
+                                         "non-smooth bifurcation, e.g. at a grazing)"}),
+        "special_y0": (("special", "state"), np.array([s["y"] for s in specials]).reshape(nsp, 14),
+                       {"long_name": "section state at t0 (SI)"}),
+    })
+    for key in ("Tm_pp", "F_max", "D2_pp", "closest_approach"):
+        long, unit = _POINT_VARS[key]
+        data[f"special_{key}"] = (("special",), np.array([s[key] for s in specials], float),
+                                  {"long_name": long, "units": unit})
+    ds = xr.Dataset(data, coords={"state": state})
+    ds.attrs.update(case=case.text(), field=label, field_name=prob.name,
+                    pyspline_version=_version(), n_points=npt, n_special=nsp,
+                    n_branches=len(branches), **attrs)
+    return ds
+
+
+def _smooth(sp) -> bool:
+    mu = sp["critical"]
+    target = {"fold": 1.0, "period_doubling": -1.0}.get(sp["type"])
+    if target is not None:
+        return abs(mu - target) < 1e-2
+    if sp["type"] == "neimark_sacker":
+        return abs(abs(mu) - 1) < 1e-2
+    return True
+
+
+def _version():
+    from . import __version__
+    return __version__
+
+
+# --------------------------------------------------------------------------- command line
+
+CONTINUE_HELP = """\
+Follow the period-n orbit of CASE in one real field from --start to --stop by pseudo-arclength
+continuation, through stable and unstable parts; locate folds (a multiplier through +1),
+period doublings (through -1; the doubled branch is followed too), Neimark-Sacker points (a
+complex pair through the unit circle) and grazing (a tooth's contact sequence changes).
+
+Writes into --out DIR:
+  DIR/continuation.nc          the branch points and special points (xarray.open_dataset(
+                               path, engine='h5netcdf'); docs/continuation.md)
+  DIR/frequency_response.png   --measure (T_m peak-to-peak) against the field: stable solid,
+                               unstable dashed, special points marked; with --sweep N the
+                               runs of a follow-up and follow-down sweep of N points over it
+  DIR/sweep.nc                 with --sweep N: that sweep
+Prints one line per special point. Exit status: README's (CaseError 2, SolverError 3; a
+corrector that fails, OrbitError: 1).
+
+example: pyspline continue cases/physical_ripple.nml --field speed_rpm --start 5000 --stop 7000
+"""
+
+
+def cmd_continue(args, fixed, exit_code) -> int:
+    import sys
+    from pathlib import Path
+    from .dataset import write_netcdf
+    from .errors import SplineError
+    from .frplots import MEASURES, frequency_response
+    out = Path(args.out)
+    try:
+        case = load_case(args.case, **fixed(args.fix))
+        command = " ".join(["pyspline", "continue", args.case, f"--field={args.field}",
+                            f"--start={args.start:g}", f"--stop={args.stop:g}", f"--n={args.n}"])
+        ds = continuation(case, args.field, args.start, args.stop, n=args.n, ds=args.ds,
+                          max_points=args.max_points, tol=args.tol, progress=not args.quiet,
+                          command=command)
+        sw = None
+        if args.sweep:
+            from .sweep import sweep
+            name, index = parse_field(case, args.field)
+            if index is not None:
+                raise CaseError(f"--sweep: a follow sweep runs whole fields; {args.field} is "
+                                "one element of an array field")
+            sw = sweep(case, progress=not args.quiet, follow="both", spectrum=False,
+                       **{name: np.linspace(args.start, args.stop, args.sweep)})
+    except SplineError as exc:
+        print(f"error: {type(exc).__name__}: {' '.join(str(exc).split())}", file=sys.stderr)
+        return exit_code(exc)
+    write_netcdf(ds, out / "continuation.nc")
+    label = ds.attrs["field"]
+    print(f"{ds.attrs['n_points']} points on {ds.attrs['n_branches']} branch(es), "
+          f"{int(ds.stable.sum())} stable, in {ds.attrs['wall_s']:.1f} s")
+    for i in range(ds.sizes["special"]):
+        kind = str(ds.special_type.values[i])
+        mu = complex(ds.special_mu_real[i], ds.special_mu_imag[i])
+        what = (f"closest approach {float(ds.special_closest_approach[i]):.3g} m" if kind ==
+                "grazing" else f"critical multiplier {mu:.4f}")
+        print(f"{kind:16s} {label} = {float(ds[f'special_{label}'][i]):.6g}  period "
+              f"{int(ds.special_n[i])}  {what}  {MEASURES['Tm_pp'][0]} "
+              f"{float(ds.special_Tm_pp[i]):.4g} N m"
+              + ("" if ds.special_smooth[i] else "  (non-smooth: the multiplier jumped across)"))
+    print(f"wrote {out / 'continuation.nc'}")
+    if sw is not None:
+        write_netcdf(sw, out / "sweep.nc")
+        print(f"wrote {out / 'sweep.nc'}")
+    path = out / "frequency_response.png"
+    frequency_response(ds, args.measure, sweep=sw, path=path,
+                       title=f"{case.name}: {MEASURES[args.measure][0]} of the periodic orbits "
+                             f"vs {label}" + (", follow sweeps up and down" if sw else ""))
+    print(f"wrote {path}")
+    return 0
+
+
+def add_continue(sub, fixed, exit_code) -> None:
+    """The `continue` subcommand (pyspline/cli.py)."""
+    import argparse
+    r = sub.add_parser("continue", help="follow a periodic orbit in one field (pseudo-arclength "
+                       "continuation): continuation.nc and frequency_response.png in --out",
+                       description=CONTINUE_HELP,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    r.add_argument("case", metavar="CASE", help="case file (namelist)")
+    r.add_argument("--field", required=True, help="the field: speed_rpm, t_d, l_x, "
+                   "ripple_amp (its first element), ripple_amp(2), unbalance(1), ...")
+    r.add_argument("--start", type=float, required=True, help="the field's first value")
+    r.add_argument("--stop", type=float, required=True, help="the field's last value")
+    r.add_argument("--n", type=int, default=1, help="shaft revolutions of the period (default 1)")
+    r.add_argument("--ds", type=float, default=0.05, help="first arclength step (default 0.05)")
+    r.add_argument("--max-points", type=int, default=200, help="most branch points (200)")
+    r.add_argument("--tol", type=float, help="corrector residual, scaled (default 100 rtol)")
+    r.add_argument("--measure", choices=("Tm_pp", "F_max", "D2_pp"), default="Tm_pp",
+                   help="response measure of the figure (default Tm_pp)")
+    r.add_argument("--sweep", type=int, default=0, metavar="N",
+                   help="also a follow-up and follow-down sweep of N points, overlaid")
+    r.add_argument("--fix", action="append", metavar="FIELD=VALUE",
+                   help="change a field of the case (e.g. rtol=1e-9)")
+    r.add_argument("--out", default=".", metavar="DIR", help="output directory (default .)")
+    r.add_argument("--quiet", action="store_true", help="no progress bar")
+    r.set_defaults(func=lambda a: cmd_continue(a, fixed, exit_code))

@@ -1,0 +1,96 @@
+"""Sweeps that follow a branch (``sweep(..., follow='up' | 'down' | 'both')``): the points of
+one swept field run in order of its value, each from the previous point's final state, so
+that hysteresis and coexisting attractors show (docs/continuation.md).
+
+The state at the end of a point becomes the next point's start ('rest' plus the state as
+dq0, dv0: exact) at a start time t0' that keeps the forcing's phase: omega' t0' = omega t_end
+modulo the revolutions after which the forcing repeats (orbits.forcing_periods; 1 for whole
+ripple orders), t_end moved by the same shift (a run length in revolutions is kept). A chain
+is serial: an executor runs one chain per direction ('both': up and down at once).
+"""
+from __future__ import annotations
+
+import warnings
+from fractions import Fraction
+from math import lcm
+
+import numpy as np
+
+from .errors import SplineWarning
+
+DIRECTIONS = ("up", "down", "both")
+
+
+def repeat_revolutions(case) -> int:
+    """The shaft revolutions after which the case's forcing repeats (ripple orders n_k of
+    non-zero amplitude: the lcm of their denominators, up to 1000; 1 otherwise)."""
+    m = 1
+    for order, amp in zip(case["ripple_order"], case["ripple_amp"]):
+        if amp:
+            m = lcm(m, Fraction(order).limit_denominator(1000).denominator)
+    return m
+
+
+def continued(case, y, t_prev: float, omega_prev: float):
+    """`case` started from state y (14,), SI, that a run at omega_prev reached at t_prev, at
+    the start time with the same forcing phase."""
+    omega = case.model.info()["omega"]
+    if not omega > 0 or not omega_prev > 0:
+        shift = 0.0
+    else:
+        span = 2 * np.pi * repeat_revolutions(case)
+        shift = (omega_prev * t_prev) % span / omega - case["t0"]
+    times = dict(t0=case["t0"] + shift)
+    if not (case["revolutions"] if "revolutions" in case else 0):
+        times["t_end"] = case["t_end"] + shift
+    return case.replace(start="rest", dq0=[float(v) for v in y[:7]],
+                        dv0=[float(v) for v in y[7:]], **times)
+
+
+def run_chain(cases: list, options: dict) -> list:
+    """Summaries of the cases run in the given order, each from the previous one's final
+    state (a failed point breaks the chain: the next starts from its own start)."""
+    from .core import simulate
+    from .sweep import _stat_names, _template, summarise
+    out, prev = [], None
+    for case in cases:
+        if isinstance(case, Exception):
+            s = _template(options, _stat_names())
+            s.update(error=str(case), error_class=type(case).__name__)
+            out.append(s)
+            prev = None
+            continue
+        try:
+            run = case if prev is None else continued(case, *prev)
+            with warnings.catch_warnings():     # the start 'rest' overlap note says nothing here
+                warnings.filterwarnings("ignore", message=r".*start = 'rest' with",
+                                        category=SplineWarning)
+                res = simulate(run)
+            out.append(summarise(res, options))
+            prev = (res.y[-1].copy(), float(res.t[-1]), run.model.info()["omega"])
+        except Exception as exc:        # noqa: BLE001 -- a failed point is a result
+            s = _template(options, _stat_names())
+            s.update(error=str(exc) or repr(exc), error_class=type(exc).__name__)
+            out.append(s)
+            prev = None
+    return out
+
+
+def follow_sweep(cases: dict, field_values, follow: str, options: dict, executor, bar):
+    """{direction: {index: summary}} of a one-field sweep run as chains (cases: {(i,): Case});
+    up: increasing field value, down: decreasing."""
+    order = np.argsort(np.asarray(field_values), kind="stable")
+    dirs = ("up", "down") if follow == "both" else (follow,)
+    chains = {d: [(int(i),) for i in (order if d == "up" else order[::-1])] for d in dirs}
+    out = {}
+    if executor is None:
+        for d, idx in chains.items():
+            out[d] = dict(zip(idx, run_chain([cases[i] for i in idx], options)))
+            bar.update(len(idx))
+    else:
+        futs = {d: executor.submit(run_chain, [cases[i] for i in idx], options)
+                for d, idx in chains.items()}
+        for d, fut in futs.items():
+            out[d] = dict(zip(chains[d], fut.result()))
+            bar.update(len(chains[d]))
+    return out

@@ -1,0 +1,121 @@
+"""Figures of continuation and follow sweeps (docs/continuation.md): the frequency-response
+curve (a response measure of the orbits against the field: stable solid, unstable dashed,
+special points marked, follow-up / follow-down sweep points over it) and the bifurcation
+diagram of a follow='both' sweep (both directions overlaid)."""
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+
+from . import plotstyle as ps
+
+#: measures of a branch point and of a sweep point: name -> (label, unit, sweep expression)
+MEASURES = {"Tm_pp": ("T_m peak-to-peak", "N m", lambda d: d["Tm_max"] - d["Tm_min"]),
+            "F_max": ("largest tooth load", "N",      # abs: F_j's sign is the flank's
+                      lambda d: np.maximum(np.abs(d["F_max"]), np.abs(d["F_min"]))),
+            "D2_pp": ("D_2 peak-to-peak", "m", lambda d: d["D2_max"] - d["D2_min"])}
+SPECIAL_MARKS = {"fold": ("o", "#D55E00", "fold (mu = +1)"),
+                 "period_doubling": ("s", "#009E73", "period doubling (mu = -1)"),
+                 "neimark_sacker": ("D", "#CC79A7", "Neimark-Sacker (|mu| = 1, complex)"),
+                 "grazing": ("X", "0.15", "grazing (contact sequence changes)")}
+DIRECTION_MARKS = {"up": ("^", "#56B4E9", "follow up"), "down": ("v", "#E69F00", "follow down")}
+
+
+def _runs(mask):
+    """(start, stop) index pairs of the runs of equal values of a boolean array."""
+    edges = np.flatnonzero(np.diff(mask.astype(int))) + 1
+    bounds = np.r_[0, edges, len(mask)]
+    return list(zip(bounds[:-1], bounds[1:]))
+
+
+def frequency_response(branch, measure: str = "Tm_pp", sweep=None, path=None,
+                       title: str | None = None) -> Figure:
+    """A response measure ('Tm_pp', 'F_max', 'D2_pp') of a continuation Dataset against its
+    field: each branch (period n) stable solid, unstable dashed, special points marked; the
+    points of a follow sweep (one direction or 'both', same field) overlaid."""
+    if measure not in MEASURES:
+        raise ValueError(f"measure must be one of {', '.join(MEASURES)}, got {measure!r}")
+    field = branch.attrs["field"]
+    name, unit, from_sweep = MEASURES[measure]
+    p = np.asarray(branch[field], float)
+    y = np.asarray(branch[measure], float)
+    fy, uy = ps.prefix(y, unit)
+    fx, ux = ps.prefix(p, ps.unit_of(branch, field))
+    fig = Figure(figsize=(9, 5.5), layout="constrained")
+    ax = fig.add_subplot()
+    handles = []
+    for b in np.unique(branch["branch"]):
+        rows = np.flatnonzero(branch["branch"].values == b)
+        n = int(branch["n"].values[rows[0]])
+        colour = ps.PERIOD_COLOURS[min(n, 5)]
+        stable = branch["stable"].values[rows].astype(bool)
+        for i, j in _runs(stable):
+            seg = rows[max(i - 1, 0):j]      # overlap one point: the line has no gaps
+            ax.plot(p[seg] / fx, y[seg] / fy, color=colour, lw=1.6,
+                    ls="-" if stable[i] else (0, (4, 2.5)), zorder=3)
+        handles.append(Line2D([], [], color=colour, lw=1.6, label=f"period-{n} orbits, stable"))
+        if not stable.all():
+            handles.append(Line2D([], [], color=colour, lw=1.6, ls=(0, (4, 2.5)),
+                                  label=f"period-{n} orbits, unstable"))
+    kinds = branch["special_type"].values.astype(str) if "special_type" in branch else []
+    for kind, (mk, colour, label) in SPECIAL_MARKS.items():
+        sel = kinds == kind
+        if np.any(sel):
+            ax.plot(branch[f"special_{field}"].values[sel] / fx,
+                    branch[f"special_{measure}"].values[sel] / fy if f"special_{measure}" in
+                    branch else np.full(sel.sum(), np.nan), ls="", marker=mk, ms=8, mfc=colour,
+                    mec="k", mew=0.6, zorder=5)
+            handles.append(Line2D([], [], ls="", marker=mk, ms=7, mfc=colour, mec="k",
+                                  label=f"{label} ({int(sel.sum())})"))
+    if sweep is not None:
+        sx = sweep.attrs.get("swept", "").split()
+        key = sx[-1] if sx else field
+        dirs = list(sweep["direction"].values) if "direction" in sweep.dims else \
+            [sweep.attrs.get("follow") or "runs"]
+        for d in dirs:
+            sub = sweep.sel(direction=d) if "direction" in sweep.dims else sweep
+            mk, colour, label = DIRECTION_MARKS.get(str(d), ("o", "0.4", "runs"))
+            label += (" (runs, each from the one before)" if str(d) in DIRECTION_MARKS else
+                      " (each from the case's start)")
+            ax.plot(np.asarray(sub[key], float) / fx, np.asarray(from_sweep(sub), float) / fy,
+                    ls="", marker=mk, ms=6, mfc="none", mec=colour, mew=1.2, zorder=4)
+            handles.append(Line2D([], [], ls="", marker=mk, ms=6, mfc="none", mec=colour,
+                                  mew=1.2, label=label))
+    ax.set_xlabel(ps.label(branch, field, factor_unit=ux))
+    ax.set_ylabel(f"{name} [{uy}]" if uy else name)
+    ax.grid(alpha=0.3, lw=0.5)
+    ax.legend(handles=handles, fontsize=8, loc="best", framealpha=0.9)
+    ax.set_title(title or f"frequency response: {name} of the periodic orbits vs {field}")
+    return ps.finish(fig, path)
+
+
+def bifurcation_follow(ds, param: str, coord: str = "section_D2", path=None,
+                       title: str | None = None) -> Figure:
+    """The bifurcation diagram of a follow='both' sweep: the section coordinate against the
+    field, the up and the down direction overlaid (markers ^ and v)."""
+    fig = Figure(figsize=(9, 5.5), layout="constrained")
+    ax = fig.add_subplot()
+    y_all = np.asarray(ds[coord], float)
+    fy, uy = ps.prefix(y_all[np.isfinite(y_all)] if np.isfinite(y_all).any() else y_all,
+                       ps.unit_of(ds, coord, "m"))
+    px = np.asarray(ds[param], float)
+    fx, ux = ps.prefix(px, ps.unit_of(ds, param))
+    handles = []
+    for d in ds["direction"].values:
+        sub = ds.sel(direction=d)
+        y = np.asarray(sub[coord], float).reshape(len(px), -1)
+        xs = np.repeat(px, y.shape[1])
+        ok = np.isfinite(y.ravel())
+        mk, colour, label = DIRECTION_MARKS.get(str(d), ("o", "0.4", str(d)))
+        ax.scatter(xs[ok] / fx, y.ravel()[ok] / fy, marker=mk, s=16, facecolors="none",
+                   edgecolors=colour, lw=0.9, rasterized=True)
+        handles.append(Line2D([], [], ls="", marker=mk, mfc="none", mec=colour, label=label))
+    ax.set_xlabel(ps.label(ds, param, factor_unit=ux))
+    ax.set_ylabel(f"{coord} [{uy}]")
+    ax.grid(alpha=0.3, lw=0.5)
+    ax.legend(handles=handles, fontsize=8, loc="best", title="each run from the one before",
+              title_fontsize=8)
+    ax.set_title(title or f"bifurcation diagram: {ps.long_name(ds, coord)} vs {param}, "
+                          "both directions")
+    return ps.finish(fig, path)

@@ -1,0 +1,254 @@
+"""Continuation of periodic orbits (pyspline.continuation, docs/continuation.md): held against
+the closed-form forced response of the linear full-contact drive, the closed-form speed at
+which that response first opens a tooth (grazing), folds of the backlash resonance with a
+multiplier at +1 and the hysteresis of follow-up / follow-down sweeps between them, the CLI."""
+import subprocess
+import sys
+import warnings
+
+import numpy as np
+import pytest
+
+import pyspline
+from conftest import CASES, jacobian
+from test_orbits import A_RIPPLE, linear_scene, scale_of
+
+# a drive whose ripple reaches the mesh: the paper's aligned drive at dof 3 with shafts of
+# k_t = 1000 N m/rad (the paper's 7.9 filter the ripple out); its mesh mode near 45 Hz
+# (damping ratio 0.014) is forced by a ripple of order 1, a = 0.15: the linear response would
+# open the teeth near 2510 rpm, so the resonance bends over (softening), folds twice and
+# hits the back flanks
+RESONANCE = pyspline.load_case(CASES / "paper_ideal.nml", start="equilibrium", method="bdf",
+                               rtol=1e-9, atol=1e-11, t_end=0.05, n_out=201, roots=True, dof=3,
+                               k_t1=1e3, k_t2=1e3, ripple_order=[1, 0, 0, 0],
+                               ripple_amp=[0.15, 0, 0, 0])
+
+
+def forced_response(case, rpm, order, amp):
+    """(y_eq, Y, A) of the linear full-contact drive at speed rpm: static equilibrium, complex
+    amplitude of the forced response y_eq + Re[Y exp(i order omega t)], and its Jacobian."""
+    c = case.replace(speed_rpm=float(rpm))
+    model = c.model
+    y_eq = model.start_state()
+    A = jacobian(model, y_eq)
+    info = model.info()
+    B = np.zeros(14, complex)
+    B[11] = -1j * (-info["r_b"] * c["t_d"] * amp / c["j_m"])
+    return y_eq, np.linalg.solve(1j * order * info["omega"] * np.eye(14) - A, B), A
+
+
+@pytest.fixture(scope="module")
+def resonance_branch():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        return pyspline.continuation(RESONANCE, "speed_rpm", 2300, 2530, progress=False)
+
+
+def test_linear_branch_is_the_closed_form():
+    """Full contact: every point of the branch over speed through the mesh resonance is the
+    closed-form forced response y_eq + Re Y(omega), its multipliers exp(lambda_i T); all
+    stable, no special point."""
+    case, *_ = linear_scene(2.0)
+    ds = pyspline.continuation(case, "speed_rpm", 2600, 3800, progress=False, ds=0.1)
+    s = scale_of(case)
+    assert ds.attrs["n_points"] >= 5 and ds.attrs["n_special"] == 0
+    assert ds.speed_rpm[0] == 2600 and ds.speed_rpm[-1] == pytest.approx(3800, rel=1e-12)
+    assert np.all(np.diff(ds.speed_rpm) > 0)
+    amp = []
+    for p, y0, mu in zip(ds.speed_rpm.values, ds.y0.values,
+                         ds.mu_real.values + 1j * ds.mu_imag.values):
+        y_eq, Y, A = forced_response(case, p, 2.0, A_RIPPLE)
+        amp.append(np.abs(Y / s).max())
+        # the corrector's tol (100 rtol) times |(I - M)^-1| (< 10 here), 1e5 below the response
+        assert np.abs((y0 - (y_eq + Y.real)) / s).max() < 1e-7 < 1e-4 * amp[-1]
+        want = np.exp(np.linalg.eigvals(A) * 2 * np.pi / (p * np.pi / 30))
+        assert max(np.abs(mu - w).min() for w in want) < 1e-5
+    assert ds.stable.all() and (ds.switches == 0).all()
+    # T_m peak-to-peak peaks at the mesh mode (105 Hz: 3160 rpm at order 2)
+    assert 2900 < float(ds.speed_rpm[int(ds.Tm_pp.argmax())]) < 3450
+
+
+def test_grazing_where_the_linear_response_first_opens_a_tooth(resonance_branch):
+    """The first grazing on the way up is where the closed-form linear response's swing of
+    D2 reaches the static contact deflection |D2_eq| - c0 (every tooth opens at once in the
+    aligned drive); located by bisection on the contact sequence of the sampled trajectory."""
+    ds = resonance_branch
+    kinds = list(ds.special_type.values)
+    first = kinds.index("grazing")
+    rpm = float(ds.special_speed_rpm[first])
+
+    def margin(p):
+        y_eq, Y, _ = forced_response(RESONANCE, p, 1.0, 0.15)
+        return abs(y_eq[5]) - RESONANCE["c0"] - abs(Y[5])
+    lo, hi = 2400.0, 2540.0
+    assert margin(lo) > 0 > margin(hi)
+    for _ in range(40):
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if margin(mid) > 0 else (lo, mid)
+    # sampled at 201 points a period, the closest approach is missed by ~ (pi/200)^2 / 2 of
+    # the swing, 0.1 rpm here
+    assert rpm == pytest.approx(lo, abs=0.1)
+    assert 0 <= float(ds.special_closest_approach[first]) < 1e-6 * RESONANCE["c0"] * 1e3
+
+
+def test_folds_have_a_multiplier_at_one(resonance_branch):
+    """The resonance bends over: two folds, each with a real multiplier at +1 (located by the
+    secant on det(M - I)); stable below the first fold, unstable between, stable after."""
+    ds = resonance_branch
+    folds = np.flatnonzero(ds.special_type.values == "fold")
+    assert len(folds) == 2
+    mu = ds.special_mu_real.values[folds] + 1j * ds.special_mu_imag.values[folds]
+    assert np.abs(mu - 1).max() < 1e-3, mu
+    assert (ds.special_smooth.values[folds] == 1).all()
+    p_hi, p_lo = ds.special_speed_rpm.values[folds]
+    assert 2400 < p_lo < p_hi < 2530
+    # the field turns back at the folds and only there; stable, unstable, stable between them
+    p, stable = ds.speed_rpm.values, ds.stable.values.astype(bool)
+    i1, i2 = np.flatnonzero(np.diff(np.sign(np.diff(p)))) + 1
+    assert p[i1] == pytest.approx(p_hi, abs=0.5) and p[i2] == pytest.approx(p_lo, abs=0.5)
+    assert stable[:i1].all() and not stable[i1 + 1:i2].any() and stable[i2 + 1:].all()
+
+def test_follow_sweeps_jump_at_the_folds(resonance_branch):
+    """follow='both' over the same scene: between the folds the up sweep stays on the lower
+    stable branch and the down sweep on the upper one (T_m peak-to-peak within 2 % of the
+    continuation's); below them both are on the one branch."""
+    ds = resonance_branch
+    folds = np.sort(ds.special_speed_rpm.values[ds.special_type.values == "fold"])
+    speeds = np.linspace(2300, 2530, 24)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        sw = pyspline.sweep(RESONANCE.replace(t_end=1.0, t_transient=0.8, n_out=1001),
+                            speed_rpm=speeds, follow="both", progress=False, spectrum=False)
+    assert list(sw.direction.values) == ["up", "down"] and sw.attrs["follow"] == "both"
+    assert (sw.error == "").all()
+    pp = (sw.Tm_max - sw.Tm_min).values
+    p, y, stable = ds.speed_rpm.values, ds.Tm_pp.values, ds.stable.values.astype(bool)
+    lower = stable & (np.arange(len(p)) < np.argmin(np.abs(p - folds[1])))
+    upper = stable & (np.arange(len(p)) > np.argmin(np.abs(p - folds[0])))
+    inside = (speeds > folds[0] + 5) & (speeds < folds[1] - 5)
+    assert inside.sum() >= 8
+    for s, up, down in zip(speeds[inside], pp[0, inside], pp[1, inside]):
+        assert up == pytest.approx(np.interp(s, p[lower], y[lower]), rel=0.02)
+        order = np.argsort(p[upper])
+        assert down == pytest.approx(np.interp(s, p[upper][order], y[upper][order]), rel=0.02)
+        assert down > 1.5 * up
+    # below the folds one attractor (the up chain's first run starts from the equilibrium:
+    # not settled in its 0.8 s, left out)
+    below = (speeds > speeds[0]) & (speeds < folds[0] - 15)
+    want = np.interp(speeds[below], p[lower], y[lower])
+    assert np.allclose(pp[:, below], want, rtol=0.02)
+
+
+def cli(tmp_path, *args):
+    # cwd: not the checkout, whose source tree would shadow the installed package
+    return subprocess.run([sys.executable, "-m", "pyspline", *args], capture_output=True,
+                          text=True, timeout=300, cwd=tmp_path)
+
+
+def test_cli_end_to_end(tmp_path):
+    """`pyspline continue` on the linear scene: continuation.nc holds the branch (the same
+    numbers as the Python call), frequency_response.png is drawn, exit 0; a field that
+    cannot be continued is a CaseError naming it, exit 2."""
+    import xarray as xr
+    case, *_ = linear_scene(2.0)
+    path = tmp_path / "scene.nml"
+    path.write_text(case.text())
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2600",
+              "--stop", "3800", "--ds", "0.1", "--out", "out", "--quiet")
+    assert run.returncode == 0, run.stderr
+    assert "wrote out/continuation.nc" in run.stdout and "points on 1 branch(es)" in run.stdout
+    ds = xr.open_dataset(tmp_path / "out" / "continuation.nc", engine="h5netcdf")
+    want = pyspline.continuation(case, "speed_rpm", 2600, 3800, ds=0.1, progress=False)
+    assert np.array_equal(ds.speed_rpm, want.speed_rpm) and np.array_equal(ds.y0, want.y0)
+    assert ds.attrs["command"].startswith("pyspline continue")
+    assert (tmp_path / "out" / "frequency_response.png").stat().st_size > 10_000
+    run = cli(tmp_path, "continue", str(path), "--field", "z", "--start", "16", "--stop", "20")
+    assert run.returncode == 2 and "field z cannot be continued" in run.stderr, run.stderr
+    # a follow sweep from the command line: both directions in sweep.nc, one overlaid figure
+    run = cli(tmp_path, "sweep", str(path), "--set", "speed_rpm=2600:3000:3", "--follow", "both",
+              "--fix", "t_end=0.04", "--out", "sw", "--quiet")
+    assert run.returncode == 0, run.stderr
+    sw = pyspline.open_sweep(tmp_path / "sw")
+    assert list(sw.direction.values) == ["up", "down"] and sw.attrs["follow"] == "both"
+    assert "--follow=both" in sw.attrs["command"] and (sw.error == "").all()
+    assert (tmp_path / "sw" / "bifurcation.png").exists()
+
+
+@pytest.mark.parametrize("field, match", [
+    ("method", "field method cannot be continued"),
+    ("rtol", "field rtol cannot be continued"),
+    ("nonsense", "unknown field 'nonsense'"),
+    ("speed_rpm(2)", "field speed_rpm is not an array"),
+    ("ripple_amp(5)", r"ripple_amp\(5\): index out of 1..4")])
+def test_bad_field(field, match):
+    with pytest.raises(pyspline.CaseError, match=match):
+        pyspline.continuation(RESONANCE, field, 0.1, 0.2, progress=False)
+
+
+def test_bad_range_and_follow():
+    with pytest.raises(pyspline.CaseError, match="start and stop must be finite and differ"):
+        pyspline.continuation(RESONANCE, "t_d", 30, 30, progress=False)
+    with pytest.raises(pyspline.CaseError, match="follow= needs exactly one swept field"):
+        pyspline.sweep(RESONANCE, speed_rpm=[1, 2], t_d=[1, 2], follow="up", progress=False)
+    with pytest.raises(pyspline.CaseError, match="follow must be one of up, down, both"):
+        pyspline.sweep(RESONANCE, speed_rpm=[1, 2], follow="sideways", progress=False)
+
+
+def test_corrector_failure_says_where():
+    """A corrector allowed no Newton step cannot converge off the start: the step halves
+    down to ds_min, then OrbitError names where, the residual reached and its history."""
+    case, *_ = linear_scene(2.0)
+    with pytest.raises(pyspline.OrbitError, match=r"continuation in speed_rpm: the corrector did "
+                       r"not converge after point 1 of branch 0, near speed_rpm = 26.*arclength step down to "
+                       r".*scaled residual .*wanted 1e-09\), history"):
+        pyspline.continuation(case, "speed_rpm", 2600, 3800, progress=False, max_corrector=0,
+                              ds_min=0.01)
+
+
+def test_neimark_sacker_pair_on_the_unit_circle():
+    """With a = 0.5 the upper branch, past its fold, loses stability to a torus and regains
+    it: two Neimark-Sacker points, each with a complex pair located on the unit circle
+    (secant on |mu|^2 - 1), and between them a complex pair outside it."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds = pyspline.continuation(RESONANCE.replace(ripple_amp=[0.5, 0, 0, 0]), "speed_rpm",
+                                   2000, 2400, ds_max=0.5, progress=False)
+    ns = np.flatnonzero(ds.special_type.values == "neimark_sacker")
+    assert len(ns) == 2
+    mu = ds.special_mu_real.values[ns] + 1j * ds.special_mu_imag.values[ns]
+    assert np.abs(np.abs(mu) - 1).max() < 1e-3, mu
+    assert (np.abs(np.angle(mu)) > 0.1).all() and (np.abs(np.angle(mu)) < np.pi - 0.1).all()
+    assert (ds.special_smooth.values[ns] == 1).all()
+    # between them (on the branch, after the first) the pair is outside: unstable
+    first, second = ds.special_speed_rpm.values[ns]
+    p = ds.speed_rpm.values
+    i1, i2 = np.flatnonzero(np.diff(np.sign(np.diff(p)))) + 1     # the two folds
+    after_fold = np.arange(len(p)) > i2
+    inside = after_fold & (p > min(first, second) + 1) & (p < max(first, second) - 1)
+    assert inside.sum() >= 2
+    pair = np.abs(ds.mu_imag.values[inside]) > 1e-6
+    outside = (ds.mu_abs.values[inside] > 1) & pair
+    assert outside.any(axis=1).all() and not ds.stable.values[inside].any()
+
+
+def test_follow_chains_on_processes_are_the_serial_ones():
+    """An executor runs one chain per direction: the same numbers as serially; 'up' and
+    'down' alone are the directions of 'both' (down listed in either order of the values)."""
+    import concurrent.futures as cf
+    case = RESONANCE.replace(t_end=0.3, t_transient=0.2, n_out=101)
+    speeds = np.linspace(2400, 2520, 5)
+    kw = dict(progress=False, spectrum=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        both = pyspline.sweep(case, speed_rpm=speeds, follow="both", **kw)
+        with cf.ProcessPoolExecutor(2) as ex:
+            par = pyspline.sweep(case, speed_rpm=speeds, follow="both", executor=ex, **kw)
+        up = pyspline.sweep(case, speed_rpm=speeds, follow="up", **kw)
+        down = pyspline.sweep(case, speed_rpm=speeds[::-1], follow="down", **kw)
+    assert np.array_equal(both.Tm_max, par.Tm_max)
+    assert np.array_equal(both.section_D2, par.section_D2, equal_nan=True)
+    assert "direction" not in up.dims and up.attrs["follow"] == "up"
+    assert np.array_equal(up.Tm_max, both.Tm_max.sel(direction="up"))
+    assert np.array_equal(down.Tm_max.values[::-1], both.Tm_max.sel(direction="down"))
+    # the directions differ here (2400-2520 r/min spans the folds' hysteresis)
+    assert not np.allclose(both.Tm_max.sel(direction="up"), both.Tm_max.sel(direction="down"))
