@@ -38,3 +38,13 @@ def test_optimised_cvode_gives_bit_identical_numbers(exe, tmp_path):
         outs.append([ln for ln in lines if not ln.startswith("# stats")])   # stats hold the time
     assert len(outs[0]) > 41
     assert outs[0] == outs[1]
+
+
+def test_every_module_of_the_source_tree_is_installed():
+    """meson.build lists the Python sources it installs: a module added to pyspline/ but not to
+    that list imports from the source tree and fails from an installed package."""
+    src = Path(__file__).resolve().parents[1] / "pyspline"
+    installed = Path(pyspline.__file__).parent
+    for path in src.rglob("*.py"):
+        rel = path.relative_to(src)
+        assert (installed / rel).exists(), f"{rel} is not in meson.build's py.install_sources"
