@@ -200,8 +200,8 @@ contains
     if (present(mode)) then
       do j = 1, m%z
         call eq11(ex, ey, evx, evy, q(6), v(6), m%omega, m%spacing_error(j), s, c, dnj, ddnj)
-        mj = mode(j)
-        fj = merge(km*(dnj - mj*cb) + cm*ddnj, 0.0_wp, mj /= 0)     ! Eqs. 15-17
+        mj = mode(j)      ! Eqs. 15-17 (mj c_bulk = +-c_bulk exactly)
+        fj = merge(km*(dnj - merge(cb, -cb, mj > 0)) + cm*ddnj, 0.0_wp, mj /= 0)
         fx1 = fx1 - fj*s
         fy1 = fy1 + fj*c
         sumf = sumf + fj
@@ -213,7 +213,7 @@ contains
       do j = 1, m%z
         call eq11(ex, ey, evx, evy, q(6), v(6), m%omega, m%spacing_error(j), s, c, dnj, ddnj)
         mj = contact_state(dnj, cb)
-        fj = merge(km*(dnj - mj*cb) + cm*ddnj, 0.0_wp, mj /= 0)
+        fj = merge(km*(dnj - merge(cb, -cb, mj > 0)) + cm*ddnj, 0.0_wp, mj /= 0)
         fx1 = fx1 - fj*s
         fy1 = fy1 + fj*c
         sumf = sumf + fj
@@ -340,25 +340,32 @@ contains
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(7)
     real(wp), intent(out) :: g(2*m%z*m%n_slices)
-    real(wp) :: sp(max_teeth), cp(max_teeth), ex, ey, dnj, ddnj, dns, zs
+    real(wp) :: s, c, s1, phi, ex, ey, dnj, ddnj, dns, zs
     integer :: j, is, k, ns
-    call tooth_angles(m%z, m%omega, t, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
+    phi = 2.0_wp*pi/m%z + m%omega*t + m%theta0 - m%alpha     ! tooth_angles, in the loop below
+    s = sin(phi)
+    c = cos(phi)
     ex = q(1) + m%l_x - q(3)
     ey = q(2) + m%l_y - q(4)
     ns = m%n_slices
     do j = 1, m%z
-      call eq11(ex, ey, 0.0_wp, 0.0_wp, q(6), 0.0_wp, 0.0_wp, m%spacing_error(j), sp(j), &
-           cp(j), dnj, ddnj)                                  ! Eq. 11 (its rate unused)
-      do is = 1, ns
-        dns = dnj
-        if (ns > 1) then
+      call eq11(ex, ey, 0.0_wp, 0.0_wp, q(6), 0.0_wp, 0.0_wp, m%spacing_error(j), s, c, dnj, &
+           ddnj)                                  ! Eq. 11 (its rate unused)
+      if (ns == 1) then
+        g(2*j - 1) = dnj - m%c_bulk
+        g(2*j) = dnj + m%c_bulk
+      else
+        do is = 1, ns
           zs = m%b*((is - 0.5_wp)/ns - 0.5_wp)
-          dns = dnj + zs*(m%gamma_y*sp(j) + m%gamma_x*cp(j))
-        end if
-        k = (j - 1)*ns + is
-        g(2*k - 1) = dns - m%c_bulk
-        g(2*k) = dns + m%c_bulk
-      end do
+          dns = dnj + zs*(m%gamma_y*s + m%gamma_x*c)
+          k = (j - 1)*ns + is
+          g(2*k - 1) = dns - m%c_bulk
+          g(2*k) = dns + m%c_bulk
+        end do
+      end if
+      s1 = s*m%cos_pitch + c*m%sin_pitch
+      c = c*m%cos_pitch - s*m%sin_pitch
+      s = s1
     end do
   end subroutine mesh_switch_functions
 
