@@ -9,7 +9,7 @@ module spline_mesh
   use spline_thermal, only: thermal_backlash, flash_temperature
   implicit none
   private
-  public :: mesh_eval, mesh_forces, mesh_switch_functions, coupling_stats_t, tooth_approach
+  public :: mesh_eval, mesh_forces, mesh_outputs, mesh_switch_functions, coupling_stats_t, tooth_approach
 
   integer, parameter :: max_coupling_iter = 60
   real(wp), parameter :: coupling_tol = 1.0e-14_wp   !< relative step tolerance on T_f
@@ -224,6 +224,60 @@ contains
     end if
     tm = m%r_b*sumf
   end subroutine mesh_forces
+
+  !> F_j, F_jx, F_jy and dn_j at nt output times (t(k), SI states y(:, k), contact states
+  !> modes(:, k), 2: decided by the state) and T_m, for a model without flash temperature or face
+  !> slices: Eqs. 8-9, 11, 15-17 and 19-22 as tooth_angles and mesh_eval evaluate them,
+  !> operation for operation (run.f90's tooth_outputs checks the first and last output against
+  !> mesh_eval), in blocks of nblk outputs, one pass per tooth (f(k, j) is contiguous in k; the
+  !> pitch rotation of tooth_angles runs over the block's outputs at once).
+  pure subroutine mesh_outputs(m, nt, t, y, modes, f, fx, fy, dn, tm)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: nt
+    real(wp), intent(in) :: t(nt), y(:, :)
+    integer, intent(in) :: modes(:, :)
+    real(wp), intent(out), dimension(nt, m%z) :: f, fx, fy, dn
+    real(wp), intent(out) :: tm(nt)
+    integer, parameter :: nblk = 64
+    real(wp) :: sp(nblk, m%z), cp(nblk, m%z)
+    real(wp) :: ex(nblk), ey(nblk), evx(nblk), evy(nblk), sumf(nblk), phi, dnj, ddnj, fj, cb
+    integer :: k0, nk, i, j, k, mj
+    cb = m%c_bulk
+    do k0 = 0, nt - 1, nblk
+      nk = min(nblk, nt - k0)
+      do i = 1, nk
+        k = k0 + i
+        phi = 2.0_wp*pi/m%z + m%omega*t(k) + m%theta0 - m%alpha     ! tooth_angles, tooth 1
+        sp(i, 1) = sin(phi)
+        cp(i, 1) = cos(phi)
+        ex(i) = y(1, k) + m%l_x - y(3, k)
+        ey(i) = y(2, k) + m%l_y - y(4, k)
+        evx(i) = y(8, k) - y(10, k)
+        evy(i) = y(9, k) - y(11, k)
+      end do
+      do j = 2, m%z             ! tooth_angles' rotation by the pitch, for nk outputs at once
+        sp(1:nk, j) = sp(1:nk, j-1)*m%cos_pitch + cp(1:nk, j-1)*m%sin_pitch
+        cp(1:nk, j) = cp(1:nk, j-1)*m%cos_pitch - sp(1:nk, j-1)*m%sin_pitch
+      end do
+      sumf = 0.0_wp
+      do j = 1, m%z
+        do i = 1, nk
+          k = k0 + i
+          call eq11(ex(i), ey(i), evx(i), evy(i), y(6, k), y(13, k), m%omega, m%spacing_error(j), &
+               sp(i, j), cp(i, j), dnj, ddnj)
+          mj = modes(j, k)
+          if (mj == 2) mj = contact_state(dnj, cb)
+          fj = merge(m%k_m*(dnj - merge(cb, -cb, mj > 0)) + m%c_m*ddnj, 0.0_wp, mj /= 0)
+          f(k, j) = fj
+          fx(k, j) = fj*sp(i, j)
+          fy(k, j) = fj*cp(i, j)
+          dn(k, j) = dnj
+          sumf(i) = sumf(i) + fj
+        end do
+      end do
+      tm(k0+1:k0+nk) = m%r_b*sumf(1:nk)
+    end do
+  end subroutine mesh_outputs
 
   !> Eq. 16: contact state of a tooth pair, +1 drive flank (dn > c), -1 back flank (dn < -c), 0 free.
   pure integer function contact_state(dn, c)
