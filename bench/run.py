@@ -80,7 +80,7 @@ def main(argv=None) -> int:
     p.add_argument("what", choices=["wp", "race", "stability", "ladder", "anatomy", "parallel",
                                     "bifurcation"])
     p.add_argument("--points", type=int, help="bifurcation: number of points (default 1000)")
-    p.add_argument("--cases", nargs="+", help="wp: the scenes (default: paper_lx1e-4 paper_T100 "
+    p.add_argument("--cases", nargs="+", help="wp, race: the scenes (default: paper_lx1e-4 paper_T100 "
                    "rattle_z24 physical_z24; --quick: the two paper scenes)")
     p.add_argument("--rtol", type=float, help="bifurcation: tolerance (default: the case's)")
     p.add_argument("--repeats", type=int, help="bifurcation: run the whole sweep this many "
@@ -99,7 +99,8 @@ def main(argv=None) -> int:
     args = p.parse_args(argv)
     if args.what == "race":
         import race
-        rows, runs = race.race(quick=args.quick, repeat=2 if args.quick else 5)
+        rows, runs = race.race(quick=args.quick, repeat=2 if args.quick else 5,
+                               cases=args.cases)
         print("\n".join(race.format_rows(rows)))
         from speed import _write_csv
         Path(args.out).mkdir(parents=True, exist_ok=True)

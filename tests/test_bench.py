@@ -149,4 +149,4 @@ def test_race_statistics_standard_error_is_the_cores():
     stat, se = race.statistics_of(case, res.t, res.Tm)
     assert res.loads["batches"] == 10
     assert se[0] == pytest.approx(res.loads["Tm_rms_se"], rel=1e-9)
-    assert np.all(se > 0) and np.all(np.isfinite(stat))
+    assert se[0] > 0 and np.all(np.isfinite(stat)) and np.all(np.isfinite(se))
