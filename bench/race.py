@@ -7,9 +7,10 @@ and with 101 outputs (<= 1e-6); physical_z24 over 1 s (<= 1e-4 and <= 1e-6); cha
 relative error of every per-tooth force F_j against a reference (CVODE BDF with located
 switches at rtol 1e-13; its agreement with the peer's DOP853 at rtol 1e-13 is printed). On
 chaos_z24 no run agrees pointwise with another beyond its predictability horizon: a run is at
-the statistics level when its T_m RMS and k_v quantiles (5, 50, 95 %) each lie within 2
+the statistics level when its T_m RMS and k_v quantiles (5, 50, 95 %) each lie within 3
 combined standard errors of the tightest run's (the standard errors by overlapping batch
-means over revolutions, as the core's Tm_rms_se).
+means over revolutions, as the core's Tm_rms_se; 3, as tests/test_stderr.py: the largest of
+four z-scores of runs that differ only by chance passes 2 about half the time).
 
 pyspline runs every CVODE variant of speed.PYSPLINE_VARIANTS with and without root finding over
 a ladder of rtol; the peer (bench/numba_peer.py: numbalsoda's DOP853 and LSODA on a numba
@@ -86,7 +87,7 @@ def race(quick=False, repeat=5, progress=print, cases=None):
             continue
         case = _case(name, fields, quick)
         stats_level = accuracies == ("statistics",)
-        rtols = [1e-5, 1e-6, 1e-7, 1e-8, 1e-9] if stats_level else \
+        rtols = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9] if stats_level else \
             [1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11]
         if quick:
             rtols = rtols[:2]
@@ -162,7 +163,7 @@ def race(quick=False, repeat=5, progress=print, cases=None):
             def ok(r, acc=acc):
                 if "failed" in r:
                     return False
-                return r["z_max"] <= 2.0 if acc == "statistics" else r["err"] <= acc
+                return r["z_max"] <= 3.0 if acc == "statistics" else r["err"] <= acc
             best = {}
             for side in ("pyspline", "peer DOP853", "peer LSODA"):
                 cand = [r for r in recs if ok(r) and (r["side"] == side or
