@@ -1,6 +1,7 @@
 """Benchmarks of pyspline (not installed with the package): run from a checkout,
-    python bench/run.py wp|stability|ladder|anatomy|parallel [--out DIR] [--quick]
-wp: work-precision chart against scipy and numbalsoda peers; stability: where methods fail;
+    python bench/run.py wp|race|stability|ladder|anatomy|parallel [--out DIR] [--quick]
+wp: work-precision chart against scipy and numbalsoda peers; race: issue 25's table against the
+numba peer (bench/race.py); stability: where methods fail;
 ladder: model levels and fidelity = auto; anatomy: where a run's time goes; parallel: scenes
 serially, on threads and on processes, fixed cost per call, RHS call cost; bifurcation: a
 1000-point sweep serially, on threads, processes and Dask.
@@ -76,10 +77,10 @@ def cmd_bench(args) -> int:
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="bench/run.py", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("what", choices=["wp", "stability", "ladder", "anatomy", "parallel",
+    p.add_argument("what", choices=["wp", "race", "stability", "ladder", "anatomy", "parallel",
                                     "bifurcation"])
     p.add_argument("--points", type=int, help="bifurcation: number of points (default 1000)")
-    p.add_argument("--cases", nargs="+", help="wp: the scenes (default: paper_lx1e-4 paper_T100 "
+    p.add_argument("--cases", nargs="+", help="wp, race: the scenes (default: paper_lx1e-4 paper_T100 "
                    "rattle_z24 physical_z24; --quick: the two paper scenes)")
     p.add_argument("--rtol", type=float, help="bifurcation: tolerance (default: the case's)")
     p.add_argument("--repeats", type=int, help="bifurcation: run the whole sweep this many "
@@ -96,6 +97,17 @@ def main(argv=None) -> int:
     p.add_argument("--out", default="out/bench", help="output directory (default out/bench)")
     p.add_argument("--quick", action="store_true", help="small sizes (for CI)")
     args = p.parse_args(argv)
+    if args.what == "race":
+        import race
+        rows, runs = race.race(quick=args.quick, repeat=2 if args.quick else 5,
+                               cases=args.cases)
+        print("\n".join(race.format_rows(rows)))
+        from speed import _write_csv
+        Path(args.out).mkdir(parents=True, exist_ok=True)
+        _write_csv(Path(args.out) / "race.csv", [
+            {k: v for k, v in r.items() if k != "times"} for r in runs])
+        print(f"wrote {args.out}/race.csv")
+        return 0
     if args.what == "parallel":
         import parallel
         return parallel.main(args)

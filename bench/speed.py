@@ -74,6 +74,10 @@ def _mesh_outputs(case, t, y):
     return tm, F
 
 
+#: the pyspline settings the benchmarks try (a new integrator method: add it here and in _cvode_kw)
+PYSPLINE_VARIANTS = ("bdf", "adams", "adams-fixedpoint")
+
+
 def _cvode_kw(variant):
     """Case fields of a CVODE variant: 'bdf', 'adams', 'adams-fixedpoint' (functional
     iteration, no Jacobian) or 'bdf-stald' (stability-limit detection)."""
@@ -182,7 +186,7 @@ def work_precision(out, quick=False, progress=True, cases=None):
         ref, agree = reference(case)
         notes.append(f"{name}: reference (CVODE BDF + roots, rtol 1e-12) vs DOP853 rtol 1e-12 on "
                      f"the Fortran RHS: T_m {agree[0]:.1e}, F_j {agree[1]:.1e}")
-        jobs = [("cvode", m, r, rt) for m in ("bdf", "adams", "adams-fixedpoint")
+        jobs = [("cvode", m, r, rt) for m in PYSPLINE_VARIANTS
                 for r in (False, True) for rt in rtols_cv]
         jobs += [("scipy", m, kind, rt) for m in SCIPY_METHODS for kind in ("fortran", "numpy")
                  for rt in rtols_sp if kind == "fortran" or oracle is not None]

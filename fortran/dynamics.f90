@@ -3,8 +3,8 @@
 module spline_dynamics
   use spline_kinds, only: wp
   use spline_errors, only: err_ok, err_solver
-  use spline_model, only: model_t, ndof, nstate
-  use spline_mesh, only: mesh_eval, mesh_switch_functions, coupling_stats_t
+  use spline_model, only: model_t, ndof, nstate, thermal_coupled
+  use spline_mesh, only: mesh_eval, mesh_forces, mesh_switch_functions, coupling_stats_t
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -35,8 +35,13 @@ contains
     integer, intent(in), optional :: mode(m%z*m%n_slices)
     type(coupling_stats_t), intent(inout), optional :: cstats
     real(wp) :: fx1, fy1, tm, s1, s3, th1dd, fu(4)
-    call mesh_eval(m, t, q, v, fx1, fy1, tm, ierr, errmsg, mode=mode, cstats=cstats)
-    if (ierr /= err_ok) return
+    if (m%n_slices == 1 .and. m%thermal /= thermal_coupled) then
+      call mesh_forces(m, t, q, v, fx1, fy1, tm, mode)     ! mesh_eval's kernel, to the bit
+      ierr = err_ok
+    else
+      call mesh_eval(m, t, q, v, fx1, fy1, tm, ierr, errmsg, mode=mode, cstats=cstats)
+      if (ierr /= err_ok) return
+    end if
     a(1) = (fx1 - m%c_p1*v(1) - m%k_p1*q(1))/m%m_1
     a(2) = (fy1 - m%c_p1*v(2) - m%k_p1*q(2))/m%m_1 - m%grav
     a(3) = (-fx1 - m%c_p2*v(3) - m%k_p2*q(3))/m%m_2

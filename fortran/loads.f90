@@ -10,6 +10,7 @@ module spline_loads
   use spline_kinds, only: wp, pi, max_teeth
   use spline_model, only: model_t, nstate
   use spline_geometry, only: tooth_angles, root_section, active_profile
+  use spline_mesh, only: tooth_approach
   use spline_errors, only: itoa, ftoa
   use spline_quantities, only: iq_tf, nload, nload_tooth, il_f_static, &
        il_load_sharing, il_load_sharing_tooth, il_free_max, il_back_max, il_free_mean, &
@@ -54,11 +55,11 @@ contains
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, y(nstate)
     integer, intent(in) :: j
-    real(wp) :: sp(max_teeth), cp(max_teeth), ex, ey
+    real(wp) :: sp(max_teeth), cp(max_teeth), dn, ddn
     call tooth_angles(m%z, m%omega, t, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
-    ex = y(1) + m%l_x - y(3)
-    ey = y(2) + m%l_y - y(4)
-    s = abs((y(8) - y(10))*sp(j) - (y(9) - y(11))*cp(j) + y(13) + m%omega*(ex*cp(j) + ey*sp(j)))
+    call tooth_approach(y(1) + m%l_x - y(3), y(2) + m%l_y - y(4), y(8) - y(10), y(9) - y(11), &
+         y(6), y(13), m%omega, m%spacing_error(j), sp(j), cp(j), dn, ddn)
+    s = abs(ddn)
   end function approach_speed
 
   !> The loads of a run from its outputs (t(k), SI states y(:, k), tooth(k, j, :) in the order

@@ -2,14 +2,14 @@
 !> dead-zone contact with time-varying backlash (Eqs. 2, 15-17), flash-temperature coupling
 !> (Eqs. 1, 3-7, 12-13) and the energy-consistent mesh forces on the bodies (Eqs. 19-22, corrected).
 module spline_mesh
-  use spline_kinds, only: wp, max_teeth
+  use spline_kinds, only: wp, pi, max_teeth
   use spline_errors, only: err_ok, err_solver, err_thermal
   use spline_model, only: model_t, thermal_oneway, thermal_coupled
   use spline_geometry, only: tooth_angles, profile_shift, contact_radius, active_profile
   use spline_thermal, only: thermal_backlash, flash_temperature
   implicit none
   private
-  public :: mesh_eval, mesh_switch_functions, coupling_stats_t
+  public :: mesh_eval, mesh_forces, mesh_outputs, mesh_switch_functions, coupling_stats_t, tooth_approach
 
   integer, parameter :: max_coupling_iter = 60
   real(wp), parameter :: coupling_tol = 1.0e-14_wp   !< relative step tolerance on T_f
@@ -71,8 +71,8 @@ contains
       ! Eq. 11 and its total time derivative (phi_j' = omega), at the face centre; tooth j of
       ! spline 1 sits e_j ahead along +dn (spacing error, docs/model.md section 11): it meets
       ! the dead zone at dn_j + e_j, the rate is unchanged
-      dnj = ex*sp(j) - ey*cp(j) + q(6) + m%spacing_error(j)
-      ddnj = evx*sp(j) - evy*cp(j) + v(6) + m%omega*(ex*cp(j) + ey*sp(j))
+      call eq11(ex, ey, evx, evy, q(6), v(6), m%omega, m%spacing_error(j), sp(j), cp(j), &
+           dnj, ddnj)
       if (ns > 1) then
         ! slices of the face (angular misalignment; thermal none or bulk: c_j = c_bulk)
         fj = 0.0_wp
@@ -153,6 +153,131 @@ contains
     if (present(cphi_out)) cphi_out = cp(1:m%z)
     if (present(mtilt)) mtilt = [mx, my]
   end subroutine mesh_eval
+
+  !> Eq. 11 and its total time derivative (phi_j' = omega) for one tooth at the face centre, the
+  !> one place they are written (right-hand side, switch functions, outputs, loads): the tooth's
+  !> angle (sp, cp) = (sin, cos) phi_j, the relative centre offset (ex, ey) of spline 1 against
+  !> spline 2 and its rate (evx, evy), D2 = q6 and its rate v6. Tooth j of spline 1 sits e_j ahead
+  !> along +dn (spacing error e, docs/model.md section 11): it meets the dead zone at dn_j + e_j,
+  !> the rate is unchanged.
+  !> For callers in other modules; this module calls eq11, which the compiler inlines (a public
+  !> procedure of a position-independent library may be interposed, so it is not inlined).
+  elemental subroutine tooth_approach(ex, ey, evx, evy, q6, v6, omega, e, sp, cp, dn, ddn)
+    real(wp), intent(in) :: ex, ey, evx, evy, q6, v6, omega, e, sp, cp
+    real(wp), intent(out) :: dn, ddn
+    call eq11(ex, ey, evx, evy, q6, v6, omega, e, sp, cp, dn, ddn)
+  end subroutine tooth_approach
+
+  elemental subroutine eq11(ex, ey, evx, evy, q6, v6, omega, e, sp, cp, dn, ddn)
+    real(wp), intent(in) :: ex, ey, evx, evy, q6, v6, omega, e, sp, cp
+    real(wp), intent(out) :: dn, ddn
+    dn = ex*sp - ey*cp + q6 + e
+    ddn = evx*sp - evy*cp + v6 + omega*(ex*cp + ey*sp)
+  end subroutine eq11
+
+  !> The right-hand side's mesh kernel: mesh_eval's F_x1, F_y1 and T_m, operation for operation
+  !> (so to the bit), for a model without face slices or coupled flash temperature (the teeth's
+  !> backlash is c_bulk; at the one-way level T_f does not act back). One pass over the teeth:
+  !> the pitch rotation of tooth_angles, Eq. 11, Eqs. 15-17 and the sums of Eqs. 19-22, with no
+  !> optional output and no option tested inside the loop. mode: as mesh_eval's.
+  pure subroutine mesh_forces(m, t, q, v, fx1, fy1, tm, mode)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t, q(7), v(7)
+    real(wp), intent(out) :: fx1, fy1, tm
+    integer, intent(in), optional :: mode(m%z)
+    real(wp) :: s, c, s1, phi, ex, ey, evx, evy, dnj, ddnj, fj, sumf, cb, km, cm, sd, cd
+    integer :: j, mj
+    phi = 2.0_wp*pi/m%z + m%omega*t + m%theta0 - m%alpha     ! tooth_angles, tooth 1
+    s = sin(phi)
+    c = cos(phi)
+    sd = m%sin_pitch; cd = m%cos_pitch
+    cb = m%c_bulk; km = m%k_m; cm = m%c_m
+    ex = q(1) + m%l_x - q(3)
+    ey = q(2) + m%l_y - q(4)
+    evx = v(1) - v(3)
+    evy = v(2) - v(4)
+    fx1 = 0.0_wp; fy1 = 0.0_wp; sumf = 0.0_wp
+    if (present(mode)) then
+      do j = 1, m%z
+        call eq11(ex, ey, evx, evy, q(6), v(6), m%omega, m%spacing_error(j), s, c, dnj, ddnj)
+        mj = mode(j)      ! Eqs. 15-17 (mj c_bulk = +-c_bulk exactly)
+        fj = merge(km*(dnj - merge(cb, -cb, mj > 0)) + cm*ddnj, 0.0_wp, mj /= 0)
+        fx1 = fx1 - fj*s
+        fy1 = fy1 + fj*c
+        sumf = sumf + fj
+        s1 = s*cd + c*sd
+        c = c*cd - s*sd
+        s = s1
+      end do
+    else
+      do j = 1, m%z
+        call eq11(ex, ey, evx, evy, q(6), v(6), m%omega, m%spacing_error(j), s, c, dnj, ddnj)
+        mj = contact_state(dnj, cb)
+        fj = merge(km*(dnj - merge(cb, -cb, mj > 0)) + cm*ddnj, 0.0_wp, mj /= 0)
+        fx1 = fx1 - fj*s
+        fy1 = fy1 + fj*c
+        sumf = sumf + fj
+        s1 = s*cd + c*sd
+        c = c*cd - s*sd
+        s = s1
+      end do
+    end if
+    tm = m%r_b*sumf
+  end subroutine mesh_forces
+
+  !> F_j, F_jx, F_jy and dn_j at nt output times (t(k), SI states y(:, k), contact states
+  !> modes(:, k), 2: decided by the state) and T_m, for a model without flash temperature or face
+  !> slices: Eqs. 8-9, 11, 15-17 and 19-22 as tooth_angles and mesh_eval evaluate them,
+  !> operation for operation (run.f90's tooth_outputs checks the first and last output against
+  !> mesh_eval), in blocks of nblk outputs, one pass per tooth (f(k, j) is contiguous in k; the
+  !> pitch rotation of tooth_angles runs over the block's outputs at once).
+  pure subroutine mesh_outputs(m, nt, t, y, modes, f, fx, fy, dn, tm)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: nt
+    real(wp), intent(in) :: t(nt), y(:, :)
+    integer, intent(in) :: modes(:, :)
+    real(wp), intent(out), dimension(nt, m%z) :: f, fx, fy, dn
+    real(wp), intent(out) :: tm(nt)
+    integer, parameter :: nblk = 64
+    real(wp) :: sp(nblk, m%z), cp(nblk, m%z)
+    real(wp) :: ex(nblk), ey(nblk), evx(nblk), evy(nblk), sumf(nblk), phi, dnj, ddnj, fj, cb
+    integer :: k0, nk, i, j, k, mj
+    cb = m%c_bulk
+    do k0 = 0, nt - 1, nblk
+      nk = min(nblk, nt - k0)
+      do i = 1, nk
+        k = k0 + i
+        phi = 2.0_wp*pi/m%z + m%omega*t(k) + m%theta0 - m%alpha     ! tooth_angles, tooth 1
+        sp(i, 1) = sin(phi)
+        cp(i, 1) = cos(phi)
+        ex(i) = y(1, k) + m%l_x - y(3, k)
+        ey(i) = y(2, k) + m%l_y - y(4, k)
+        evx(i) = y(8, k) - y(10, k)
+        evy(i) = y(9, k) - y(11, k)
+      end do
+      do j = 2, m%z             ! tooth_angles' rotation by the pitch, for nk outputs at once
+        sp(1:nk, j) = sp(1:nk, j-1)*m%cos_pitch + cp(1:nk, j-1)*m%sin_pitch
+        cp(1:nk, j) = cp(1:nk, j-1)*m%cos_pitch - sp(1:nk, j-1)*m%sin_pitch
+      end do
+      sumf = 0.0_wp
+      do j = 1, m%z
+        do i = 1, nk
+          k = k0 + i
+          call eq11(ex(i), ey(i), evx(i), evy(i), y(6, k), y(13, k), m%omega, m%spacing_error(j), &
+               sp(i, j), cp(i, j), dnj, ddnj)
+          mj = modes(j, k)
+          if (mj == 2) mj = contact_state(dnj, cb)
+          fj = merge(m%k_m*(dnj - merge(cb, -cb, mj > 0)) + m%c_m*ddnj, 0.0_wp, mj /= 0)
+          f(k, j) = fj
+          fx(k, j) = fj*sp(i, j)
+          fy(k, j) = fj*cp(i, j)
+          dn(k, j) = dnj
+          sumf(i) = sumf(i) + fj
+        end do
+      end do
+      tm(k0+1:k0+nk) = m%r_b*sumf(1:nk)
+    end do
+  end subroutine mesh_outputs
 
   !> Eq. 16: contact state of a tooth pair, +1 drive flank (dn > c), -1 back flank (dn < -c), 0 free.
   pure integer function contact_state(dn, c)
@@ -269,24 +394,32 @@ contains
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(7)
     real(wp), intent(out) :: g(2*m%z*m%n_slices)
-    real(wp) :: sp(max_teeth), cp(max_teeth), ex, ey, dnj, dns, zs
+    real(wp) :: s, c, s1, phi, ex, ey, dnj, ddnj, dns, zs
     integer :: j, is, k, ns
-    call tooth_angles(m%z, m%omega, t, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
+    phi = 2.0_wp*pi/m%z + m%omega*t + m%theta0 - m%alpha     ! tooth_angles, in the loop below
+    s = sin(phi)
+    c = cos(phi)
     ex = q(1) + m%l_x - q(3)
     ey = q(2) + m%l_y - q(4)
     ns = m%n_slices
     do j = 1, m%z
-      dnj = ex*sp(j) - ey*cp(j) + q(6) + m%spacing_error(j)   ! Eq. 11 with the spacing error
-      do is = 1, ns
-        dns = dnj
-        if (ns > 1) then
+      call eq11(ex, ey, 0.0_wp, 0.0_wp, q(6), 0.0_wp, 0.0_wp, m%spacing_error(j), s, c, dnj, &
+           ddnj)                                  ! Eq. 11 (its rate unused)
+      if (ns == 1) then
+        g(2*j - 1) = dnj - m%c_bulk
+        g(2*j) = dnj + m%c_bulk
+      else
+        do is = 1, ns
           zs = m%b*((is - 0.5_wp)/ns - 0.5_wp)
-          dns = dnj + zs*(m%gamma_y*sp(j) + m%gamma_x*cp(j))
-        end if
-        k = (j - 1)*ns + is
-        g(2*k - 1) = dns - m%c_bulk
-        g(2*k) = dns + m%c_bulk
-      end do
+          dns = dnj + zs*(m%gamma_y*s + m%gamma_x*c)
+          k = (j - 1)*ns + is
+          g(2*k - 1) = dns - m%c_bulk
+          g(2*k) = dns + m%c_bulk
+        end do
+      end if
+      s1 = s*m%cos_pitch + c*m%sin_pitch
+      c = c*m%cos_pitch - s*m%sin_pitch
+      s = s1
     end do
   end subroutine mesh_switch_functions
 

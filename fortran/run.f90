@@ -4,11 +4,11 @@
 !> of spline_lyapunov when the case asks), the per-tooth quantities (Eqs. 11, 15-22 and, for the
 !> thermal levels that have it, Eqs. 1-7) at every output time, and the checks of the result.
 module spline_run
-  use spline_kinds, only: wp, pi
+  use spline_kinds, only: wp
   use spline_errors, only: err_ok, err_solver, itoa
   use spline_model, only: model_t, nstate, ndof, thermal_oneway, thermal_coupled, set_thermal_level
   use spline_dynamics, only: start_state
-  use spline_mesh, only: mesh_eval
+  use spline_mesh, only: mesh_eval, mesh_outputs
   use spline_solver, only: integrate
   use spline_quantities, only: nsolver_stats, nstats, ntooth_q, iq_tf, tooth_q, state_q, &
        ist_core_wall, ist_dof, ist_thermal_level, ist_eps_lateral, ist_eps_thermal, ist_closed, &
@@ -110,8 +110,8 @@ contains
     integer :: k, j, q, i, k1
     closed = 0.0_wp; t_closed = 0.0_wp
     ! one contiguous pass over each array; the output-by-output search only to name a failure
-    if (all(ieee_is_finite(t)) .and. all(ieee_is_finite(y)) .and. all(ieee_is_finite(tm)) .and. &
-         all(ieee_is_finite(tooth))) then
+    if (all_finite(size(t), t) .and. all_finite(size(y), y) .and. all_finite(size(tm), tm) .and. &
+         all_finite(size(tooth), tooth)) then
       k1 = size(t) + 1
     else
       k1 = 1
@@ -174,6 +174,24 @@ contains
            '(e.g. a runaway state)'
     end subroutine bad
   end subroutine result_checks
+
+  !> Whether every element of x(n) is finite, in one branch-free pass the compiler vectorises:
+  !> x*0 is 0 for a finite x and NaN for an infinite or NaN one (no early exit: it is rare).
+  pure logical function all_finite(n, x)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: x(n)
+    real(wp) :: acc(8)
+    integer :: i, i1
+    acc = 0.0_wp
+    i1 = n - mod(n, 8)
+    do i = 1, i1, 8
+      acc = acc + x(i:i+7)*0.0_wp
+    end do
+    do i = i1 + 1, n
+      acc(1) = acc(1) + x(i)*0.0_wp
+    end do
+    all_finite = all(acc == 0.0_wp)
+  end function all_finite
 
   !> Warnings about a finished run, one per line ('' if none), from its statistics: the
   !> one-way flash temperature that would have closed the backlash (result_checks). The
@@ -295,60 +313,18 @@ contains
 
   !> The per-tooth quantities of tooth_quantities at every output time, for a model without
   !> flash temperature (thermal none or bulk: T_f = 0, both contact radii on the pitch circle,
-  !> c_j = c_bulk) or face slices: Eqs. 8-9, 11, 15-17 and 19-22 as tooth_angles and mesh_eval
-  !> evaluate them, operation for operation, in blocks of nblk outputs, one pass per tooth
-  !> (tooth(k, j, q) is contiguous in k: a row per output would touch z ntooth_q cache lines;
-  !> the pitch rotation of tooth_angles runs over the block's outputs at once).
+  !> c_j = c_bulk) or face slices: F, F_x, F_y and dn from spline_mesh's mesh_outputs (Eqs. 8-9,
+  !> 11, 15-17, 19-22 as mesh_eval evaluates them), the constants filled in.
   subroutine bulk_tooth_outputs(m, t, y, modes, tooth, tm)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t(:), y(:, :)
     integer, intent(in) :: modes(:, :)
     real(wp), intent(out) :: tooth(:, :, :), tm(:)
-    integer, parameter :: nblk = 64
-    real(wp), allocatable :: sp(:, :), cp(:, :)
-    real(wp) :: ex(nblk), ey(nblk), evx(nblk), evy(nblk), sumf(nblk), phi, dnj, ddnj, fj, cb
-    integer :: k0, nk, i, j, k, mj
-    allocate(sp(nblk, m%z), cp(nblk, m%z))
-    cb = m%c_bulk
-    tooth(:, :, 5) = cb                ! c_j
+    tooth(:, :, 5) = m%c_bulk          ! c_j
     tooth(:, :, 6) = 0.0_wp            ! T_f
     tooth(:, :, 7:8) = m%r_pitch       ! r_c1, r_c2
-    do k0 = 0, size(t) - 1, nblk
-      nk = min(nblk, size(t) - k0)
-      do i = 1, nk
-        k = k0 + i
-        phi = 2.0_wp*pi/m%z + m%omega*t(k) + m%theta0 - m%alpha     ! tooth_angles, tooth 1
-        sp(i, 1) = sin(phi)
-        cp(i, 1) = cos(phi)
-        ex(i) = y(1, k) + m%l_x - y(3, k)
-        ey(i) = y(2, k) + m%l_y - y(4, k)
-        evx(i) = y(ndof+1, k) - y(ndof+3, k)
-        evy(i) = y(ndof+2, k) - y(ndof+4, k)
-      end do
-      do j = 2, m%z             ! tooth_angles' rotation by the pitch, for nk outputs at once
-        sp(1:nk, j) = sp(1:nk, j-1)*m%cos_pitch + cp(1:nk, j-1)*m%sin_pitch
-        cp(1:nk, j) = cp(1:nk, j-1)*m%cos_pitch - sp(1:nk, j-1)*m%sin_pitch
-      end do
-      sumf = 0.0_wp
-      do j = 1, m%z
-        do i = 1, nk
-          k = k0 + i
-          dnj = ex(i)*sp(i, j) - ey(i)*cp(i, j) + y(6, k) + m%spacing_error(j)   ! as mesh_eval
-          ddnj = evx(i)*sp(i, j) - evy(i)*cp(i, j) + y(ndof+6, k) + m%omega*(ex(i)*cp(i, j) + &
-               ey(i)*sp(i, j))
-          mj = modes(j, k)
-          if (mj == 2) mj = merge(1, merge(-1, 0, dnj < -cb), dnj > cb)
-          fj = 0.0_wp
-          if (mj /= 0) fj = m%k_m*(dnj - mj*cb) + m%c_m*ddnj
-          tooth(k, j, 1) = fj
-          tooth(k, j, 2) = fj*sp(i, j)
-          tooth(k, j, 3) = fj*cp(i, j)
-          tooth(k, j, 4) = dnj
-          sumf(i) = sumf(i) + fj
-        end do
-      end do
-      tm(k0+1:k0+nk) = m%r_b*sumf(1:nk)
-    end do
+    call mesh_outputs(m, size(t), t, y, modes, tooth(:, :, 1), tooth(:, :, 2), tooth(:, :, 3), &
+         tooth(:, :, 4), tm)
   end subroutine bulk_tooth_outputs
 
   !> Every per-tooth quantity (order of spline_quantities tooth_q) and the meshing torque at one state y (SI):

@@ -425,7 +425,6 @@ contains
       cv%sv => FN_VMake_Serial(int(size(yr), c_long), yr, cv%sunctx)
       if (.not. associated(cv%sv)) flag = -1
     end if
-    if (flag == 0) flag = FN_VEnableFusedOps_Serial(cv%sv, 1)   ! fused kernels: less work per step
     if (flag == 0) then
       stage = 'creating CVODE'
       if (m%method_bdf == 1) then

@@ -310,9 +310,11 @@ def simulate(case) -> Result:
     q, s = _names("tooth"), _names("stats")
     t0 = time.perf_counter()
     nft = model.n_out if model.n_slices else 0
+    # the per-tooth array (the largest) is allocated here, not zeroed (f2py zeroes its own)
+    tooth = np.empty((model.n_out, model.z, len(q)), order="F")
     t, y, tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, ierr, msg = \
         _api.api_simulate(model.bytes, model.z, model.n_out, len(q), len(s), model.n_section,
-                          model.n_lyapunov, nft, model.n_slices)
+                          model.n_lyapunov, nft, model.n_slices, tooth)
     wall = time.perf_counter() - t0
     raise_for(ierr, msg)
     st = {n: (float(v) if unit else int(v)) for (n, unit, _), v in zip(s, stats)}  # counts: int

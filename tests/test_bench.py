@@ -3,6 +3,7 @@ failures as failures, and their reference is checked against a second method."""
 import csv
 import sys
 
+import numpy as np
 import pytest
 
 import pyspline
@@ -136,3 +137,16 @@ def test_bifurcation_repeats_quick(tmp_path, exe, monkeypatch):
     for r in table[1:]:
         assert float(r["core_time_over_serial_median"]) > 0      # timings: no bound (noisy host)
         assert float(r["ceiling"]) == pytest.approx(2 / float(r["core_time_over_serial_median"]))
+
+
+def test_race_statistics_standard_error_is_the_cores():
+    """bench/race.py's standard errors (numpy, per revolution, overlapping batch means) against
+    the core's Tm_rms_se (spline_loads::batch_means) on a short chaotic run."""
+    import race
+    case = pyspline.load_case(CASES / "chaos_z24.nml", t_transient=0.02, t_end=0.12, n_out=2001,
+                              lyapunov=False, section="none")
+    res = pyspline.simulate(case)
+    stat, se = race.statistics_of(case, res.t, res.Tm)
+    assert res.loads["batches"] == 10
+    assert se[0] == pytest.approx(res.loads["Tm_rms_se"], rel=1e-9)
+    assert se[0] > 0 and np.all(np.isfinite(stat)) and np.all(np.isfinite(se))

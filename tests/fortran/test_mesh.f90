@@ -6,7 +6,7 @@
 program test_mesh
   use spline_kinds, only: wp, pi
   use spline_model, only: model_t
-  use spline_mesh, only: mesh_eval, mesh_switch_functions
+  use spline_mesh, only: mesh_eval, mesh_forces, mesh_switch_functions, tooth_approach
   use check, only: check_true, check_close, check_done, default_case_model
   implicit none
   real(wp), parameter :: eps = epsilon(1.0_wp)
@@ -14,7 +14,7 @@ program test_mesh
   real(wp) :: q(7), v(7), fx, fy, tm, fx2, fy2, tm2, c, km, z, d, vel, fj, t, tz, th, scale, h
   real(wp) :: ex, ey, dn(1000), f(1000), g(2000), want_fx, want_fy, gx, gy, gd, gx2
   real(wp) :: phi, s, co, dnj, ddn, delta, sumf
-  integer :: ierr, j, k, n_pos, n_neg
+  integer :: ierr, j, k, n_pos, n_neg, modes_k(1000)
   character(len=256) :: msg
   character(len=64) :: tag
   logical :: ok
@@ -150,6 +150,44 @@ program test_mesh
   call mesh_eval(ms, t, q, v, fx2, fy2, tm2, ierr, msg)
   call check_close('4 slices, no tilt: T_m as one slice', tm2, tm, 0.0_wp, 1.0e-14_wp*ms%r_b*scale)
   call check_close('4 slices, no tilt: F_x1 as one slice', fx2, fx, 0.0_wp, 1.0e-14_wp*scale)
+
+  ! ---- the right-hand side's kernel (mesh_forces) is mesh_eval's arithmetic: equal to the bit
+  !      in partial contact (teeth on both flanks and free), with the contact states decided by
+  !      the state and frozen (some frozen states disagreeing with the state), with spacing errors;
+  !      and Eq. 11 for other modules (tooth_approach) is mesh_eval's dn_j
+  ms = md
+  ms%l_x = 0.7_wp*c; ms%l_y = -0.4_wp*c
+  ok = .true.
+  do k = 1, 40
+    ms%spacing = mod(k, 2) == 0
+    ms%spacing_error(1:md%z) = merge(0.05_wp*c*[(sin(3.1_wp*j + k), j = 1, md%z)], &
+         [(0.0_wp, j = 1, md%z)], ms%spacing)
+    t = 1.0e-4_wp*k
+    q = c*[sin(1.3_wp*k), cos(0.7_wp*k), 0.3_wp*sin(2.1_wp*k), -0.2_wp*cos(k + 0.5_wp), &
+         10*sin(0.3_wp*k), 1.1_wp*sin(0.9_wp*k), 5*cos(0.4_wp*k)]
+    v = 0.01_wp*[cos(1.7_wp*k), sin(0.2_wp*k), sin(k + 1.0_wp), cos(2.3_wp*k), 1.0_wp, &
+         sin(1.9_wp*k), -1.0_wp]
+    call mesh_eval(ms, t, q, v, fx, fy, tm, ierr, msg, dn=dn, f=f)
+    call mesh_forces(ms, t, q, v, fx2, fy2, tm2)
+    ok = ok .and. fx2 == fx .and. fy2 == fy .and. tm2 == tm
+    n_pos = count(dn(1:md%z) > c); n_neg = count(dn(1:md%z) < -c)
+    modes_k(1:md%z) = [(merge(1, merge(-1, 0, dn(j) < -c), dn(j) > c), j = 1, md%z)]
+    modes_k(1:md%z:3) = -modes_k(1:md%z:3)        ! some frozen states off the state's
+    call mesh_eval(ms, t, q, v, fx, fy, tm, ierr, msg, mode=modes_k(1:md%z))
+    call mesh_forces(ms, t, q, v, fx2, fy2, tm2, modes_k(1:md%z))
+    ok = ok .and. fx2 == fx .and. fy2 == fy .and. tm2 == tm
+    call mesh_eval(ms, t, q, v, fx, fy, tm, ierr, msg, dn=dn, sphi_out=g(1:md%z), &
+         cphi_out=g(md%z+1:2*md%z))
+    do j = 1, md%z
+      call tooth_approach(q(1) + ms%l_x - q(3), q(2) + ms%l_y - q(4), v(1) - v(3), v(2) - v(4), &
+           q(6), v(6), ms%omega, ms%spacing_error(j), g(j), g(md%z + j), dnj, ddn)
+      ok = ok .and. dnj == dn(j)
+    end do
+  end do
+  call check_true('mesh_forces = mesh_eval to the bit, state-decided and frozen contact states, '// &
+       'with and without spacing errors; tooth_approach = mesh_eval''s dn_j (40 states)', ok)
+  call check_true('those states have teeth on both flanks and free', n_pos > 0 .and. n_neg > 0 &
+       .and. n_pos + n_neg < md%z)
 
   call check_done('test_mesh')
 
