@@ -62,7 +62,7 @@ def test_scene_does_not_zoom_into_round_off():
 
 
 def test_scene_draws_a_small_real_ripple():
-    # D2's stiffness ripple in physical_ripple: 1.7e-6 of D2; T_m 2e-3 of its value
+    # D2's stiffness ripple in physical_ripple with the paper's shafts: 1.7e-6 of D2; T_m 2e-3
     t, D2, vD2, Tm, F = _equilibrium(ripple_d2=1.7e-6)
     Tm = Tm * (1 + 2e-3 * np.sin(2 * np.pi * 1600 * t))
     fig = pl.scene(t, D2, vD2, Tm, F, speed_rpm=6000, z=16)
