@@ -19,7 +19,7 @@ CASE = ROOT / "cases" / "paper_lx1e-4.nml"
 SHORT = dict(t_end=0.05, n_out=401)          # 5 revolutions: fast, sections and a Benettin record
 TIMINGS = ("core_wall_s", "wall_s")
 #: the sweep's RMS is numpy's (pairwise sums), the summary's the executable's sequential sum
-RMS = ("Tm_rms", "kv_rms", "F_rms")
+RMS = ("Tm_rms", "kv_rms", "F_rms", "D2_rms")
 
 
 def building_block(marker):

@@ -209,3 +209,58 @@ def test_batch_means_of_a_periodic_run_vanish():
     assert ld["load_sharing_rev_se"] < 1e-6
     one = pyspline.simulate(full_contact(t_end=0.015, n_out=1081)).loads
     assert one["batches"] == 1 and np.isnan(one["Tm_rms_se"]) and np.isnan(one["load_sharing_rev"])
+
+
+def obm_se(x):
+    """Overlapping batch means (Meketon & Schmeiser 1984), batches of floor(sqrt(n)) values,
+    written from the formula of docs/model.md section 15 (not the core's loop)."""
+    x = np.asarray(x, dtype=float)
+    n = len(x)
+    m = int(np.sqrt(n))
+    means = np.convolve(x, np.ones(m) / m, mode="valid")
+    return np.sqrt(m * np.sum((means - x.mean()) ** 2) / ((n - m) * (n - m + 1)))
+
+
+def test_batch_means_of_every_statistic_against_a_count():
+    """Batches of m = 3 revolutions (10 whole revolutions of the offset scene, which keeps
+    impacting): every standard error, recomputed here per revolution from Result.Tm, kv, F, dn,
+    D2 and Tf with the flank count of independent_count, and the standard error of the tooth
+    with the largest fraction for free_frac_max_se / back_frac_max_se."""
+    case = pyspline.load_case(CASES / "template.nml", name="offset10", t_d=2.0, t_l=2.0,
+                              l_x=4e-4, grav=0.0, start="rest", thermal="oneway", t_end=0.1,
+                              n_out=1999)
+    res = pyspline.simulate(case)
+    ld = res.loads
+    omega = case["speed_rpm"] * 2 * np.pi / 60
+    rev = np.floor(omega * (res.t - res.t[0]) / (2 * np.pi)).astype(int)   # as the core rounds
+    nb = int(ld["batches"])
+    assert nb == 10 and int(np.sqrt(nb)) == 3
+    flank, onset = independent_count(res)
+    onset = np.vstack([np.zeros((1, flank.shape[1]), bool), onset])          # at output k
+    by = [rev == b for b in range(nb)]
+    rms = lambda x: np.sqrt(np.mean(x ** 2))                                  # noqa: E731
+    per_rev = {
+        "Tm_rms_se": [rms(res.Tm[k]) for k in by],
+        "kv_rms_se": [rms(res.kv[k]) for k in by],
+        "F_rms_se": [rms(res.F[k]) for k in by],
+        "D2_rms_se": [rms(res.D2[k]) for k in by],
+        "teeth_free_mean_se": [(flank[k] == 0).sum(1).mean() for k in by],
+        "impacts_per_rev_se": [onset[k].sum() for k in by],
+        "Tf_max_rev_se": [res.Tf[k].max() for k in by],
+        "load_sharing_rev_se": [np.abs(res.F[k]).max() / ld["F_static"] for k in by],
+    }
+    for n, x in per_rev.items():
+        assert ld[n] == pytest.approx(obm_se(x), rel=1e-9, abs=1e-300), n
+        assert ld[n] > 0, n                                    # the scene varies between revolutions
+    assert ld["Tf_max_rev"] == pytest.approx(np.mean(per_rev["Tf_max_rev_se"]), rel=1e-12)
+    assert ld["load_sharing_rev"] == pytest.approx(np.mean(per_rev["load_sharing_rev_se"]), rel=1e-12)
+    free = np.array([(flank[k] == 0).mean(0) for k in by])                    # (nb, Z)
+    back = np.array([(flank[k] == 1).mean(0) for k in by])
+    np.testing.assert_allclose(ld["free_frac_se"], [obm_se(c) for c in free.T], rtol=1e-9)
+    np.testing.assert_allclose(ld["back_frac_se"], [obm_se(c) for c in back.T], rtol=1e-9)
+    assert ld["free_frac_max_se"] == ld["free_frac_se"][np.argmax(ld["free_frac"])]
+    assert ld["back_frac_max_se"] == ld["back_frac_se"][np.argmax(ld["back_frac"])]
+    assert (ld["free_frac_se"] > 0).any() and (ld["back_frac_se"] > 0).any()
+    # the standard error of a mean of correlated batches is not the naive one
+    naive = np.std(per_rev["Tm_rms_se"], ddof=1) / np.sqrt(nb)
+    assert ld["Tm_rms_se"] != pytest.approx(naive, rel=1e-3)
