@@ -27,9 +27,9 @@ module spline_loads
   !> allowables of case-hardened steel splines (58-63 HRC) at full load, 10^4 torque cycles,
   !> uniform drive: shear 50,000 psi (Dudley, "When splines need stress control", Product
   !> Engineering 1957, as in Machinery's Handbook's involute-spline stress tables); flank
-  !> compression of a fixed spline 9 x 5,000 psi (same tables); root bending 400 MPa, ISO
-  !> 6336-5's nominal bending endurance of case-hardened steel, about 1000 MPa with its fillet
-  !> concentration, over a spline fillet's concentration of about 2 and a safety of 1.25.
+  !> compression of a fixed spline 9 x 5,000 psi (same tables); root bending 400 MPa, a
+  !> typical value, not a standard's: of the order of ISO 6336-5's nominal bending endurance
+  !> limit of good case-hardened gear steel (about 500 MPa, approximate) over a safety of 1.25.
   real(wp), parameter :: sigma_root_limit = 400.0e6_wp, sigma_flank_limit = 310.0e6_wp, &
        tau_pitch_limit = 345.0e6_wp
 
@@ -168,10 +168,12 @@ contains
   !> section 15, "Tooth stresses"), from its tangential part at the pitch circle
   !> f_t = f cos(alpha) spread evenly over the face width b:
   !> - root bending sigma_root = 6 f_t h_f / (b t_f^2): the tooth a cantilever loaded at the
-  !>   pitch circle, h_f above its root section t_f thick (spline_geometry::root_section);
+  !>   pitch circle, h_f above its root section t_f thick (spline_geometry::root_section; the
+  !>   cantilever of Lewis 1892, no form or stress-correction factor);
   !> - flank bearing sigma_flank = f_t / (b h_w) over the working depth h_w = m (the active
-  !>   profile, spline_geometry::active_profile);
-  !> - shear at the pitch circle tau_pitch = f_t / (b s), s the tooth thickness there.
+  !>   profile, spline_geometry::active_profile; Dudley 1957's compressive stress);
+  !> - shear at the pitch circle tau_pitch = f_t / (b s), s the tooth thickness there (Dudley
+  !>   1957's tooth shear with f_t the peak, not 2 T / (D N)).
   pure subroutine tooth_stresses(m, f, sigma_root, sigma_flank, tau_pitch)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: f
