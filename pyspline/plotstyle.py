@@ -174,19 +174,20 @@ def no_content(span, unit) -> str:
 
 # --------------------------------------------------------------------------- colour limits
 
-def settled_limits(t, q, rtol=1e-8) -> tuple[float, float, str]:
+def settled_limits(t, q, rtol=1e-8, start=0.5) -> tuple[float, float, str]:
     """Colour limits (lo, hi) of q (time along axis 0) and the words for the colour bar. The
-    whole range ('') unless the first half of the run reaches beyond the second half's range
-    by more than a tenth of it (a start transient): then the second half's range, saying so.
-    A second half that is round-off gets limits around its value (`flat_limits`)."""
+    whole range ('') unless the first part of the run (the fraction `start` of it: half for
+    the colour maps, a tenth for line plots) reaches beyond the range of the rest by more than
+    a tenth of it (a start transient): then the rest's range, saying so. A rest that is
+    round-off gets limits around its value (`flat_limits`)."""
     t = np.asarray(t, dtype=float)
     q = np.asarray(q, dtype=float)
-    late = q[t >= t[0] + 0.5 * (t[-1] - t[0])]
+    late = q[t >= t[0] + start * (t[-1] - t[0])]
     late = late[np.isfinite(late)]
     whole = q[np.isfinite(q)]
     if late.size == 0:
         return 0.0, 1.0, ""
-    t_half = eng(t[0] + 0.5 * (t[-1] - t[0]), 3)
+    t_half = eng(t[0] + start * (t[-1] - t[0]), 3)
     lo, hi = float(late.min()), float(late.max())
     if roundoff_span(late, rtol=rtol) is not None:
         lo, hi = flat_limits(float(late.mean()), 0.0)
