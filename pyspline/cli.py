@@ -156,7 +156,7 @@ def cmd_run(args) -> int:
         try:
             with warnings.catch_warnings(record=True) as rec:
                 warnings.simplefilter("always", SplineWarning)
-                res = simulate(path)
+                res = simulate(load_case(path, **_fixed(getattr(args, "fix", None))))
             for w in rec:                       # shown as usual (the warning: lines), counted
                 warnings.showwarning(w.message, w.category, w.filename, w.lineno)
             print(_summary(res, sum(issubclass(w.category, SplineWarning) for w in rec)))
@@ -536,6 +536,8 @@ def main(argv=None) -> int:
     r.add_argument("cases", nargs="+")
     r.add_argument("--out", help="directory for .npz results (NAME.npz per case; never replaces "
                    "a file pyspline did not write; cases of the same name get NAME-2.npz, ...)")
+    r.add_argument("--fix", action="append", metavar="FIELD=VALUE",
+                   help="change a field of every case (e.g. thermal=oneway)")
     r.set_defaults(func=cmd_run)
     r = sub.add_parser("reproduce", help="run the paper's scenarios and write into --out (default "
                        "out/) the figures (fig*.png), verification.md/.csv and summary.json")
