@@ -264,3 +264,28 @@ def test_batch_means_of_every_statistic_against_a_count():
     # the standard error of a mean of correlated batches is not the naive one
     naive = np.std(per_rev["Tm_rms_se"], ddof=1) / np.sqrt(nb)
     assert ld["Tm_rms_se"] != pytest.approx(naive, rel=1e-3)
+
+
+def test_run_answers_the_engineers_questions(capsys):
+    """`pyspline run CASE` answers, one line each: which teeth carry what, does it rattle, how
+    hot, how close to the limits, how far to trust it, is the input plausible (README). --fix
+    changes a field; the numbers are the run's loads."""
+    from pyspline.cli import main
+    path = CASES / "physical_z24.nml"
+    assert main(["run", str(path), "--fix", "t_end=0.1", "--fix", "n_out=401",
+                 "--fix", "thermal=oneway"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert [ln.split(":")[0].strip() for ln in out[1:]] == ["teeth", "rattle", "heat", "limits",
+                                                             "trust", "input"]
+    ld = pyspline.simulate(pyspline.load_case(path, t_end=0.1, n_out=401, thermal="oneway")).loads
+    assert f"load sharing {ld['load_sharing']:.3f} (tooth {ld['load_sharing_tooth']:.0f}" in out[1]
+    assert f"T_f max {ld['Tf_max']:.3g} degC (tooth {ld['Tf_max_tooth']:.0f}" in out[3]
+    assert f"{100 * ld['stress_ratio']:.0f} % of the typical allowable" in out[4]
+    assert f"{ld['revolutions']:.1f} revolutions" in out[5] and "+-" in out[5]
+    assert out[6].endswith("no plausibility warning")
+    assert main(["run", str(CASES / "paper_lx1e-4.nml"), "--fix", "t_end=0.01"]) == 0
+    assert capsys.readouterr().out.splitlines()[-1].endswith("1 plausibility warning (the "
+                                                              "warning: lines)")
+    # the stress ratio is the largest stress over its limit (docs/model.md section 15)
+    limits = {"sigma_root": 400e6, "sigma_flank": 310e6, "tau_pitch": 345e6}
+    assert ld["stress_ratio"] == pytest.approx(max(ld[n] / v for n, v in limits.items()), rel=1e-14)
