@@ -2,7 +2,7 @@
 
 commands (each --help says what it writes and where):
   cases list | copy NAME [DEST]   the shipped cases; copy one to start your own (template)
-  run CASE...                     run cases, print a summary line each (--out DIR: NAME.npz)
+  run CASE...                     run cases, print what each answers (--out DIR: NAME.npz)
   plot CASE... [--out DIR]        one scene as a figure: DIR/NAME.png
   sweep CASE --set F=a:b:n ...    sweep one or two fields (or --table design.csv): DIR/sweep.nc
   merge SUMMARY... --out DIR      spline-dyn --summary files into DIR/sweep.nc
@@ -531,7 +531,8 @@ def main(argv=None) -> int:
     r.add_argument("dest", nargs="?", help="file or directory to write (default: ./NAME.nml)")
     r.add_argument("--force", action="store_true", help="replace an existing file")
     r.set_defaults(func=cmd_cases)
-    r = sub.add_parser("run", help="run case files and print a summary line each; with --out, "
+    r = sub.add_parser("run", help="run case files and print a summary of each (loads, rattle, "
+                       "heat, limits, standard errors, warnings); with --out, "
                        "the results as DIR/NAME.npz (t, y, Tm and the per-tooth arrays, SI)")
     r.add_argument("cases", nargs="+")
     r.add_argument("--out", help="directory for .npz results (NAME.npz per case; never replaces "

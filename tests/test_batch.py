@@ -10,7 +10,9 @@ import numpy as np
 import pytest
 
 import pyspline
-from conftest import ROOT
+from conftest import ROOT, PAPER_SHAFTS
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 from pyspline.batch import merge, read_summary
 from pyspline.cli import main
 from pyspline.sweep import summarise
