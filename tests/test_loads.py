@@ -167,6 +167,14 @@ def test_executable_writes_the_same_loads(exe, offset_scene, scene, tmp_path):
     run = subprocess.run([exe, str(nml), "-o", str(out)], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     assert "load sharing factor" in run.stdout
+    assert "standard errors (overlapping batch means" in run.stdout
+    assert "largest stress over its typical allowable" in run.stdout
+    # a summary-only run (batch) prints the same answers
+    quiet = subprocess.run([exe, str(nml), "--summary", str(tmp_path / "c.summary")],
+                           capture_output=True, text=True)
+    assert quiet.returncode == 0, quiet.stderr
+    answers = run.stdout[run.stdout.index("  load sharing factor"):]
+    assert quiet.stdout.endswith(answers[:answers.index("\n  " + "steps")] + "\n")
     got = read_csv_loads(out)
     res = pyspline.simulate(case)
     assert set(got) == set(res.loads)
