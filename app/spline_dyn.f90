@@ -23,7 +23,8 @@ program spline_dyn
   use spline_quantities, only: nstats, stat_q, state_q, iq_tf, ntooth_q, tooth_q, nout_q, output_q, nload, &
        load_q, nload_tooth, load_tooth_q, il_load_sharing, il_free_mean, il_back_teeth, &
        il_impacts_rev, il_closing_speed, il_tf_max, il_tf_max_tooth, il_tf_max_t, il_sigma_root, &
-       il_sigma_flank, il_tau_pitch
+       il_sigma_flank, il_tau_pitch, il_batches, il_tm_rms_se, il_sharing_rev, il_sharing_rev_se, &
+       il_free_mean_se, il_impacts_rev_se, il_tf_rev, il_tf_rev_se, il_stress_ratio
   use spline_loads, only: run_loads, stress_warnings
   use spline_sections, only: section_count
   use spline_lyapunov, only: lyapunov_count
@@ -219,6 +220,7 @@ program spline_dyn
   if (have_summary) call write_summary(.true.)
   if (.not. write_csv) then
     write(*, '(a)') 'case '//trim(m%name)//': '//summary
+    call report_loads()
     stop 0, quiet=.true.
   end if
 
@@ -304,6 +306,16 @@ program spline_dyn
   write(*, '(a,2es12.4)') '  meshing torque T_m min/max [N m]: ', minval(tm), maxval(tm)
   write(*, '(a,2es12.4)') '  tooth force F_j min/max [N]:      ', minval(tooth(:, :, 1)), &
        maxval(tooth(:, :, 1))
+  call report_loads()
+  do i = 1, nstats
+    write(*, '(2x,a24,g0)') stat_q(i)%name, stats(i)
+  end do
+
+contains
+
+  !> The loads of the run on stdout (spline_loads::run_loads, docs/model.md section 15): which
+  !> teeth carry what, rattle, flash temperature, stresses and their limits, standard errors.
+  subroutine report_loads()
   write(*, '(a,f8.3,a,f6.2,a,i0,a,f8.3,a,es10.3,a)') '  load sharing factor ', &
        loads(il_load_sharing), ', free teeth (mean) ', loads(il_free_mean), &
        ', teeth on the back flank ', nint(loads(il_back_teeth)), ', impacts/rev ', &
@@ -312,11 +324,17 @@ program spline_dyn
        loads(il_tf_max), ' (tooth ', nint(loads(il_tf_max_tooth)), ', t = ', loads(il_tf_max_t), ' s)'
   write(*, '(a,3f10.2)') '  tooth stresses root bending / flank bearing / shear at pitch [MPa]:', &
        1.0e-6_wp*loads([il_sigma_root, il_sigma_flank, il_tau_pitch])
-  do i = 1, nstats
-    write(*, '(2x,a24,g0)') stat_q(i)%name, stats(i)
-  end do
-
-contains
+  write(*, '(a,f7.1,a)') '  largest stress over its typical allowable (docs/model.md section 15):', &
+       100.0_wp*loads(il_stress_ratio), ' %'
+  write(*, '(a,i0,a)') '  standard errors (overlapping batch means of ', nint(loads(il_batches)), &
+       ' whole revolutions; NaN: fewer than 2):'
+  write(*, '(a,es11.4,a,f8.3,a,es10.3,a,f6.2,a,es10.3,a,f8.3,a,es10.3,a,es11.4,a,es10.3)') &
+       '    T_m RMS +- ', loads(il_tm_rms_se), '; load sharing per revolution ', &
+       loads(il_sharing_rev), ' +- ', loads(il_sharing_rev_se), '; free teeth ', &
+       loads(il_free_mean), ' +- ', loads(il_free_mean_se), '; impacts/rev ', &
+       loads(il_impacts_rev), ' +- ', loads(il_impacts_rev_se), '; T_f max per revolution ', &
+       loads(il_tf_rev), ' +- ', loads(il_tf_rev_se)
+  end subroutine report_loads
 
   !> Command argument i, whatever its length.
   function argument(i) result(s)

@@ -16,7 +16,10 @@ module spline_loads
        il_load_sharing, il_load_sharing_tooth, il_free_max, il_back_max, il_free_mean, &
        il_unloaded, il_back_teeth, il_impacts_rev, il_closing_speed, il_tf_max, il_tf_max_tooth, &
        il_tf_max_t, il_revolutions, il_batches, il_tm_rms_se, il_sharing_rev, &
-       il_sharing_rev_se, il_sigma_root, il_sigma_flank, il_tau_pitch, ilt_f_peak, ilt_load_factor, ilt_free, ilt_back, ilt_onsets
+       il_sharing_rev_se, il_sigma_root, il_sigma_flank, il_tau_pitch, il_kv_rms_se, &
+       il_f_rms_se, il_d2_rms_se, il_free_mean_se, il_free_max_se, il_back_max_se, &
+       il_impacts_rev_se, il_tf_rev, il_tf_rev_se, il_stress_ratio, ilt_f_peak, ilt_load_factor, ilt_free, &
+       ilt_back, ilt_onsets, ilt_free_se, ilt_back_se
   implicit none
   private
   public :: run_loads, tooth_flank, drive_flank, approach_speed, tooth_stresses, stress_warnings
@@ -25,9 +28,9 @@ module spline_loads
   !> allowables of case-hardened steel splines (58-63 HRC) at full load, 10^4 torque cycles,
   !> uniform drive: shear 50,000 psi (Dudley, "When splines need stress control", Product
   !> Engineering 1957, as in Machinery's Handbook's involute-spline stress tables); flank
-  !> compression of a fixed spline 9 x 5,000 psi (same tables); root bending 400 MPa, ISO
-  !> 6336-5's nominal bending endurance of case-hardened steel, about 1000 MPa with its fillet
-  !> concentration, over a spline fillet's concentration of about 2 and a safety of 1.25.
+  !> compression of a fixed spline 9 x 5,000 psi (same tables); root bending 400 MPa, a
+  !> typical value, not a standard's: of the order of ISO 6336-5's nominal bending endurance
+  !> limit of good case-hardened gear steel (about 500 MPa, approximate) over a safety of 1.25.
   real(wp), parameter :: sigma_root_limit = 400.0e6_wp, sigma_flank_limit = 310.0e6_wp, &
        tau_pitch_limit = 345.0e6_wp
 
@@ -76,13 +79,15 @@ contains
   !> - T_f max over teeth and outputs, the first tooth and time where it occurs (0 and -1 if it
   !>   is 0 throughout: a thermal level without T_f).
   !> - standard errors by batch means (batch_means): per whole revolution of the outputs the
-  !>   RMS of T_m and the load-sharing factor, their standard errors by overlapping batches of
+  !>   value of each mean-like statistic, their standard errors by overlapping batches of
   !>   floor(sqrt(revolutions)) revolutions (std_error).
   pure subroutine run_loads(m, t, y, tooth, tm, loads, tload)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t(:), y(:, :), tooth(:, :, :), tm(:)
     real(wp), intent(out) :: loads(nload), tload(m%z, nload_tooth)
-    integer :: nt, j, k, fl, prev, drive, onsets
+    integer :: nt, j, k, fl, prev, drive, onsets, nb
+    integer, allocatable :: rev(:)
+    real(wp), allocatable :: free_b(:, :), back_b(:, :), ons_b(:)
     real(wp) :: fs, tfm, speed
     nt = size(t)
     loads = 0.0_wp; tload = 0.0_wp
@@ -91,6 +96,15 @@ contains
     fs = abs(m%t_d)/(m%z*m%r_b)
     onsets = 0
     speed = 0.0_wp
+    ! the revolution (batch) of each output, 0 past the last whole one (batch_means)
+    loads(il_revolutions) = m%omega*(t(nt) - t(1))/(2.0_wp*pi)
+    nb = int(loads(il_revolutions))
+    allocate(rev(nt), free_b(max(nb, 1), m%z), back_b(max(nb, 1), m%z), ons_b(max(nb, 1)))
+    do k = 1, nt
+      rev(k) = int(m%omega*(t(k) - t(1))/(2.0_wp*pi)) + 1
+      if (rev(k) > nb) rev(k) = 0
+    end do
+    free_b = 0.0_wp; back_b = 0.0_wp; ons_b = 0.0_wp
     do j = 1, m%z
       prev = 0
       do k = 1, nt
@@ -98,9 +112,14 @@ contains
         fl = tooth_flank(tooth(k, j, 1), tooth(k, j, 4))
         if (fl == 0) tload(j, ilt_free) = tload(j, ilt_free) + 1
         if (fl == -drive) tload(j, ilt_back) = tload(j, ilt_back) + 1
+        if (rev(k) > 0) then
+          if (fl == 0) free_b(rev(k), j) = free_b(rev(k), j) + 1
+          if (fl == -drive) back_b(rev(k), j) = back_b(rev(k), j) + 1
+        end if
         if (k > 1 .and. fl /= 0 .and. fl /= prev) then
           tload(j, ilt_onsets) = tload(j, ilt_onsets) + 1
           speed = max(speed, approach_speed(m, t(k - 1), y(:, k - 1), j))
+          if (rev(k) > 0) ons_b(rev(k)) = ons_b(rev(k)) + 1
         end if
         prev = fl
       end do
@@ -113,6 +132,8 @@ contains
     loads(il_f_static) = fs
     call tooth_stresses(m, maxval(tload(:, ilt_f_peak)), loads(il_sigma_root), &
          loads(il_sigma_flank), loads(il_tau_pitch))
+    loads(il_stress_ratio) = max(loads(il_sigma_root)/sigma_root_limit, &
+         loads(il_sigma_flank)/sigma_flank_limit, loads(il_tau_pitch)/tau_pitch_limit)
     loads(il_load_sharing) = maxval(tload(:, ilt_load_factor))
     loads(il_load_sharing_tooth) = maxloc(tload(:, ilt_f_peak), 1)
     if (fs == 0.0_wp) loads(il_load_sharing) = ieee_value(fs, ieee_quiet_nan)
@@ -123,11 +144,10 @@ contains
     tload(:, ilt_back) = tload(:, ilt_back)/nt
     loads(il_free_max) = maxval(tload(:, ilt_free))
     loads(il_back_max) = maxval(tload(:, ilt_back))
-    loads(il_revolutions) = m%omega*(t(nt) - t(1))/(2.0_wp*pi)
     onsets = nint(sum(tload(:, ilt_onsets)))
     if (loads(il_revolutions) > 0.0_wp) loads(il_impacts_rev) = onsets/loads(il_revolutions)
     loads(il_closing_speed) = speed
-    call batch_means(m, t, tooth, tm, fs, loads)
+    call batch_means(m, rev, y, tooth, tm, fs, free_b, back_b, ons_b, loads, tload)
     tfm = maxval(tooth(:, :, iq_tf))
     loads(il_tf_max) = tfm
     loads(il_tf_max_tooth) = 0.0_wp
@@ -149,10 +169,12 @@ contains
   !> section 15, "Tooth stresses"), from its tangential part at the pitch circle
   !> f_t = f cos(alpha) spread evenly over the face width b:
   !> - root bending sigma_root = 6 f_t h_f / (b t_f^2): the tooth a cantilever loaded at the
-  !>   pitch circle, h_f above its root section t_f thick (spline_geometry::root_section);
+  !>   pitch circle, h_f above its root section t_f thick (spline_geometry::root_section; the
+  !>   cantilever of Lewis 1892, no form or stress-correction factor);
   !> - flank bearing sigma_flank = f_t / (b h_w) over the working depth h_w = m (the active
-  !>   profile, spline_geometry::active_profile);
-  !> - shear at the pitch circle tau_pitch = f_t / (b s), s the tooth thickness there.
+  !>   profile, spline_geometry::active_profile; Dudley 1957's compressive stress);
+  !> - shear at the pitch circle tau_pitch = f_t / (b s), s the tooth thickness there (Dudley
+  !>   1957's tooth shear with f_t the peak, not 2 T / (D N)).
   pure subroutine tooth_stresses(m, f, sigma_root, sigma_flank, tau_pitch)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: f
@@ -207,34 +229,47 @@ contains
   end function stress_warnings
 
   !> Standard errors by batch means (e.g. Law & Kelton, Simulation Modeling and Analysis,
-  !> ch. 9.5): output k belongs to revolution b = floor(omega (t_k - t_1) / 2 pi) + 1; the
-  !> nb = floor(revolutions) whole ones are the batches (outputs past them are left out). Per
-  !> batch x_b: the RMS of T_m, sqrt(mean T_m^2), and the load-sharing factor max |F_j| / F_s;
-  !> the standard error of their mean by std_error (overlapping batches of floor(sqrt(nb))
-  !> revolutions: in a chaotic run consecutive revolutions are correlated). NaN with fewer
-  !> than 2 batches (and for the load sharing when F_s = 0).
-  pure subroutine batch_means(m, t, tooth, tm, fs, loads)
+  !> ch. 9.5): output k belongs to revolution rev(k) = floor(omega (t_k - t_1) / 2 pi) + 1
+  !> (run_loads; 0 past the nb = floor(revolutions) whole ones, which are the batches). Per
+  !> batch b its value of each statistic that is a mean over the outputs (docs/model.md
+  !> section 15): the RMS of T_m, k_v = |T_m| / T_d, F_j (all teeth) and D_2; the
+  !> load-sharing factor max |F_j| / F_s and the largest T_f of the revolution (their means
+  !> load_sharing_rev, Tf_max_rev: what an extreme is given instead); per tooth the fractions
+  !> free and on the back flank (free_b, back_b: counts), the mean number of free teeth and
+  !> the contact onsets (ons_b) of the revolution. The standard error of their mean by
+  !> std_error (overlapping batches of floor(sqrt(nb)) revolutions: in a chaotic run
+  !> consecutive revolutions are correlated); that of free_frac_max and back_frac_max is the
+  !> standard error of the tooth that has the largest. NaN with fewer than 2 batches (and for
+  !> k_v and the load sharing when T_d = 0).
+  pure subroutine batch_means(m, rev, y, tooth, tm, fs, free_b, back_b, ons_b, loads, tload)
     type(model_t), intent(in) :: m
-    real(wp), intent(in) :: t(:), tooth(:, :, :), tm(:), fs
-    real(wp), intent(inout) :: loads(nload)
-    real(wp), allocatable :: sq(:), fmax(:), cnt(:)
+    integer, intent(in) :: rev(:)
+    real(wp), intent(in) :: y(:, :), tooth(:, :, :), tm(:), fs
+    real(wp), intent(inout) :: free_b(:, :), back_b(:, :), ons_b(:)
+    real(wp), intent(inout) :: loads(nload), tload(m%z, nload_tooth)
+    real(wp), allocatable :: sq(:), fmax(:), cnt(:), sqf(:), sqd(:), tfb(:)
     real(wp) :: nan
-    integer :: nb, b, k
+    integer :: nb, b, k, j
     nan = ieee_value(0.0_wp, ieee_quiet_nan)
     nb = int(loads(il_revolutions))
     loads(il_batches) = nb
-    loads(il_tm_rms_se) = nan
-    loads(il_sharing_rev) = nan
-    loads(il_sharing_rev_se) = nan
+    loads([il_tm_rms_se, il_sharing_rev, il_sharing_rev_se, il_kv_rms_se, il_f_rms_se, &
+         il_d2_rms_se, il_free_mean_se, il_free_max_se, il_back_max_se, il_impacts_rev_se, &
+         il_tf_rev, il_tf_rev_se]) = nan
+    tload(:, ilt_free_se) = nan
+    tload(:, ilt_back_se) = nan
     if (nb < 2) return
-    allocate(sq(nb), fmax(nb), cnt(nb))
-    sq = 0.0_wp; fmax = 0.0_wp; cnt = 0.0_wp
-    do k = 1, size(t)
-      b = int(m%omega*(t(k) - t(1))/(2.0_wp*pi)) + 1
-      if (b > nb) cycle
+    allocate(sq(nb), fmax(nb), cnt(nb), sqf(nb), sqd(nb), tfb(nb))
+    sq = 0.0_wp; fmax = 0.0_wp; cnt = 0.0_wp; sqf = 0.0_wp; sqd = 0.0_wp; tfb = 0.0_wp
+    do k = 1, size(rev)
+      b = rev(k)
+      if (b == 0) cycle
       sq(b) = sq(b) + tm(k)**2
       cnt(b) = cnt(b) + 1
       fmax(b) = max(fmax(b), maxval(abs(tooth(k, :, 1))))
+      sqf(b) = sqf(b) + sum(tooth(k, :, 1)**2)
+      sqd(b) = sqd(b) + y(6, k)**2
+      tfb(b) = max(tfb(b), maxval(tooth(k, :, iq_tf)))
     end do
     if (any(cnt == 0.0_wp)) return          ! a revolution without outputs: no batches
     sq = sqrt(sq/cnt)
@@ -243,7 +278,22 @@ contains
       fmax = fmax/fs
       loads(il_sharing_rev) = sum(fmax)/nb
       loads(il_sharing_rev_se) = std_error(fmax)
+      loads(il_kv_rms_se) = std_error(sq/abs(m%t_d))
     end if
+    loads(il_f_rms_se) = std_error(sqrt(sqf/(cnt*m%z)))
+    loads(il_d2_rms_se) = std_error(sqrt(sqd/cnt))
+    loads(il_tf_rev) = sum(tfb)/nb
+    loads(il_tf_rev_se) = std_error(tfb)
+    loads(il_impacts_rev_se) = std_error(ons_b)
+    loads(il_free_mean_se) = std_error(sum(free_b, 2)/cnt)
+    do j = 1, m%z
+      free_b(:, j) = free_b(:, j)/cnt
+      back_b(:, j) = back_b(:, j)/cnt
+      tload(j, ilt_free_se) = std_error(free_b(:, j))
+      tload(j, ilt_back_se) = std_error(back_b(:, j))
+    end do
+    loads(il_free_max_se) = tload(maxloc(tload(:, ilt_free), 1), ilt_free_se)
+    loads(il_back_max_se) = tload(maxloc(tload(:, ilt_back), 1), ilt_back_se)
   end subroutine batch_means
 
   !> Standard error of the mean of x(1..n) (n >= 2), consecutive and possibly correlated, by

@@ -14,7 +14,7 @@ module spline_quantities
   type :: quantity_t
     character(len=24) :: name
     character(len=16) :: unit
-    character(len=96) :: descr
+    character(len=128) :: descr
   end type quantity_t
 
   !> The states, in the order of a state vector y (SI).
@@ -99,8 +99,8 @@ module spline_quantities
   !> The loads of a run (spline_loads::run_loads, docs/model.md section 15), per tooth: their
   !> positions in a run's tooth-load array (ilt_*) and the table.
   integer, parameter, public :: ilt_f_peak = 1, ilt_load_factor = 2, ilt_free = 3, &
-       ilt_back = 4, ilt_onsets = 5
-  integer, parameter :: nload_tooth = 5
+       ilt_back = 4, ilt_onsets = 5, ilt_free_se = 6, ilt_back_se = 7
+  integer, parameter :: nload_tooth = 7
   type(quantity_t), parameter :: load_tooth_q(nload_tooth) = [ &
        quantity_t('F_peak', 'N', 'largest tooth load |F_j| over the outputs'), &
        quantity_t('load_factor', '-', 'tooth load factor F_peak / (T_d / (Z r_b))'), &
@@ -108,7 +108,11 @@ module spline_quantities
        quantity_t('back_frac', '-', 'fraction of the outputs the tooth is in contact on its &
             &back flank'), &
        quantity_t('onsets', '', 'contact onsets (impacts): free or on the other flank at one &
-            &output, in contact at the next')]
+            &output, in contact at the next'), &
+       quantity_t('free_frac_se', '-', 'standard error of free_frac by overlapping batch means &
+            &of revolutions (NaN: < 2 batches)'), &
+       quantity_t('back_frac_se', '-', 'standard error of back_frac by overlapping batch means &
+            &of revolutions (NaN: < 2 batches)')]
 
   !> The loads of a run, the scalars: their positions in a run's load array (il_*) and the table.
   integer, parameter, public :: il_f_static = 1, il_load_sharing = 2, il_load_sharing_tooth = 3, &
@@ -116,8 +120,10 @@ module spline_quantities
        il_impacts_rev = 9, il_closing_speed = 10, il_tf_max = 11, il_tf_max_tooth = 12, &
        il_tf_max_t = 13, il_revolutions = 14, il_batches = 15, il_tm_rms_se = 16, &
        il_sharing_rev = 17, il_sharing_rev_se = 18, il_sigma_root = 19, il_sigma_flank = 20, &
-       il_tau_pitch = 21
-  integer, parameter :: nload = 21
+       il_tau_pitch = 21, il_kv_rms_se = 22, il_f_rms_se = 23, il_d2_rms_se = 24, &
+       il_free_mean_se = 25, il_free_max_se = 26, il_back_max_se = 27, il_impacts_rev_se = 28, &
+       il_tf_rev = 29, il_tf_rev_se = 30, il_stress_ratio = 31
+  integer, parameter :: nload = 31
   type(quantity_t), parameter :: load_q(nload) = [ &
        quantity_t('F_static', 'N', 'static tooth load of equal load sharing |T_d| / (Z r_b)'), &
        quantity_t('load_sharing', '-', 'load-sharing factor: the largest tooth load factor'), &
@@ -148,6 +154,25 @@ module spline_quantities
        quantity_t('sigma_flank', 'Pa', 'nominal flank bearing (compressive) stress at that load, &
             &F cos(alpha) / (b h_w)'), &
        quantity_t('tau_pitch', 'Pa', 'nominal tooth shear stress at the pitch circle at that load, &
-            &F cos(alpha) / (b s)')]
+            &F cos(alpha) / (b s)'), &
+       quantity_t('kv_rms_se', '-', 'standard error of the RMS of k_v by overlapping batch means &
+            &(NaN: < 2 batches or T_d = 0)'), &
+       quantity_t('F_rms_se', 'N', 'standard error of the RMS of the tooth loads F_j over all &
+            &teeth by overlapping batch means (NaN: < 2 batches)'), &
+       quantity_t('D2_rms_se', 'm', 'standard error of the RMS of D_2 by overlapping batch means &
+            &(NaN: < 2 batches)'), &
+       quantity_t('teeth_free_mean_se', '', 'standard error of teeth_free_mean by overlapping &
+            &batch means (NaN: < 2 batches)'), &
+       quantity_t('free_frac_max_se', '-', 'standard error of the free fraction of the tooth of &
+            &free_frac_max (NaN: < 2 batches)'), &
+       quantity_t('back_frac_max_se', '-', 'standard error of the back-flank fraction of the &
+            &tooth of back_frac_max (NaN: < 2 batches)'), &
+       quantity_t('impacts_per_rev_se', '', 'standard error of the contact onsets per &
+            &revolution by overlapping batch means (NaN: < 2 batches)'), &
+       quantity_t('Tf_max_rev', 'degC', 'mean over the revolutions of each one''s largest T_f'), &
+       quantity_t('Tf_max_rev_se', 'degC', 'standard error of Tf_max_rev by overlapping batch &
+            &means (NaN: < 2 batches)'), &
+       quantity_t('stress_ratio', '-', 'largest of sigma_root, sigma_flank, tau_pitch over its &
+            &limit (1: at the typical allowable warned beyond)')]
 
 end module spline_quantities

@@ -107,7 +107,8 @@ def summary_point(summary: dict, options: dict) -> dict:
         lyapunov_summary(s, lt, lg, float(lg[-1] / (lt - t0)[-1]), t0)
     for q in ("Tm", "kv", "F"):
         s.update({f"{q}_{w}": one(f"run.{q}_{w}") for w in ("max", "min", "rms")})
-    s.update(Tf_max=one("run.Tf_max"), D2_max=one("run.D2_max"), D2_min=one("run.D2_min"))
+    s.update(Tf_max=one("run.Tf_max"), D2_max=one("run.D2_max"), D2_min=one("run.D2_min"),
+             D2_rms=one("run.D2_rms"))
     s.update({k: one("loads." + k) for k in SWEEP_LOADS})
     for k in _stat_names():
         if "stats." + k in v:

@@ -2,7 +2,7 @@
 
 commands (each --help says what it writes and where):
   cases list | copy NAME [DEST]   the shipped cases; copy one to start your own (template)
-  run CASE...                     run cases, print a summary line each (--out DIR: NAME.npz)
+  run CASE...                     run cases, print what each answers (--out DIR: NAME.npz)
   plot CASE... [--out DIR]        one scene as a figure: DIR/NAME.png
   sweep CASE --set F=a:b:n ...    sweep one or two fields (or --table design.csv): DIR/sweep.nc
   continue CASE --field F ...     follow a periodic orbit in F: DIR/continuation.nc, figure
@@ -27,23 +27,50 @@ from .batch import add_merge
 from .sweep import MERGED, POINTS_DIR, parse_values, sweep
 
 
-def _summary(res) -> str:
+def _pm(value, se, fmt) -> str:
+    """value +- its standard error to 2 digits (left out where there is none: NaN)."""
+    return f"{value:{fmt}}" + (f" +- {se:.2g}" if np.isfinite(se) else "")
+
+
+def _summary(res, warned: int | None = None) -> str:
+    """What `pyspline run` prints for a run: a line of ranges, then the engineer's questions
+    (docs/model.md section 15): which teeth carry what, does it rattle, how hot, how close to
+    the limits, how far to trust the numbers (+- a standard error by batch means over
+    revolutions), and whether the input drew plausibility warnings (`warned`: their number)."""
     F = res.tooth["F"]
     s = res.stats
     ld = res.loads      # the core's loads of the run (docs/model.md section 15)
-    return (f"{res.case.name:>16s}  F_j [{F.min():8.2f}, {F.max():8.2f}] N  "
-            f"T_m [{res.Tm.min():7.2f}, {res.Tm.max():7.2f}] N m  "
-            f"k_v [{res.kv.min():.3f}, {res.kv.max():.3f}]  "
-            f"D2 [{res.D2.min():.4e}, {res.D2.max():.4e}] m  "
-            f"load sharing {ld['load_sharing']:.3f}  "
-            f"free teeth {ld['teeth_free_mean']:.1f}/{F.shape[1]}  "
-            f"back flank {ld['teeth_back']:.0f}  "
-            f"impacts/rev {ld['impacts_per_rev']:.2f}  "
-            f"T_f max {ld['Tf_max']:.1f} degC  "
-            f"stress root/flank/shear {ld['sigma_root'] * 1e-6:.1f}/"
-            f"{ld['sigma_flank'] * 1e-6:.1f}/{ld['tau_pitch'] * 1e-6:.1f} MPa  "
-            f"{res.level}  "
-            f"steps {s['steps']}  {s['wall_s']*1e3:.0f} ms")
+    z = F.shape[1]
+    lines = [
+        f"{res.case.name:>16s}  F_j [{F.min():8.2f}, {F.max():8.2f}] N  "
+        f"T_m [{res.Tm.min():7.2f}, {res.Tm.max():7.2f}] N m  "
+        f"k_v [{res.kv.min():.3f}, {res.kv.max():.3f}]  "
+        f"D2 [{res.D2.min():.4e}, {res.D2.max():.4e}] m  "
+        f"{res.level}  steps {s['steps']}  {s['wall_s']*1e3:.0f} ms",
+        f"  teeth:  load sharing {ld['load_sharing']:.3f} (tooth "
+        f"{ld['load_sharing_tooth']:.0f}: {ld['F_static'] * ld['load_sharing']:.1f} N against "
+        f"{ld['F_static']:.1f} N static); per revolution "
+        f"{_pm(ld['load_sharing_rev'], ld['load_sharing_rev_se'], '.3f')}",
+        f"  rattle: free teeth {_pm(ld['teeth_free_mean'], ld['teeth_free_mean_se'], '.2f')} "
+        f"of {z} (never loaded {ld['teeth_unloaded']:.0f}); on the back flank "
+        f"{ld['teeth_back']:.0f} teeth; impacts/rev "
+        f"{_pm(ld['impacts_per_rev'], ld['impacts_per_rev_se'], '.2f')}; closing speed max "
+        f"{ld['closing_speed_max'] * 1e3:.1f} mm/s",
+        f"  heat:   T_f max {ld['Tf_max']:.3g} degC"
+        + (f" (tooth {ld['Tf_max_tooth']:.0f}, t = {ld['Tf_max_t_s']:.4g} s); per revolution "
+           f"{_pm(ld['Tf_max_rev'], ld['Tf_max_rev_se'], '.3g')} degC"
+           if ld["Tf_max_tooth"] > 0 else " (no flash temperature at this thermal level)"),
+        f"  limits: stress root/flank/shear {ld['sigma_root'] * 1e-6:.1f}/"
+        f"{ld['sigma_flank'] * 1e-6:.1f}/{ld['tau_pitch'] * 1e-6:.1f} MPa, "
+        f"{100 * ld['stress_ratio']:.0f} % of the typical allowable (docs/model.md section 15)",
+        f"  trust:  {ld['revolutions']:.1f} revolutions; T_m RMS "
+        f"{_pm(float(np.sqrt(np.mean(res.Tm ** 2))), ld['Tm_rms_se'], '.4g')} N m"
+        + ("" if ld["batches"] >= 2 else " (no standard errors: fewer than 2 whole revolutions)")]
+    if warned is not None:
+        lines.append("  input:  " + ("no plausibility warning" if not warned else
+                                     f"{warned} plausibility warning{'s' * (warned > 1)} "
+                                     "(the warning: lines)"))
+    return "\n".join(lines)
 
 
 #: exit status of each failure (README, "Errors and exit codes"; spline-dyn's err_exit_code)
@@ -128,8 +155,12 @@ def cmd_run(args) -> int:
     out = Path(args.out) if args.out else None
     for path in args.cases:
         try:
-            res = simulate(path)
-            print(_summary(res))
+            with warnings.catch_warnings(record=True) as rec:
+                warnings.simplefilter("always", SplineWarning)
+                res = simulate(load_case(path, **_fixed(getattr(args, "fix", None))))
+            for w in rec:                       # shown as usual (the warning: lines), counted
+                warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+            print(_summary(res, sum(issubclass(w.category, SplineWarning) for w in rec)))
             if out is not None:
                 out.mkdir(parents=True, exist_ok=True)
                 saved, note = _save_result(res, out, taken)
@@ -512,11 +543,14 @@ def main(argv=None) -> int:
     r.add_argument("dest", nargs="?", help="file or directory to write (default: ./NAME.nml)")
     r.add_argument("--force", action="store_true", help="replace an existing file")
     r.set_defaults(func=cmd_cases)
-    r = sub.add_parser("run", help="run case files and print a summary line each; with --out, "
+    r = sub.add_parser("run", help="run case files and print a summary of each (loads, rattle, "
+                       "heat, limits, standard errors, warnings); with --out, "
                        "the results as DIR/NAME.npz (t, y, Tm and the per-tooth arrays, SI)")
     r.add_argument("cases", nargs="+")
     r.add_argument("--out", help="directory for .npz results (NAME.npz per case; never replaces "
                    "a file pyspline did not write; cases of the same name get NAME-2.npz, ...)")
+    r.add_argument("--fix", action="append", metavar="FIELD=VALUE",
+                   help="change a field of every case (e.g. thermal=oneway)")
     r.set_defaults(func=cmd_run)
     r = sub.add_parser("reproduce", help="run the paper's scenarios and write into --out (default "
                        "out/) the figures (fig*.png), verification.md/.csv and summary.json")

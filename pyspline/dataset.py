@@ -62,6 +62,7 @@ _VAR_ATTRS = {
 #: the quantity's, their long_name what of its description.
 _OF_QUANTITY = {f"{q}_{w}": (w, q) for q in ("Tm", "kv", "F") for w in ("max", "min", "rms")}
 _OF_QUANTITY.update(Tf_max=("max", "Tf"), D2_max=("max", "D2"), D2_min=("min", "D2"),
+                    D2_rms=("rms", "D2"),
                     section_D2=("section", "D2"), section_vD2=("section", "vD2"))
 _WHAT = {"max": "max of the {}", "min": "min of the {}", "rms": "RMS of the {}",
          "section": "{} on the Poincare section"}

@@ -9,8 +9,9 @@ backend, so sweeps do not accumulate open figures.
 
 No figure magnifies round-off: a signal whose span is below the solver's resolution
 (plotstyle.roundoff_span: 3e-7 of its size, or 10 rtol) is drawn on a range around its value
-and labelled "no dynamic content"; colour scales come from the second half of a run (a start
-transient is clipped, and the colour bar says so); spectra end at the Nyquist frequency of the
+and labelled "no dynamic content"; colour scales come from the second half of a run and line
+panels from the run after its first tenth (a start transient is clipped, and the colour bar or a
+note says so, with where the transient reaches); spectra end at the Nyquist frequency of the
 data and say when the tooth pass lies beyond it (with a SplineWarning).
 
 Imports only numpy, matplotlib and pyspline.errors (xarray when a sweep's waterfalls are
@@ -36,10 +37,13 @@ __all__ = ["bifurcation", "bifurcation_grid", "eng", "lyapunov_vs_param", "param
 
 def _time_signal(ax, t, x, name, unit, colour, rtol, scale=0.0):
     """x(t) on ax with an SI prefix and no offset text; a round-off signal (`ps.roundoff_span`)
-    on +-1 % around its value, with a note. Returns (factor, prefixed unit, span or None)."""
+    on +-1 % around its value, with a note; a signal whose start transient reaches beyond the
+    second half's range (`ps.settled_limits`) on that range, saying so and where the transient
+    reaches. Returns (factor, prefixed unit, span or None)."""
     span = ps.roundoff_span(x, scale, rtol)
     size = ps.scale_of(x, scale)
-    k, u = ps.prefix([size] if span is not None else x, unit)
+    late = None if span is not None else settled_range(t, x, rtol, unit)
+    k, u = ps.prefix([size] if span is not None else (late[:2] if late else x), unit)
     ax.plot(t, x / k, lw=0.7, color=colour)
     ax.set_ylabel(f"{name} [{u}]" if u else name)
     ax.grid(alpha=0.3, lw=0.5)
@@ -47,7 +51,33 @@ def _time_signal(ax, t, x, name, unit, colour, rtol, scale=0.0):
     if span is not None:
         ax.set_ylim(*(v / k for v in ps.flat_limits(float(np.nanmean(x)), scale)))
         ps.note(ax, ps.no_content(span, unit))
+    elif late:
+        ax.set_ylim(late[0] / k, late[1] / k)
+        ps.note(ax, late[2])
     return k, u, span
+
+
+#: A line plot's range leaves out the start transient: the range after this fraction of the
+#: run, when the start reaches beyond it (`ps.settled_limits`). A tenth, not the colour maps'
+#: half: a line shows how the drive settles (the ring-down after the engagement's impacts).
+LINE_START = 0.1
+
+
+def settled_range(t, x, rtol, unit=""):
+    """(lo, hi, words) of the axis of a line plot of x(t) that leaves out a start transient,
+    by the colour scales' rule (`ps.settled_limits`) after the first LINE_START of the run,
+    with 5 % margins; None when there is no transient to leave out. The words say which range
+    is drawn and where the transient reaches (in `unit`)."""
+    lo, hi, words = ps.settled_limits(t, x, rtol, start=LINE_START)
+    if not words:
+        return None
+    pad = 0.05 * (hi - lo)
+    x = np.asarray(x, dtype=float)
+    unit = "" if unit in ("", "-") else f" {unit}"
+    reach = f"{ps.eng(np.nanmin(x), 3)} to {ps.eng(np.nanmax(x), 3)}{unit}"
+    words = words.replace("colour range", "range").replace(
+        "; start transient clipped", f"; start transient clipped ({reach})")
+    return lo - pad, hi + pad, words
 
 
 def _tooth_map(fig, ax, t, q, label, cmap, rtol):
@@ -91,7 +121,8 @@ def scene(t, D2, vD2, Tm, F, Tf=None, section=None, spectrum=None, speed_rpm=Non
     2Zx) dashed and a shaft-order axis on top. A panel whose data is not given says so; a
     signal that is round-off says "no dynamic content" (dD2/dt with D2, on a range of omega
     |D2|, omega the shaft's angular speed); the colour maps take their range from the
-    second half of the run; a tooth pass above the Nyquist frequency is named on the spectrum
+    second half of the run, the lines (D_2, T_m, the phase plane) from the run after its first
+    tenth when a start transient reaches beyond it (`settled_range`); a tooth pass above the Nyquist frequency is named on the spectrum
     and warned about (SplineWarning, with the n_out that resolves it)."""
     t = np.asarray(t, dtype=float)
     D2 = np.asarray(D2, dtype=float)
@@ -125,7 +156,7 @@ def scene(t, D2, vD2, Tm, F, Tf=None, section=None, spectrum=None, speed_rpm=Non
     ax_t.set_xlabel("time t [s]")
     ax_t.set_title("meshing torque T_m", fontsize=10)
 
-    _phase_plane(ax_p, D2, vD2, section, (kd, ud, d_flat), v_scale)
+    _phase_plane(ax_p, D2, vD2, section, (kd, ud, d_flat), v_scale, t, rtol)
     _tooth_map(fig, ax_f, t, F, "tooth load F_j [N]", "viridis", rtol)
     ax_f.set_title("tooth load F_j", fontsize=10)
     if Tf is None:
@@ -146,12 +177,15 @@ def scene(t, D2, vD2, Tm, F, Tf=None, section=None, spectrum=None, speed_rpm=Non
     return ps.finish(fig, path)
 
 
-def _phase_plane(ax, D2, vD2, section, d_axis, v_scale):
+def _phase_plane(ax, D2, vD2, section, d_axis, v_scale, t=None, rtol=1e-8):
     """(D2, dD2/dt) with the section points; when D2 is round-off, both axes are drawn on
     +-1 % around their values (dD2/dt of v_scale), and the panel says so."""
     kd, ud, d_flat = d_axis
     v_flat = None if d_flat is None else float(np.ptp(vD2))   # v = dD2/dt: flat with D2
-    kv, uv = ps.prefix([v_scale] if v_flat is not None else vD2, "m/s")
+    late_d = settled_range(t, D2, rtol, "m") if t is not None and d_flat is None else None
+    late_v = settled_range(t, vD2, rtol, "m/s") if t is not None and d_flat is None else None
+    kv, uv = ps.prefix([v_scale] if v_flat is not None else (late_v[:2] if late_v else vD2),
+                       "m/s")
     ax.plot(D2 / kd, vD2 / kv, lw=0.4, color="0.55", label="trajectory")
     if section is not None:
         s = np.asarray(section, dtype=float).reshape(-1, 2)
@@ -171,6 +205,11 @@ def _phase_plane(ax, D2, vD2, section, d_axis, v_scale):
     if v_flat is not None:
         ax.set_ylim(*(v / kv for v in ps.flat_limits(float(np.nanmean(vD2)), v_scale)))
         words.append(f"dD_2/dt: {ps.no_content(v_flat, 'm/s')}")
+    for late, k, setlim, label in ((late_d, kd, ax.set_xlim, "D_2"),     # a start transient
+                                   (late_v, kv, ax.set_ylim, "dD_2/dt")):  # left out
+        if late:
+            setlim(late[0] / k, late[1] / k)
+            words.append(f"{label}: {late[2]}")
     if words:
         ps.note(ax, "\n".join(words), loc="lower left")
 

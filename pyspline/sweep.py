@@ -39,7 +39,7 @@ __all__ = ["local_dask_client", "open_sweep", "parse_values", "point_cases", "re
 
 #: Bump when the content of a point summary changes: older point files are then recomputed.
 #: 2: the default Benettin separation (lyapunov_d0 = 0: 1e4 rtol, was 1e-8) changed exponents.
-SUMMARY_VERSION = 2
+SUMMARY_VERSION = 3
 #: Step of the common shaft-order axis of the T_m spectra [shaft orders].
 ORDER_STEP = 0.05
 SECTIONS = ("shaft", "tooth", "none")
@@ -220,7 +220,7 @@ def _template(options: dict, stat_names: Sequence[str]) -> dict:
                  lyapunov_slope=nan, predictability_horizon=nan, chaotic=nan)
     for q in ("Tm", "kv", "F"):
         s.update({f"{q}_max": nan, f"{q}_min": nan, f"{q}_rms": nan})
-    s.update(Tf_max=nan, D2_max=nan, D2_min=nan)
+    s.update(Tf_max=nan, D2_max=nan, D2_min=nan, D2_rms=nan)
     s.update({k: nan for k in SWEEP_LOADS})
     s.update({k: nan for k in stat_names})
     if options.get("orders") is not None:
@@ -233,7 +233,9 @@ def _template(options: dict, stat_names: Sequence[str]) -> dict:
 #: section 15; Tf_max too), units from the core's table.
 SWEEP_LOADS = ("load_sharing", "free_frac_max", "back_frac_max", "teeth_free_mean", "teeth_back",
                "impacts_per_rev", "closing_speed_max", "Tm_rms_se", "load_sharing_rev",
-               "load_sharing_rev_se", "sigma_root", "sigma_flank", "tau_pitch")
+               "load_sharing_rev_se", "sigma_root", "sigma_flank", "tau_pitch", "kv_rms_se",
+               "F_rms_se", "D2_rms_se", "teeth_free_mean_se", "free_frac_max_se",
+               "back_frac_max_se", "impacts_per_rev_se", "Tf_max_rev", "Tf_max_rev_se")
 
 
 @functools.cache
@@ -304,7 +306,8 @@ def summarise(res, options: dict) -> dict:
         s.update({f"{q}_max": st["max"], f"{q}_min": st["min"], f"{q}_rms": st["rms"]})
     s["Tf_max"] = float(np.max(res.tooth["Tf"]))
     s.update({k: float(res.loads[k]) for k in SWEEP_LOADS})
-    s.update(D2_max=float(res.D2.max()), D2_min=float(res.D2.min()))
+    s.update(D2_max=float(res.D2.max()), D2_min=float(res.D2.min()),
+             D2_rms=float(np.sqrt(np.mean(res.D2 ** 2))))
     for k in _stat_names():
         if k in res.stats:
             s[k] = float(res.stats[k])
@@ -436,10 +439,12 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     section_t/section_D2/section_vD2 (dim 'section_point', NaN-padded), period and
     period_residual; lyapunov, lyapunov_spread, lyapunov_rel_spread, lyapunov_slope,
     predictability_horizon, chaotic (1 if the exponent exceeds its spread; if lyapunov);
-    Tm_/kv_/F_ max, min, rms, Tf_max, D2_max, D2_min; the loads (SWEEP_LOADS: load_sharing,
-    free_frac_max, back_frac_max, teeth_free_mean, teeth_back, impacts_per_rev,
-    closing_speed_max, and the batch-means standard errors Tm_rms_se, load_sharing_rev,
-    load_sharing_rev_se; docs/model.md section 15);
+    Tm_/kv_/F_ max, min, rms, Tf_max, D2_max, D2_min, D2_rms; the loads (SWEEP_LOADS:
+    load_sharing, free_frac_max, back_frac_max, teeth_free_mean, teeth_back, impacts_per_rev,
+    closing_speed_max, the stresses, the per-revolution means load_sharing_rev, Tf_max_rev,
+    and the batch-means standard errors NAME_se of Tm_rms, kv_rms, F_rms, D2_rms,
+    teeth_free_mean, free_frac_max, back_frac_max, impacts_per_rev, load_sharing_rev,
+    Tf_max_rev; docs/model.md section 15);
     solver statistics (steps, rhs_evals, ..., core_wall_s, wall_s); Tm_spectrum (dim 'order');
     error, error_class ('' if ok), point_hash. A failed point has NaN values and its error.
     attrs: case (namelist text of the base case), pyspline_version, command, swept, section,

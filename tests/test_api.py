@@ -15,7 +15,9 @@ import numpy as np
 import pytest
 
 import pyspline
-from conftest import CASES, PAPER
+from conftest import CASES, PAPER, PAPER_SHAFTS
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
 SHORT = dict(t_end=0.02, n_out=81)
 SCENES = {   # one of each: mechanical, coupled flash temperature, a mid-run failure, Z = 7
@@ -153,7 +155,8 @@ def _sigint_after(delay):
     return timer
 
 
-LONG = dict(t_end=60.0, n_out=3)    # about 15 s of work: the test fails by time if SIGINT is lost
+LONG = dict(t_end=60.0, n_out=3, max_steps=10**8)   # about 20 s of work (max_steps: 30 s between
+# outputs): the test fails by time if SIGINT is lost
 
 
 def test_sigint_stops_a_long_run_quickly():

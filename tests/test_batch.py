@@ -10,7 +10,9 @@ import numpy as np
 import pytest
 
 import pyspline
-from conftest import ROOT
+from conftest import ROOT, PAPER_SHAFTS
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 from pyspline.batch import merge, read_summary
 from pyspline.cli import main
 from pyspline.sweep import summarise
@@ -19,7 +21,7 @@ CASE = ROOT / "cases" / "paper_lx1e-4.nml"
 SHORT = dict(t_end=0.05, n_out=401)          # 5 revolutions: fast, sections and a Benettin record
 TIMINGS = ("core_wall_s", "wall_s")
 #: the sweep's RMS is numpy's (pairwise sums), the summary's the executable's sequential sum
-RMS = ("Tm_rms", "kv_rms", "F_rms")
+RMS = ("Tm_rms", "kv_rms", "F_rms", "D2_rms")
 
 
 def building_block(marker):

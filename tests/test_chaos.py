@@ -14,7 +14,9 @@ import numpy as np
 import pytest
 
 import pyspline
-from conftest import CASES
+from conftest import CASES, PAPER_SHAFTS, DEMONSTRATION_SCENES
+
+pytestmark = [PAPER_SHAFTS, DEMONSTRATION_SCENES]   # expected warnings (conftest)
 
 RTOLS = (1e-6, 1e-7)
 

@@ -5,7 +5,9 @@ import numpy as np
 import pytest
 
 import pyspline
-from conftest import CASES
+from conftest import CASES, PAPER_SHAFTS
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
 EPS = np.finfo(float).eps
 

@@ -39,6 +39,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from conftest import PAPER_SHAFTS
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
+
 #: Exit status of spline-dyn for each outcome. The one place to adjust them.
 EXIT_CODES = {"CaseError": 2, "SolverError": 3, "ThermalInterferenceError": 4, "ok": 0, "usage": 2}
 

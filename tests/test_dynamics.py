@@ -5,7 +5,9 @@ import pytest
 
 import pyspline
 from pyspline.analysis import classify_period
-from conftest import CASES, jacobian
+from conftest import CASES, jacobian, PAPER_SHAFTS
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
 LX = pyspline.load_case(CASES / "paper_lx1e-4.nml")
 

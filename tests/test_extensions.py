@@ -5,7 +5,9 @@ import numpy as np
 import pytest
 
 import pyspline
-from conftest import CASES, jacobian
+from conftest import CASES, jacobian, PAPER_SHAFTS
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
 # the paper's aligned drive in full contact: its mesh is a linear isotropic spring, so the
 # whole system is linear and time invariant about its static equilibrium

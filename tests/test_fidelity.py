@@ -6,7 +6,9 @@ import numpy as np
 import pytest
 
 import pyspline
-from conftest import CASES, PAPER
+from conftest import CASES, PAPER, PAPER_SHAFTS
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
 SHORT = dict(t_end=0.1, n_out=161, start="rest")
 MARGIN = 0.5                       # fidelity.f90: auto reduces when estimate <= MARGIN * tol

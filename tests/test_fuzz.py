@@ -24,6 +24,9 @@ from hypothesis import HealthCheck, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
 import pyspline  # noqa: E402
+from conftest import PAPER_SHAFTS  # noqa: E402
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
 EXAMPLES = int(os.environ.get("PYSPLINE_FUZZ_EXAMPLES", "0") or 0)
 FUZZ = settings(max_examples=EXAMPLES or 50, deadline=None, derandomize=not EXAMPLES,

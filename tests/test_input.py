@@ -10,7 +10,9 @@ import f90nml
 import pytest
 
 import pyspline
-from conftest import CASES, PAPER
+from conftest import CASES, PAPER, PAPER_SHAFTS, DEMONSTRATION_SCENES
+
+pytestmark = [PAPER_SHAFTS, DEMONSTRATION_SCENES]   # expected warnings (conftest)
 
 
 @pytest.mark.parametrize("fields,words", [

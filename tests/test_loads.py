@@ -11,7 +11,12 @@ import oracle
 import pyspline
 from pyspline.core import LOAD_QUANTITIES, TOOTH_LOAD_QUANTITIES
 from pyspline.sweep import SWEEP_LOADS
-from conftest import CASES
+from conftest import CASES, PAPER_SHAFTS
+
+#: the offset scenes below are built to impact (offset beyond the backlash, from rest): their
+#: supports, start and stress warnings are expected
+pytestmark = [PAPER_SHAFTS, pytest.mark.filterwarnings(
+    r"ignore:case offset\w*:pyspline.SplineWarning")]
 
 REV_OUT = 721       # outputs in one revolution: each tooth's angle sweeps 2 pi in 0.5 deg steps
 
@@ -111,8 +116,8 @@ def test_free_back_flank_and_onsets_against_a_count(offset_scene):
 def test_no_drive_torque_has_no_load_factor():
     """T_d = 0: the static tooth load is 0, load factors are NaN (undefined), not infinite;
     the counts remain."""
-    case = pyspline.load_case(CASES / "template.nml", t_d=0.0, t_l=0.0, l_x=4e-4, grav=0.0,
-                              start="rest", t_end=0.005, n_out=201)
+    case = pyspline.load_case(CASES / "template.nml", name="offset0", t_d=0.0, t_l=0.0,
+                              l_x=4e-4, grav=0.0, start="rest", t_end=0.005, n_out=201)
     ld = pyspline.simulate(case).loads
     assert ld["F_static"] == 0 and np.isnan(ld["load_sharing"])
     assert np.isnan(ld["load_factor"]).all() and ld["onsets"].sum() > 0
@@ -162,6 +167,14 @@ def test_executable_writes_the_same_loads(exe, offset_scene, scene, tmp_path):
     run = subprocess.run([exe, str(nml), "-o", str(out)], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     assert "load sharing factor" in run.stdout
+    assert "standard errors (overlapping batch means" in run.stdout
+    assert "largest stress over its typical allowable" in run.stdout
+    # a summary-only run (batch) prints the same answers
+    quiet = subprocess.run([exe, str(nml), "--summary", str(tmp_path / "c.summary")],
+                           capture_output=True, text=True)
+    assert quiet.returncode == 0, quiet.stderr
+    answers = run.stdout[run.stdout.index("  load sharing factor"):]
+    assert quiet.stdout.endswith(answers[:answers.index("\n  " + "steps")] + "\n")
     got = read_csv_loads(out)
     res = pyspline.simulate(case)
     assert set(got) == set(res.loads)
@@ -209,3 +222,83 @@ def test_batch_means_of_a_periodic_run_vanish():
     assert ld["load_sharing_rev_se"] < 1e-6
     one = pyspline.simulate(full_contact(t_end=0.015, n_out=1081)).loads
     assert one["batches"] == 1 and np.isnan(one["Tm_rms_se"]) and np.isnan(one["load_sharing_rev"])
+
+
+def obm_se(x):
+    """Overlapping batch means (Meketon & Schmeiser 1984), batches of floor(sqrt(n)) values,
+    written from the formula of docs/model.md section 15 (not the core's loop)."""
+    x = np.asarray(x, dtype=float)
+    n = len(x)
+    m = int(np.sqrt(n))
+    means = np.convolve(x, np.ones(m) / m, mode="valid")
+    return np.sqrt(m * np.sum((means - x.mean()) ** 2) / ((n - m) * (n - m + 1)))
+
+
+def test_batch_means_of_every_statistic_against_a_count():
+    """Batches of m = 3 revolutions (10 whole revolutions of the offset scene, which keeps
+    impacting): every standard error, recomputed here per revolution from Result.Tm, kv, F, dn,
+    D2 and Tf with the flank count of independent_count, and the standard error of the tooth
+    with the largest fraction for free_frac_max_se / back_frac_max_se."""
+    case = pyspline.load_case(CASES / "template.nml", name="offset10", t_d=2.0, t_l=2.0,
+                              l_x=4e-4, grav=0.0, start="rest", thermal="oneway", t_end=0.1,
+                              n_out=1999)
+    res = pyspline.simulate(case)
+    ld = res.loads
+    omega = case["speed_rpm"] * 2 * np.pi / 60
+    rev = np.floor(omega * (res.t - res.t[0]) / (2 * np.pi)).astype(int)   # as the core rounds
+    nb = int(ld["batches"])
+    assert nb == 10 and int(np.sqrt(nb)) == 3
+    flank, onset = independent_count(res)
+    onset = np.vstack([np.zeros((1, flank.shape[1]), bool), onset])          # at output k
+    by = [rev == b for b in range(nb)]
+    rms = lambda x: np.sqrt(np.mean(x ** 2))                                  # noqa: E731
+    per_rev = {
+        "Tm_rms_se": [rms(res.Tm[k]) for k in by],
+        "kv_rms_se": [rms(res.kv[k]) for k in by],
+        "F_rms_se": [rms(res.F[k]) for k in by],
+        "D2_rms_se": [rms(res.D2[k]) for k in by],
+        "teeth_free_mean_se": [(flank[k] == 0).sum(1).mean() for k in by],
+        "impacts_per_rev_se": [onset[k].sum() for k in by],
+        "Tf_max_rev_se": [res.Tf[k].max() for k in by],
+        "load_sharing_rev_se": [np.abs(res.F[k]).max() / ld["F_static"] for k in by],
+    }
+    for n, x in per_rev.items():
+        assert ld[n] == pytest.approx(obm_se(x), rel=1e-9, abs=1e-300), n
+        assert ld[n] > 0, n                                    # the scene varies between revolutions
+    assert ld["Tf_max_rev"] == pytest.approx(np.mean(per_rev["Tf_max_rev_se"]), rel=1e-12)
+    assert ld["load_sharing_rev"] == pytest.approx(np.mean(per_rev["load_sharing_rev_se"]), rel=1e-12)
+    free = np.array([(flank[k] == 0).mean(0) for k in by])                    # (nb, Z)
+    back = np.array([(flank[k] == 1).mean(0) for k in by])
+    np.testing.assert_allclose(ld["free_frac_se"], [obm_se(c) for c in free.T], rtol=1e-9)
+    np.testing.assert_allclose(ld["back_frac_se"], [obm_se(c) for c in back.T], rtol=1e-9)
+    assert ld["free_frac_max_se"] == ld["free_frac_se"][np.argmax(ld["free_frac"])]
+    assert ld["back_frac_max_se"] == ld["back_frac_se"][np.argmax(ld["back_frac"])]
+    assert (ld["free_frac_se"] > 0).any() and (ld["back_frac_se"] > 0).any()
+    # the standard error of a mean of correlated batches is not the naive one
+    naive = np.std(per_rev["Tm_rms_se"], ddof=1) / np.sqrt(nb)
+    assert ld["Tm_rms_se"] != pytest.approx(naive, rel=1e-3)
+
+
+def test_run_answers_the_engineers_questions(capsys):
+    """`pyspline run CASE` answers, one line each: which teeth carry what, does it rattle, how
+    hot, how close to the limits, how far to trust it, is the input plausible (README). --fix
+    changes a field; the numbers are the run's loads."""
+    from pyspline.cli import main
+    path = CASES / "physical_z24.nml"
+    assert main(["run", str(path), "--fix", "t_end=0.1", "--fix", "n_out=401",
+                 "--fix", "thermal=oneway"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert [ln.split(":")[0].strip() for ln in out[1:]] == ["teeth", "rattle", "heat", "limits",
+                                                             "trust", "input"]
+    ld = pyspline.simulate(pyspline.load_case(path, t_end=0.1, n_out=401, thermal="oneway")).loads
+    assert f"load sharing {ld['load_sharing']:.3f} (tooth {ld['load_sharing_tooth']:.0f}" in out[1]
+    assert f"T_f max {ld['Tf_max']:.3g} degC (tooth {ld['Tf_max_tooth']:.0f}" in out[3]
+    assert f"{100 * ld['stress_ratio']:.0f} % of the typical allowable" in out[4]
+    assert f"{ld['revolutions']:.1f} revolutions" in out[5] and "+-" in out[5]
+    assert out[6].endswith("no plausibility warning")
+    assert main(["run", str(CASES / "paper_lx1e-4.nml"), "--fix", "t_end=0.01"]) == 0
+    assert capsys.readouterr().out.splitlines()[-1].endswith("1 plausibility warning (the "
+                                                              "warning: lines)")
+    # the stress ratio is the largest stress over its limit (docs/model.md section 15)
+    limits = {"sigma_root": 400e6, "sigma_flank": 310e6, "tau_pitch": 345e6}
+    assert ld["stress_ratio"] == pytest.approx(max(ld[n] / v for n, v in limits.items()), rel=1e-14)

@@ -12,7 +12,9 @@ import pytest
 import pyspline
 from pyspline.core import _names, cf_units
 from pyspline.dataset import field_meta
-from conftest import CASES, ROOT
+from conftest import CASES, ROOT, PAPER_SHAFTS
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
 OUTPUTS = {n: (u, d) for n, u, d in _names("outputs")}
 TOOTH = [n for n, *_ in _names("tooth")]

@@ -7,7 +7,9 @@ import pytest
 
 import oracle
 import pyspline
-from conftest import PAPER
+from conftest import PAPER, PAPER_SHAFTS
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
 
 def random_states(case, n, rng):

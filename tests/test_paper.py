@@ -6,7 +6,9 @@ import pytest
 
 import pyspline
 from pyspline import paper
-from conftest import CASES
+from conftest import CASES, PAPER_SHAFTS
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
 
 def strobe(x, v):

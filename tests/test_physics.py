@@ -4,7 +4,9 @@ import pytest
 
 import oracle
 import pyspline
-from conftest import PAPER
+from conftest import PAPER, PAPER_SHAFTS
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
 
 def conservative_case(**kw):

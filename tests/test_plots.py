@@ -62,7 +62,7 @@ def test_scene_does_not_zoom_into_round_off():
 
 
 def test_scene_draws_a_small_real_ripple():
-    # D2's stiffness ripple in physical_ripple: 1.7e-6 of D2; T_m 2e-3 of its value
+    # D2's stiffness ripple in physical_ripple with the paper's shafts: 1.7e-6 of D2; T_m 2e-3
     t, D2, vD2, Tm, F = _equilibrium(ripple_d2=1.7e-6)
     Tm = Tm * (1 + 2e-3 * np.sin(2 * np.pi * 1600 * t))
     fig = pl.scene(t, D2, vD2, Tm, F, speed_rpm=6000, z=16)
@@ -95,6 +95,46 @@ def test_colour_limits_leave_out_the_start_transient():
     assert lo > -200                                        # not the spike's -5000
     cbar_label = fig.axes[-1].get_ylabel() + " ".join(a.get_ylabel() for a in fig.axes)
     assert "start transient clipped" in cbar_label
+
+
+def _from_rest(n=4001):
+    """A run from rest: D2 falls from 0 to -100 um in 20 ms with an overshoot, T_m spikes to
+    about -420 N m at the engagement, then both ring down (150 Hz, decay 5 1/s) to -100.2 um and
+    -50 N m: physical_z24's shape."""
+    t = np.linspace(0.0, 1.0, n)
+    ring = np.exp(-5 * t) * np.sin(2 * np.pi * 150 * t)
+    engage = np.clip(t / 0.02, 0, 1)
+    D2 = -100.2e-6 * engage + 0.07e-6 * ring - 5e-6 * np.exp(-((t - 0.012) / 0.003) ** 2)
+    vD2 = np.gradient(D2, t)
+    Tm = -50.0 * engage + 15.0 * ring - 378.0 * np.exp(-((t - 0.012) / 0.002) ** 2)
+    F = np.repeat(Tm[:, None] / (24 * 0.0127), 24, axis=1)
+    return t, D2, vD2, Tm, F
+
+
+def test_line_panels_leave_out_the_start_transient():
+    """D_2(t), T_m(t) and the phase plane are drawn on the range after the first tenth of the
+    run (plots.LINE_START), with 5 % margins, when the start reaches beyond it; the note says
+    so and where the transient reaches."""
+    t, D2, vD2, Tm, F = _from_rest()
+    fig = pl.scene(t, D2, vD2, Tm, F, speed_rpm=3000, z=24)
+    ax_d, ax_t, ax_p = fig.axes[:3]
+    late = t >= 0.1
+    for ax, x, k, axis in ((ax_d, D2, 1e-6, "y"), (ax_t, Tm, 1.0, "y"), (ax_p, D2, 1e-6, "x"),
+                           (ax_p, vD2, 1e-6, "y")):
+        lo, hi = (v * k for v in (ax.get_ylim() if axis == "y" else ax.get_xlim()))
+        span = np.ptp(x[late])
+        assert lo == pytest.approx(x[late].min() - 0.05 * span, rel=1e-9, abs=1e-9 * span)
+        assert hi == pytest.approx(x[late].max() + 0.05 * span, rel=1e-9, abs=1e-9 * span)
+        assert x.min() < lo or x.max() > hi                  # the start is clipped
+        assert "start transient clipped" in _texts(ax)
+    assert f"({ps.eng(Tm.min(), 3)} to {ps.eng(Tm.max(), 3)} N m)" in _texts(ax_t)
+    assert Tm.min() < -400 and ax_t.get_ylim()[0] > -70      # not the spike
+    # a steady oscillation has no transient: its whole range is drawn
+    steady = -50.0 + 5.0 * np.sin(2 * np.pi * 150 * t)
+    fig = pl.scene(t, D2, vD2, steady, F, speed_rpm=3000, z=24)
+    assert "start transient" not in _texts(fig.axes[1])
+    lo, hi = fig.axes[1].get_ylim()
+    assert lo <= steady.min() and hi >= steady.max() and hi - lo < 1.2 * np.ptp(steady)
 
 
 def test_colour_limits_without_transient_are_the_whole_range():

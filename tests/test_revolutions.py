@@ -7,7 +7,9 @@ import numpy as np
 import pytest
 
 import pyspline
-from conftest import CASES, PAPER
+from conftest import CASES, PAPER, PAPER_SHAFTS
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 from pyspline import sweepplots
 
 SPEEDS = [2000.0, 3700.0, 6000.0, 12500.0, 20000.0]

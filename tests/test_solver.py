@@ -5,7 +5,9 @@ import numpy as np
 import pytest
 
 import pyspline
-from conftest import CASES, PAPER
+from conftest import CASES, PAPER, PAPER_SHAFTS
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
 SHORT = dict(t_end=0.1, n_out=401)
 

@@ -10,7 +10,9 @@ import pytest
 
 import oracle
 import pyspline
-from conftest import PAPER
+from conftest import PAPER, PAPER_SHAFTS
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
 #: the paper's 16 teeth at theta_j = 2 pi j / 16
 THETA = 2 * np.pi * np.arange(1, 17) / 16

@@ -11,7 +11,9 @@ import numpy as np
 import pytest
 
 import pyspline
-from conftest import CASES
+from conftest import CASES, PAPER_SHAFTS, DEMONSTRATION_SCENES
+
+pytestmark = [PAPER_SHAFTS, DEMONSTRATION_SCENES]   # expected warnings (conftest)
 
 RTOLS = (1e-6, 1e-7)
 REV_OUT = 20                       # outputs per revolution: T_m RMS needs no more

@@ -4,7 +4,9 @@ import pytest
 from scipy.integrate import quad
 
 import pyspline
-from conftest import PAPER
+from conftest import PAPER, PAPER_SHAFTS
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
 
 def spline_terms(**kw):

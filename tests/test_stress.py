@@ -14,7 +14,9 @@ import numpy as np
 import pytest
 
 import pyspline as ps
-from conftest import CASES
+from conftest import CASES, PAPER_SHAFTS
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
 #: The limits docs/model.md section 15 states [MPa].
 LIMITS = {"sigma_root": 400.0, "sigma_flank": 310.0, "tau_pitch": 345.0}

@@ -20,7 +20,9 @@ from pyspline.core import _names
 xr = pytest.importorskip("xarray")
 sw = sys.modules["pyspline.sweep"]      # pyspline.sweep is the function; this is its module
 
-from conftest import CASES  # noqa: E402
+from conftest import CASES, PAPER_SHAFTS  # noqa: E402
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 TIMING = ["wall_s", "core_wall_s"]      # the only numbers that differ between two runs

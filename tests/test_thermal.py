@@ -3,7 +3,9 @@ import numpy as np
 import pytest
 
 import pyspline
-from conftest import CASES, PAPER
+from conftest import CASES, PAPER, PAPER_SHAFTS
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
 HOT = dict(PAPER, l_x=1e-4, start="rest", t_end=0.1, n_out=641)
 
