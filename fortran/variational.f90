@@ -69,8 +69,9 @@ contains
       ierr = err_case
       errmsg = 'case '//trim(m%name)//': thermal = ''coupled'': the variational equations '// &
            '(exact monodromy, tangent Lyapunov exponent) do not cover it (the tooth force '// &
-           'depends on itself through the flash temperature): use thermal = ''oneway'', '// &
-           'fidelity = ''auto'', or the finite-difference monodromy (monodromy = ''fd'')'
+           'depends on itself through the flash temperature): use thermal = ''oneway'' or '// &
+           'fidelity = ''auto''; or the finite-difference monodromy (monodromy = ''fd''), the '// &
+           'separated copy (lyapunov_method = ''copy'')'
     end if
   end subroutine variational_check
 
