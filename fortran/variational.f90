@@ -17,8 +17,8 @@ module spline_variational
   use fsundials_matrix_mod
   use fsundials_linearsolver_mod
   use fnvector_serial_mod
-  use fsunmatrix_dense_mod
-  use fsunlinsol_dense_mod
+  use fsunmatrix_band_mod
+  use fsunlinsol_band_mod
   use fsundials_nonlinearsolver_mod
   use fsunnonlinsol_fixedpoint_mod
   use spline_kinds, only: wp, max_teeth
@@ -238,7 +238,8 @@ contains
   contains
 
     !> CVODE on yr at tau: the case's method, tolerances and (non)linear solver (Newton with
-    !> the exact block-diagonal Jacobian, jac_cb), root finding on the contact switches.
+    !> the exact block-diagonal Jacobian, tan_jac_cb, in a band matrix), root finding on the
+    !> contact switches.
     subroutine setup(flag)
       integer(c_int), intent(out) :: flag
       integer(c_long) :: nn
@@ -265,9 +266,12 @@ contains
       stage = 'attaching the (non)linear solver'
       flag = -1
       if (m%newton) then
-        amat => FSUNDenseMatrix(nn, nn, sunctx)
+        ! block diagonal (tan_jac_cb): a band of half-width n - 1 holds it, and its LU costs
+        ! (1 + ntan) n^3 instead of ((1 + ntan) n)^3 at every restart (a rattling drive restarts
+        ! thousands of times a revolution)
+        amat => FSUNBandMatrix(nn, int(n - 1, c_long), int(n - 1, c_long), sunctx)
         if (.not. associated(amat)) return
-        ls => FSUNLinSol_Dense(sv, amat, sunctx)
+        ls => FSUNLinSol_Band(sv, amat, sunctx)
         if (.not. associated(ls)) return
         flag = FCVodeSetLinearSolver(mem, ls, amat)
         if (flag == 0) flag = FCVodeSetJacFn(mem, c_funloc(tan_jac_cb))
@@ -435,18 +439,23 @@ contains
     type(SUNMatrix) :: jmat
     type(c_ptr), value :: udata
     type(tan_ctx_t), pointer :: ctx
-    real(c_double), pointer :: jd(:, :), flat(:)
+    real(c_double), pointer :: flat(:)
     real(wp) :: jac(nstate, nstate)
-    integer :: n, k, nn
+    integer :: n, k, i, j, ldim, smu
     call c_f_pointer(udata, ctx)
     n = ctx%n
-    nn = n*(1 + ctx%ntan)
-    flat => FSUNDenseMatrix_Data(jmat)
-    jd(1:nn, 1:nn) => flat
-    jd = 0.0_c_double
+    flat => FSUNBandMatrix_Data(jmat)
+    ldim = int(FSUNBandMatrix_LDim(jmat))
+    smu = int(FSUNBandMatrix_StoredUpperBandwidth(jmat))
+    flat = 0.0_c_double
     call rhs_jacobian(ctx%m, tau, ctx%modes(1:ctx%nc), jac)
+    ! band storage: entry (r, c) (0-based) at data(c ldim + smu + r - c)
     do k = 0, ctx%ntan
-      jd(k*n+1:(k+1)*n, k*n+1:(k+1)*n) = jac(ctx%idx(1:n), ctx%idx(1:n))
+      do j = 1, n
+        do i = 1, n
+          flat((k*n + j - 1)*ldim + smu + i - j + 1) = jac(ctx%idx(i), ctx%idx(j))
+        end do
+      end do
     end do
     ret = 0
   end function tan_jac_cb
