@@ -83,6 +83,9 @@ def map_and_monodromy(model, t0: float, t1: float, y: np.ndarray, saltation: boo
     if isinstance(model, Case):
         model = load(model)
     y = np.asarray(y, dtype=float)
+    if y.shape != (NSTATE,) or not np.isfinite(y).all():
+        raise CaseError(f"case {model.case.name}: y (shape {y.shape}) must be a state of "
+                        f"{NSTATE} finite SI values ({', '.join(STATE_QUANTITIES)})")
     y1, phi, mask, _nsw, ierr, msg = _api.api_map_monodromy(model.bytes, float(t0), float(t1), y,
                                                             int(bool(saltation)))
     raise_for(ierr, msg)
@@ -174,6 +177,9 @@ def periodic_orbit(case, n: int = 1, guess=None, t0: float | None = None, tol: f
     rtol = case["rtol"]
     tol = 100 * rtol if tol is None else float(tol)
     scale = _scale(model)
+    if monodromy not in ("exact", "fd"):
+        raise CaseError(f"case {case.name}: monodromy = {monodromy!r}: 'exact' (variational "
+                        "equations) or 'fd' (central differences of the map)")
     if guess is None:
         y = _settled_state(model, t0, period)
     else:
@@ -184,9 +190,6 @@ def periodic_orbit(case, n: int = 1, guess=None, t0: float | None = None, tol: f
         if not np.isfinite(y).all():
             raise CaseError(f"case {case.name}: guess is not finite")
     h = rtol ** (1 / 3)
-    if monodromy not in ("exact", "fd"):
-        raise CaseError(f"case {case.name}: monodromy = {monodromy!r}: 'exact' (variational "
-                        "equations) or 'fd' (central differences of the map)")
 
     def step(y, with_m):
         """(scaled residual, M or None, free) at y: one variational run (exact), or the map and,

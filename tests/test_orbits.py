@@ -217,3 +217,5 @@ def test_coupled_thermal_level_is_not_covered():
         pyspline.orbits.map_and_monodromy(case.replace(thermal="coupled"), 0.0, 0.01, y_eq)
     with pytest.raises(pyspline.CaseError, match="monodromy = 'newton'"):
         pyspline.periodic_orbit(case, monodromy="newton")
+    with pytest.raises(pyspline.CaseError, match=r"y \(shape \(6,\)\) must be a state of 14"):
+        pyspline.orbits.map_and_monodromy(case, 0.0, 0.01, y_eq[:6])
