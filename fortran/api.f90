@@ -27,14 +27,14 @@ module spline_api
        output_q, nload, load_q, nload_tooth, load_tooth_q
   use spline_loads, only: run_loads, stress_warnings
   use spline_sections, only: section_count
-  use spline_lyapunov, only: lyapunov_count
-  use spline_orbits, only: period_map
+  use spline_lyapunov, only: lyapunov_count, lyapunov_benettin, lyapunov_tangent
+  use spline_orbits, only: period_map, map_and_monodromy
   implicit none
   private
   public :: api_load_file, api_load_fields, api_load_text, api_model_size, api_simulate
   public :: api_rhs, api_rhs_mesh, api_start_state, api_loads
   public :: api_output_times, api_model_info, api_defaults, api_names, api_tooth_stiffness
-  public :: api_field_hint, api_warnings, api_period_map
+  public :: api_field_hint, api_warnings, api_period_map, api_map_monodromy, api_lyapunov
 
   integer, parameter :: ninfo = 12   !< entries of api_model_info
   integer, parameter :: nsizes = 5   !< entries of a load's sizes (load_model)
@@ -353,6 +353,56 @@ contains
     end if
     ierr = ie
   end subroutine api_period_map
+
+  !> The period map and its monodromy from the variational equations with the saltation
+  !> matrices (spline_orbits::map_and_monodromy; salt = 0: without them): y1 the SI state at
+  !> t1, phi(1:k, 1:k) dP/dy0 over the k integrated states (mask) in the scaled states of
+  !> Eq. 25, nswitch the contact switches located. Called without the GIL.
+  subroutine api_map_monodromy(model, nb, t0, t1, y0, salt, y1, phi, mask, nswitch, ierr, errmsg)
+    integer(c_int), intent(in) :: nb, salt
+    integer(c_int), intent(in) :: model(nb)
+    real(c_double), intent(in) :: t0, t1, y0(14)
+    real(c_double), intent(out) :: y1(14), phi(14, 14)
+    integer(c_int), intent(out) :: mask(14), nswitch, ierr
+    character(len=msglen), intent(out) :: errmsg
+    type(model_t) :: m
+    integer :: ie, mk(14), ns
+    y1 = 0; phi = 0; mask = 0; nswitch = 0
+    call unpack(model, m, ie, errmsg)
+    if (ie == err_ok) then
+      call map_and_monodromy(m, t0, t1, y0, y1, phi, mk, ns, ie, errmsg, interruptible=.true., &
+           saltation=salt /= 0)
+      mask = mk
+      nswitch = ns
+    end if
+    ierr = ie
+  end subroutine api_map_monodromy
+
+  !> The largest Lyapunov exponent's running sums from (t_start, y_start), SI, over nl
+  !> renormalisations of the model's lyapunov_interval: tangent = 0 by a separated copy
+  !> (spline_lyapunov::lyapunov_benettin, as runs do), 1 by the tangent vector
+  !> (lyapunov_tangent). The model level as the case sets it (not auto). Called without the GIL.
+  subroutine api_lyapunov(model, nb, tangent, t_start, y_start, nl, lt, lg, ierr, errmsg)
+    integer(c_int), intent(in) :: nb, tangent, nl
+    integer(c_int), intent(in) :: model(nb)
+    real(c_double), intent(in) :: t_start, y_start(14)
+    real(c_double), intent(out) :: lt(nl), lg(nl)
+    integer(c_int), intent(out) :: ierr
+    character(len=msglen), intent(out) :: errmsg
+    type(model_t) :: m
+    integer :: ie
+    lt = 0; lg = 0
+    call unpack(model, m, ie, errmsg)
+    if (ie == err_ok) then
+      m%t_end = t_start + nl*m%lyap_dt
+      if (tangent /= 0) then
+        call lyapunov_tangent(m, t_start, y_start, lt, lg, ie, errmsg, interruptible=.true.)
+      else
+        call lyapunov_benettin(m, t_start, y_start, lt, lg, ie, errmsg, interruptible=.true.)
+      end if
+    end if
+    ierr = ie
+  end subroutine api_lyapunov
 
   !> The output times of a loaded model (uniform after the transient).
   subroutine api_output_times(model, nb, nt, t, ierr, errmsg)

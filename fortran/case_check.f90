@@ -8,7 +8,8 @@ module spline_case_check
   use spline_errors, only: err_ok, err_case, itoa
   use spline_case_type, only: case_t, fields, nfields, field_index, ndof_case, nripple, &
        option_index, case_output_bytes, case_run_times, max_output_bytes, thermal_values, method_values, &
-       nonlinear_values, start_values, fidelity_values, jacobian_values, section_values
+       nonlinear_values, start_values, fidelity_values, jacobian_values, section_values, &
+       lyapunov_method_values
   use spline_case_text, only: num, size_text
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
@@ -199,6 +200,7 @@ contains
     if (.not. one_of(nonlinear_values, c%nonlinear, 'nonlinear')) return
     if (.not. one_of(start_values, c%start, 'start')) return
     if (.not. one_of(section_values, c%section, 'section')) return
+    if (.not. one_of(lyapunov_method_values, c%lyapunov_method, 'lyapunov_method')) return
     if (.not. ranges('lyapunov_interval', 'lyapunov_d0')) return  ! d0 = 0: chosen from rtol
     if ((c%lyapunov .or. option_index(section_values, c%section) > 1) .and. c%speed_rpm <= 0.0_wp) then
       call fail('speed_rpm', 'must be positive for a Poincare section or a Lyapunov exponent '// &

@@ -10,7 +10,7 @@ module spline_case_type
        case_name_of, option_index, case_output_bytes, case_run_times
   public :: namelen, optlen, nripple, ndof_case, max_case_bytes, max_output_bytes
   public :: thermal_values, method_values, nonlinear_values, start_values, fidelity_values, &
-       jacobian_values, section_values
+       jacobian_values, section_values, lyapunov_method_values
 
   integer, parameter :: namelen = 128
   integer, parameter :: nripple = 4         !< torque-ripple orders a case can give
@@ -33,6 +33,8 @@ module spline_case_type
   character(len=optlen), parameter :: jacobian_values(1) = [character(len=optlen) :: 'dq']
   character(len=optlen), parameter :: section_values(3) = [character(len=optlen) :: &
        'none', 'shaft', 'tooth']
+  character(len=optlen), parameter :: lyapunov_method_values(2) = [character(len=optlen) :: &
+       'copy', 'tangent']
 
   !> The fields of a case with their defaults: the paper's spline and drive (docs/model.md
   !> section 12). Unit and meaning of each: the table `fields` below (same order).
@@ -73,6 +75,7 @@ module spline_case_type
     character(len=optlen) :: section = 'none'
     logical  :: lyapunov = .false.
     real(wp) :: lyapunov_interval = 1.0_wp, lyapunov_d0 = 0.0_wp
+    character(len=optlen) :: lyapunov_method = 'copy'
     ! beyond the paper (docs/model.md "Beyond the paper"): every field from fillet on
     logical  :: fillet = .true.
     real(wp) :: fillet_radius = 0.0_wp, r_bore = 0.0_wp, r_rim = 0.0_wp, zeta_m = 0.0_wp
@@ -104,7 +107,7 @@ module spline_case_type
     real(wp) :: lo = 0.0_wp, hi = 0.0_wp
     character(len=80) :: note = ''
   end type field_t
-  integer, parameter :: nfields = 85
+  integer, parameter :: nfields = 86
   real(wp), parameter :: inf_ = huge(1.0_wp)
   type(field_t), parameter :: fields(nfields) = [ &
        field_t('name', 'c', namelen, '', 'case name, used in messages (default: the file name)'), &
@@ -219,6 +222,8 @@ module spline_case_type
                'r', 1.0e-3_wp, 1.0e3_wp, 'shaft revolutions'), &
        field_t('lyapunov_d0', 'r', 1, '-', 'initial separation, scaled states of Eq. 25; 0: auto', &
                'z', 1.0e-12_wp, 1.0e-3_wp, 'a separation of the scaled states (0: chosen from rtol)'), &
+       field_t('lyapunov_method', 'c', optlen, '', 'copy (a separated copy) | tangent (variational '// &
+               'equations)'), &
        field_t('fillet', 'l', 1, '', 'fillet-foundation term k_f in a computed k_m'), &
        field_t('fillet_radius', 'r', 1, 'm', 'root fillet radius; 0 = 0.2 module'), &
        field_t('r_bore', 'r', 1, 'm', 'bore radius of the external spline; 0 = half its root radius'), &

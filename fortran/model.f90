@@ -7,7 +7,8 @@ module spline_model
   use, intrinsic :: iso_fortran_env, only: int64
   use spline_errors, only: err_ok, err_case, err_thermal, itoa, ftoa
   use spline_case, only: case_t, case_validate, case_run_times, namelen, option_index, thermal_values, &
-       method_values, nonlinear_values, start_values, fidelity_values, section_values, nripple
+       method_values, nonlinear_values, start_values, fidelity_values, section_values, nripple, &
+       lyapunov_method_values
   use spline_geometry, only: iso4156_radii, pitch_rotation, tooth_angles
   use spline_stiffness, only: spline_mesh_stiffness_fillet
   use spline_thermal, only: backlash_coefficient, thermal_backlash
@@ -66,6 +67,7 @@ module spline_model
     real(wp) :: l_ref, w_ref                !< scales of Eq. 25
     integer  :: section = 0                 !< Poincare section: 0 none, 1 shaft, 2 tooth pass
     logical  :: lyapunov = .false.          !< largest Lyapunov exponent (Benettin)
+    logical  :: lyap_tangent = .false.      !< by the tangent vector (else a separated copy)
     real(wp) :: lyap_dt = 0.0_wp            !< renormalisation interval [s]
     real(wp) :: lyap_d0 = 0.0_wp            !< initial separation (scaled states, Eq. 25)
     ! derived geometry
@@ -139,6 +141,7 @@ contains
     m%start_equilibrium = option_index(start_values, c%start) == 1
     m%section = option_index(section_values, c%section) - 1
     m%lyapunov = c%lyapunov
+    m%lyap_tangent = option_index(lyapunov_method_values, c%lyapunov_method) == 2
     m%lyap_d0 = lyapunov_separation(c%lyapunov_d0, c%rtol)
     if (m%omega > 0.0_wp) m%lyap_dt = c%lyapunov_interval*2.0_wp*pi/m%omega
 

@@ -10,9 +10,10 @@ module spline_orbits
   use spline_solver, only: integrate
   use spline_fidelity, only: auto_level
   use spline_quantities, only: nsolver_stats
+  use spline_variational, only: tangent_flow
   implicit none
   private
-  public :: period_map
+  public :: period_map, map_and_monodromy
 
 contains
 
@@ -49,5 +50,34 @@ contains
       if (ierr /= err_ok) return
     end do
   end subroutine period_map
+
+  !> The period map and its monodromy from the variational equations (spline_variational):
+  !> y1 the SI state at t1 of the run from y0 (SI) at t0, phi(1:k, 1:k) = dP/dy0 over the k
+  !> integrated states (mask, in their order) in the scaled states of Eq. 25, with the saltation
+  !> matrix at every located contact switch (saltation = .false.: without it, to show it
+  !> matters). The model level as period_map's. nswitch: the switches located.
+  subroutine map_and_monodromy(m, t0, t1, y0, y1, phi, mask, nswitch, ierr, errmsg, &
+       interruptible, saltation)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t0, t1, y0(nstate)
+    real(wp), intent(out) :: y1(nstate), phi(nstate, nstate)
+    integer, intent(out) :: mask(nstate), nswitch, ierr
+    character(len=*), intent(out) :: errmsg
+    logical, intent(in), optional :: interruptible, saltation
+    type(model_t) :: run
+    real(wp) :: eps_lat, eps_th
+    integer :: k, idx(nstate), n
+    call auto_level(m, run, eps_lat, eps_th)
+    run%t0 = t0
+    run%t_end = t1
+    call integrated_states(run, idx, n)
+    mask = 0
+    mask(idx(1:n)) = 1
+    phi = 0.0_wp
+    do k = 1, n
+      phi(k, k) = 1.0_wp
+    end do
+    call tangent_flow(run, t1, y0, n, phi, y1, ierr, errmsg, interruptible, saltation, nswitch)
+  end subroutine map_and_monodromy
 
 end module spline_orbits

@@ -15,7 +15,7 @@ module spline_run
        ist_closed_t
   use spline_fidelity, only: auto_level, auto_tol, backlash_estimate
   use spline_sections, only: section_count, section_times
-  use spline_lyapunov, only: lyapunov_benettin
+  use spline_lyapunov, only: lyapunov_benettin, lyapunov_tangent
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -76,8 +76,11 @@ contains
     end if
     if (present(lyap_t)) then
       lyap_t = 0.0_wp; lyap_g = 0.0_wp
-      if (ierr == err_ok .and. m%lyapunov) &
-           call lyapunov_benettin(run, t(1), y(:, 1), lyap_t, lyap_g, ierr, errmsg, interruptible)
+      if (ierr == err_ok .and. m%lyapunov .and. m%lyap_tangent) then
+        call lyapunov_tangent(run, t(1), y(:, 1), lyap_t, lyap_g, ierr, errmsg, interruptible)
+      else if (ierr == err_ok .and. m%lyapunov) then
+        call lyapunov_benettin(run, t(1), y(:, 1), lyap_t, lyap_g, ierr, errmsg, interruptible)
+      end if
     end if
     closed = 0.0_wp; t_closed = 0.0_wp
     if (ierr == err_ok) call result_checks(run, t, y, tooth, tm, closed, t_closed, ierr, errmsg, &

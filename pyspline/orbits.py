@@ -40,7 +40,7 @@ class Orbit:
     t0: float                #: section time [s]
     y0: np.ndarray           #: the orbit's state at t0 (14,), SI
     trajectory: Result       #: simulate from (t0, y0) over one period (case's n_out points)
-    monodromy: np.ndarray    #: M (k, k), central differences of the core's map
+    monodromy: np.ndarray    #: M (k, k): variational equations + saltation, or central differences
     states: tuple            #: names of the k states M acts on
     multipliers: np.ndarray  #: eigenvalues of M, largest modulus first
     stable: bool             #: every |mu| < 1 - margin
@@ -48,7 +48,8 @@ class Orbit:
     residual: float          #: max |P^n(y0) - y0| in the scaled states of Eq. 25
     iterations: int          #: Newton steps taken
     residuals: list = field(default_factory=list)   #: the scaled residual before each step and at the end
-    fd_step: float = 0.0     #: the central-difference step (scaled states)
+    fd_step: float = 0.0     #: the central-difference step (scaled states; method 'fd')
+    method: str = "exact"    #: how M was computed: 'exact' or 'fd'
 
 
 def _period_map(model, t0: float, t1: float, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -60,6 +61,62 @@ def _period_map(model, t0: float, t1: float, ys: np.ndarray) -> tuple[np.ndarray
         raise SolverError(f"case {model.case.name}: the period map from t = {t0} s to {t1} s "
                           "gave a non-finite state (the model left its range)")
     return y1, mask.astype(bool)
+
+
+def _scale(model) -> np.ndarray:
+    """The scales of Eq. 25 per state: l_ref for displacements, l_ref w_ref for velocities."""
+    info = model.info()
+    return np.r_[np.full(7, info["l_ref"]), np.full(7, info["l_ref"] * info["w_ref"])]
+
+
+def map_and_monodromy(model, t0: float, t1: float, y: np.ndarray, saltation: bool = True
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The period map from t0 to t1 and its monodromy, from the core's variational equations.
+
+    model: a loaded model (pyspline.load) or a Case. y: (14,) SI state at t0. Returns (y1, M,
+    free): y1 (14,) the SI state at t1; M (k, k) = dP/dy0 over the integrated states in the
+    scaled states of Eq. 25 (l_ref, l_ref w_ref), the tangents integrated beside the state
+    (spline_variational::tangent_flow) with the saltation matrix at every root-located contact
+    switch (saltation=False leaves it out: wrong wherever a switch is crossed, kept to show
+    it); free (14,) bool, the integrated states (the torsional six at dof 3). One run.
+    CaseError for the thermal level coupled (not covered), SolverError when the run fails."""
+    if isinstance(model, Case):
+        model = load(model)
+    y = np.asarray(y, dtype=float)
+    if y.shape != (NSTATE,) or not np.isfinite(y).all():
+        raise CaseError(f"case {model.case.name}: y (shape {y.shape}) must be a state of "
+                        f"{NSTATE} finite SI values ({', '.join(STATE_QUANTITIES)})")
+    y1, phi, mask, _nsw, ierr, msg = _api.api_map_monodromy(model.bytes, float(t0), float(t1), y,
+                                                            int(bool(saltation)))
+    raise_for(ierr, msg)
+    if not np.isfinite(y1).all() or not np.isfinite(phi).all():
+        raise SolverError(f"case {model.case.name}: the variational run from t = {t0} s to {t1} s "
+                          "gave a non-finite state or monodromy (the model left its range)")
+    free = mask.astype(bool)
+    k = int(free.sum())
+    return y1, np.array(phi[:k, :k]), free
+
+
+def fd_monodromy(model, t0: float, t1: float, y: np.ndarray, h: float | None = None
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """map_and_monodromy's (y1, M, free) with M by central differences of the core's map
+    (period_map): state i (scaled) stepped by h max(1, |y_i|), h = rtol^(1/3) by default; all
+    2k + 1 runs in one call. For checking the exact M."""
+    if isinstance(model, Case):
+        model = load(model)
+    y = np.asarray(y, dtype=float)
+    scale = _scale(model)
+    h = model.case["rtol"] ** (1 / 3) if h is None else float(h)
+    y1, free = _period_map(model, t0, t1, y[:, None])
+    idx = np.flatnonzero(free)
+    steps = h * np.maximum(1.0, np.abs(y[idx] / scale[idx]))
+    cols = np.repeat(y[:, None], 2 * len(idx), axis=1)
+    for c, (i, s) in enumerate(zip(idx, steps)):
+        cols[i, 2 * c] += s * scale[i]
+        cols[i, 2 * c + 1] -= s * scale[i]
+    yd, _ = _period_map(model, t0, t1, cols)
+    z1 = yd[idx] / scale[idx, None]
+    return y1[:, 0], (z1[:, 0::2] - z1[:, 1::2]) / (2 * steps), free
 
 
 def forcing_periods(case: Case, n: int) -> None:
@@ -81,53 +138,27 @@ def forcing_periods(case: Case, n: int) -> None:
                         f"a whole number{hint}")
 
 
-def _scale(info: dict) -> np.ndarray:
-    """The scales of Eq. 25 of the 14 states: l_ref for displacements, l_ref w_ref for velocities."""
-    return np.r_[np.full(7, info["l_ref"]), np.full(7, info["l_ref"] * info["w_ref"])]
-
-
-def map_and_monodromy(model, t0: float, t1: float, y: np.ndarray):
-    """(y1, M, free): the core's map of the state y (14,), SI, at t0 to y1 (14,), SI, at t1;
-    the monodromy M = dP/dy0 (k, k) over the k integrated states, in the scaled states of
-    Eq. 25; free (14,) bool, the mask of the integrated states.
-
-    M by central differences of the map: state i (scaled) stepped by h = rtol^(1/3)
-    max(1, |y_i|), rtol the case's; all 2k differenced runs go to the core in one call."""
-    scale = _scale(model.info())
-    h = model.case["rtol"] ** (1 / 3)
-    y = np.asarray(y, dtype=float)
-    y1, free = _period_map(model, t0, t1, y[:, None])
-    idx = np.flatnonzero(free)
-    steps = h * np.maximum(1.0, np.abs(y[idx] / scale[idx]))
-    cols = np.repeat(y[:, None], 2 * len(idx), axis=1)
-    for c, (i, s) in enumerate(zip(idx, steps)):
-        cols[i, 2 * c] += s * scale[i]
-        cols[i, 2 * c + 1] -= s * scale[i]
-    yc, _ = _period_map(model, t0, t1, cols)
-    z1 = yc[idx] / scale[idx, None]
-    return y1[:, 0], (z1[:, 0::2] - z1[:, 1::2]) / (2 * steps), free
-
-
 def periodic_orbit(case, n: int = 1, guess=None, t0: float | None = None, tol: float | None = None,
-                   max_iter: int = 12, margin: float = 1e-4) -> Orbit:
+                   max_iter: int = 12, margin: float = 1e-4, monodromy: str = "exact") -> Orbit:
     """The period-n orbit of a forced case near a guess, and its Floquet multipliers.
 
     Newton on F(y) = P^n(y) - y = 0, with P^n the core's map over n shaft periods from the
-    section time t0 (default: the case's t0) and the Jacobian M - I, where the monodromy
-    M = dP^n/dy0 comes from central differences of the map: state i (scaled by Eq. 25: l_ref
-    for the displacements, l_ref w_ref for the velocities) stepped by h = rtol^(1/3), rtol the
-    case's (the truncation error h^2 balances the map's noise of order rtol / h). All 2k
-    differenced runs go to the core in one call. A step that does not lower the residual is
-    halved (up to 6 times). The variational equations with the saltation matrices at the
-    contact switches (exact M, docs/orbits.md) are the next step; no continuation yet, and an
-    orbit that grazes a contact switch is not detected (its map is not differentiable there).
+    section time t0 (default: the case's t0) and the Jacobian M - I, in the scaled states of
+    Eq. 25 (l_ref for the displacements, l_ref w_ref for the velocities). The monodromy
+    M = dP^n/dy0: monodromy='exact' (default) from the core's variational equations with the
+    saltation matrix at every located contact switch, in the same run as the map
+    (map_and_monodromy: one run per Newton step); monodromy='fd' from central differences of
+    the map, state i stepped by h = rtol^(1/3) (the truncation error h^2 balances the map's
+    noise rtol / h), 2k + 1 runs per step. A step that does not lower the residual is halved
+    (up to 6 times). An orbit that grazes a contact switch is not detected (its map is not
+    differentiable there; docs/orbits.md).
 
     guess: a state (14,), SI, at t0; default: the state at t0 + k n T that ends (or first
     follows) the case's own run from its start (its t_end settles it).
     tol: the scaled residual max_i |P^n(y0) - y0|_i to reach; default 100 rtol.
-    margin: stable means every |mu| < 1 - margin (the multipliers carry the error of the
-    differences, about h^2 + rtol / h: 1e-7 to 4e-7 measured at rtol 1e-11; keep margin well
-    above it).
+    margin: stable means every |mu| < 1 - margin (the multipliers carry the error of M: the
+    differences' h^2 + rtol / h, 1e-7 to 4e-7 at rtol 1e-11; exact M a few 1e-9 there; keep
+    margin well above it).
 
     Returns an Orbit. Raises CaseError for bad input (n, guess, a case without a forcing
     period), OrbitError when Newton does not converge (what was tried, the residual reached),
@@ -145,7 +176,10 @@ def periodic_orbit(case, n: int = 1, guess=None, t0: float | None = None, tol: f
     t1 = t0 + period
     rtol = case["rtol"]
     tol = 100 * rtol if tol is None else float(tol)
-    scale = np.r_[np.full(7, info["l_ref"]), np.full(7, info["l_ref"] * info["w_ref"])]
+    scale = _scale(model)
+    if monodromy not in ("exact", "fd"):
+        raise CaseError(f"case {case.name}: monodromy = {monodromy!r}: 'exact' (variational "
+                        "equations) or 'fd' (central differences of the map)")
     if guess is None:
         y = _settled_state(model, t0, period)
     else:
@@ -157,20 +191,26 @@ def periodic_orbit(case, n: int = 1, guess=None, t0: float | None = None, tol: f
             raise CaseError(f"case {case.name}: guess is not finite")
     h = rtol ** (1 / 3)
 
-    def residual(y):
-        y1, mask = _period_map(model, t0, t1, y[:, None])
-        return (y1[:, 0] - y) / scale, mask
+    def step(y, with_m):
+        """(scaled residual, M or None, free) at y: one variational run (exact), or the map and,
+        if with_m, its 2k differenced runs (fd)."""
+        if monodromy == "exact":
+            y1, M, free = map_and_monodromy(model, t0, t1, y)
+        elif with_m:
+            y1, M, free = fd_monodromy(model, t0, t1, y, h)
+        else:
+            y1, free = _period_map(model, t0, t1, y[:, None])
+            y1, M = y1[:, 0], None
+        return (y1 - y) / scale, M, free
 
-    def monodromy(y, free):
-        return map_and_monodromy(model, t0, t1, y)[1]
-
-    r, free = residual(y)
+    r, M, free = step(y, True)
     hist = [float(np.abs(r[free]).max())]
     it = 0
     while hist[-1] > tol:
         if it == max_iter:
             _fail(case, n, period, t0, it, hist, tol, "the iteration limit max_iter was reached")
-        M = monodromy(y, free)
+        if M is None:
+            _, M, _ = step(y, True)
         try:
             dz = np.linalg.solve(M - np.eye(len(M)), -r[free])
         except np.linalg.LinAlgError:
@@ -179,23 +219,25 @@ def periodic_orbit(case, n: int = 1, guess=None, t0: float | None = None, tol: f
         for _ in range(7):
             y_new = y.copy()
             y_new[free] += dz * scale[free]
-            r_new, _ = residual(y_new)
+            r_new, M_new, _ = step(y_new, False)
             if np.abs(r_new[free]).max() < hist[-1]:
                 break
             dz = dz / 2
         else:
             _fail(case, n, period, t0, it, hist, tol,
                   "the Newton step, halved 6 times, did not lower the residual")
-        y, r = y_new, r_new
+        y, r, M = y_new, r_new, M_new
         hist.append(float(np.abs(r[free]).max()))
-    M = monodromy(y, free)
+    if M is None:
+        _, M, _ = step(y, True)
     mu = np.linalg.eigvals(M)
     mu = mu[np.argsort(-np.abs(mu), kind="stable")]
     names = tuple(str(s) for s, f in zip(STATE_QUANTITIES, free) if f)
     return Orbit(case=case, n=n, period=period, t0=t0, y0=y, trajectory=_trajectory(case, t0, t1, y),
                  monodromy=M, states=names, multipliers=mu,
                  stable=bool(np.all(np.abs(mu) < 1 - margin)), margin=margin,
-                 residual=hist[-1], iterations=it, residuals=hist, fd_step=h)
+                 residual=hist[-1], iterations=it, residuals=hist,
+                 fd_step=h if monodromy == "fd" else 0.0, method=monodromy)
 
 
 def _fail(case, n, period, t0, it, hist, tol, why):

@@ -1,0 +1,481 @@
+!> The variational equations of Eq. 25 (docs/orbits.md, spec section 11): the state and tangent
+!> vectors Phi integrated beside it, dPhi/dtau = J(tau) Phi, with the saltation matrix
+!>   S = I + (f+ - f-) h_y / (h_y f- + h_t)
+!> applied to Phi at every located contact switch h = dn_k -+ c = 0 (the mesh damping acts only
+!> in contact, so the vector field jumps there). Between switches the contact state of every
+!> tooth (slice) is frozen and the right-hand side is affine in the state, so J depends on time
+!> and the contact states only: it is written here in closed form (rhs_jacobian) from Eqs.
+!> 11, 15-17 and 19-24. Everything is in the scaled states and time of Eq. 25. The thermal level
+!> coupled (the tooth force depends on itself through the flash temperature) is not covered.
+!> Reentrant: the run's state sits in a context local to tangent_flow, handed to CVODE as user
+!> data; every SUNDIALS return is checked.
+module spline_variational
+  use, intrinsic :: iso_c_binding
+  use fcvode_mod
+  use fsundials_context_mod
+  use fsundials_nvector_mod
+  use fsundials_matrix_mod
+  use fsundials_linearsolver_mod
+  use fnvector_serial_mod
+  use fsunmatrix_band_mod
+  use fsunlinsol_band_mod
+  use fsundials_nonlinearsolver_mod
+  use fsunnonlinsol_fixedpoint_mod
+  use spline_kinds, only: wp, max_teeth
+  use spline_errors, only: err_ok, err_case, err_solver, err_interrupted, msglen
+  use spline_model, only: model_t, nstate, ndof, thermal_coupled
+  use spline_geometry, only: tooth_angles
+  use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, integrated_states
+  use spline_mesh, only: mesh_switch_functions
+  implicit none
+  private
+  public :: rhs_jacobian, tangent_flow, variational_check
+
+  !> One tangent run: owned by tangent_flow, given to CVODE as user data.
+  type :: tan_ctx_t
+    type(model_t) :: m
+    integer :: n = nstate, idx(nstate), ntan = 0
+    real(c_double) :: ys_full(nstate)          !< scaled full state; the frozen entries stay here
+    integer, allocatable :: modes(:)            !< contact state per contact (+1, 0, -1)
+    integer :: nc = 0                           !< contacts: teeth, or slices of teeth
+    logical :: watch = .false.
+    integer(c_int) :: sigint0 = 0
+    integer :: cb_ierr = err_ok
+    character(len=msglen) :: cb_msg = ''
+  end type tan_ctx_t
+
+  interface   ! fortran/interrupt.c
+    integer(c_int) function sigint_watch() bind(C, name='spline_sigint_watch')
+      import :: c_int
+    end function sigint_watch
+    subroutine sigint_unwatch() bind(C, name='spline_sigint_unwatch')
+    end subroutine sigint_unwatch
+    integer(c_int) function sigint_count() bind(C, name='spline_sigint_count')
+      import :: c_int
+    end function sigint_count
+  end interface
+
+contains
+
+  !> ierr = err_case (errmsg says why) for a model the variational equations do not cover:
+  !> the thermal level coupled.
+  subroutine variational_check(m, ierr, errmsg)
+    type(model_t), intent(in) :: m
+    integer, intent(out) :: ierr
+    character(len=*), intent(out) :: errmsg
+    ierr = err_ok
+    errmsg = ''
+    if (m%thermal == thermal_coupled) then
+      ierr = err_case
+      errmsg = 'case '//trim(m%name)//': thermal = ''coupled'': the variational equations '// &
+           '(exact monodromy, tangent Lyapunov exponent) do not cover it (the tooth force '// &
+           'depends on itself through the flash temperature): use thermal = ''oneway'' or '// &
+           'fidelity = ''auto''; or the finite-difference monodromy (monodromy = ''fd''), the '// &
+           'separated copy (lyapunov_method = ''copy'')'
+    end if
+  end subroutine variational_check
+
+  !> J = d(ys')/d(ys), the Jacobian of Eq. 25 (rhs_scaled) at scaled time tau with the contact
+  !> states frozen at modes (exact: the right-hand side is affine in the state there). A tooth
+  !> (slice) in contact carries F = k_m (dn -+ c) + c_m d(dn)/dt (Eqs. 15-17; / n_s per slice)
+  !> with dn = e_x sin(phi) - e_y cos(phi) + D2 + e_j (Eq. 11), so
+  !>   dF/dq = k_m u + c_m omega w,  dF/dv = c_m u,
+  !>   u = (sin, -cos, -sin, cos, 0, 1, 0), w = (cos, sin, -cos, -sin, 0, 0, 0);
+  !> F_x1 = -sum F sin, F_y1 = sum F cos, T_m = r_b sum F (Eqs. 19-22), and the accelerations
+  !> of Eqs. 23-24 (spline_dynamics::accelerations) are linear in them and in q, v.
+  pure subroutine rhs_jacobian(m, tau, modes, jac)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: tau
+    integer, intent(in) :: modes(:)
+    real(wp), intent(out) :: jac(nstate, nstate)
+    real(wp) :: sp(max_teeth), cp(max_teeth), u(ndof), w(ndof), gf(nstate), gx(nstate), gy(nstate)
+    real(wp) :: gt(nstate), a(ndof, nstate), ds1(nstate), ds3(nstate), dth1(nstate), wt, d(nstate)
+    integer :: j, i, ns
+    call tooth_angles(m%z, m%omega, tau/m%w_ref, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
+    ns = m%n_slices
+    gx = 0.0_wp; gy = 0.0_wp; gt = 0.0_wp
+    do j = 1, m%z
+      wt = real(count(modes((j - 1)*ns + 1:j*ns) /= 0), wp)/ns   ! share of the face in contact
+      if (wt == 0.0_wp) cycle
+      u = [sp(j), -cp(j), -sp(j), cp(j), 0.0_wp, 1.0_wp, 0.0_wp]
+      w = [cp(j), sp(j), -cp(j), -sp(j), 0.0_wp, 0.0_wp, 0.0_wp]
+      gf(1:ndof) = wt*(m%k_m*u + m%c_m*m%omega*w)
+      gf(ndof+1:) = wt*m%c_m*u
+      gx = gx - gf*sp(j)
+      gy = gy + gf*cp(j)
+      gt = gt + m%r_b*gf
+    end do
+    a = 0.0_wp
+    a(1, :) = gx/m%m_1; a(1, 1) = a(1, 1) - m%k_p1/m%m_1; a(1, 8) = a(1, 8) - m%c_p1/m%m_1
+    a(2, :) = gy/m%m_1; a(2, 2) = a(2, 2) - m%k_p1/m%m_1; a(2, 9) = a(2, 9) - m%c_p1/m%m_1
+    a(3, :) = -gx/m%m_2; a(3, 3) = a(3, 3) - m%k_p2/m%m_2; a(3, 10) = a(3, 10) - m%c_p2/m%m_2
+    a(4, :) = -gy/m%m_2; a(4, 4) = a(4, 4) - m%k_p2/m%m_2; a(4, 11) = a(4, 11) - m%c_p2/m%m_2
+    ds1 = 0.0_wp; ds1(5) = m%k_t1/m%r_b; ds1(12) = m%c_t1/m%r_b
+    ds3 = 0.0_wp; ds3(7) = m%k_t2/m%r_b; ds3(14) = m%c_t2/m%r_b
+    dth1 = (gt - ds1)/m%j_1
+    a(5, :) = m%r_b*(dth1 - ds1/m%j_m)
+    a(6, :) = m%r_b*((-gt - ds3)/m%j_2 - dth1)
+    a(7, :) = m%r_b*((-gt - ds3)/m%j_2 - ds3/m%j_l)
+    ! SI -> scaled (Eq. 25): J_s(i, k) = J(i, k) d_k / (w_ref d_i), d = (l, l w_ref)
+    d(1:ndof) = m%l_ref
+    d(ndof+1:) = m%l_ref*m%w_ref
+    jac = 0.0_wp
+    do i = 1, ndof
+      jac(i, ndof + i) = 1.0_wp            ! dq/dt = v: d_k / (w d_i) = 1
+    end do
+    do i = 1, ndof
+      jac(ndof + i, :) = a(i, :)*d/(m%w_ref*d(ndof + i))
+    end do
+  end subroutine rhs_jacobian
+
+  !> Integrate the state from y0 (SI, at m%t0) to t1 and the ntan tangent vectors phi(:, k)
+  !> (scaled integrated states, ctx order: integrated_states) beside it: the variational
+  !> equations of the run with root-located contact switches (always, whatever the case's
+  !> roots), the saltation matrix applied to phi at each switch (unless saltation = .false.,
+  !> kept to show it matters). CVODE's method, (non)linear solver and tolerances are the case's;
+  !> the tangents are in its error control. y1: the SI state at t1; phi: the tangents there.
+  !> nswitch (optional): the switches located. ierr: err_case (variational_check), err_solver,
+  !> err_interrupted; errmsg says why.
+  subroutine tangent_flow(m, t1, y0, ntan, phi, y1, ierr, errmsg, interruptible, saltation, nswitch)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t1, y0(nstate)
+    integer, intent(in) :: ntan
+    real(wp), intent(inout) :: phi(:, :)
+    real(wp), intent(out) :: y1(nstate)
+    integer, intent(out) :: ierr
+    character(len=*), intent(out) :: errmsg
+    logical, intent(in), optional :: interruptible, saltation
+    integer, intent(out), optional :: nswitch
+    type(tan_ctx_t), target :: ctx
+    real(c_double), allocatable, target :: yr(:)
+    type(c_ptr) :: sunctx, mem
+    type(N_Vector), pointer :: sv
+    type(SUNMatrix), pointer :: amat
+    type(SUNLinearSolver), pointer :: ls
+    type(SUNNonlinearSolver), pointer :: nls
+    real(c_double) :: tau, tau1, tret(1)
+    integer(c_int) :: flag, nroot
+    integer(c_int), allocatable :: rootsfound(:)
+    integer(c_long) :: cnt(1)
+    integer(8) :: done
+    integer :: n, k, nsw
+    logical :: salt
+    character(len=48) :: stage
+    salt = .true.
+    if (present(saltation)) salt = saltation
+    y1 = 0.0_wp
+    nsw = 0
+    if (present(nswitch)) nswitch = 0
+    call variational_check(m, ierr, errmsg)
+    if (ierr /= err_ok) return
+    ctx%m = m
+    ctx%ntan = ntan
+    call integrated_states(m, ctx%idx, ctx%n)
+    n = ctx%n
+    ctx%nc = m%z*m%n_slices
+    allocate(ctx%modes(ctx%nc))
+    nroot = int(2*ctx%nc, c_int)
+    allocate(rootsfound(nroot))
+    call to_scaled(m, y0, ctx%ys_full)
+    if (n < nstate) ctx%ys_full(ndof+1:ndof+4) = 0.0_wp   ! dof 3: lateral states held, at rest
+    allocate(yr(n*(1 + ntan)))
+    yr(1:n) = ctx%ys_full(ctx%idx(1:n))
+    do k = 1, ntan
+      yr(k*n+1:(k+1)*n) = phi(1:n, k)
+    end do
+    tau = m%t0*m%w_ref
+    tau1 = t1*m%w_ref
+    call sync_modes(ctx, tau, yr)
+    if (present(interruptible)) ctx%watch = interruptible
+    if (ctx%watch) ctx%sigint0 = sigint_watch()
+    sunctx = c_null_ptr; mem = c_null_ptr
+    sv => null(); amat => null(); ls => null(); nls => null()
+    done = 0
+    call setup(flag)
+    do while (flag == 0 .and. tau < tau1)
+      flag = FCVodeSetMaxNumSteps(mem, int(max(1_8, min(int(m%max_steps, 8), &
+           int(m%max_total_steps, 8)) - done), c_long))
+      if (flag /= 0) exit
+      stage = 'integrating'
+      flag = FCVode(mem, tau1, sv, tret, CV_NORMAL)
+      if (flag < 0) exit
+      tau = tret(1)
+      if (flag == CV_ROOT_RETURN) then
+        stage = 'reading the roots found'
+        flag = FCVodeGetRootInfo(mem, rootsfound)
+        if (flag /= 0) exit
+        call switch(rootsfound)
+        if (ctx%cb_ierr /= err_ok) then
+          flag = -1
+          exit
+        end if
+        if (FCVodeGetNumSteps(mem, cnt) == 0) done = done + cnt(1)
+        stage = 'restarting at a contact switch'
+        flag = FCVodeReInit(mem, tau, sv)
+      else
+        flag = 0
+      end if
+    end do
+    if (flag /= 0) then
+      call fail(flag)
+    else
+      y1 = 0.0_wp
+      ctx%ys_full(ctx%idx(1:n)) = yr(1:n)
+      call from_scaled(m, ctx%ys_full, y1)
+      do k = 1, ntan
+        phi(1:n, k) = yr(k*n+1:(k+1)*n)
+      end do
+    end if
+    if (present(nswitch)) nswitch = nsw
+    if (ctx%watch) call sigint_unwatch()
+    if (c_associated(mem)) call FCVodeFree(mem)
+    if (associated(ls)) flag = FSUNLinSolFree(ls)
+    if (associated(nls)) flag = FSUNNonlinSolFree(nls)
+    if (associated(amat)) call FSUNMatDestroy(amat)
+    if (associated(sv)) call FN_VDestroy(sv)
+    if (c_associated(sunctx)) flag = FSUNContext_Free(sunctx)
+
+  contains
+
+    !> CVODE on yr at tau: the case's method, tolerances and (non)linear solver (Newton with
+    !> the exact block-diagonal Jacobian, tan_jac_cb, in a band matrix), root finding on the
+    !> contact switches.
+    subroutine setup(flag)
+      integer(c_int), intent(out) :: flag
+      integer(c_long) :: nn
+      nn = int(size(yr), c_long)
+      stage = 'creating the SUNDIALS context'
+      flag = FSUNContext_Create(c_null_ptr, sunctx)
+      if (flag /= 0) return
+      stage = 'creating the state vector'
+      sv => FN_VMake_Serial(nn, yr, sunctx)
+      flag = -1
+      if (.not. associated(sv)) return
+      stage = 'creating CVODE'
+      if (m%method_bdf == 1) then
+        mem = FCVodeCreate(CV_BDF, sunctx)
+      else
+        mem = FCVodeCreate(CV_ADAMS, sunctx)
+      end if
+      if (.not. c_associated(mem)) return
+      stage = 'initialising CVODE'
+      flag = FCVodeInit(mem, c_funloc(tan_rhs_cb), tau, sv)
+      if (flag == 0) flag = FCVodeSetUserData(mem, c_loc(ctx))
+      if (flag == 0) flag = FCVodeSStolerances(mem, real(m%rtol, c_double), real(m%atol, c_double))
+      if (flag /= 0) return
+      stage = 'attaching the (non)linear solver'
+      flag = -1
+      if (m%newton) then
+        ! block diagonal (tan_jac_cb): a band of half-width n - 1 holds it, and its LU costs
+        ! (1 + ntan) n^3 instead of ((1 + ntan) n)^3 at every restart (a rattling drive restarts
+        ! thousands of times a revolution)
+        amat => FSUNBandMatrix(nn, int(n - 1, c_long), int(n - 1, c_long), sunctx)
+        if (.not. associated(amat)) return
+        ls => FSUNLinSol_Band(sv, amat, sunctx)
+        if (.not. associated(ls)) return
+        flag = FCVodeSetLinearSolver(mem, ls, amat)
+        if (flag == 0) flag = FCVodeSetJacFn(mem, c_funloc(tan_jac_cb))
+      else
+        nls => FSUNNonlinSol_FixedPoint(sv, 0, sunctx)
+        if (.not. associated(nls)) return
+        flag = FCVodeSetNonlinearSolver(mem, nls)
+      end if
+      if (flag /= 0) return
+      stage = 'setting the solver options'
+      if (m%stald .and. m%method_bdf == 1) flag = FCVodeSetStabLimDet(mem, 1)
+      if (flag /= 0) return
+      stage = 'setting up root finding'
+      flag = FCVodeRootInit(mem, nroot, c_funloc(tan_roots_cb))
+      if (flag == 0) flag = FCVodeSetNoInactiveRootWarn(mem)
+    end subroutine setup
+
+    !> Flip the contact states of the contacts whose switch was located, one at a time, each
+    !> with its saltation matrix applied to the tangents.
+    subroutine switch(rootsfound)
+      integer(c_int), intent(in) :: rootsfound(:)
+      integer :: j, new
+      ctx%ys_full(ctx%idx(1:n)) = yr(1:n)
+      do j = 1, ctx%nc
+        new = ctx%modes(j)
+        if (rootsfound(2*j - 1) == 1) new = 1
+        if (rootsfound(2*j - 1) == -1) new = 0
+        if (rootsfound(2*j) == -1) new = -1
+        if (rootsfound(2*j) == 1) new = 0
+        if (new == ctx%modes(j)) cycle
+        nsw = nsw + 1
+        if (salt) call apply_saltation(ctx, tau, j, new, yr)
+        ctx%modes(j) = new
+        if (ctx%cb_ierr /= err_ok) return
+      end do
+    end subroutine switch
+
+    subroutine fail(flag)
+      integer(c_int), intent(in) :: flag
+      character(len=:), allocatable :: fname
+      ierr = err_solver
+      if (ctx%cb_ierr /= err_ok) then
+        ierr = ctx%cb_ierr
+        errmsg = ctx%cb_msg
+      else if (ctx%watch .and. sigint_count() /= ctx%sigint0) then
+        ierr = err_interrupted
+        write(errmsg, '(a,es12.5,a)') 'case '//trim(m%name)//': interrupted (SIGINT) at t = ', &
+             tau/m%w_ref, ' s'
+      else if (flag == CV_TOO_MUCH_WORK) then
+        write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': the variational run took '// &
+             'max_steps = ', m%max_steps, ' CVODE steps without reaching its end, at t = ', &
+             tau/m%w_ref, ' s (flag CV_TOO_MUCH_WORK): raise max_steps'
+      else
+        fname = FCVodeGetReturnFlagName(int(flag, c_long))
+        write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': CVODE failed in the '// &
+             'variational run while '//trim(stage)//' with flag '//fname//' (', flag, &
+             ') at t = ', tau/m%w_ref, ' s'
+      end if
+    end subroutine fail
+
+  end subroutine tangent_flow
+
+  !> Contact states from the signs of the switch functions at tau (the run's start).
+  subroutine sync_modes(ctx, tau, v)
+    type(tan_ctx_t), intent(inout) :: ctx
+    real(c_double), intent(in) :: tau, v(:)
+    real(wp) :: y(nstate), g(2*ctx%nc), ys(nstate)
+    integer :: j
+    ys = ctx%ys_full
+    ys(ctx%idx(1:ctx%n)) = v(1:ctx%n)
+    call from_scaled(ctx%m, ys, y)
+    call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), g)
+    do j = 1, ctx%nc
+      ctx%modes(j) = 0
+      if (g(2*j - 1) > 0.0_wp) ctx%modes(j) = 1
+      if (g(2*j) < 0.0_wp) ctx%modes(j) = -1
+    end do
+  end subroutine sync_modes
+
+  !> Phi <- S Phi at the switch of contact k (tooth j, slice s) to state new, at tau:
+  !> S = I + (f+ - f-) h_y^T / (h_y f- + h_tau), h = dn_k -+ c (Eq. 11, scaled states), f-, f+
+  !> the right-hand sides with the old and new contact states (the velocity rows jump by the
+  !> mesh damping's force). h_y f- + h_tau = d(dn_k)/dtau: the contact's approach rate.
+  subroutine apply_saltation(ctx, tau, k, new, v)
+    type(tan_ctx_t), intent(inout) :: ctx
+    real(c_double), intent(in) :: tau
+    integer, intent(in) :: k, new
+    real(c_double), intent(inout) :: v(:)
+    real(wp) :: ys(nstate), y(nstate), fm(nstate), fp(nstate), hy(nstate), ht, den, sp(max_teeth)
+    real(wp) :: cp(max_teeth), ex, ey, zs, dfi(nstate), hphi
+    integer :: mode_new(size(ctx%modes)), j, is, ns, n, c, ie
+    associate(m => ctx%m)
+      n = ctx%n
+      ns = m%n_slices
+      j = (k - 1)/ns + 1
+      is = k - (j - 1)*ns
+      ys = ctx%ys_full
+      ys(ctx%idx(1:n)) = v(1:n)
+      call from_scaled(m, ys, y)
+      call tooth_angles(m%z, m%omega, tau/m%w_ref, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
+      zs = 0.0_wp
+      if (ns > 1) zs = m%b*((is - 0.5_wp)/ns - 0.5_wp)
+      ex = y(1) + m%l_x - y(3)
+      ey = y(2) + m%l_y - y(4)
+      hy = 0.0_wp
+      hy(1:ndof) = m%l_ref*[sp(j), -cp(j), -sp(j), cp(j), 0.0_wp, 1.0_wp, 0.0_wp]
+      ht = m%omega*(ex*cp(j) + ey*sp(j) + zs*(m%gamma_y*cp(j) - m%gamma_x*sp(j)))/m%w_ref
+      mode_new = ctx%modes
+      mode_new(k) = new
+      call rhs_scaled(m, tau, ys, fm, ie, ctx%cb_msg, ctx%modes(1:ctx%nc))
+      if (ie == err_ok) call rhs_scaled(m, tau, ys, fp, ie, ctx%cb_msg, mode_new(1:ctx%nc))
+      if (ie /= err_ok) then
+        ctx%cb_ierr = ie
+        return
+      end if
+      den = dot_product(hy, fm) + ht
+      if (den == 0.0_wp) return            ! grazing: S is unbounded there (not handled)
+      dfi = (fp - fm)/den
+      do c = 1, ctx%ntan
+        hphi = dot_product(hy(ctx%idx(1:n)), v(c*n+1:(c+1)*n))
+        v(c*n+1:(c+1)*n) = v(c*n+1:(c+1)*n) + dfi(ctx%idx(1:n))*hphi
+      end do
+    end associate
+  end subroutine apply_saltation
+
+  !> CVODE's right-hand side: Eq. 25 on the integrated states (frozen contact states), and
+  !> J Phi for the tangents.
+  integer(c_int) function tan_rhs_cb(tau, sv_y, sv_f, udata) result(ret) bind(C)
+    real(c_double), value :: tau
+    type(N_Vector) :: sv_y, sv_f
+    type(c_ptr), value :: udata
+    type(tan_ctx_t), pointer :: ctx
+    real(c_double), pointer :: ys(:), fs(:)
+    real(wp) :: yf(nstate), ff(nstate), jac(nstate, nstate), jr(nstate, nstate)
+    integer :: ie, n, k
+    call c_f_pointer(udata, ctx)
+    ys => FN_VGetArrayPointer(sv_y)
+    fs => FN_VGetArrayPointer(sv_f)
+    n = ctx%n
+    yf = ctx%ys_full
+    yf(ctx%idx(1:n)) = ys(1:n)
+    call rhs_scaled(ctx%m, tau, yf, ff, ie, ctx%cb_msg, ctx%modes(1:ctx%nc))
+    fs(1:n) = ff(ctx%idx(1:n))
+    if (ctx%ntan > 0) then
+      call rhs_jacobian(ctx%m, tau, ctx%modes(1:ctx%nc), jac)
+      jr(1:n, 1:n) = jac(ctx%idx(1:n), ctx%idx(1:n))
+      do k = 1, ctx%ntan
+        fs(k*n+1:(k+1)*n) = matmul(jr(1:n, 1:n), ys(k*n+1:(k+1)*n))
+      end do
+    end if
+    ret = 0
+    if (ie /= err_ok) then
+      ctx%cb_ierr = ie
+      ret = -1
+    else if (ctx%watch) then
+      if (sigint_count() /= ctx%sigint0) ret = -1
+    end if
+  end function tan_rhs_cb
+
+  !> The augmented system's Jacobian: J on the diagonal blocks (the state's and each tangent's;
+  !> J does not depend on the state between switches, so the blocks off the diagonal are 0).
+  integer(c_int) function tan_jac_cb(tau, sv_y, sv_f, jmat, udata, t1, t2, t3) result(ret) bind(C)
+    real(c_double), value :: tau
+    type(N_Vector) :: sv_y, sv_f, t1, t2, t3
+    type(SUNMatrix) :: jmat
+    type(c_ptr), value :: udata
+    type(tan_ctx_t), pointer :: ctx
+    real(c_double), pointer :: flat(:)
+    real(wp) :: jac(nstate, nstate)
+    integer :: n, k, i, j, ldim, smu
+    call c_f_pointer(udata, ctx)
+    n = ctx%n
+    flat => FSUNBandMatrix_Data(jmat)
+    ldim = int(FSUNBandMatrix_LDim(jmat))
+    smu = int(FSUNBandMatrix_StoredUpperBandwidth(jmat))
+    flat = 0.0_c_double
+    call rhs_jacobian(ctx%m, tau, ctx%modes(1:ctx%nc), jac)
+    ! band storage: entry (r, c) (0-based) at data(c ldim + smu + r - c)
+    do k = 0, ctx%ntan
+      do j = 1, n
+        do i = 1, n
+          flat((k*n + j - 1)*ldim + smu + i - j + 1) = jac(ctx%idx(i), ctx%idx(j))
+        end do
+      end do
+    end do
+    ret = 0
+  end function tan_jac_cb
+
+  !> Root functions: the contact switches of Eq. 16 (spline_mesh::mesh_switch_functions).
+  integer(c_int) function tan_roots_cb(tau, sv_y, gout, udata) result(ret) bind(C)
+    real(c_double), value :: tau
+    type(N_Vector) :: sv_y
+    real(c_double) :: gout(*)
+    type(c_ptr), value :: udata
+    type(tan_ctx_t), pointer :: ctx
+    real(c_double), pointer :: ys(:)
+    real(wp) :: y(nstate), yf(nstate)
+    call c_f_pointer(udata, ctx)
+    ys => FN_VGetArrayPointer(sv_y)
+    yf = ctx%ys_full
+    yf(ctx%idx(1:ctx%n)) = ys(1:ctx%n)
+    call from_scaled(ctx%m, yf, y)
+    call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), gout(1:2*ctx%nc))
+    ret = 0
+  end function tan_roots_cb
+
+end module spline_variational
