@@ -28,7 +28,7 @@ module spline_model
   integer, parameter :: stiffness_nquad = 32   !< Gauss points: converged to 1e-15 from 16 on
   !> Marks a model_t built by this build's constructor (layout version in the last digits):
   !> a copy handed back from outside is checked against it.
-  integer, parameter :: model_magic = 517730006
+  integer, parameter :: model_magic = 517730007
   !> A given k_m this many times below Eq. 18 draws a warning (model_warnings): the paper's
   !> calibrated 2.54e5 N/m is ~7600 times below for its spline, a deliberate fit; N/mm read
   !> as N/m is 1000 times, on top of such a fit 1e4 is passed.
@@ -53,7 +53,8 @@ module spline_model
     logical  :: auto = .false.              !< fidelity = auto
     real(wp) :: fidelity_tol = 1.0e-3_wp
     real(wp) :: t_bulk, f_m, u_flash, eta_hertz
-    integer  :: method_bdf = 1              !< 1 = BDF, 0 = Adams
+    integer  :: method_bdf = 1              !< 1 = BDF, 0 = Adams (CVODE)
+    logical  :: erk = .false.               !< ARKODE ERKStep instead of CVODE (spline_erk)
     logical  :: newton = .true.             !< Newton + dense solver, else fixed-point iteration
     logical  :: roots = .false.
     logical  :: stald = .false.
@@ -128,6 +129,7 @@ contains
     m%dof = c%dof; m%fidelity_tol = c%fidelity_tol
     m%auto = option_index(fidelity_values, c%fidelity) == 2
     m%method_bdf = merge(1, 0, option_index(method_values, c%method) == 1)
+    m%erk = option_index(method_values, c%method) == 3
     select case (option_index(nonlinear_values, c%nonlinear))
     case (1)
       m%newton = .true.

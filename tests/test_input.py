@@ -25,7 +25,7 @@ from conftest import CASES, PAPER
     (dict(t_end=math.nan), ["t_end", "finite"]),
     (dict(c0=math.inf), ["c0", "finite"]),
     (dict(thermal="hot"), ["thermal", "none, bulk, oneway or coupled"]),
-    (dict(method="rk4"), ["method", "bdf or adams"]),
+    (dict(method="rk4"), ["method", "bdf, adams, erk or auto"]),
     (dict(z=16.5), ["z", "whole number"]),
     (dict(dq0=[0.0, 1.0]), ["dq0", "7 numbers"]),
     (dict(speed_rpm=-100.0), ["speed_rpm"]),
