@@ -273,7 +273,11 @@ contains
         call fail(flag, tau, 'stepping onto a contact switch')
         return
       end if
-      call apply_roots(ctx, rootsfound, nroots)
+      if (cv%erk) then
+        call settle_roots(ctx, rootsfound, tau, yr, nroots)
+      else
+        call apply_roots(ctx, rootsfound, nroots)
+      end if
       ok = restart_cvode('restarting at a contact switch')
     end function switch_contacts
 
@@ -538,6 +542,33 @@ contains
     end do
     nroots = nroots + count(rootsfound /= 0)
   end subroutine apply_roots
+
+  !> ERKStep landed on located roots (integrator_land_on_root): a root whose switch function has
+  !> reached or crossed zero in the landed state v, in its direction, switches its tooth as
+  !> apply_roots does. The root was found on the interpolant of the crossing step; the landed
+  !> state, of the method's order, may not have crossed yet (by 1e-15 of c): that tooth keeps its
+  !> state until it does (a contact switched early adds its damping force c_m d(dn)/dt at once,
+  !> at the impact speed). A switch function exactly zero there counts as crossed: root finding
+  !> leaves out a function that is zero at its start, and would miss that switch.
+  subroutine settle_roots(ctx, rootsfound, tau, v, nroots)
+    type(solver_ctx_t), intent(inout) :: ctx
+    integer(c_int), intent(in) :: rootsfound(:)
+    real(c_double), intent(in) :: tau, v(:)
+    integer, intent(inout) :: nroots
+    real(wp) :: y(nstate), g(2*ctx%m%z*ctx%m%n_slices)
+    integer(c_int) :: crossed(size(rootsfound))
+    integer :: c, o, i
+    crossed = 0
+    do c = 1, ctx%ncopy
+      o = (c - 1)*ctx%nrc
+      call from_scaled(ctx%m, copy_state(ctx, v, c), y)
+      call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), g)
+      do i = 1, ctx%nrc
+        if (rootsfound(o + i)*g(i) >= 0.0_wp) crossed(o + i) = rootsfound(o + i)
+      end do
+    end do
+    call apply_roots(ctx, crossed, nroots)
+  end subroutine settle_roots
 
   !> CVODE's right-hand side: Eq. 25 on the integrated states, the others held in ys_full.
   !> Returns -1 (unrecoverable) on a physics error or a SIGINT, kept in the context.

@@ -39,20 +39,21 @@ def test_erk_agrees_with_the_oracle():
     assert np.abs(res.Tm - tm).max() < 1e-6 * np.abs(tm).max()
 
 
-@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(
-    strict=True, reason="chaos_z24 (from rest, teeth overlapping their backlash): ERK and CVODE "
-    "differ by 1.6e-3 of F over 10 ms where Adams and BDF agree to 4e-5; cause not found"))
-    if n == "chaos_z24" else n for n in SHIPPED])
+@pytest.mark.parametrize("name", SHIPPED)
 def test_erk_agrees_with_cvode_on_every_shipped_case(name):
     """A short run of every shipped case (its own physics, sections, level) by ERK and by CVODE
-    BDF, both with the switches located at rtol 1e-11: the per-tooth forces agree to 1e-5."""
+    BDF, both with the switches located at rtol 1e-11: the same switches are located, and the
+    per-tooth forces agree to 1e-6, or, in the impacting scenes (physical_z24, chaos_z24), to
+    within 5 times what CVODE's own Adams and BDF differ by (7e-6 and 4e-5 of F in 10 ms)."""
     case = pyspline.load_case(CASES / f"{name}.nml", t_transient=0.0, lyapunov=False)
     case = case.replace(t_end=min(case["t_end"], 0.01), n_out=81, roots=True, rtol=1e-11,
                         atol=1e-13)
     erk = pyspline.simulate(case.replace(method="erk"))
     cv = pyspline.simulate(case.replace(method="bdf"))
+    adams = pyspline.simulate(case.replace(method="adams"))
     assert erk.stats["jac_evals"] == 0 and erk.stats["steps"] > 0
-    assert f_error(erk, cv) < 1e-5       # physical_z24: 7.4e-6 (its impacts), the others below
+    assert erk.stats["roots_found"] == cv.stats["roots_found"]
+    assert f_error(erk, cv) < max(1e-6, 5 * f_error(adams, cv))
 
 
 @pytest.fixture(scope="module")
@@ -73,7 +74,7 @@ def test_erk_converges_as_rtol_tightens(z24):
     errs = [f_error(pyspline.simulate(case.replace(method="erk", roots=True, rtol=rt,
                                                    atol=rt * 1e-2)), ref)
             for rt in (1e-7, 1e-9, 1e-11)]
-    assert errs[1] < 0.01 * errs[0] and errs[2] < errs[1] and errs[2] < 1e-5, errs
+    assert errs[1] < errs[0] / 3 and errs[2] < errs[1] / 3 and errs[2] < 2e-6, errs
 
 
 def test_roots_located_with_erk(z24):
