@@ -108,3 +108,26 @@ def test_erk_failure_names_arkode():
     case = pyspline.load_case(CASES / "physical_z24.nml", t_end=0.01, method="erk", max_steps=20)
     with pytest.raises(pyspline.SolverError, match="ARKODE took max_steps = 20 steps"):
         pyspline.simulate(case)
+
+
+def test_default_on_physical_z24_is_accurate():
+    """physical_z24 with its own settings (method and roots by default: auto picks ERK from
+    rest, with the switches located) over its engagement: per-tooth force error at most 1e-4
+    against a tight reference with located switches (CVODE BDF, rtol 1e-12)."""
+    case = pyspline.load_case(CASES / "physical_z24.nml", t_end=0.1, n_out=401)
+    assert case["method"] == "auto" and case["roots"] is True
+    res = pyspline.simulate(case)
+    ref = pyspline.simulate(case.replace(method="bdf", rtol=1e-12, atol=1e-14, max_steps=10**7))
+    assert res.stats["roots_found"] == ref.stats["roots_found"] > 100
+    assert f_error(res, ref) <= 1e-4
+
+
+@pytest.mark.parametrize("name,picked", [("physical_z24", "erk"), ("physical_ripple", "bdf"),
+                                         ("paper_lx1e-4", "adams"), ("physical_tilt", "adams")])
+def test_auto_is_the_method_it_picks(name, picked):
+    """method = 'auto' runs bit for bit as the method docs/model.md says it picks."""
+    case = pyspline.load_case(CASES / f"{name}.nml", t_end=0.01, n_out=41, t_transient=0.0,
+                              method="auto")
+    a, b = pyspline.simulate(case), pyspline.simulate(case.replace(method=picked))
+    np.testing.assert_array_equal(a.y, b.y)
+    assert a.stats["steps"] == b.stats["steps"]
