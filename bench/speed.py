@@ -75,12 +75,14 @@ def _mesh_outputs(case, t, y):
 
 
 def _cvode_kw(variant):
-    """Case fields of a CVODE variant: 'bdf', 'adams', 'adams-fixedpoint' (functional
-    iteration, no Jacobian) or 'bdf-stald' (stability-limit detection)."""
+    """Case fields of a pyspline variant: 'bdf', 'adams', 'adams-fixedpoint' (functional
+    iteration, no Jacobian), 'bdf-stald' (stability-limit detection), 'erk' or 'auto'."""
     if variant == "adams-fixedpoint":
         return dict(method="adams", nonlinear="fixedpoint")
     if variant == "bdf-stald":
         return dict(method="bdf", stald=True)
+    if variant in PYSPLINE_LABEL:                 # 'erk', 'auto': as the case would run them
+        return dict(method=variant)
     return dict(method=variant, nonlinear="newton", stald=False)
 
 
@@ -161,6 +163,10 @@ def reference(case):
 WP_CASES = {"paper_lx1e-4": 0.3, "paper_T100": 0.3, "rattle_z24": 0.05, "physical_z24": 0.1}
 
 
+#: labels of the pyspline settings that are not CVODE's (method = 'erk': ARKODE ERKStep)
+PYSPLINE_LABEL = {"erk": "ARKODE", "auto": "pyspline"}
+
+
 def work_precision(out, quick=False, progress=True, cases=None):
     """The work-precision chart and table (WP_CASES; quick: the two paper scenes, 0.05 s)."""
     from tqdm import tqdm
@@ -182,7 +188,7 @@ def work_precision(out, quick=False, progress=True, cases=None):
         ref, agree = reference(case)
         notes.append(f"{name}: reference (CVODE BDF + roots, rtol 1e-12) vs DOP853 rtol 1e-12 on "
                      f"the Fortran RHS: T_m {agree[0]:.1e}, F_j {agree[1]:.1e}")
-        jobs = [("cvode", m, r, rt) for m in ("bdf", "adams", "adams-fixedpoint")
+        jobs = [("cvode", m, r, rt) for m in ("bdf", "adams", "adams-fixedpoint", "erk", "auto")
                 for r in (False, True) for rt in rtols_cv]
         jobs += [("scipy", m, kind, rt) for m in SCIPY_METHODS for kind in ("fortran", "numpy")
                  for rt in rtols_sp if kind == "fortran" or oracle is not None]
@@ -191,7 +197,8 @@ def work_precision(out, quick=False, progress=True, cases=None):
                      for rt in rtols_cv]
         for solver, method, opt, rtol in tqdm(jobs, desc=f"work-precision {name}",
                                               disable=not progress):
-            label = (f"CVODE {method}{' + roots' if opt else ''}" if solver == "cvode"
+            label = (f"{PYSPLINE_LABEL.get(method, 'CVODE')} {method}{' + roots' if opt else ''}"
+                     if solver == "cvode"
                      else f"{solver} {method} ({opt} RHS)")
             row = dict(case=name, method=label, rtol=rtol)
             try:
@@ -236,7 +243,7 @@ def speed_ratios(rows, accuracy=1e-6):
         def best(pred):
             cand = [r for r in good if pred(r["method"])]
             return min(cand, key=lambda r: r["time_s"]) if cand else None
-        cv = best(lambda m: m.startswith("CVODE"))
+        cv = best(lambda m: m.startswith(tuple(set(PYSPLINE_LABEL.values()) | {"CVODE"})))
         for kind in ("numpy", "fortran", "numba"):
             peer = best(lambda m, k=kind: f"({k} RHS)" in m)
             out.append(dict(case=name, accuracy=accuracy, peer_rhs=kind,
