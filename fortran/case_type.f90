@@ -175,7 +175,7 @@ module spline_case_type
        field_t('u_flash', 'r', 1, '-', 'Blok factor u', 'n', 0.0_wp, 10.0_wp, 'Blok''s factor (0.83)'), &
        field_t('eta_hertz', 'r', 1, '-', 'Hertz factor eta', 'p', 1.0e-2_wp, 100.0_wp, &
                'Hertz factor (1.127)'), &
-       field_t('method', 'c', optlen, '', 'auto | adams | bdf (CVODE) | erk (ARKODE, order 8)'), &
+       field_t('method', 'c', optlen, '', 'auto | adams | bdf (CVODE) | erk (ARKODE, order 5)'), &
        field_t('jacobian', 'c', optlen, '', 'dq: dense difference-quotient Jacobian'), &
        field_t('nonlinear', 'c', optlen, '', 'auto (adams: fixedpoint, bdf: newton) | newton | fixedpoint'), &
        field_t('roots', 'l', 1, '', 'locate the contact switches by root finding'), &
