@@ -58,7 +58,7 @@ contains
     type(model_t), intent(in) :: m
     real(c_double), intent(in) :: tau
     integer(c_int), intent(in) :: nroot
-    type(c_funptr), intent(in) :: rhs, roots, errh
+    type(c_funptr), value :: rhs, roots, errh   ! by value: no address constant to relocate
     type(c_ptr), intent(in) :: udata
     type(integrator_t), intent(inout) :: cv
     integer(c_int), intent(out) :: flag

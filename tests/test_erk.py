@@ -120,6 +120,10 @@ def test_default_on_physical_z24_is_accurate():
     ref = pyspline.simulate(case.replace(method="bdf", rtol=1e-12, atol=1e-14, max_steps=10**7))
     assert res.stats["roots_found"] == ref.stats["roots_found"] > 100
     assert f_error(res, ref) <= 1e-4
+    # its exact Poincare sections (whole shaft revolutions) too, against the states' range
+    assert len(res.section_t) == 5 and np.array_equal(res.section_t, ref.section_t)
+    span = np.ptp(ref.y, axis=0)
+    assert (np.abs(res.section_y - ref.section_y).max(axis=0) <= 1e-4 * span).all()
 
 
 @pytest.mark.parametrize("name,picked", [("physical_z24", "erk"), ("physical_ripple", "bdf"),
