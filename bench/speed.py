@@ -75,16 +75,18 @@ def _mesh_outputs(case, t, y):
 
 
 #: the pyspline settings the benchmarks try (a new integrator method: add it here and in _cvode_kw)
-PYSPLINE_VARIANTS = ("bdf", "adams", "adams-fixedpoint")
+PYSPLINE_VARIANTS = ("bdf", "adams", "adams-fixedpoint", "erk", "auto")
 
 
 def _cvode_kw(variant):
-    """Case fields of a CVODE variant: 'bdf', 'adams', 'adams-fixedpoint' (functional
-    iteration, no Jacobian) or 'bdf-stald' (stability-limit detection)."""
+    """Case fields of a pyspline variant: 'bdf', 'adams', 'adams-fixedpoint' (functional
+    iteration, no Jacobian), 'bdf-stald' (stability-limit detection), 'erk' or 'auto'."""
     if variant == "adams-fixedpoint":
         return dict(method="adams", nonlinear="fixedpoint")
     if variant == "bdf-stald":
         return dict(method="bdf", stald=True)
+    if variant in PYSPLINE_LABEL:                 # 'erk', 'auto': as the case would run them
+        return dict(method=variant)
     return dict(method=variant, nonlinear="newton", stald=False)
 
 
@@ -165,6 +167,10 @@ def reference(case):
 WP_CASES = {"paper_lx1e-4": 0.3, "paper_T100": 0.3, "rattle_z24": 0.05, "physical_z24": 0.1}
 
 
+#: labels of the pyspline settings that are not CVODE's (method = 'erk': ARKODE ERKStep)
+PYSPLINE_LABEL = {"erk": "ARKODE", "auto": "pyspline"}
+
+
 def work_precision(out, quick=False, progress=True, cases=None):
     """The work-precision chart and table (WP_CASES; quick: the two paper scenes, 0.05 s)."""
     from tqdm import tqdm
@@ -195,7 +201,8 @@ def work_precision(out, quick=False, progress=True, cases=None):
                      for rt in rtols_cv]
         for solver, method, opt, rtol in tqdm(jobs, desc=f"work-precision {name}",
                                               disable=not progress):
-            label = (f"CVODE {method}{' + roots' if opt else ''}" if solver == "cvode"
+            label = (f"{PYSPLINE_LABEL.get(method, 'CVODE')} {method}{' + roots' if opt else ''}"
+                     if solver == "cvode"
                      else f"{solver} {method} ({opt} RHS)")
             row = dict(case=name, method=label, rtol=rtol)
             try:
@@ -240,7 +247,7 @@ def speed_ratios(rows, accuracy=1e-6):
         def best(pred):
             cand = [r for r in good if pred(r["method"])]
             return min(cand, key=lambda r: r["time_s"]) if cand else None
-        cv = best(lambda m: m.startswith("CVODE"))
+        cv = best(lambda m: m.startswith(tuple(set(PYSPLINE_LABEL.values()) | {"CVODE"})))
         for kind in ("numpy", "fortran", "numba"):
             peer = best(lambda m, k=kind: f"({k} RHS)" in m)
             out.append(dict(case=name, accuracy=accuracy, peer_rhs=kind,

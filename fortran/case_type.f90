@@ -24,7 +24,8 @@ module spline_case_type
   ! The values of the option fields; spline_model maps each to its position.
   character(len=optlen), parameter :: thermal_values(4) = [character(len=optlen) :: &
        'none', 'bulk', 'oneway', 'coupled']
-  character(len=optlen), parameter :: method_values(2) = [character(len=optlen) :: 'bdf', 'adams']
+  character(len=optlen), parameter :: method_values(4) = [character(len=optlen) :: &
+       'bdf', 'adams', 'erk', 'auto']
   character(len=optlen), parameter :: nonlinear_values(3) = [character(len=optlen) :: &
        'newton', 'fixedpoint', 'auto']
   character(len=optlen), parameter :: start_values(2) = [character(len=optlen) :: &
@@ -58,8 +59,8 @@ module spline_case_type
     !> The solver defaults are what won where it was measured (docs/performance.md, "Impacting
     !> scenes, and how the defaults were chosen"): Adams with fixed-point iteration, on every
     !> scene of the stability sweep and on the impacting Z = 24 scene.
-    character(len=optlen) :: method = 'adams', jacobian = 'dq', nonlinear = 'auto'
-    logical  :: roots = .false., stald = .false., linear_tail = .true.
+    character(len=optlen) :: method = 'auto', jacobian = 'dq', nonlinear = 'auto'
+    logical  :: roots = .true., stald = .false., linear_tail = .true.
     real(wp) :: rtol = 1.0e-8_wp, atol = 1.0e-10_wp
     integer  :: max_steps = 100000, max_total_steps = 20000000
     real(wp) :: t0 = 0.0_wp, t_end = 0.1_wp, t_transient = 0.0_wp
@@ -177,7 +178,7 @@ module spline_case_type
        field_t('u_flash', 'r', 1, '-', 'Blok factor u', 'n', 0.0_wp, 10.0_wp, 'Blok''s factor (0.83)'), &
        field_t('eta_hertz', 'r', 1, '-', 'Hertz factor eta', 'p', 1.0e-2_wp, 100.0_wp, &
                'Hertz factor (1.127)'), &
-       field_t('method', 'c', optlen, '', 'adams | bdf (CVODE)'), &
+       field_t('method', 'c', optlen, '', 'auto | adams | bdf (CVODE) | erk (ARKODE, order 5)'), &
        field_t('jacobian', 'c', optlen, '', 'dq: dense difference-quotient Jacobian'), &
        field_t('nonlinear', 'c', optlen, '', 'auto (adams: fixedpoint, bdf: newton) | newton | fixedpoint'), &
        field_t('roots', 'l', 1, '', 'locate the contact switches by root finding'), &

@@ -1,10 +1,11 @@
 !> Time integration with CVODE (SUNDIALS 6.4, Fortran 2003 interface) of the scaled system of
-!> Eq. 25, with optional root finding on the contact switches of Eq. 16.
+!> Eq. 25, with optional root finding on the contact switches of Eq. 16; or with ARKODE's
+!> ERKStep (method = 'erk'), made and driven through spline_erk.
 !>
 !> Reentrant: all run state sits in a solver_ctx_t local to `integrate`, which CVODE hands to
 !> the callbacks as their user data. No module variable changes during a run. The SUNDIALS
-!> objects are made in cvode_setup and freed in cvode_free; every SUNDIALS return value is
-!> checked. Version-specific calls (context creation) are in sundials_context_new.
+!> objects are made in cvode_setup and freed in spline_erk::integrator_free; every SUNDIALS
+!> return value is checked. Version-specific calls (context creation) are in sundials_context_new.
 module spline_solver
   use, intrinsic :: iso_c_binding
   use fcvode_mod
@@ -23,10 +24,12 @@ module spline_solver
   use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, integrated_states
   use spline_mesh, only: mesh_switch_functions, coupling_stats_t
   use spline_linear, only: tail_t, tail_possible, tail_try, tail_state, tail_states
-  use spline_quantities, only: nstats => nsolver_stats, ist_steps, ist_rhs_evals, ist_jac_evals, &
-       ist_lin_rhs_evals, ist_err_test_fails, ist_nonlin_conv_fails, ist_roots_found, &
-       ist_root_fn_evals, ist_last_step, ist_mode_resyncs, ist_coupling_residual, &
-       ist_coupling_iterations, ist_linear_tail_t
+  use spline_erk, only: integrator_t, erk_create, integrator_evolve, integrator_root_info, &
+       integrator_steps, integrator_restart, integrator_last_step, integrator_flag_name, &
+       integrator_name, add_counters, integrator_free, integrator_land_on_root
+  use spline_quantities, only: nstats => nsolver_stats, ist_steps, ist_roots_found, &
+       ist_last_step, ist_mode_resyncs, ist_coupling_residual, ist_coupling_iterations, &
+       ist_linear_tail_t
   implicit none
   private
   public :: integrate
@@ -48,16 +51,6 @@ module spline_solver
     character(len=msglen) :: cb_msg = ''
     character(len=msglen) :: cvode_msg = '' !< CVODE's own last error text
   end type solver_ctx_t
-
-  !> The SUNDIALS objects of one run (cvode_setup makes them, cvode_free frees them).
-  type :: cvode_t
-    type(c_ptr) :: sunctx = c_null_ptr
-    type(c_ptr) :: mem = c_null_ptr         !< CVODE
-    type(N_Vector), pointer :: sv => null() !< the state vector, on the caller's array
-    type(SUNMatrix), pointer :: amat => null()
-    type(SUNLinearSolver), pointer :: ls => null()
-    type(SUNNonlinearSolver), pointer :: nls => null()
-  end type cvode_t
 
   interface   ! fortran/interrupt.c
     integer(c_int) function sigint_watch() bind(C, name='spline_sigint_watch')
@@ -108,7 +101,7 @@ contains
     real(wp), intent(in), optional :: y0b(nstate)
     real(wp), intent(out), optional :: youtb(nstate, nt)
     type(solver_ctx_t), target :: ctx
-    type(cvode_t) :: cv
+    type(integrator_t) :: cv
     real(c_double), allocatable, target :: yr(:)   !< CVODE's state vector (the copies' integrated states)
     real(c_double) :: tau                          !< where the integration stands (scaled time)
     real(c_double) :: tau_chk, dchk                !< next linear-tail check, and their spacing
@@ -136,7 +129,7 @@ contains
     end if
     call collect_stats()
     if (ctx%watch) call sigint_unwatch()
-    call cvode_free(cv)
+    call integrator_free(cv)
 
   contains
 
@@ -215,8 +208,7 @@ contains
           return
         end if
         tau_to = next_stop(tau_out)
-        flag = FCVodeSetMaxNumSteps(cv%mem, int(allow, c_long))
-        if (flag == 0) flag = FCVode(cv%mem, tau_to, cv%sv, tret, CV_NORMAL)
+        flag = integrator_evolve(cv, allow, tau_to, tret)
         if (flag == CV_TOO_MUCH_WORK) then
           call fail_work(tret(1))
           return
@@ -269,13 +261,23 @@ contains
     !> crossed, restart. .false. if a call failed (ierr, errmsg set).
     logical function switch_contacts() result(ok)
       integer(c_int) :: rootsfound(nroot), flag
-      flag = FCVodeGetRootInfo(cv%mem, rootsfound)
+      flag = integrator_root_info(cv, rootsfound)
       ok = flag == 0
       if (.not. ok) then
         call fail(flag, tau, 'reading the roots found')
         return
       end if
-      call apply_roots(ctx, rootsfound, nroots)
+      flag = integrator_land_on_root(cv, tau)
+      ok = flag == 0
+      if (.not. ok) then
+        call fail(flag, tau, 'stepping onto a contact switch')
+        return
+      end if
+      if (cv%erk) then
+        call settle_roots(ctx, rootsfound, tau, yr, nroots)
+      else
+        call apply_roots(ctx, rootsfound, nroots)
+      end if
       ok = restart_cvode('restarting at a contact switch')
     end function switch_contacts
 
@@ -334,17 +336,16 @@ contains
     integer(8) function steps_done() result(n)
       integer(c_long) :: cnt(1)
       n = nint(stats(ist_steps), 8)
-      if (FCVodeGetNumSteps(cv%mem, cnt) == 0) n = n + cnt(1)
+      if (integrator_steps(cv, cnt) == 0) n = n + cnt(1)
     end function steps_done
 
-    !> Restart CVODE at tau (a contact switch: the right-hand side's branch changed), its
-    !> counters kept first (CVodeReInit zeroes them); .false. if it failed (ierr, errmsg set).
+    !> Restart the integrator at tau (a contact switch: the right-hand side's branch changed;
+    !> spline_erk::integrator_restart); .false. if it failed (ierr, errmsg set).
     logical function restart_cvode(what) result(ok)
       character(len=*), intent(in) :: what
       integer(c_int) :: flag
-      call add_counters(ctx, cv%mem, stats)
       fresh = .true.
-      flag = FCVodeReInit(cv%mem, tau, cv%sv)
+      flag = integrator_restart(cv, tau, stats)
       ok = flag == 0
       if (.not. ok) call fail(flag, tau, what)
     end function restart_cvode
@@ -353,8 +354,8 @@ contains
     subroutine collect_stats()
       real(c_double) :: hlast(1)
       if (c_associated(cv%mem)) then
-        call add_counters(ctx, cv%mem, stats)
-        if (FCVodeGetLastStep(cv%mem, hlast) == 0) stats(ist_last_step) = hlast(1)/m%w_ref
+        call add_counters(cv, stats)
+        if (integrator_last_step(cv, hlast) == 0) stats(ist_last_step) = hlast(1)/m%w_ref
       end if
       stats(ist_roots_found) = nroots
       stats(ist_mode_resyncs) = nresync
@@ -370,10 +371,11 @@ contains
       if (ctx%cb_ierr /= err_ok .or. ierr /= err_solver) return
       if (total_bound) then
         write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': the run took max_total_steps = ', &
-             m%max_total_steps, ' CVODE steps in all by t = ', tau/m%w_ref, ' s (flag '// &
+             m%max_total_steps, ' '//integrator_name(cv)//' steps in all by t = ', tau/m%w_ref, ' s (flag '// &
              'CV_TOO_MUCH_WORK): raise max_total_steps, or find why the steps are so small'
       else
-        write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': CVODE took max_steps = ', &
+        write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': '//integrator_name(cv)// &
+             ' took max_steps = ', &
              m%max_steps, ' steps between two output times without reaching the next, at t = ', &
              tau/m%w_ref, ' s (flag CV_TOO_MUCH_WORK): raise max_steps or n_out'
       end if
@@ -397,8 +399,9 @@ contains
              tau/m%w_ref, ' s'
         return
       end if
-      fname = FCVodeGetReturnFlagName(int(flag, c_long))
-      write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': CVODE failed while '//what// &
+      fname = integrator_flag_name(cv, flag)
+      write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': '//integrator_name(cv)// &
+           ' failed while '//what// &
            ' with flag '//fname//' (', flag, ') at t = ', tau/m%w_ref, ' s'
       if (len_trim(ctx%cvode_msg) > 0) errmsg = trim(errmsg)//': '//trim(ctx%cvode_msg)
     end subroutine fail
@@ -408,22 +411,29 @@ contains
   !> Create CVODE for the run of ctx on the state vector yr at tau, with its tolerances,
   !> (non)linear solver, step bound and, when the contact states are frozen, nroot root
   !> functions. Each SUNDIALS call is checked in turn: flag /= 0 is the first failure, stage
-  !> names the step. cv holds what was made (cvode_free frees it, whatever failed).
+  !> names the step. cv holds what was made (integrator_free frees it, whatever failed).
   subroutine cvode_setup(m, ctx, yr, tau, nroot, cv, flag, stage)
     type(model_t), intent(in) :: m
     type(solver_ctx_t), intent(inout), target :: ctx
     real(c_double), intent(inout), target :: yr(:)
     real(c_double), intent(in) :: tau
     integer(c_int), intent(in) :: nroot
-    type(cvode_t), intent(out) :: cv
+    type(integrator_t), intent(out) :: cv
     integer(c_int), intent(out) :: flag
     character(len=*), intent(out) :: stage
+    cv%newton = m%newton .and. .not. m%erk
+    cv%roots = ctx%frozen
     stage = 'creating the SUNDIALS context'
     flag = sundials_context_new(cv%sunctx)
     if (flag == 0) then
       stage = 'creating the state vector'
       cv%sv => FN_VMake_Serial(int(size(yr), c_long), yr, cv%sunctx)
       if (.not. associated(cv%sv)) flag = -1
+    end if
+    if (flag == 0 .and. m%erk) then
+      call erk_create(m, tau, nroot, c_funloc(rhs_cb), c_funloc(roots_cb), c_funloc(err_cb), &
+           c_loc(ctx), cv, flag, stage)
+      return
     end if
     if (flag == 0) then
       stage = 'creating CVODE'
@@ -475,48 +485,12 @@ contains
     end if
   end subroutine cvode_setup
 
-  !> Free what cvode_setup made (the statistics read first: integrate's collect_stats).
-  subroutine cvode_free(cv)
-    type(cvode_t), intent(inout) :: cv
-    integer(c_int) :: flag
-    if (c_associated(cv%mem)) call FCVodeFree(cv%mem)
-    if (associated(cv%ls)) flag = FSUNLinSolFree(cv%ls)
-    if (associated(cv%nls)) flag = FSUNNonlinSolFree(cv%nls)
-    if (associated(cv%amat)) call FSUNMatDestroy(cv%amat)
-    if (associated(cv%sv)) call FN_VDestroy(cv%sv)
-    flag = FSUNContext_Free(cv%sunctx)
-  end subroutine cvode_free
-
   !> A SIGINT arrived since the run began (only for runs that watch).
   logical function interrupted(ctx)
     type(solver_ctx_t), intent(in) :: ctx
     interrupted = .false.
     if (ctx%watch) interrupted = sigint_count() /= ctx%sigint0
   end function interrupted
-
-  !> Add CVODE's counters since the last (re)initialisation to stats (positions ist_* of spline_quantities).
-  !> A counter that cannot be read (nonzero flag) adds nothing.
-  subroutine add_counters(ctx, mem, stats)
-    type(solver_ctx_t), intent(in) :: ctx
-    type(c_ptr), intent(in) :: mem
-    real(wp), intent(inout) :: stats(nstats)
-    integer(c_long) :: cnt(1)
-    call add(ist_steps, FCVodeGetNumSteps(mem, cnt))
-    call add(ist_rhs_evals, FCVodeGetNumRhsEvals(mem, cnt))
-    if (ctx%m%newton) then
-      call add(ist_jac_evals, FCVodeGetNumJacEvals(mem, cnt))
-      call add(ist_lin_rhs_evals, FCVodeGetNumLinRhsEvals(mem, cnt))
-    end if
-    call add(ist_err_test_fails, FCVodeGetNumErrTestFails(mem, cnt))
-    call add(ist_nonlin_conv_fails, FCVodeGetNumNonlinSolvConvFails(mem, cnt))
-    if (ctx%frozen) call add(ist_root_fn_evals, FCVodeGetNumGEvals(mem, cnt))
-  contains
-    subroutine add(i, flag)          ! the getter has filled cnt by the time this runs
-      integer, intent(in) :: i
-      integer(c_int), intent(in) :: flag
-      if (flag == 0) stats(i) = stats(i) + cnt(1)
-    end subroutine add
-  end subroutine add_counters
 
   !> SUNDIALS 6.x context (SUNDIALS 7 takes SUN_COMM_NULL here): the one version-specific call.
   integer(c_int) function sundials_context_new(sunctx) result(flag)
@@ -567,6 +541,33 @@ contains
     end do
     nroots = nroots + count(rootsfound /= 0)
   end subroutine apply_roots
+
+  !> ERKStep landed on located roots (integrator_land_on_root): a root whose switch function has
+  !> reached or crossed zero in the landed state v, in its direction, switches its tooth as
+  !> apply_roots does. The root was found on the interpolant of the crossing step; the landed
+  !> state, of the method's order, may not have crossed yet (by 1e-15 of c): that tooth keeps its
+  !> state until it does (a contact switched early adds its damping force c_m d(dn)/dt at once,
+  !> at the impact speed). A switch function exactly zero there counts as crossed: root finding
+  !> leaves out a function that is zero at its start, and would miss that switch.
+  subroutine settle_roots(ctx, rootsfound, tau, v, nroots)
+    type(solver_ctx_t), intent(inout) :: ctx
+    integer(c_int), intent(in) :: rootsfound(:)
+    real(c_double), intent(in) :: tau, v(:)
+    integer, intent(inout) :: nroots
+    real(wp) :: y(nstate), g(2*ctx%m%z*ctx%m%n_slices)
+    integer(c_int) :: crossed(size(rootsfound))
+    integer :: c, o, i
+    crossed = 0
+    do c = 1, ctx%ncopy
+      o = (c - 1)*ctx%nrc
+      call from_scaled(ctx%m, copy_state(ctx, v, c), y)
+      call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), g)
+      do i = 1, ctx%nrc
+        if (rootsfound(o + i)*g(i) >= 0.0_wp) crossed(o + i) = rootsfound(o + i)
+      end do
+    end do
+    call apply_roots(ctx, crossed, nroots)
+  end subroutine settle_roots
 
   !> CVODE's right-hand side: Eq. 25 on the integrated states, the others held in ys_full.
   !> Returns -1 (unrecoverable) on a physics error or a SIGINT, kept in the context.

@@ -1,14 +1,14 @@
 #!/usr/bin/env bash
 # Install the toolchain (gfortran, SUNDIALS 6.4 with its Fortran 2003 modules) and the Python
-# packages, build an optimised CVODE, then build and install pyspline (the f2py extension and
+# packages, build an optimised CVODE and ARKODE, then build and install pyspline (the f2py extension and
 # the spline-dyn executable).
 #
-# Why build CVODE: Debian 12's SUNDIALS 6.4.1 libraries are compiled without optimisation
+# Why build CVODE and ARKODE: Debian 12's SUNDIALS 6.4.1 libraries are compiled without optimisation
 # (debian/rules sets CMAKE_C_FLAGS=-fcommon, which replaces the -O2 of dpkg-buildflags, and
 # no CMAKE_BUILD_TYPE), and CVODE's own work per step is most of a run. So this script takes
-# Debian's source package of the same version (apt-get source) and builds CVODE and its
-# Fortran modules optimised (C: -O3 -fno-semantic-interposition) into $PYSPLINE_SUNDIALS (~15 s,
-# once; default under ~/.cache). Same version, same numbers: on x86-64 without -march the
+# Debian's source package of the same version (apt-get source) and builds CVODE, ARKODE (ERKStep,
+# method = 'erk') and their Fortran modules optimised (C: -O3 -fno-semantic-interposition) into $PYSPLINE_SUNDIALS (~1 min,
+# once; default under ~/.cache; a prefix without ARKODE, from an older setup.sh, is rebuilt). Same version, same numbers: on x86-64 without -march the
 # compiler contracts no FMAs and reassociates no sums, so results are bit-identical to the
 # Debian build (tests/test_build.py); a run is up to 2.4x faster at -O2, and -O3 took another
 # 11 % off a paper_lx1e-4 point (docs/building.md). If the source cannot be had, pyspline is built on Debian's libraries, with a warning.
@@ -37,8 +37,8 @@ python3 -m pip install -q --disable-pip-version-check ross-rotordynamics "plotly
 
 # The source of exactly the installed version: same interface, same numbers.
 version="$(dpkg-query -W -f='${Version}' libsundials-dev)"
-prefix="${PYSPLINE_SUNDIALS:-${XDG_CACHE_HOME:-$HOME/.cache}/pyspline/sundials-$version-O3}"
-build_cvode() {
+prefix="${PYSPLINE_SUNDIALS:-${XDG_CACHE_HOME:-$HOME/.cache}/pyspline/sundials-$version-O3-arkode}"
+build_sundials() {
   local work src
   work="$(mktemp -d)"
   # Debian's source package needs a deb-src entry for the same archive as the binaries.
@@ -54,7 +54,7 @@ build_cvode() {
   cmake -S "$src" -B "$work/build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
     -DCMAKE_C_FLAGS_RELEASE="-O3 -fno-semantic-interposition" -DCMAKE_Fortran_FLAGS_RELEASE=-O2 \
     -DCMAKE_Fortran_COMPILER=gfortran -DBUILD_FORTRAN_MODULE_INTERFACE=ON \
-    -DBUILD_ARKODE=OFF -DBUILD_CVODES=OFF -DBUILD_IDA=OFF -DBUILD_IDAS=OFF -DBUILD_KINSOL=OFF \
+    -DBUILD_ARKODE=ON -DBUILD_CVODES=OFF -DBUILD_IDA=OFF -DBUILD_IDAS=OFF -DBUILD_KINSOL=OFF \
     -DBUILD_STATIC_LIBS=OFF -DEXAMPLES_ENABLE_C=OFF -DEXAMPLES_ENABLE_F2003=OFF \
     -DEXAMPLES_INSTALL=OFF -DCMAKE_INSTALL_PREFIX="$prefix" \
     -DCMAKE_INSTALL_RPATH="$prefix/lib" -DCMAKE_INSTALL_LIBDIR=lib >"$work/cmake.log" 2>&1 \
@@ -65,9 +65,9 @@ build_cvode() {
 }
 setup_args=()
 if [ "$prefix" != "system" ]; then
-  if [ ! -f "$prefix/fortran/fcvode_mod.mod" ]; then
-    echo "setup: building optimised CVODE $version into $prefix (Debian's build is unoptimised)"
-    build_cvode || { echo "setup: WARNING: could not build CVODE; using Debian's unoptimised SUNDIALS (same numbers, ~2.4x slower)" >&2; prefix=system; }
+  if [ ! -f "$prefix/fortran/fcvode_mod.mod" ] || [ ! -f "$prefix/fortran/farkode_erkstep_mod.mod" ]; then
+    echo "setup: building optimised CVODE and ARKODE $version into $prefix (Debian's build is unoptimised)"
+    build_sundials || { echo "setup: WARNING: could not build CVODE and ARKODE; using Debian's unoptimised SUNDIALS (same numbers, ~2.4x slower)" >&2; prefix=system; }
   fi
   [ "$prefix" != "system" ] && setup_args=("-Csetup-args=-Dsundials_prefix=$prefix")
 fi

@@ -62,17 +62,21 @@ def test_executable_matches_python(name, exe, tmp_path):
 def test_physical_impacting_scene_statistics_agree_across_solvers():
     """cases/physical_z24 (computed stiffness, zeta_m = 0.01) engages from rest with hundreds of
     impacts, then settles. Its statistics after the engagement are the same for the defaults
-    (Adams, fixed-point iteration, rtol 1e-8, no root finding), for BDF + Newton with the
-    contact switches located, and for a tight Adams + Newton run: the numbers a user reads do
-    not depend on the solver (unlike rattle_z24's at a damping ratio of 2e-7)."""
+    (method auto: ERK, switches located, rtol 1e-8), for Adams with fixed-point iteration and
+    no root finding (the defaults before), for BDF + Newton with the contact switches located,
+    and for a tight Adams + Newton run: the numbers a user reads do not depend on the solver
+    (unlike rattle_z24's at a damping ratio of 2e-7)."""
     case = pyspline.load_case(CASES / "physical_z24.nml", t_end=0.6, n_out=2401)
     runs = {"defaults": pyspline.simulate(case),
+            "adams": pyspline.simulate(case.replace(method="adams", roots=False)),
             "bdf+roots": pyspline.simulate(case.replace(method="bdf", roots=True, rtol=1e-6,
                                                         atol=1e-8)),
-            "tight": pyspline.simulate(case.replace(nonlinear="newton", rtol=1e-11,
+            "tight": pyspline.simulate(case.replace(method="adams", roots=False,
+                                                    nonlinear="newton", rtol=1e-11,
                                                     atol=1e-13))}
     assert runs["bdf+roots"].stats["roots_found"] > 100            # it does impact
-    assert runs["defaults"].stats["roots_found"] == 0              # defaults: no root finding
+    assert runs["defaults"].stats["roots_found"] > 100             # defaults: located
+    assert runs["adams"].stats["roots_found"] == 0
 
     def stats(r):
         late = r.t >= 0.3
@@ -81,5 +85,5 @@ def test_physical_impacting_scene_statistics_agree_across_solvers():
                      r.tooth["F"][late].max()]
 
     ref = stats(runs["tight"])
-    for name in ("defaults", "bdf+roots"):
+    for name in ("defaults", "adams", "bdf+roots"):
         np.testing.assert_allclose(stats(runs[name]), ref, rtol=1e-4, err_msg=name)
