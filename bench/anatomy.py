@@ -51,11 +51,14 @@ def _time_rhs_exe() -> Path:
     from pyspline import _build_info
     build = HERE / "build" / "meson"
     meson = [sys.executable, "-m", "mesonbuild.mesonmain"]
-    if not (build / "build.ninja").exists():
-        prefix = (str(Path(_build_info.SUNDIALS_LIBDIR).parent) if _build_info.SUNDIALS_LIBDIR
-                  else "")
-        subprocess.run(meson + ["setup", str(build), str(HERE.parent),
+    prefix = (str(Path(_build_info.SUNDIALS_LIBDIR).parent) if _build_info.SUNDIALS_LIBDIR
+              else "")
+    marker = build / "sundials_prefix.txt"      # a build for another SUNDIALS is set up anew
+    if not (build / "build.ninja").exists() or not marker.exists() or marker.read_text() != prefix:
+        wipe = ["--wipe"] if (build / "build.ninja").exists() else []
+        subprocess.run(meson + ["setup", *wipe, str(build), str(HERE.parent),
                                 f"-Dsundials_prefix={prefix}"], check=True, capture_output=True)
+        marker.write_text(prefix)
     subprocess.run(meson + ["compile", "-C", str(build), "time-rhs"], check=True,
                    capture_output=True)
     return build / "time-rhs"
