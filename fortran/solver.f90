@@ -18,6 +18,7 @@ module spline_solver
   use fsunlinsol_dense_mod
   use fsundials_nonlinearsolver_mod
   use fsunnonlinsol_fixedpoint_mod
+  use spline_sigint, only: sigint_watch, sigint_unwatch, sigint_count
   use spline_kinds, only: wp, pi
   use spline_errors, only: err_ok, err_solver, err_interrupted, msglen
   use spline_model, only: model_t, nstate, ndof
@@ -51,17 +52,6 @@ module spline_solver
     character(len=msglen) :: cb_msg = ''
     character(len=msglen) :: cvode_msg = '' !< CVODE's own last error text
   end type solver_ctx_t
-
-  interface   ! fortran/interrupt.c
-    integer(c_int) function sigint_watch() bind(C, name='spline_sigint_watch')
-      import :: c_int
-    end function sigint_watch
-    subroutine sigint_unwatch() bind(C, name='spline_sigint_unwatch')
-    end subroutine sigint_unwatch
-    integer(c_int) function sigint_count() bind(C, name='spline_sigint_count')
-      import :: c_int
-    end function sigint_count
-  end interface
 
 contains
 
