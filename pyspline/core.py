@@ -199,7 +199,8 @@ class Result:
     """A simulation in SI units. Per-tooth arrays have shape (nt, Z).
 
     Every quantity is an attribute: the states ``x1 y1 x2 y2 D1 D2 D3`` [m] and their
-    velocities ``vx1 ... vD3`` [m/s] (nt,), the per-tooth ``F Fx Fy dn c Tf rc1 rc2`` (nt, Z),
+    velocities ``vx1 ... vD3`` [m/s] (nt,), the per-tooth ``F Fx Fy dn c Tf rc1 rc2`` (nt, Z;
+    without flash temperature or slices c, Tf, rc1, rc2 are constants, read-only broadcasts),
     ``Tm`` and ``kv`` (nt,); ``loads``: the load sharing, free and back-flank teeth, impacts
     and T_f max of the run (the core's). ``to_xarray()`` gives all of it as an xarray.Dataset."""
     case: Case
