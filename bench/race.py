@@ -87,7 +87,10 @@ def race(quick=False, repeat=5, progress=print, cases=None):
             continue
         case = _case(name, fields, quick)
         stats_level = accuracies == ("statistics",)
-        rtols = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9] if stats_level else \
+        # statistics: down to rtol 1e-1, so the cheapest passing run is found, not bounded by
+        # the ladder (every method passed at 1e-4, the loosest rung before, and most at 1e-2)
+        rtols = [1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9] \
+            if stats_level else \
             [1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11]
         if quick:
             rtols = rtols[:2]

@@ -206,27 +206,29 @@ contains
     errmsg = 'not a loaded case of this build of pyspline (load the case again)'
   end subroutine unpack
 
-  !> Simulate a loaded model: output times t, SI states y (nt x 14), per-tooth quantities tooth
+  !> Simulate a loaded model: output times t, SI states y (14 x nt: a column per output), per-tooth quantities tooth
   !> (nt x z x nq, order of api_names('tooth')), meshing torque tm and run statistics; the
   !> Poincare section (times sec_t, SI states sec_y: nsec x 14) and the Benettin record (times
   !> lyap_t, cumulative log growth lyap_g), sized by the load's sizes; for a sliced face (nslice > 0,
   !> nft = nt, else both 0) the load of every slice face(nt, z, nslice) and the tilting moment
-  !> tilt(nt, 2) (M_x, M_y) on spline 1 [N m].
+  !> tilt(nt, 2) (M_x, M_y) on spline 1 [N m]. nqw: the quantities written into tooth, 4 for a
+  !> level without flash temperature or slices (F, F_x, F_y, dn; its c_j, T_f, r_c1, r_c2 are
+  !> the constants consts, run_case's nq), else nq (consts 0).
   !> A SIGINT during the run stops it (ierr 4). Called without the GIL.
   subroutine api_simulate(model, nb, z, nt, nq, ns, nsec, nlyap, nft, nslice, t, y, tooth, tm, &
-       stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, ierr, errmsg)
+       stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, nqw, consts, ierr, errmsg)
     integer(c_int), intent(in) :: nb, z, nt, nq, ns, nsec, nlyap, nft, nslice
     integer(c_int), intent(in) :: model(nb)
-    real(c_double), intent(out) :: t(nt), y(nt, 14), tooth(nt, z, nq), tm(nt), stats(ns)
+    real(c_double), intent(out) :: t(nt), y(14, nt), tooth(nt, z, nq), tm(nt), stats(ns)
     real(c_double), intent(out) :: sec_t(nsec), sec_y(nsec, 14), lyap_t(nlyap), lyap_g(nlyap)
-    real(c_double), intent(out) :: face(nft, z, nslice), tilt(nft, 2)
-    integer(c_int), intent(out) :: ierr
+    real(c_double), intent(out) :: face(nft, z, nslice), tilt(nft, 2), consts(4)
+    integer(c_int), intent(out) :: nqw, ierr
     character(len=msglen), intent(out) :: errmsg
     type(model_t) :: m
-    real(wp), allocatable :: ycol(:, :), scol(:, :)
-    integer :: ie
+    real(wp), allocatable :: scol(:, :)
+    integer :: ie, nw
     stats = 0; sec_t = 0; sec_y = 0; lyap_t = 0; lyap_g = 0   ! t, y, tooth, tm: below
-    face = 0; tilt = 0
+    face = 0; tilt = 0; nqw = nq; consts = 0
     call unpack(model, m, ie, errmsg)
     if (ie == err_ok .and. (m%z /= z .or. m%n_out /= nt .or. nq /= ntooth_q .or. ns /= nstats &
          .or. nsec /= section_count(m) .or. nlyap /= lyapunov_count(m) .or. &
@@ -235,15 +237,16 @@ contains
       errmsg = 'api_simulate: array sizes do not match the loaded case'
     end if
     if (ie == err_ok) then
-      allocate(ycol(nstate, nt), scol(nstate, nsec))
+      allocate(scol(nstate, nsec))
       if (nslice > 0) then
-        call run_case(m, t, ycol, tooth, tm, stats, ie, errmsg, interruptible=.true., &
-             sec_t=sec_t, sec_y=scol, lyap_t=lyap_t, lyap_g=lyap_g, face=face, tilt=tilt)
+        call run_case(m, t, y, tooth, tm, stats, ie, errmsg, interruptible=.true., &
+             sec_t=sec_t, sec_y=scol, lyap_t=lyap_t, lyap_g=lyap_g, face=face, tilt=tilt, &
+             nq=nw, consts=consts)
       else
-        call run_case(m, t, ycol, tooth, tm, stats, ie, errmsg, interruptible=.true., &
-             sec_t=sec_t, sec_y=scol, lyap_t=lyap_t, lyap_g=lyap_g)
+        call run_case(m, t, y, tooth, tm, stats, ie, errmsg, interruptible=.true., &
+             sec_t=sec_t, sec_y=scol, lyap_t=lyap_t, lyap_g=lyap_g, nq=nw, consts=consts)
       end if
-      y = transpose(ycol)
+      nqw = nw
       sec_y = transpose(scol)
     else
       t = 0; y = 0; tooth = 0; tm = 0       ! run_case defines them whenever it runs
@@ -258,7 +261,7 @@ contains
        errmsg)
     integer(c_int), intent(in) :: nb, z, nt, nq, nl, ntl
     integer(c_int), intent(in) :: model(nb)
-    real(c_double), intent(in) :: t(nt), y(nt, 14), tooth(nt, z, nq), tm(nt)
+    real(c_double), intent(in) :: t(nt), y(14, nt), tooth(nt, z, nq), tm(nt)
     real(c_double), intent(out) :: loads(nl), tload(z, ntl)
     integer(c_int), intent(out) :: ierr
     character(len=msglen), intent(out) :: errmsg
@@ -266,11 +269,11 @@ contains
     integer :: ie
     loads = 0; tload = 0
     call unpack(model, m, ie, errmsg)
-    if (ie == err_ok .and. (m%z /= z .or. nq /= ntooth_q .or. nl /= nload .or. &
+    if (ie == err_ok .and. (m%z /= z .or. (nq /= ntooth_q .and. nq /= 4) .or. nl /= nload .or. &
          ntl /= nload_tooth)) then
       ie = err_case; errmsg = 'api_loads: array sizes do not match the loaded case'
     end if
-    if (ie == err_ok) call run_loads(m, t, transpose(y), tooth, tm, loads, tload)
+    if (ie == err_ok) call run_loads(m, t, y, tooth, tm, loads, tload)
     ierr = ie
   end subroutine api_loads
 

@@ -66,7 +66,8 @@ contains
   end function approach_speed
 
   !> The loads of a run from its outputs (t(k), SI states y(:, k), tooth(k, j, :) in the order
-  !> of spline_quantities tooth_q, T_m tm(k)): loads(nload) in the order of load_q, tload(z, nload_tooth)
+  !> of spline_quantities tooth_q, or only the first 4 (F, F_x, F_y, dn: a level without T_f,
+  !> run_case's nq), T_m tm(k)): loads(nload) in the order of load_q, tload(z, nload_tooth)
   !> in the order of load_tooth_q. Over the output times as given (after the transient):
   !> - F_peak_j = max_k |F_j(t_k)|, load factor F_peak_j / F_s with F_s = |T_d| / (Z r_b), the
   !>   load of each tooth when all Z share T_d equally (NaN if T_d = 0); load_sharing = max_j.
@@ -85,10 +86,10 @@ contains
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t(:), y(:, :), tooth(:, :, :), tm(:)
     real(wp), intent(out) :: loads(nload), tload(m%z, nload_tooth)
-    integer :: nt, j, k, fl, prev, drive, onsets, nb
+    integer :: nt, j, k, fl, prev, drive, onsets, nb, nfree, nback, nons
     integer, allocatable :: rev(:)
     real(wp), allocatable :: free_b(:, :), back_b(:, :), ons_b(:)
-    real(wp) :: fs, tfm, speed
+    real(wp) :: fs, tfm, speed, fpk
     nt = size(t)
     loads = 0.0_wp; tload = 0.0_wp
     if (nt == 0) return
@@ -105,24 +106,31 @@ contains
       if (rev(k) > nb) rev(k) = 0
     end do
     free_b = 0.0_wp; back_b = 0.0_wp; ons_b = 0.0_wp
-    do j = 1, m%z
+    do j = 1, m%z        ! tooth_flank inline (a public function is not inlined in a PIC build)
       prev = 0
+      fpk = 0.0_wp
+      nfree = 0; nback = 0; nons = 0
       do k = 1, nt
-        tload(j, ilt_f_peak) = max(tload(j, ilt_f_peak), abs(tooth(k, j, 1)))
-        fl = tooth_flank(tooth(k, j, 1), tooth(k, j, 4))
-        if (fl == 0) tload(j, ilt_free) = tload(j, ilt_free) + 1
-        if (fl == -drive) tload(j, ilt_back) = tload(j, ilt_back) + 1
+        fpk = max(fpk, abs(tooth(k, j, 1)))
+        fl = 0
+        if (tooth(k, j, 1) /= 0.0_wp) fl = merge(1, -1, tooth(k, j, 4) > 0.0_wp)
+        if (fl == 0) nfree = nfree + 1
+        if (fl == -drive) nback = nback + 1
         if (rev(k) > 0) then
           if (fl == 0) free_b(rev(k), j) = free_b(rev(k), j) + 1
           if (fl == -drive) back_b(rev(k), j) = back_b(rev(k), j) + 1
         end if
         if (k > 1 .and. fl /= 0 .and. fl /= prev) then
-          tload(j, ilt_onsets) = tload(j, ilt_onsets) + 1
+          nons = nons + 1
           speed = max(speed, approach_speed(m, t(k - 1), y(:, k - 1), j))
           if (rev(k) > 0) ons_b(rev(k)) = ons_b(rev(k)) + 1
         end if
         prev = fl
       end do
+      tload(j, ilt_f_peak) = fpk
+      tload(j, ilt_free) = nfree
+      tload(j, ilt_back) = nback
+      tload(j, ilt_onsets) = nons
     end do
     if (fs > 0.0_wp) then
       tload(:, ilt_load_factor) = tload(:, ilt_f_peak)/fs
@@ -148,7 +156,8 @@ contains
     if (loads(il_revolutions) > 0.0_wp) loads(il_impacts_rev) = onsets/loads(il_revolutions)
     loads(il_closing_speed) = speed
     call batch_means(m, rev, y, tooth, tm, fs, free_b, back_b, ons_b, loads, tload)
-    tfm = maxval(tooth(:, :, iq_tf))
+    tfm = 0.0_wp                 ! T_f = 0 where the outputs stop before it (no flash temperature)
+    if (size(tooth, 3) >= iq_tf) tfm = maxval(tooth(:, :, iq_tf))
     loads(il_tf_max) = tfm
     loads(il_tf_max_tooth) = 0.0_wp
     loads(il_tf_max_t) = -1.0_wp
@@ -269,7 +278,7 @@ contains
       fmax(b) = max(fmax(b), maxval(abs(tooth(k, :, 1))))
       sqf(b) = sqf(b) + sum(tooth(k, :, 1)**2)
       sqd(b) = sqd(b) + y(6, k)**2
-      tfb(b) = max(tfb(b), maxval(tooth(k, :, iq_tf)))
+      if (size(tooth, 3) >= iq_tf) tfb(b) = max(tfb(b), maxval(tooth(k, :, iq_tf)))
     end do
     if (any(cnt == 0.0_wp)) return          ! a revolution without outputs: no batches
     sq = sqrt(sq/cnt)

@@ -49,8 +49,11 @@ contains
   !> renormalisation times and the cumulative log growth of the separation (lyapunov_benettin);
   !> face(n_out, z, n_slices), tilt(n_out, 2) the load along the face and the tilting moment
   !> (sliced faces: angular misalignment, tooth_outputs).
+  !> nq, consts (both or neither): a run whose quantities c_j, T_f, r_c1, r_c2 (tooth_q 5..8)
+  !> are the level's constants (no flash temperature, no slices) writes only tooth(:, :, 1:4),
+  !> nq = 4, consts = (c_j, T_f, r_c1, r_c2); else every quantity, nq = ntooth_q, consts = 0.
   subroutine run_case(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-       lyap_t, lyap_g, face, tilt)
+       lyap_t, lyap_g, face, tilt, nq, consts)
     type(model_t), intent(in) :: m
     real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
     real(wp), intent(out) :: tm(m%n_out), stats(nstats)
@@ -59,20 +62,26 @@ contains
     logical, intent(in), optional :: interruptible
     real(wp), intent(out), optional :: sec_t(:), sec_y(:, :), lyap_t(:), lyap_g(:)
     real(wp), intent(out), optional :: face(:, :, :), tilt(:, :)
+    integer, intent(out), optional :: nq
+    real(wp), intent(out), optional :: consts(ntooth_q - 4)
     type(model_t) :: run
-    real(wp) :: eps_lat, eps_th, closed, t_closed
+    real(wp) :: eps_lat, eps_th, closed, t_closed, cq(ntooth_q - 4)
     integer(8) :: c0, c1, rate
+    integer :: nw
     call system_clock(c0, rate)
     call auto_level(m, run, eps_lat, eps_th)
     call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-         face, tilt)
-    if (ierr == err_ok .and. m%auto .and. m%thermal == thermal_coupled) then
+         face, tilt, present(nq), nw, cq)
+    if (ierr == err_ok .and. m%auto .and. m%thermal == thermal_coupled .and. nw >= iq_tf) then
       eps_th = backlash_estimate(m, maxval(abs(tooth(:, :, iq_tf))))
       if (eps_th > auto_tol(m)) then
         call set_thermal_level(run, thermal_coupled)
         call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-             face, tilt)
+             face, tilt, present(nq), nw, cq)
       end if
+    end if
+    if (present(nq)) then
+      nq = nw; consts = cq
     end if
     if (present(lyap_t)) then
       lyap_t = 0.0_wp; lyap_g = 0.0_wp
@@ -83,8 +92,8 @@ contains
       end if
     end if
     closed = 0.0_wp; t_closed = 0.0_wp
-    if (ierr == err_ok) call result_checks(run, t, y, tooth, tm, closed, t_closed, ierr, errmsg, &
-         sec_t, sec_y, lyap_t, lyap_g)
+    if (ierr == err_ok) call result_checks(run, t, y, tooth(:, :, 1:nw), tm, closed, t_closed, &
+         ierr, errmsg, sec_t, sec_y, lyap_t, lyap_g)
     call system_clock(c1)
     stats(ist_core_wall) = real(c1 - c0, wp)/rate
     stats(ist_dof) = real(run%dof, wp)
@@ -125,7 +134,7 @@ contains
         if (.not. ieee_is_finite(y(i, k))) call bad('the state '//trim(state_q(i)%name), '', k)
       end do
       if (.not. ieee_is_finite(tm(k))) call bad('the meshing torque T_m', '', k)
-      do q = 1, ntooth_q
+      do q = 1, size(tooth, 3)
         do j = 1, size(tooth, 2)
           if (.not. ieee_is_finite(tooth(k, j, q))) call bad(trim(tooth_q(q)%name)//' of tooth', &
                ' '//itoa(j), k)
@@ -214,9 +223,9 @@ contains
     end if
   end function run_warnings
 
-  !> One run of the model at the level m sets.
+  !> One run of the model at the level m sets (lazy, nw, consts: run_case's nq, consts).
   subroutine run_level(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-       face, tilt)
+       face, tilt, lazy, nw, consts)
     type(model_t), intent(in) :: m
     real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
     real(wp), intent(out) :: tm(m%n_out), stats(nstats)
@@ -224,11 +233,15 @@ contains
     character(len=*), intent(out) :: errmsg
     logical, intent(in), optional :: interruptible
     real(wp), intent(out), optional :: sec_t(:), sec_y(:, :), face(:, :, :), tilt(:, :)
+    logical, intent(in) :: lazy
+    integer, intent(out) :: nw
+    real(wp), intent(out) :: consts(ntooth_q - 4)
     real(wp) :: y0(nstate)
     real(wp), allocatable :: ts(:), ysec(:, :)
     integer, allocatable :: modes(:, :)
     errmsg = ''
     stats = 0.0_wp
+    nw = ntooth_q; consts = 0.0_wp
     t = 0.0_wp; y = 0.0_wp
     allocate(modes(m%z*m%n_slices, m%n_out))
     call output_times(m, t)
@@ -239,9 +252,9 @@ contains
       tooth = 0.0_wp; tm = 0.0_wp
       return
     end if
-    call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt)
+    call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt, lazy, nw, consts)
     if (ierr /= err_ok) then
-      tooth = 0.0_wp; tm = 0.0_wp
+      tooth = 0.0_wp; tm = 0.0_wp; nw = ntooth_q; consts = 0.0_wp
     end if
   contains
     subroutine integrate_level()
@@ -269,7 +282,9 @@ contains
   !> Without flash temperature or slices, bulk_tooth_outputs forms them in one pass per tooth; it
   !> must agree with tooth_quantities (mesh_eval, the definition) to the bit at the first and the
   !> last output, else (a change to one and not the other) every output is formed by mesh_eval.
-  subroutine tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt)
+  !> lazy (optional): there, c_j, T_f, r_c1, r_c2 are not written but returned once in consts
+  !> (nw = 4 quantities written; else nw = ntooth_q, consts = 0).
+  subroutine tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt, lazy, nw, consts)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t(:), y(:, :)
     integer, intent(in) :: modes(:, :)
@@ -277,12 +292,31 @@ contains
     integer, intent(out) :: ierr
     character(len=*), intent(inout) :: errmsg
     real(wp), intent(out), optional :: face(:, :, :), tilt(:, :)
-    real(wp) :: row(m%z, ntooth_q), fs(m%n_slices, m%z), mt(2)
-    integer :: k
+    logical, intent(in), optional :: lazy
+    integer, intent(out), optional :: nw
+    real(wp), intent(out), optional :: consts(ntooth_q - 4)
+    real(wp) :: row(m%z, ntooth_q), fs(m%n_slices, m%z), mt(2), cq(ntooth_q - 4)
+    integer :: k, nq
+    logical :: lz
     ierr = err_ok
+    lz = .false.
+    if (present(lazy)) lz = lazy
+    nq = ntooth_q
+    cq = 0.0_wp
     if (.not. present(face) .and. m%n_slices == 1 .and. m%thermal < thermal_oneway) then
-      call bulk_tooth_outputs(m, t, y, modes, tooth, tm)
-      if (same_as_mesh(1) .and. same_as_mesh(size(t))) return
+      cq = [m%c_bulk, 0.0_wp, m%r_pitch, m%r_pitch]     ! c_j, T_f, r_c1, r_c2
+      if (lz) nq = 4
+      call bulk_tooth_outputs(m, t, y, modes, tooth, tm, cq, .not. lz)
+      if (same_as_mesh(1) .and. same_as_mesh(size(t))) then
+        if (present(nw)) then
+          nw = nq; consts = cq
+        end if
+        return
+      end if
+    end if
+    nq = ntooth_q
+    if (present(nw)) then
+      nw = nq; consts = 0.0_wp
     end if
     do k = 1, size(t)
       call quantities_at(k)
@@ -305,11 +339,15 @@ contains
     logical function same_as_mesh(k) result(same)
       integer, intent(in) :: k
       real(wp) :: tmk
+      integer :: j
       same = .true.
       if (k < 1) return
       tmk = tm(k)
       call quantities_at(k)
-      same = ierr == err_ok .and. all(row == tooth(k, :, :)) .and. tm(k) == tmk
+      same = ierr == err_ok .and. all(row(:, 1:nq) == tooth(k, :, 1:nq)) .and. tm(k) == tmk
+      do j = nq + 1, ntooth_q
+        same = same .and. all(row(:, j) == cq(j - 4))
+      end do
       ierr = err_ok
     end function same_as_mesh
   end subroutine tooth_outputs
@@ -317,15 +355,21 @@ contains
   !> The per-tooth quantities of tooth_quantities at every output time, for a model without
   !> flash temperature (thermal none or bulk: T_f = 0, both contact radii on the pitch circle,
   !> c_j = c_bulk) or face slices: F, F_x, F_y and dn from spline_mesh's mesh_outputs (Eqs. 8-9,
-  !> 11, 15-17, 19-22 as mesh_eval evaluates them), the constants filled in.
-  subroutine bulk_tooth_outputs(m, t, y, modes, tooth, tm)
+  !> 11, 15-17, 19-22 as mesh_eval evaluates them), the constants cq (c_j, T_f, r_c1, r_c2)
+  !> filled in if fill.
+  subroutine bulk_tooth_outputs(m, t, y, modes, tooth, tm, cq, fill)
     type(model_t), intent(in) :: m
-    real(wp), intent(in) :: t(:), y(:, :)
+    real(wp), intent(in) :: t(:), y(:, :), cq(ntooth_q - 4)
     integer, intent(in) :: modes(:, :)
-    real(wp), intent(out) :: tooth(:, :, :), tm(:)
-    tooth(:, :, 5) = m%c_bulk          ! c_j
-    tooth(:, :, 6) = 0.0_wp            ! T_f
-    tooth(:, :, 7:8) = m%r_pitch       ! r_c1, r_c2
+    real(wp), intent(inout) :: tooth(:, :, :)
+    real(wp), intent(out) :: tm(:)
+    logical, intent(in) :: fill
+    integer :: q
+    if (fill) then
+      do q = 5, ntooth_q
+        tooth(:, :, q) = cq(q - 4)
+      end do
+    end if
     call mesh_outputs(m, size(t), t, y, modes, tooth(:, :, 1), tooth(:, :, 2), tooth(:, :, 3), &
          tooth(:, :, 4), tm)
   end subroutine bulk_tooth_outputs

@@ -199,7 +199,8 @@ class Result:
     """A simulation in SI units. Per-tooth arrays have shape (nt, Z).
 
     Every quantity is an attribute: the states ``x1 y1 x2 y2 D1 D2 D3`` [m] and their
-    velocities ``vx1 ... vD3`` [m/s] (nt,), the per-tooth ``F Fx Fy dn c Tf rc1 rc2`` (nt, Z),
+    velocities ``vx1 ... vD3`` [m/s] (nt,), the per-tooth ``F Fx Fy dn c Tf rc1 rc2`` (nt, Z;
+    without flash temperature or slices c, Tf, rc1, rc2 are constants, read-only broadcasts),
     ``Tm`` and ``kv`` (nt,); ``loads``: the load sharing, free and back-flank teeth, impacts
     and T_f max of the run (the core's). ``to_xarray()`` gives all of it as an xarray.Dataset."""
     case: Case
@@ -312,11 +313,12 @@ def simulate(case) -> Result:
     nft = model.n_out if model.n_slices else 0
     # the per-tooth array (the largest) is allocated here, not zeroed (f2py zeroes its own)
     tooth = np.empty((model.n_out, model.z, len(q)), order="F")
-    t, y, tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, ierr, msg = \
+    t, ycol, tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, nqw, consts, ierr, msg = \
         _api.api_simulate(model.bytes, model.z, model.n_out, len(q), len(s), model.n_section,
                           model.n_lyapunov, nft, model.n_slices, tooth)
     wall = time.perf_counter() - t0
     raise_for(ierr, msg)
+    y = ycol.T                # (nt, 14), a view of the core's columns (no transposed copy)
     st = {n: (float(v) if unit else int(v)) for (n, unit, _), v in zip(s, stats)}  # counts: int
     st["wall_s"] = wall
     _warn(_api.api_warnings(model.bytes, stats, 1))      # the run's (one-way backlash, Eq. 2)
@@ -324,8 +326,12 @@ def simulate(case) -> Result:
     if model.n_lyapunov:
         span = lyap_t - (t[0] if len(t) else 0.0)
         lyap = dict(t=lyap_t, log_growth=lyap_g, exponent=float(lyap_g[-1] / span[-1]))
-    return Result(case=model.case, t=t, y=y,
-                  tooth={n: tooth[:, :, i] for i, (n, *_) in enumerate(q)}, Tm=tm, stats=st,
+    # a level without flash temperature or slices writes F, Fx, Fy, dn only (nqw = 4): its
+    # c, Tf, rc1, rc2 are constants, given once (consts) and broadcast (read-only views)
+    tooth = tooth[:, :, :nqw]
+    per = {n: (tooth[:, :, i] if i < nqw else np.broadcast_to(consts[i - 4], tooth.shape[:2]))
+           for i, (n, *_) in enumerate(q)}
+    return Result(case=model.case, t=t, y=y, tooth=per, Tm=tm, stats=st,
                   section_t=sec_t, section_y=sec_y, lyapunov=lyap,
                   face=face if model.n_slices else None, tilt=tilt if model.n_slices else None,
                   loads=run_loads(model, t, y, tooth, tm))
@@ -334,11 +340,13 @@ def simulate(case) -> Result:
 def run_loads(model, t, y, tooth, tm) -> dict:
     """The loads of a run from its outputs (the core's spline_loads::run_loads; the numbers
     spline-dyn writes): {name: value} for the scalars of LOAD_QUANTITIES (float) and the
-    per-tooth arrays (Z,) of TOOTH_LOAD_QUANTITIES. tooth: (nt, Z, nq) as api_simulate gives it,
-    tm: T_m (nt,)."""
+    per-tooth arrays (Z,) of TOOTH_LOAD_QUANTITIES. tooth: (nt, Z, nq) as api_simulate gives it
+    (all of Result.tooth's quantities in their order, or F, Fx, Fy, dn alone for a level without
+    T_f), tm: T_m (nt,)."""
     model = load(model)
     loads, tload, ierr, msg = _api.api_loads(model.bytes, len(LOAD_QUANTITIES),
-                                             len(TOOTH_LOAD_QUANTITIES), t, y, tooth, tm)
+                                             len(TOOTH_LOAD_QUANTITIES), t, np.asarray(y).T,
+                                             tooth, tm)
     raise_for(ierr, msg)
     _warn(_api.api_warnings(model.bytes, loads, 2))      # nominal stresses beyond their limits
     out = {n: float(v) for n, v in zip(LOAD_QUANTITIES, loads)}
