@@ -252,3 +252,65 @@ def test_follow_chains_on_processes_are_the_serial_ones():
     assert np.array_equal(down.Tm_max.values[::-1], both.Tm_max.sel(direction="down"))
     # the directions differ here (2400-2520 r/min spans the folds' hysteresis)
     assert not np.allclose(both.Tm_max.sel(direction="up"), both.Tm_max.sel(direction="down"))
+
+
+# double-sided impacts: the resonance's drive with a ripple twice the mean torque (the drive
+# torque reverses every revolution, so the teeth strike both flanks, 4 switches per tooth and
+# revolution); continued in speed, the period-1 orbit's multiplier moves smoothly through -1
+# at 1623.6 r/min with the contact sequence unchanged (a smooth period doubling)
+DOUBLING = RESONANCE.replace(ripple_amp=[2.0, 0, 0, 0], speed_rpm=1600.0)
+
+
+def test_period_doubling_switches_to_the_doubled_branch():
+    """A period doubling located with a multiplier at -1 (secant on det(M + I)) on a branch
+    whose contact sequence does not change there; the branch switch follows the period-2
+    orbit from it (subcritical: it bends back, folds, and comes back stable). Its points are
+    genuine period-2 orbits: P^2(y) = y with P(y) far from y, two section points over two
+    revolutions, and a brute-force run from the equilibrium settles on the same two points."""
+    from pyspline.orbits import _period_map, map_and_monodromy
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds = pyspline.continuation(DOUBLING, "speed_rpm", 1600, 1650, max_points=120,
+                                   progress=False)
+    pd = np.flatnonzero(ds.special_type.values == "period_doubling")
+    assert len(pd) == 1 and ds.special_branch.values[pd[0]] == 0
+    mu = complex(ds.special_mu_real[pd[0]], ds.special_mu_imag[pd[0]])
+    assert abs(mu + 1) < 1e-3 and ds.special_smooth.values[pd[0]] == 1, mu
+    p_pd = float(ds.special_speed_rpm[pd[0]])
+    assert 1600 < p_pd < 1650
+    # branch 0 (period 1): stable below, a real multiplier below -1 above; one contact sequence
+    b0 = ds.branch.values == 0
+    p0, st0 = ds.speed_rpm.values[b0], ds.stable.values[b0].astype(bool)
+    assert st0[p0 < p_pd - 0.5].all() and not st0[p0 > p_pd + 0.5].any()
+    real = np.abs(ds.mu_imag.values[b0]) < 1e-9
+    assert (np.where(real, ds.mu_real.values[b0], 0).min(axis=1)[p0 > p_pd + 0.5] < -1).all()
+    assert len(set(ds.switches.values[b0])) == 1
+    # branch 1: period 2, starts at the doubling, ends at stop stable
+    b1 = np.flatnonzero(ds.branch.values == 1)
+    assert len(b1) >= 5 and (ds.n.values[b1] == 2).all()
+    assert float(ds.speed_rpm[b1[0]]) == pytest.approx(p_pd, abs=0.5)
+    last = b1[-1]
+    assert float(ds.speed_rpm[last]) == pytest.approx(1650, rel=1e-12) and ds.stable[last]
+    case = DOUBLING.replace(speed_rpm=1650.0)
+    y = ds.y0.values[last]
+    T = 60 / 1650.0
+    s = scale_of(case)
+    y2, _, free = map_and_monodromy(case, 0.0, 2 * T, y)
+    y1 = _period_map(case.model, 0.0, T, y[:, None])[0][:, 0]
+    assert np.abs((y2 - y)[free] / s[free]).max() < 1e-5
+    assert np.abs((y1 - y)[free] / s[free]).max() > 0.1
+    # its section over two revolutions: two points (y and P(y)), one revolution apart
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        run = pyspline.simulate(case.replace(start="rest", dq0=list(y[:7]), dv0=list(y[7:]),
+                                             t_end=40 * T, n_out=401, section="shaft"))
+        brute = pyspline.simulate(case.replace(t_end=100 * T, t_transient=70 * T, n_out=401,
+                                               section="shaft", max_steps=10_000_000))
+    for sec in (run.section_y[-10:], brute.section_y[-10:]):
+        even, odd = sec[0::2], sec[1::2]
+        assert np.ptp(even[:, free], axis=0).max() / s[free].min() < 1e-4
+        assert np.abs(even[0] - odd[0])[free].max() > 0.1 * s[free].min()
+        def off(a, b):
+            return np.abs((a - b)[free] / s[free]).max()
+        # the two points are the orbit's y and P(y), in either order
+        assert min(off(even[0], y) + off(odd[0], y1), off(even[0], y1) + off(odd[0], y)) < 1e-4
