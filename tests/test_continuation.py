@@ -188,6 +188,8 @@ def test_bad_field(field, match):
 def test_bad_range_and_follow():
     with pytest.raises(pyspline.CaseError, match="start and stop must be finite and differ"):
         pyspline.continuation(RESONANCE, "t_d", 30, 30, progress=False)
+    with pytest.raises(pyspline.CaseError, match="monodromy = 'adjoint': 'exact'"):
+        pyspline.continuation(RESONANCE, "t_d", 30, 31, monodromy="adjoint", progress=False)
     with pytest.raises(pyspline.CaseError, match="follow= needs exactly one swept field"):
         pyspline.sweep(RESONANCE, speed_rpm=[1, 2], t_d=[1, 2], follow="up", progress=False)
     with pytest.raises(pyspline.CaseError, match="follow must be one of up, down, both"):
@@ -314,3 +316,27 @@ def test_period_doubling_switches_to_the_doubled_branch():
             return np.abs((a - b)[free] / s[free]).max()
         # the two points are the orbit's y and P(y), in either order
         assert min(off(even[0], y) + off(odd[0], y1), off(even[0], y1) + off(odd[0], y)) < 1e-4
+
+
+def test_bench_continuation_quick():
+    """bench/run.py continuation --quick: both monodromies on both scenes, interleaved; the
+    two continuations of the resonance meet the same special points at the same speeds and
+    end on the same orbit (no timing asserted)."""
+    import importlib.util
+    from conftest import ROOT
+    sys.path.insert(0, str(ROOT / "bench"))
+    spec = importlib.util.spec_from_file_location("bench_continuation",
+                                                  ROOT / "bench" / "continuation.py")
+    bc = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bc)
+    rows, summary = bc.measure(quick=True, repeat=1)
+    assert [(r["scene"], r["monodromy"]) for r in rows] == [
+        ("resonance", "exact"), ("resonance", "fd"), ("impacting", "exact"), ("impacting", "fd")]
+    assert all(r["steps"] >= r["points"] > 5 and r["step_median_s"] > 0 for r in rows)
+    res, imp = summary
+    assert res["agree"]["branches"] == "1/1" and res["agree"]["specials"]
+    assert not any("missing" in s for s in res["agree"]["specials"])
+    assert res["agree"]["d_last_y0"] < 1e-5 and imp["agree"]["d_last_y0"] < 1e-5
+    assert imp["agree"]["branches"].startswith("2/")      # exact: the doubled branch
+    lines = bc.format_summary(summary, 1)
+    assert sum("fd / exact" in line for line in lines) == 2
