@@ -9,7 +9,10 @@ Two scenes of docs/continuation.md, each continued in speed_rpm with monodromy='
   opening and striking the back flank, two folds, grazings;
 - impacting: the same drive with a = 2 (double-sided impacts, 64 switches a revolution),
   1600 to 1650 r/min: a period doubling and the doubled branch.
-Per scene and monodromy: the medians of the wall time of the whole continuation, per branch
+Beside them (the issue's comparison), on the resonance: one orbit with its multipliers
+(periodic_orbit from a settled 1 s run), the exact continuation, and the peer, a follow-up and
+follow-down brute-force sweep of 200 speeds over the same range (1 s runs, the last 0.2 s kept;
+it finds the stable branches only). Per scene and monodromy: the medians of the wall time of the whole continuation, per branch
 point, and per Newton step (one evaluation of the residual, M and dF/dp: timed around each
 call), their ratios fd / exact, and how the two branches agree (special points matched by
 type; the state and multipliers at the last point). Writes continuation.csv into --out.
@@ -121,6 +124,41 @@ def measure(quick: bool, repeat: int):
     return rows, summary
 
 
+def beside_sweep(quick: bool, repeat: int) -> dict:
+    """Medians of: one periodic orbit (with its multipliers) of the resonance at its start
+    speed, from a settled 1 s run; the exact continuation over the range; a follow='both'
+    sweep of 200 speeds (24 with quick) over it, interleaved."""
+    name, case, start, stop = scenes(quick)[0]
+    npts = 24 if quick else 200
+    settled = case.replace(t_end=1.0, t_transient=0.8, n_out=1001)
+    times = {"orbit": [], "continuation": [], "sweep": []}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        for _ in range(repeat):
+            t = time.perf_counter()
+            orbit = pyspline.periodic_orbit(settled)
+            times["orbit"].append(time.perf_counter() - t)
+            t = time.perf_counter()
+            ds = pyspline.continuation(case, "speed_rpm", start, stop, progress=False)
+            times["continuation"].append(time.perf_counter() - t)
+            t = time.perf_counter()
+            pyspline.sweep(settled, speed_rpm=np.linspace(start, stop, npts), follow="both",
+                           progress=False, spectrum=False)
+            times["sweep"].append(time.perf_counter() - t)
+    return dict(scene=name, range=f"{start:g}-{stop:g}", sweep_points=npts,
+                points=ds.attrs["n_points"], special=ds.attrs["n_special"],
+                largest_mu=float(abs(orbit.multipliers[0])),
+                **{k: statistics.median(v) for k, v in times.items()})
+
+
+def format_beside(b) -> list[str]:
+    return [f"{b['scene']} {b['range']} r/min: one orbit with its multipliers (max |mu| "
+            f"{b['largest_mu']:.4f}) {b['orbit']:.2f} s; continuation ({b['points']} points, "
+            f"{b['special']} special) {b['continuation']:.2f} s; follow sweep up and down, "
+            f"{b['sweep_points']} speeds of 1 s runs, {b['sweep']:.2f} s "
+            f"(continuation / sweep {b['continuation'] / b['sweep']:.2f}x)"]
+
+
 def format_summary(summary, repeat) -> list[str]:
     lines = [f"medians of {repeat} interleaved runs; per point = whole continuation / points, "
              "per step = one Newton step's residual + M + dF/dp",
@@ -151,6 +189,7 @@ def main(args) -> int:
     repeat = args.repeats or (1 if args.quick else 3)
     rows, summary = measure(args.quick, repeat)
     print("\n".join(format_summary(summary, repeat)))
+    print("\n".join(format_beside(beside_sweep(args.quick, repeat))))
     _write_csv(out / "continuation.csv", rows)
     print(f"wrote {out}/continuation.csv")
     return 0
