@@ -263,17 +263,23 @@ def test_follow_chains_on_processes_are_the_serial_ones():
 DOUBLING = RESONANCE.replace(ripple_amp=[2.0, 0, 0, 0], speed_rpm=1600.0)
 
 
-def test_period_doubling_switches_to_the_doubled_branch():
+@pytest.fixture(scope="module")
+def doubling_branch():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        return pyspline.continuation(DOUBLING, "speed_rpm", 1600, 1650, max_points=120,
+                                     progress=False)
+
+
+def test_period_doubling_switches_to_the_doubled_branch(doubling_branch):
     """A period doubling located with a multiplier at -1 (secant on det(M + I)) on a branch
     whose contact sequence does not change there; the branch switch follows the period-2
     orbit from it (subcritical: it bends back, folds, and comes back stable). Its points are
     genuine period-2 orbits: P^2(y) = y with P(y) far from y, two section points over two
-    revolutions, and a brute-force run from the equilibrium settles on the same two points."""
+    revolutions, and a brute-force run from the equilibrium settles on the same two points
+    (at 1600 r/min, below the doubling, on the period-1 orbit: one section point)."""
     from pyspline.orbits import _period_map, map_and_monodromy
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", pyspline.SplineWarning)
-        ds = pyspline.continuation(DOUBLING, "speed_rpm", 1600, 1650, max_points=120,
-                                   progress=False)
+    ds = doubling_branch
     pd = np.flatnonzero(ds.special_type.values == "period_doubling")
     assert len(pd) == 1 and ds.special_branch.values[pd[0]] == 0
     mu = complex(ds.special_mu_real[pd[0]], ds.special_mu_imag[pd[0]])
@@ -316,6 +322,45 @@ def test_period_doubling_switches_to_the_doubled_branch():
             return np.abs((a - b)[free] / s[free]).max()
         # the two points are the orbit's y and P(y), in either order
         assert min(off(even[0], y) + off(odd[0], y1), off(even[0], y1) + off(odd[0], y)) < 1e-4
+    # below the doubling (and below the period-2 branch's fold) the brute force is period 1
+    T0 = 60 / 1600.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        low = pyspline.simulate(DOUBLING.replace(t_end=160 * T0, t_transient=130 * T0, n_out=401,
+                                                 section="shaft", max_steps=10_000_000))
+    s0 = scale_of(DOUBLING)
+    assert float(ds.speed_rpm[0]) == 1600 and ds.stable[0]
+    assert np.abs((low.section_y[-10:] - ds.y0.values[0])[:, free] / s0[free]).max() < 1e-3
+
+
+def test_frequency_response_figure(doubling_branch):
+    """The figure: each branch stable solid and unstable dashed (period 1 and period 2), the
+    special points marked at their located values, the follow sweeps' points over them."""
+    from pyspline.frplots import frequency_response
+    ds = doubling_branch
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        sw = pyspline.sweep(DOUBLING.replace(t_end=0.5, t_transient=0.3, n_out=201),
+                            speed_rpm=np.linspace(1600, 1650, 4), follow="both",
+                            progress=False, spectrum=False)
+    fig = frequency_response(ds, "Tm_pp", sweep=sw)
+    ax = fig.axes[0]
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    for want in ("period-1 orbits, stable", "period-1 orbits, unstable", "period-2 orbits, stable",
+                 "period-2 orbits, unstable", "period doubling (mu = -1) (1)", "fold (mu = +1) (1)"):
+        assert want in labels, labels
+    assert any(lab.startswith("follow up") for lab in labels)
+    assert any(lab.startswith("follow down") for lab in labels)
+    lines = ax.get_lines()
+    dashed = [ln for ln in lines if ln.get_linestyle() not in ("-", "None", "")]
+    assert dashed and any(ln.get_linestyle() == "-" for ln in lines)
+    pd = ds.special_type.values == "period_doubling"
+    mark = [ln for ln in lines if ln.get_marker() == "s"]
+    assert len(mark) == 1
+    fx = float(ds.speed_rpm[0]) / lines[0].get_xdata()[0]       # the axis' unit prefix
+    fy = float(ds.Tm_pp[0]) / lines[0].get_ydata()[0]
+    assert np.allclose(mark[0].get_xdata() * fx, ds.special_speed_rpm.values[pd])
+    assert np.allclose(mark[0].get_ydata() * fy, ds.special_Tm_pp.values[pd])
 
 
 def test_bench_continuation_quick():
