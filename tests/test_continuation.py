@@ -188,6 +188,10 @@ def test_bad_field(field, match):
 def test_bad_range_and_follow():
     with pytest.raises(pyspline.CaseError, match="start and stop must be finite and differ"):
         pyspline.continuation(RESONANCE, "t_d", 30, 30, progress=False)
+    with pytest.raises(pyspline.CaseError, match=r"guess has shape \(6,\): a state has 14"):
+        pyspline.continuation(RESONANCE, "t_d", 30, 31, guess=np.zeros(6), progress=False)
+    with pytest.raises(pyspline.CaseError, match="speed_rpm = 0.0: the shaft does not turn"):
+        pyspline.continuation(RESONANCE.replace(speed_rpm=0.0), "t_d", 30, 31, progress=False)
     with pytest.raises(pyspline.CaseError, match="monodromy = 'adjoint': 'exact'"):
         pyspline.continuation(RESONANCE, "t_d", 30, 31, monodromy="adjoint", progress=False)
     with pytest.raises(pyspline.CaseError, match="follow= needs exactly one swept field"):
