@@ -239,6 +239,17 @@ def test_saltation_of_a_single_switch(impacting):
         assert np.abs(M0 - Mf).max() > 1, np.abs(M0 - Mf).max()
 
 
+def test_variational_run_is_bounded_by_max_total_steps(impacting):
+    """The variational run restarts at every switch: its work is bounded over the restarts by
+    max_total_steps (a grazing touch whose root finding chatters cannot run on without end):
+    a SolverError naming the field, where one revolution of this orbit needs more steps."""
+    orbit, model = impacting
+    case = model.case.replace(max_total_steps=200)
+    with pytest.raises(pyspline.SolverError, match="variational run took max_total_steps = 200 "
+                       "CVODE steps in all by t = .*raise max_total_steps"):
+        pyspline.orbits.map_and_monodromy(case, orbit.t0, orbit.t0 + orbit.period, orbit.y0)
+
+
 def test_coupled_thermal_level_is_not_covered():
     case, y_eq, _, _ = linear_scene(2.0)
     with pytest.raises(pyspline.CaseError, match="thermal = 'coupled'.*variational equations.*fd"):
