@@ -1,10 +1,12 @@
 """Benchmarks of pyspline (not installed with the package): run from a checkout,
-    python bench/run.py wp|race|stability|ladder|anatomy|parallel [--out DIR] [--quick]
+    python bench/run.py wp|race|stability|ladder|anatomy|parallel|bifurcation|continuation
+                        [--out DIR] [--quick]
 wp: work-precision chart against scipy and numbalsoda peers; race: issue 25's table against the
 numba peer (bench/race.py); stability: where methods fail;
 ladder: model levels and fidelity = auto; anatomy: where a run's time goes; parallel: scenes
 serially, on threads and on processes, fixed cost per call, RHS call cost; bifurcation: a
-1000-point sweep serially, on threads, processes and Dask.
+1000-point sweep serially, on threads, processes and Dask; continuation: continuation of
+periodic orbits with the exact monodromy against central differences (bench/continuation.py).
 Each writes a PNG and/or CSV into --out (default out/bench) and prints a table."""
 from __future__ import annotations
 
@@ -78,12 +80,13 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="bench/run.py", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("what", choices=["wp", "race", "stability", "ladder", "anatomy", "parallel",
-                                    "bifurcation"])
+                                    "bifurcation", "continuation"])
     p.add_argument("--points", type=int, help="bifurcation: number of points (default 1000)")
     p.add_argument("--cases", nargs="+", help="wp, race: the scenes (default: paper_lx1e-4 paper_T100 "
                    "rattle_z24 physical_z24; --quick: the two paper scenes)")
     p.add_argument("--rtol", type=float, help="bifurcation: tolerance (default: the case's)")
-    p.add_argument("--repeats", type=int, help="bifurcation: run the whole sweep this many "
+    p.add_argument("--repeats", type=int, help="continuation: interleaved runs per monodromy "
+                   "(default 3, --quick 1); bifurcation: run the whole sweep this many "
                    "times per executor, in rotating order; medians and ranges (default 1)")
     p.add_argument("--blocks", type=int, help="bifurcation: run the sweep as this many "
                    "interleaved blocks, the executors in rotating order (default 1: each "
@@ -114,6 +117,9 @@ def main(argv=None) -> int:
     if args.what == "bifurcation":
         import bifurcation
         return bifurcation.main(args)
+    if args.what == "continuation":
+        import continuation
+        return continuation.main(args)
     return cmd_bench(args)
 
 

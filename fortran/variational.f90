@@ -149,7 +149,7 @@ contains
     integer(c_long) :: cnt(1)
     integer(8) :: done
     integer :: n, k, nsw
-    logical :: salt
+    logical :: salt, total_bound
     character(len=48) :: stage
     salt = .true.
     if (present(saltation)) salt = saltation
@@ -181,10 +181,19 @@ contains
     sunctx = c_null_ptr; mem = c_null_ptr
     sv => null(); amat => null(); ls => null(); nls => null()
     done = 0
+    total_bound = .false.
     call setup(flag)
     do while (flag == 0 .and. tau < tau1)
-      flag = FCVodeSetMaxNumSteps(mem, int(max(1_8, min(int(m%max_steps, 8), &
-           int(m%max_total_steps, 8)) - done), c_long))
+      ! max_steps per CVode call (each restart counts from 0), max_total_steps over the run:
+      ! restarts at switches that chatter (a grazing touch) must not go on without bound
+      if (done >= int(m%max_total_steps, 8)) then
+        total_bound = .true.
+        flag = CV_TOO_MUCH_WORK
+        exit
+      end if
+      total_bound = int(m%max_total_steps, 8) - done <= int(m%max_steps, 8)
+      flag = FCVodeSetMaxNumSteps(mem, int(min(int(m%max_steps, 8), &
+           int(m%max_total_steps, 8) - done), c_long))
       if (flag /= 0) exit
       stage = 'integrating'
       flag = FCVode(mem, tau1, sv, tret, CV_NORMAL)
@@ -310,6 +319,10 @@ contains
         ierr = err_interrupted
         write(errmsg, '(a,es12.5,a)') 'case '//trim(m%name)//': interrupted (SIGINT) at t = ', &
              tau/m%w_ref, ' s'
+      else if (flag == CV_TOO_MUCH_WORK .and. total_bound) then
+        write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': the variational run took '// &
+             'max_total_steps = ', m%max_total_steps, ' CVODE steps in all by t = ', tau/m%w_ref, &
+             ' s (flag CV_TOO_MUCH_WORK): raise max_total_steps, or find why the steps are so small'
       else if (flag == CV_TOO_MUCH_WORK) then
         write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': the variational run took '// &
              'max_steps = ', m%max_steps, ' CVODE steps without reaching its end, at t = ', &

@@ -22,8 +22,8 @@ import numpy as np
 from .case import Case, defaults, load_case
 from .core import STATE_QUANTITIES, load
 from .errors import CaseError, SolverError, SplineWarning
-from .orbits import (OrbitError, _period_map, _trajectory, forcing_periods, map_and_monodromy,
-                     periodic_orbit)
+from .orbits import (OrbitError, _period_map, _trajectory, fd_monodromy, forcing_periods,
+                     map_and_monodromy, periodic_orbit)
 
 __all__ = ["continuation", "SPECIAL_TYPES"]
 
@@ -77,8 +77,9 @@ def field_label(name: str, index) -> str:
 class _Problem:
     """The case at a value p of the field, its map and monodromy in the start's scales."""
 
-    def __init__(self, case, name, index, n, start, stop, t0):
+    def __init__(self, case, name, index, n, start, stop, t0, monodromy="exact"):
         self.case, self.name, self.index, self.n = case, name, index, n
+        self.monodromy = map_and_monodromy if monodromy == "exact" else fd_monodromy
         self.p0, self.pscale = float(start), abs(float(stop) - float(start))
         self.t0 = t0
         self.models = {}
@@ -116,7 +117,7 @@ class _Problem:
         y = y_fixed.copy()
         y[self.free] = u[:-1] * self.d0[self.free]
         model = self.model(p)
-        y1, Mp, free = map_and_monodromy(model, self.t0, self.t1(p, n), y)
+        y1, Mp, free = self.monodromy(model, self.t0, self.t1(p, n), y)
         d = _scale(model.info())[free] / self.d0[free]     # M in the start's scales
         M = d[:, None] * Mp / d[None, :]
         F = (y1 - y)[free] / self.d0[free]
@@ -229,7 +230,7 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
                  ds: float = 0.05, ds_min: float = 1e-4, ds_max: float = 0.25, max_angle: float = 0.15,
                  max_points: int = 200, tol: float | None = None, max_corrector: int = 6,
                  margin: float = 1e-4, switch: bool = True, detect: bool = True,
-                 progress: bool = True, command: str | None = None):
+                 monodromy: str = "exact", progress: bool = True, command: str | None = None):
     """Pseudo-arclength continuation of the period-n orbit of `case` in `field` from `start`
     to `stop`, through stable and unstable parts; returns an xarray.Dataset.
 
@@ -247,6 +248,8 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     switch : at a period doubling continue the doubled branch (n -> 2n) from it along the
         critical eigenvector.
     detect : locate folds, period doublings, Neimark-Sacker points and grazing.
+    monodromy : 'exact' (variational equations, one run per corrector iteration) or 'fd'
+        (central differences of the map, 2k + 1 runs: for checking, bench/continuation.py).
 
     Dataset: dim 'point' (the branch points in order; variable 'branch' numbers the branches,
     'n' their periods): the field's value, y0 (point, state), Tm_pp, F_max, D2_pp, the
@@ -262,13 +265,16 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     if not (np.isfinite(start) and np.isfinite(stop)) or start == stop:
         raise CaseError(f"case {base.name}: field {label}: start and stop must be finite and "
                         f"differ, got {start:g}, {stop:g}")
+    if monodromy not in ("exact", "fd"):
+        raise CaseError(f"case {base.name}: monodromy = {monodromy!r}: 'exact' (variational "
+                        "equations) or 'fd' (central differences of the map)")
     wall0 = time.perf_counter()
     t0 = float(base["t0"])
-    prob = _Problem(base, name, index, n, start, stop, t0)
+    prob = _Problem(base, name, index, n, start, stop, t0, monodromy)
     c0 = prob.case_at(start)
     forcing_periods(c0, n)
     tol = 100 * base["rtol"] if tol is None else float(tol)
-    orbit = periodic_orbit(c0, n=n, guess=guess, tol=tol)
+    orbit = periodic_orbit(c0, n=n, guess=guess, tol=tol, monodromy=monodromy)
     prob.free = _map_only(prob.model(start), t0, prob.t1(start, n), orbit.y0)[2]
     k = int(prob.free.sum())
     branches, specials = [], []
@@ -295,7 +301,7 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
         bar.close()
     wall = time.perf_counter() - wall0
     return continuation_dataset(base, prob, label, branches, specials, margin, k, dict(
-        start=start, stop=stop, n=n, tol=tol, wall_s=wall,
+        start=start, stop=stop, n=n, tol=tol, wall_s=wall, monodromy=monodromy,
         command=command or f"pyspline.continuation({base.name!r}, {label!r}, {start:g}, "
                            f"{stop:g}, n={n})"))
 

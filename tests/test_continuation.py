@@ -188,6 +188,12 @@ def test_bad_field(field, match):
 def test_bad_range_and_follow():
     with pytest.raises(pyspline.CaseError, match="start and stop must be finite and differ"):
         pyspline.continuation(RESONANCE, "t_d", 30, 30, progress=False)
+    with pytest.raises(pyspline.CaseError, match=r"guess has shape \(6,\): a state has 14"):
+        pyspline.continuation(RESONANCE, "t_d", 30, 31, guess=np.zeros(6), progress=False)
+    with pytest.raises(pyspline.CaseError, match="speed_rpm = 0.0: the shaft does not turn"):
+        pyspline.continuation(RESONANCE.replace(speed_rpm=0.0), "t_d", 30, 31, progress=False)
+    with pytest.raises(pyspline.CaseError, match="monodromy = 'adjoint': 'exact'"):
+        pyspline.continuation(RESONANCE, "t_d", 30, 31, monodromy="adjoint", progress=False)
     with pytest.raises(pyspline.CaseError, match="follow= needs exactly one swept field"):
         pyspline.sweep(RESONANCE, speed_rpm=[1, 2], t_d=[1, 2], follow="up", progress=False)
     with pytest.raises(pyspline.CaseError, match="follow must be one of up, down, both"):
@@ -252,3 +258,134 @@ def test_follow_chains_on_processes_are_the_serial_ones():
     assert np.array_equal(down.Tm_max.values[::-1], both.Tm_max.sel(direction="down"))
     # the directions differ here (2400-2520 r/min spans the folds' hysteresis)
     assert not np.allclose(both.Tm_max.sel(direction="up"), both.Tm_max.sel(direction="down"))
+
+
+# double-sided impacts: the resonance's drive with a ripple twice the mean torque (the drive
+# torque reverses every revolution, so the teeth strike both flanks, 4 switches per tooth and
+# revolution); continued in speed, the period-1 orbit's multiplier moves smoothly through -1
+# at 1623.6 r/min with the contact sequence unchanged (a smooth period doubling)
+DOUBLING = RESONANCE.replace(ripple_amp=[2.0, 0, 0, 0], speed_rpm=1600.0)
+
+
+@pytest.fixture(scope="module")
+def doubling_branch():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        return pyspline.continuation(DOUBLING, "speed_rpm", 1600, 1650, max_points=120,
+                                     progress=False)
+
+
+def test_period_doubling_switches_to_the_doubled_branch(doubling_branch):
+    """A period doubling located with a multiplier at -1 (secant on det(M + I)) on a branch
+    whose contact sequence does not change there; the branch switch follows the period-2
+    orbit from it (subcritical: it bends back, folds, and comes back stable). Its points are
+    genuine period-2 orbits: P^2(y) = y with P(y) far from y, two section points over two
+    revolutions, and a brute-force run from the equilibrium settles on the same two points
+    (at 1600 r/min, below the doubling, on the period-1 orbit: one section point)."""
+    from pyspline.orbits import _period_map, map_and_monodromy
+    ds = doubling_branch
+    pd = np.flatnonzero(ds.special_type.values == "period_doubling")
+    assert len(pd) == 1 and ds.special_branch.values[pd[0]] == 0
+    mu = complex(ds.special_mu_real[pd[0]], ds.special_mu_imag[pd[0]])
+    assert abs(mu + 1) < 1e-3 and ds.special_smooth.values[pd[0]] == 1, mu
+    p_pd = float(ds.special_speed_rpm[pd[0]])
+    assert 1600 < p_pd < 1650
+    # branch 0 (period 1): stable below, a real multiplier below -1 above; one contact sequence
+    b0 = ds.branch.values == 0
+    p0, st0 = ds.speed_rpm.values[b0], ds.stable.values[b0].astype(bool)
+    assert st0[p0 < p_pd - 0.5].all() and not st0[p0 > p_pd + 0.5].any()
+    real = np.abs(ds.mu_imag.values[b0]) < 1e-9
+    assert (np.where(real, ds.mu_real.values[b0], 0).min(axis=1)[p0 > p_pd + 0.5] < -1).all()
+    assert len(set(ds.switches.values[b0])) == 1
+    # branch 1: period 2, starts at the doubling, ends at stop stable
+    b1 = np.flatnonzero(ds.branch.values == 1)
+    assert len(b1) >= 5 and (ds.n.values[b1] == 2).all()
+    assert float(ds.speed_rpm[b1[0]]) == pytest.approx(p_pd, abs=0.5)
+    last = b1[-1]
+    assert float(ds.speed_rpm[last]) == pytest.approx(1650, rel=1e-12) and ds.stable[last]
+    case = DOUBLING.replace(speed_rpm=1650.0)
+    y = ds.y0.values[last]
+    T = 60 / 1650.0
+    s = scale_of(case)
+    y2, _, free = map_and_monodromy(case, 0.0, 2 * T, y)
+    y1 = _period_map(case.model, 0.0, T, y[:, None])[0][:, 0]
+    assert np.abs((y2 - y)[free] / s[free]).max() < 1e-5
+    assert np.abs((y1 - y)[free] / s[free]).max() > 0.1
+    # its section over two revolutions: two points (y and P(y)), one revolution apart
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        run = pyspline.simulate(case.replace(start="rest", dq0=list(y[:7]), dv0=list(y[7:]),
+                                             t_end=40 * T, n_out=401, section="shaft"))
+        brute = pyspline.simulate(case.replace(t_end=100 * T, t_transient=70 * T, n_out=401,
+                                               section="shaft", max_steps=10_000_000))
+    for sec in (run.section_y[-10:], brute.section_y[-10:]):
+        even, odd = sec[0::2], sec[1::2]
+        assert np.ptp(even[:, free], axis=0).max() / s[free].min() < 1e-4
+        assert np.abs(even[0] - odd[0])[free].max() > 0.1 * s[free].min()
+        def off(a, b):
+            return np.abs((a - b)[free] / s[free]).max()
+        # the two points are the orbit's y and P(y), in either order
+        assert min(off(even[0], y) + off(odd[0], y1), off(even[0], y1) + off(odd[0], y)) < 1e-4
+    # below the doubling (and below the period-2 branch's fold) the brute force is period 1
+    T0 = 60 / 1600.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        low = pyspline.simulate(DOUBLING.replace(t_end=160 * T0, t_transient=130 * T0, n_out=401,
+                                                 section="shaft", max_steps=10_000_000))
+    s0 = scale_of(DOUBLING)
+    assert float(ds.speed_rpm[0]) == 1600 and ds.stable[0]
+    assert np.abs((low.section_y[-10:] - ds.y0.values[0])[:, free] / s0[free]).max() < 1e-3
+
+
+def test_frequency_response_figure(doubling_branch):
+    """The figure: each branch stable solid and unstable dashed (period 1 and period 2), the
+    special points marked at their located values, the follow sweeps' points over them."""
+    from pyspline.frplots import frequency_response
+    ds = doubling_branch
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        sw = pyspline.sweep(DOUBLING.replace(t_end=0.5, t_transient=0.3, n_out=201),
+                            speed_rpm=np.linspace(1600, 1650, 4), follow="both",
+                            progress=False, spectrum=False)
+    fig = frequency_response(ds, "Tm_pp", sweep=sw)
+    ax = fig.axes[0]
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    for want in ("period-1 orbits, stable", "period-1 orbits, unstable", "period-2 orbits, stable",
+                 "period-2 orbits, unstable", "period doubling (mu = -1) (1)", "fold (mu = +1) (1)"):
+        assert want in labels, labels
+    assert any(lab.startswith("follow up") for lab in labels)
+    assert any(lab.startswith("follow down") for lab in labels)
+    lines = ax.get_lines()
+    dashed = [ln for ln in lines if ln.get_linestyle() not in ("-", "None", "")]
+    assert dashed and any(ln.get_linestyle() == "-" for ln in lines)
+    pd = ds.special_type.values == "period_doubling"
+    mark = [ln for ln in lines if ln.get_marker() == "s"]
+    assert len(mark) == 1
+    fx = float(ds.speed_rpm[0]) / lines[0].get_xdata()[0]       # the axis' unit prefix
+    fy = float(ds.Tm_pp[0]) / lines[0].get_ydata()[0]
+    assert np.allclose(mark[0].get_xdata() * fx, ds.special_speed_rpm.values[pd])
+    assert np.allclose(mark[0].get_ydata() * fy, ds.special_Tm_pp.values[pd])
+
+
+def test_bench_continuation_quick():
+    """bench/run.py continuation --quick: both monodromies on both scenes, interleaved; the
+    two continuations of the resonance meet the same special points at the same speeds and
+    end on the same orbit (no timing asserted)."""
+    import importlib.util
+    from conftest import ROOT
+    sys.path.insert(0, str(ROOT / "bench"))
+    spec = importlib.util.spec_from_file_location("bench_continuation",
+                                                  ROOT / "bench" / "continuation.py")
+    bc = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bc)
+    rows, summary = bc.measure(quick=True, repeat=1)
+    assert [(r["scene"], r["monodromy"]) for r in rows] == [
+        ("resonance", "exact"), ("resonance", "fd"), ("impacting", "exact"), ("impacting", "fd")]
+    assert all(r["steps"] >= r["points"] > 5 and r["step_median_s"] > 0 for r in rows)
+    res, imp = summary
+    assert res["agree"]["branches"] == "1/1" and res["agree"]["specials"]
+    assert not any("missing" in s for s in res["agree"]["specials"])
+    assert res["agree"]["d_last_y0"] < 1e-5 and imp["agree"]["d_last_y0"] < 1e-5
+    assert imp["agree"]["branches"].startswith("2/")      # exact: the doubled branch
+    lines = bc.format_summary(summary, 1)
+    assert sum("fd / exact" in line for line in lines) == 2
