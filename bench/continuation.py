@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 import pyspline
+from pyspline.orbits import _scale
 from pyspline.paper import cases_dir
 from speed import _write_csv
 
@@ -90,8 +91,7 @@ def agreement(case, a, b) -> dict:
             f"{kind} {float(a.special_speed_rpm[i]):.2f}/{float(b.special_speed_rpm[j]):.2f} "
             + ("" if kind == "grazing" else f"mu {mu[0].real:.4f}/{mu[1].real:.4f}"))
     ia, ib = int((a.branch.values == 0).sum() - 1), int((b.branch.values == 0).sum() - 1)
-    info = case.replace(speed_rpm=float(a.speed_rpm[ia])).model.info()
-    s = np.r_[np.full(7, info["l_ref"]), np.full(7, info["l_ref"] * info["w_ref"])]
+    s = _scale(case.replace(speed_rpm=float(a.speed_rpm[ia])).model)
     out["d_last_y0"] = float(np.abs((a.y0.values[ia] - b.y0.values[ib]) / s).max())
     mua = np.sort_complex(a.mu_real.values[ia] + 1j * a.mu_imag.values[ia])
     mub = np.sort_complex(b.mu_real.values[ib] + 1j * b.mu_imag.values[ib])

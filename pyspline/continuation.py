@@ -22,8 +22,8 @@ import numpy as np
 from .case import Case, defaults, load_case
 from .core import STATE_QUANTITIES, load
 from .errors import CaseError, SolverError, SplineWarning
-from .orbits import (OrbitError, _period_map, _trajectory, fd_monodromy, forcing_periods,
-                     map_and_monodromy, periodic_orbit)
+from .orbits import (OrbitError, _period_map, _scale, _trajectory, fd_monodromy,
+                     forcing_periods, map_and_monodromy, periodic_orbit)
 
 __all__ = ["continuation", "SPECIAL_TYPES"]
 
@@ -83,7 +83,7 @@ class _Problem:
         self.p0, self.pscale = float(start), abs(float(stop) - float(start))
         self.t0 = t0
         self.models = {}
-        self.d0 = _scale(self.model(self.p0).info())
+        self.d0 = _scale(self.model(self.p0))
         self.rtol = case["rtol"]
         self.h = self.rtol ** (1 / 3)
 
@@ -118,7 +118,7 @@ class _Problem:
         y[self.free] = u[:-1] * self.d0[self.free]
         model = self.model(p)
         y1, Mp, free = self.monodromy(model, self.t0, self.t1(p, n), y)
-        d = _scale(model.info())[free] / self.d0[free]     # M in the start's scales
+        d = _scale(model)[free] / self.d0[free]     # M in the start's scales
         M = d[:, None] * Mp / d[None, :]
         F = (y1 - y)[free] / self.d0[free]
         hp = self.h * max(abs(p), self.pscale)
@@ -135,12 +135,6 @@ def _map_only(model, t0, t1, y):
     """The core's map alone (no monodromy): (y1, None, free)."""
     y1, free = _period_map(model, t0, t1, np.asarray(y, float)[:, None])
     return y1[:, 0], None, free
-
-
-def _scale(info: dict) -> np.ndarray:
-    """The scales of Eq. 25 of the 14 states (l_ref; l_ref w_ref for the velocities): those
-    of orbits.map_and_monodromy's M."""
-    return np.r_[np.full(7, info["l_ref"]), np.full(7, info["l_ref"] * info["w_ref"])]
 
 
 # --------------------------------------------------------------------------- test functions

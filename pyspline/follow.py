@@ -51,13 +51,11 @@ def run_chain(cases: list, options: dict) -> list:
     """Summaries of the cases run in the given order, each from the previous one's final
     state (a failed point breaks the chain: the next starts from its own start)."""
     from .core import simulate
-    from .sweep import _stat_names, _template, summarise
+    from .sweep import failed_summary, summarise
     out, prev = [], None
     for case in cases:
         if isinstance(case, Exception):
-            s = _template(options, _stat_names())
-            s.update(error=str(case), error_class=type(case).__name__)
-            out.append(s)
+            out.append(failed_summary(case, options))
             prev = None
             continue
         try:
@@ -69,9 +67,7 @@ def run_chain(cases: list, options: dict) -> list:
             out.append(summarise(res, options))
             prev = (res.y[-1].copy(), float(res.t[-1]), run.model.info()["omega"])
         except Exception as exc:        # noqa: BLE001 -- a failed point is a result
-            s = _template(options, _stat_names())
-            s.update(error=str(exc) or repr(exc), error_class=type(exc).__name__)
-            out.append(s)
+            out.append(failed_summary(exc, options))
             prev = None
     return out
 

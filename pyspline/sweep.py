@@ -290,6 +290,14 @@ def lyapunov_summary(s: dict, lyap_t, log_growth, exponent: float, t0: float) ->
                  lyapunov_slope=fit.slope, chaotic=float(analysis.is_chaotic(exponent, fit.spread)))
 
 
+def failed_summary(exc: Exception, options: dict) -> dict:
+    """The summary of a point that failed: all NaN, the message in 'error' (never empty: a
+    message-less exception gives its repr) and the class name in 'error_class'."""
+    s = _template(options, _stat_names())
+    s.update(error=str(exc) or repr(exc), error_class=type(exc).__name__)
+    return s
+
+
 def summarise(res, options: dict) -> dict:
     """The summary of one Result (see `sweep` for the keys), all numbers in SI units."""
     s = _template(options, _stat_names())
@@ -325,9 +333,7 @@ def run_point(case: Case, options: dict) -> dict:
     try:
         return summarise(simulate(case), options)
     except Exception as exc:              # noqa: BLE001 -- a failed point is a result
-        s = _template(options, _stat_names())
-        s.update(error=str(exc) or repr(exc), error_class=type(exc).__name__)
-        return s
+        return failed_summary(exc, options)
 
 
 class PointSummaries:
@@ -505,9 +511,7 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
         points_dir.mkdir(parents=True, exist_ok=True)
     for index, c in cases.items():
         if isinstance(c, Exception):       # rejected at once: a result, nothing to run
-            s = _template(options, _stat_names())
-            s.update(error=str(c), error_class=type(c).__name__)
-            summaries[index] = s
+            summaries[index] = failed_summary(c, options)
             continue
         if points_dir is not None:     # (without `out`, hashed while the first tasks run)
             hashes[index] = point_hash(c, options)
