@@ -22,7 +22,7 @@ module spline_loads
        ilt_back, ilt_onsets, ilt_free_se, ilt_back_se
   implicit none
   private
-  public :: run_loads, tooth_flank, drive_flank, approach_speed, tooth_stresses, stress_warnings
+  public :: run_loads, drive_flank, approach_speed, tooth_stresses, stress_warnings
 
   !> Limits of stress_warnings [Pa] (docs/model.md section 15, "Tooth stresses"): typical
   !> allowables of case-hardened steel splines (58-63 HRC) at full load, 10^4 torque cycles,
@@ -106,14 +106,13 @@ contains
       if (rev(k) > nb) rev(k) = 0
     end do
     free_b = 0.0_wp; back_b = 0.0_wp; ons_b = 0.0_wp
-    do j = 1, m%z        ! tooth_flank inline (a public function is not inlined in a PIC build)
+    do j = 1, m%z        ! tooth_flank is private, so the compiler inlines it (a public one was a call)
       prev = 0
       fpk = 0.0_wp
       nfree = 0; nback = 0; nons = 0
       do k = 1, nt
         fpk = max(fpk, abs(tooth(k, j, 1)))
-        fl = 0
-        if (tooth(k, j, 1) /= 0.0_wp) fl = merge(1, -1, tooth(k, j, 4) > 0.0_wp)
+        fl = tooth_flank(tooth(k, j, 1), tooth(k, j, 4))
         if (fl == 0) nfree = nfree + 1
         if (fl == -drive) nback = nback + 1
         if (rev(k) > 0) then
