@@ -34,29 +34,32 @@ contains
     character(len=*), intent(inout) :: errmsg
     integer, intent(in), optional :: mode(m%z*m%n_slices)
     type(coupling_stats_t), intent(inout), optional :: cstats
-    real(wp) :: fx1, fy1, tm, s1, s3, th1dd, fu(4)
+    real(wp) :: fx1, fy1, tm, s1, s3, th1dd, fu(4), td
     if (m%n_slices == 1 .and. m%thermal /= thermal_coupled) then
-      call mesh_forces(m, t, q, v, fx1, fy1, tm, mode)     ! mesh_eval's kernel, to the bit
+      call mesh_forces(m, t, q, v, fx1, fy1, tm, mode)     ! mesh_eval's kernel, to round-off
       ierr = err_ok
     else
       call mesh_eval(m, t, q, v, fx1, fy1, tm, ierr, errmsg, mode=mode, cstats=cstats)
       if (ierr /= err_ok) return
     end if
-    a(1) = (fx1 - m%c_p1*v(1) - m%k_p1*q(1))/m%m_1
-    a(2) = (fy1 - m%c_p1*v(2) - m%k_p1*q(2))/m%m_1 - m%grav
-    a(3) = (-fx1 - m%c_p2*v(3) - m%k_p2*q(3))/m%m_2
-    a(4) = (-fy1 - m%c_p2*v(4) - m%k_p2*q(4))/m%m_2 - m%grav
-    if (any(m%unbalance /= 0.0_wp)) then
+    ! divisions by the masses, inertias and r_b as products with the model's reciprocals
+    a(1) = (fx1 - m%c_p1*v(1) - m%k_p1*q(1))*m%inv_m1
+    a(2) = (fy1 - m%c_p1*v(2) - m%k_p1*q(2))*m%inv_m1 - m%grav
+    a(3) = (-fx1 - m%c_p2*v(3) - m%k_p2*q(3))*m%inv_m2
+    a(4) = (-fy1 - m%c_p2*v(4) - m%k_p2*q(4))*m%inv_m2 - m%grav
+    if (m%unbalance(1) /= 0.0_wp .or. m%unbalance(2) /= 0.0_wp) then
       call unbalance_forces(m, t, fu)
-      a(1:2) = a(1:2) + fu(1:2)/m%m_1
-      a(3:4) = a(3:4) + fu(3:4)/m%m_2
+      a(1:2) = a(1:2) + fu(1:2)*m%inv_m1
+      a(3:4) = a(3:4) + fu(3:4)*m%inv_m2
     end if
-    s1 = (m%k_t1*q(5) + m%c_t1*v(5))/m%r_b
-    s3 = (m%k_t2*q(7) + m%c_t2*v(7))/m%r_b
-    th1dd = (tm - s1)/m%j_1
-    a(5) = m%r_b*(th1dd - (driving_torque(m, t) + s1)/m%j_m)
-    a(6) = m%r_b*((-tm - s3)/m%j_2 - th1dd)
-    a(7) = m%r_b*((-tm - s3)/m%j_2 - (s3 - m%t_l)/m%j_l)
+    s1 = (m%k_t1*q(5) + m%c_t1*v(5))*m%inv_rb
+    s3 = (m%k_t2*q(7) + m%c_t2*v(7))*m%inv_rb
+    th1dd = (tm - s1)*m%inv_j1
+    td = m%t_d                               ! T_d(t) (driving_torque) only with a ripple
+    if (m%n_ripple > 0) td = driving_torque(m, t)
+    a(5) = m%r_b*(th1dd - (td + s1)*m%inv_jm)
+    a(6) = m%r_b*((-tm - s3)*m%inv_j2 - th1dd)
+    a(7) = m%r_b*((-tm - s3)*m%inv_j2 - (s3 - m%t_l)*m%inv_jl)
   end subroutine accelerations
 
   !> Driving torque with ripple (docs/model.md section 11): T_d(t) = T_d [1 + sum_k a_k sin(n_k omega t
@@ -112,9 +115,9 @@ contains
     type(coupling_stats_t), intent(inout), optional :: cstats
     real(wp) :: y(nstate), a(ndof)
     call from_scaled(m, ys, y)
-    call accelerations(m, tau/m%w_ref, y(1:ndof), y(ndof+1:), a, ierr, errmsg, mode, cstats)
+    call accelerations(m, tau*m%inv_w_ref, y(1:ndof), y(ndof+1:), a, ierr, errmsg, mode, cstats)
     dys(1:ndof) = ys(ndof+1:)
-    dys(ndof+1:) = a/(m%l_ref*m%w_ref**2)
+    dys(ndof+1:) = a*m%inv_acc_ref
   end subroutine rhs_scaled
 
   !> The states the integrator carries, as indices into the full state (Eq. 24): all 14 at

@@ -175,53 +175,61 @@ contains
     ddn = evx*sp - evy*cp + v6 + omega*(ex*cp + ey*sp)
   end subroutine eq11
 
-  !> The right-hand side's mesh kernel: mesh_eval's F_x1, F_y1 and T_m, operation for operation
-  !> (so to the bit), for a model without face slices or coupled flash temperature (the teeth's
-  !> backlash is c_bulk; at the one-way level T_f does not act back). One pass over the teeth:
-  !> the pitch rotation of tooth_angles, Eq. 11, Eqs. 15-17 and the sums of Eqs. 19-22, with no
-  !> optional output and no option tested inside the loop. mode: as mesh_eval's.
+  !> The right-hand side's mesh kernel: mesh_eval's F_x1, F_y1 and T_m to round-off (a few ulp of
+  !> dn_j; tests/fortran/test_mesh.f90), for a model without face slices or coupled flash
+  !> temperature (the teeth's backlash is c_bulk; at the one-way level T_f does not act back).
+  !> Eq. 11 in tooth 1's frame with the model's tooth offsets (no rotation chain from tooth to
+  !> tooth), Eqs. 15-17 without a branch, so that the compiler vectorises the pass over the
+  !> teeth, then the sums of Eqs. 19-22. mode: as mesh_eval's.
   pure subroutine mesh_forces(m, t, q, v, fx1, fy1, tm, mode)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(7), v(7)
     real(wp), intent(out) :: fx1, fy1, tm
     integer, intent(in), optional :: mode(m%z)
-    real(wp) :: s, c, s1, phi, ex, ey, evx, evy, dnj, ddnj, fj, sumf, cb, km, cm, sd, cd
-    integer :: j, mj
+    real(wp) :: s, c, phi, ex, ey, evx, evy, cb, km, cm, a, b, va, vb, sfc, sfs, sumf, q6, v6
+    real(wp) :: dnj, ddnj, fs(max_teeth)    ! fixed size: no allocation per call
+    integer :: j, z
     phi = 2.0_wp*pi/m%z + m%omega*t + m%theta0 - m%alpha     ! tooth_angles, tooth 1
     s = sin(phi)
     c = cos(phi)
-    sd = m%sin_pitch; cd = m%cos_pitch
     cb = m%c_bulk; km = m%k_m; cm = m%c_m
     ex = q(1) + m%l_x - q(3)
     ey = q(2) + m%l_y - q(4)
     evx = v(1) - v(3)
     evy = v(2) - v(4)
-    fx1 = 0.0_wp; fy1 = 0.0_wp; sumf = 0.0_wp
+    ! Eq. 11 in tooth 1's frame: dn_j = a cos(o_j) + b sin(o_j) + q6 + e_j,
+    ! ddn_j = va cos(o_j) + vb sin(o_j) + v6, o_j = (j - 1) 2 pi / Z (the model's offsets)
+    a = ex*s - ey*c
+    b = ex*c + ey*s
+    va = evx*s - evy*c + m%omega*b
+    vb = evx*c + evy*s - m%omega*a
+    ! Eqs. 15-17 without a branch: in contact (|dn_j| > c_bulk, Eq. 16, or the frozen state
+    ! mode(j) /= 0) F_j = k_m (dn_j - sign(c_bulk, dn_j)) + c_m d(dn_j)/dt, else 0
+    z = m%z
+    q6 = q(6); v6 = v(6)
     if (present(mode)) then
-      do j = 1, m%z
-        call eq11(ex, ey, evx, evy, q(6), v(6), m%omega, m%spacing_error(j), s, c, dnj, ddnj)
-        mj = mode(j)      ! Eqs. 15-17 (mj c_bulk = +-c_bulk exactly)
-        fj = merge(km*(dnj - merge(cb, -cb, mj > 0)) + cm*ddnj, 0.0_wp, mj /= 0)
-        fx1 = fx1 - fj*s
-        fy1 = fy1 + fj*c
-        sumf = sumf + fj
-        s1 = s*cd + c*sd
-        c = c*cd - s*sd
-        s = s1
+      do j = 1, z
+        dnj = a*m%cos_offset(j) + b*m%sin_offset(j) + q6 + m%spacing_error(j)
+        ddnj = va*m%cos_offset(j) + vb*m%sin_offset(j) + v6
+        fs(j) = abs(real(mode(j), wp))*(km*(dnj - mode(j)*cb) + cm*ddnj)
       end do
     else
-      do j = 1, m%z
-        call eq11(ex, ey, evx, evy, q(6), v(6), m%omega, m%spacing_error(j), s, c, dnj, ddnj)
-        mj = contact_state(dnj, cb)
-        fj = merge(km*(dnj - merge(cb, -cb, mj > 0)) + cm*ddnj, 0.0_wp, mj /= 0)
-        fx1 = fx1 - fj*s
-        fy1 = fy1 + fj*c
-        sumf = sumf + fj
-        s1 = s*cd + c*sd
-        c = c*cd - s*sd
-        s = s1
+      do j = 1, z     ! 0.5 - sign(0.5, c_bulk - |dn_j|): 1 where |dn_j| > c_bulk, else 0
+        dnj = a*m%cos_offset(j) + b*m%sin_offset(j) + q6 + m%spacing_error(j)
+        ddnj = va*m%cos_offset(j) + vb*m%sin_offset(j) + v6
+        fs(j) = (0.5_wp - sign(0.5_wp, cb - abs(dnj)))*(km*(dnj - sign(cb, dnj)) + cm*ddnj)
       end do
     end if
+    sfc = 0.0_wp; sfs = 0.0_wp; sumf = 0.0_wp
+    do j = 1, z
+      sfc = sfc + fs(j)*m%cos_offset(j)
+      sfs = sfs + fs(j)*m%sin_offset(j)
+      sumf = sumf + fs(j)
+    end do
+    ! Eqs. 19-22 in tooth 1's frame: sum F_j sin(phi_j) = s sfc + c sfs,
+    ! sum F_j cos(phi_j) = c sfc - s sfs
+    fx1 = -(s*sfc + c*sfs)
+    fy1 = c*sfc - s*sfs
     tm = m%r_b*sumf
   end subroutine mesh_forces
 

@@ -29,7 +29,7 @@ module spline_model
   integer, parameter :: stiffness_nquad = 32   !< Gauss points: converged to 1e-15 from 16 on
   !> Marks a model_t built by this build's constructor (layout version in the last digits):
   !> a copy handed back from outside is checked against it.
-  integer, parameter :: model_magic = 517730007
+  integer, parameter :: model_magic = 517730008
   !> A given k_m this many times below Eq. 18 draws a warning (model_warnings): the paper's
   !> calibrated 2.54e5 N/m is ~7600 times below for its spline, a deliberate fit; N/mm read
   !> as N/m is 1000 times, on top of such a fit 1e4 is passed.
@@ -66,6 +66,9 @@ module spline_model
     logical  :: start_equilibrium = .true.
     real(wp) :: dq0(ndof), dv0(ndof)
     real(wp) :: l_ref, w_ref                !< scales of Eq. 25
+    !> reciprocals for the right-hand side (spline_dynamics::accelerations, rhs_scaled):
+    !> 1/m_1, 1/m_2, 1/J_1, 1/J_2, 1/J_M, 1/J_L, 1/r_b, 1/w_ref, 1/(l_ref w_ref^2)
+    real(wp) :: inv_m1, inv_m2, inv_j1, inv_j2, inv_jm, inv_jl, inv_rb, inv_w_ref, inv_acc_ref
     integer  :: section = 0                 !< Poincare section: 0 none, 1 shaft, 2 tooth pass
     logical  :: lyapunov = .false.          !< largest Lyapunov exponent (Benettin)
     logical  :: lyap_tangent = .false.      !< by the tangent vector (else a separated copy)
@@ -77,6 +80,9 @@ module spline_model
     real(wp) :: r_b                         !< base radius R cos(alpha)
     real(wp) :: theta0                      !< pi / (2 Z)  (Eq. 9)
     real(wp) :: sin_pitch, cos_pitch        !< of the pitch angle 2 pi / Z (Eqs. 8-9, once per case)
+    !> cos and sin of tooth j's offset (j - 1) 2 pi / Z from tooth 1 (0 beyond z): the
+    !> right-hand side's kernel (spline_mesh::mesh_forces)
+    real(wp) :: cos_offset(max_teeth) = 0.0_wp, sin_offset(max_teeth) = 0.0_wp
     real(wp) :: kappa                       !< 2 lambda s cos(alpha): backlash loss per degC (Eq. 2)
     real(wp) :: c_bulk                      !< backlash with the bulk rise only [m]
     logical  :: k_m_computed = .false.      !< k_m from Eq. 18 (the case left k_m = 0)
@@ -109,6 +115,7 @@ contains
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
     real(wp) :: rf1, rf2, ra2, rho_f, r_bore, r_rim
+    integer :: j
 
     call case_validate(c, ierr, errmsg)
     if (ierr /= err_ok) return
@@ -154,6 +161,8 @@ contains
     m%r_b = m%r_pitch*m%cos_alpha
     m%theta0 = pi/(2.0_wp*m%z)
     call pitch_rotation(m%z, m%sin_pitch, m%cos_pitch)
+    m%cos_offset(1:m%z) = [(cos((j - 1)*2.0_wp*pi/m%z), j = 1, m%z)]
+    m%sin_offset(1:m%z) = [(sin((j - 1)*2.0_wp*pi/m%z), j = 1, m%z)]
 
     ! Eq. 18 at the pitch point, with the fillet-foundation terms k_f1, k_f2 (Sainsot 2004)
     ! when the case counts them: always reported; used if the case leaves k_m = 0. The fillet
@@ -237,6 +246,11 @@ contains
     m%w_ref = c%w_ref
     if (m%w_ref == 0.0_wp) m%w_ref = m%omega
     if (m%w_ref == 0.0_wp) m%w_ref = sqrt(max(m%k_p1, m%k_m)/m%m_1)
+    m%inv_m1 = 1.0_wp/m%m_1; m%inv_m2 = 1.0_wp/m%m_2
+    m%inv_j1 = 1.0_wp/m%j_1; m%inv_j2 = 1.0_wp/m%j_2
+    m%inv_jm = 1.0_wp/m%j_m; m%inv_jl = 1.0_wp/m%j_l
+    m%inv_rb = 1.0_wp/m%r_b; m%inv_w_ref = 1.0_wp/m%w_ref
+    m%inv_acc_ref = 1.0_wp/(m%l_ref*m%w_ref**2)
     m%magic = model_magic
     errmsg = ''
     ierr = err_ok

@@ -20,8 +20,9 @@ from pyspline.sweep import summarise
 CASE = ROOT / "cases" / "paper_lx1e-4.nml"
 SHORT = dict(t_end=0.05, n_out=401)          # 5 revolutions: fast, sections and a Benettin record
 TIMINGS = ("core_wall_s", "wall_s")
-#: the sweep's RMS is numpy's (pairwise sums), the summary's the executable's sequential sum
-RMS = ("Tm_rms", "kv_rms", "F_rms", "D2_rms")
+#: the sweep's RMS is numpy's (pairwise sums), the summary's the executable's sequential sum;
+#: period_residual is relative to the RMS of D2 and dD2/dt (sweep.section_summary)
+RMS = ("Tm_rms", "kv_rms", "F_rms", "D2_rms", "period_residual")
 
 
 def building_block(marker):
