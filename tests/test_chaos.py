@@ -89,7 +89,8 @@ def test_benettin_separation_needs_located_switches_when_tiny():
     assert all(abs(lam) < 5 for lam in located), located
     assert abs(located[0] - located[1]) < 0.5, located
     assert abs(pyspline.simulate(case).lyapunov["exponent"]) < 5          # default d0, no roots
-    assert pyspline.simulate(case.replace(lyapunov_d0=1e-9)).lyapunov["exponent"] > 20
+    with pytest.warns(pyspline.SplineWarning, match="below the default separation"):
+        assert pyspline.simulate(case.replace(lyapunov_d0=1e-9)).lyapunov["exponent"] > 20
 
 
 def test_tangent_exponent_agrees_with_the_copy(runs):
@@ -117,7 +118,8 @@ def test_tangent_exponent_locates_the_switches_itself():
                               unbalance=[2e-4, 0.0], t_transient=0.3, t_end=0.8, n_out=2001,
                               max_steps=10**7, lyapunov=True, lyapunov_d0=1e-8, roots=False,
                               k_t1=7.855, k_t2=7.856, method="adams")   # the paper's soft shafts
-    blind = pyspline.simulate(case).lyapunov["exponent"]
+    with pytest.warns(pyspline.SplineWarning, match="below the default separation"):
+        blind = pyspline.simulate(case).lyapunov["exponent"]
     ref = pyspline.simulate(case.replace(roots=True)).lyapunov["exponent"]
     lam = pyspline.simulate(case.replace(lyapunov_method="tangent")).lyapunov["exponent"]
     assert blind > 100 and abs(ref) < 5 and abs(lam - ref) < 0.05, (blind, lam, ref)
@@ -132,7 +134,8 @@ def test_auto_method_keeps_the_copy_on_cvode():
                               unbalance=[2e-4, 0.0], t_transient=0.3, t_end=0.8, n_out=2001,
                               max_steps=10**7, lyapunov=True, lyapunov_d0=1e-8)
     auto = pyspline.simulate(case)
-    erk = pyspline.simulate(case.replace(method="erk"))
+    with pytest.warns(pyspline.SplineWarning, match="with method = 'erk'"):
+        erk = pyspline.simulate(case.replace(method="erk"))
     tangent = pyspline.simulate(case.replace(lyapunov_method="tangent"))
     lam = auto.lyapunov["exponent"]
     assert abs(lam - tangent.lyapunov["exponent"]) < 0.05 and abs(lam) < 5, lam

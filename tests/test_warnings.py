@@ -24,7 +24,8 @@ EXAMPLE = dict(name="real_spline", z=26, module_m=1.5875e-3, alpha_deg=30.0, b=0
 PLAUSIBLE = dict(EXAMPLE, k_p1=1e12, k_p2=1e12, k_t1=1e5, k_t2=1e5, l_x=50e-6)
 
 KINDS = {"supports": "fields k_p1 =", "windup": "winds its shaft", "start": "start = 'rest'",
-         "load": "loads each tooth", "k_m": "potential-energy mesh stiffness"}
+         "load": "loads each tooth", "k_m": "potential-energy mesh stiffness",
+         "separation": "below the default separation"}
 
 
 def messages(fields) -> list[str]:
@@ -132,6 +133,22 @@ def test_tooth_load_of_a_torque_in_n_mm():
                    f"{100 * f['rel']:.3f} % of the module", "(limit 5 %)"):
         assert number in msg, (number, msg)
     assert "load" not in kinds(messages(EXAMPLE))          # 150 N m: 0.5 um, 0.03 %
+
+
+def test_benettin_separation_below_the_default_where_switches_are_not_located():
+    """A given lyapunov_d0 below the default 1e4 rtol (within [1e-8, 1e-3]) warns with the copy
+    that does not locate its own switches (roots off, or ERK); with CVODE and roots, the
+    tangent, or the default d0 it does not. tests/test_chaos.py shows what it reads there."""
+    fields = dict(PLAUSIBLE, lyapunov=True, lyapunov_d0=1e-8, rtol=1e-8, atol=1e-10)
+    default = min(1e-3, max(1e-8, 1e4 * fields["rtol"]))
+    for extra, why in ((dict(roots=False), "roots = .false."), (dict(method="erk"), "method = 'erk'")):
+        msg = one(messages(dict(fields, **extra)), "separation")
+        for number in ("lyapunov_d0 = 1.000E-08", f"default separation {default:.3E}", why):
+            assert number in msg, (number, msg)
+    for quiet in (dict(roots=True, method="adams"), dict(roots=False, lyapunov_method="tangent"),
+                  dict(roots=False, lyapunov_d0=0.0), dict(roots=False, lyapunov_d0=default),
+                  dict(roots=False, lyapunov=False)):
+        assert messages(dict(fields, **quiet)) == [], quiet
 
 
 def test_plausible_input_warns_nothing():
