@@ -44,6 +44,8 @@ module spline_erk
     type(SUNMatrix), pointer :: amat => null()
     type(SUNLinearSolver), pointer :: ls => null()
     type(SUNNonlinearSolver), pointer :: nls => null()
+    !> ERKStep: the step that crossed the last located switch, to restart with after it
+    real(c_double) :: h_cross = 0.0_c_double
   end type integrator_t
 
   !> failed error tests allowed on one step (ARKODE's default 7 gave up on paper_lx1e-4)
@@ -134,6 +136,7 @@ contains
     if (flag /= 0) return
     t1 = tn(1) - h(1)
     if (.not. (t1 < troot)) return
+    cv%h_cross = h(1)
     flag = FERKStepGetDky(cv%mem, t1, 0_c_int, cv%sv)    ! the step's start: its own state
     if (flag == 0) flag = FERKStepRootInit(cv%mem, 0_c_int, c_null_funptr)
     if (flag == 0) flag = FERKStepReset(cv%mem, t1, cv%sv)
@@ -174,6 +177,10 @@ contains
     real(wp), intent(inout) :: stats(nstats)
     if (cv%erk) then
       flag = FERKStepReset(cv%mem, tau, cv%sv)
+      ! with the step that crossed the switch, not the landing's remainder (ERKStep's growth
+      ! limit would otherwise take several steps to recover it after every switch)
+      if (flag == 0 .and. cv%h_cross > 0.0_c_double) flag = FERKStepSetInitStep(cv%mem, cv%h_cross)
+      cv%h_cross = 0.0_c_double
     else
       call add_counters(cv, stats)
       flag = FCVodeReInit(cv%mem, tau, cv%sv)
