@@ -29,7 +29,7 @@ module spline_erk
   public :: integrator_t, erk_create, integrator_evolve, integrator_root_info, integrator_steps, &
        integrator_land_on_root, &
        integrator_restart, integrator_last_step, integrator_flag_name, integrator_name, &
-       add_counters, integrator_free
+       add_counters, integrator_free, cvode_restart_fraction
 
   !> The SUNDIALS objects of one run: CVODE's (spline_solver::cvode_setup) or ERKStep's.
   type :: integrator_t
