@@ -572,9 +572,9 @@ contains
     real(c_double) :: yf(nstate), ff(nstate)
     integer :: ierr, c, o, n
     call c_f_pointer(udata, ctx)
-    ys => FN_VGetArrayPointer(sv_y)
-    fs => FN_VGetArrayPointer(sv_f)
     n = ctx%n
+    ys => vector_data(sv_y, n*ctx%ncopy)
+    fs => vector_data(sv_f, n*ctx%ncopy)
     ierr = err_ok
     do c = 1, ctx%ncopy
       o = (c - 1)*n
@@ -605,6 +605,21 @@ contains
       end if
     end subroutine copy_rhs
   end function rhs_cb
+
+  !> The n numbers of the serial vector v. SUNDIALS' Fortran FN_VGetArrayPointer asks the
+  !> vector's length through three more calls on each use (2 % of an ERK run on chaos_z24).
+  function vector_data(v, n) result(x)
+    type(N_Vector), target, intent(in) :: v
+    integer, intent(in) :: n
+    real(c_double), pointer, contiguous :: x(:)
+    interface
+      type(c_ptr) function array_pointer(v) bind(C, name='N_VGetArrayPointer')
+        import :: c_ptr
+        type(c_ptr), value :: v
+      end function array_pointer
+    end interface
+    call c_f_pointer(array_pointer(c_loc(v)), x, [n])
+  end function vector_data
 
   integer(c_int) function roots_cb(tau, sv_y, gout, udata) result(ret) bind(C)
     real(c_double), value :: tau
