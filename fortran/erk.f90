@@ -9,7 +9,8 @@
 !> run's logic (outputs, sections, linear tail, root finding, work bounds) is one; ERKStep uses
 !> the same right-hand side, root functions and error handler (given as C function pointers and
 !> user data). Every SUNDIALS return is checked. ERKStep's dense output is its Hermite
-!> interpolant of degree 4 (one right-hand side per output time or root-function value).
+!> interpolant of degree 4 (one right-hand side per step interpolated), of degree 3 (none) at
+!> rtol >= 1e-5 (cubic_rtol).
 module spline_erk
   use, intrinsic :: iso_c_binding
   use fcvode_mod
@@ -17,6 +18,7 @@ module spline_erk
   use farkode_erkstep_mod
   use fsundials_context_mod
   use fsundials_nvector_mod
+  use fnvector_serial_mod, only: FN_VEnableFusedOps_Serial
   use fsundials_matrix_mod
   use fsundials_linearsolver_mod
   use fsundials_nonlinearsolver_mod
@@ -50,7 +52,9 @@ module spline_erk
 
   !> failed error tests allowed on one step (ARKODE's default 7 gave up on paper_lx1e-4)
   integer(c_int), parameter :: max_err_test_fails = 30
-  integer(c_int), parameter :: interpolant_degree = 4
+  !> dense output: Hermite of degree 4 (one right-hand side per step that is interpolated) where
+  !> rtol < cubic_rtol, of degree 3 (none) where looser (spline_erk::erk_create)
+  real(wp), parameter :: cubic_rtol = 1.0e-5_wp
   !> CVODE's first step after a contact switch, as a fraction of the step that crossed it. Its
   !> own estimate (CVodeReInit) chattered at loose tolerances: chaos_z24 with roots at rtol
   !> 3e-2 found 867 726 switches where tight runs find 11 200 (2.8 s; BDF at 1e-2, 4.2 s). With
@@ -78,9 +82,14 @@ contains
     cv%nroot = nroot
     cv%groots = roots
     stage = 'creating ARKODE ERKStep'
-    flag = 0
-    cv%mem = FERKStepCreate(rhs, tau, cv%sv, cv%sunctx)
-    if (.not. c_associated(cv%mem)) flag = -1
+    ! the stage sums, the solution and its error estimate as one loop each, not one vector
+    ! operation per term (N_VLinearCombination; the same operations in the same order: results
+    ! bit for bit); before ERKStep clones its vectors from cv%sv
+    flag = FN_VEnableFusedOps_Serial(cv%sv, 1_c_int)
+    if (flag == 0) then
+      cv%mem = FERKStepCreate(rhs, tau, cv%sv, cv%sunctx)
+      if (.not. c_associated(cv%mem)) flag = -1
+    end if
     if (flag == 0) flag = FERKStepSetUserData(cv%mem, ud)
     if (flag == 0) flag = FERKStepSetErrHandlerFn(cv%mem, errh, ud)
     if (flag == 0) then
@@ -96,10 +105,15 @@ contains
     ! expect: the step must shrink by orders of magnitude, more than 7 failed tries allow
     if (flag == 0) flag = FERKStepSetMaxErrTestFails(cv%mem, max_err_test_fails)
     ! dense output (outputs, root finding): Hermite of degree 4 (the most for order 5), one
-    ! right-hand side per use; with the 8th-order table degree 5 (two) gave the same F error
-    ! (paper_lx1e-4, 6401 outputs: 6.8e-8 against 8.9e-8 at rtol 1e-8; physical_z24 6.0e-5
-    ! against 4.7e-5) for 60 % more right-hand sides, degree 3 (none) 20 times the error
-    if (flag == 0) flag = FERKStepSetInterpolantDegree(cv%mem, interpolant_degree)
+    ! right-hand side per step that is interpolated (an output or the root functions in it); with
+    ! the 8th-order table degree 5 (two) gave the same F error for 60 % more right-hand sides.
+    ! Degree 3 (none) where rtol >= cubic_rtol: there the step's own error is the larger, with
+    ! Dormand-Prince (F error, degree 3 / degree 4, at rtol 1e-3, 1e-4, 1e-5: paper_lx1e-4 with
+    ! 6401 outputs 0.67, 1.05, 1.00 for 45, 42, 33 % fewer right-hand sides; physical_z24 with
+    ! roots 1.23, 1.81, 1.02 for 50, 46, 45 % fewer); tighter it is not (at 1e-6 to 1e-8 3.0, 3.3,
+    ! 4.5 and 1.6, 2.0, 1.6 times the error): docs/model.md section 8
+    if (flag == 0) flag = FERKStepSetInterpolantDegree(cv%mem, merge(3_c_int, 4_c_int, &
+         m%rtol >= cubic_rtol))
     if (flag == 0 .and. nroot > 0) then
       stage = 'setting up root finding'
       flag = FERKStepRootInit(cv%mem, nroot, roots)

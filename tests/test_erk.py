@@ -87,9 +87,24 @@ def test_roots_located_with_erk(z24):
     assert f_error(on, ref) < 1e-4 and f_error(on, ref) < 0.1 * f_error(off, ref)
 
 
-@pytest.mark.parametrize("name", ["physical_z24", "paper_lx1e-4"])
-def test_executable_matches_python_with_erk(name, exe, tmp_path):
+def test_outputs_cost_no_rhs_at_loose_rtol(z24):
+    """ERKStep's dense output: the cubic Hermite interpolant at rtol >= 1e-5 needs no
+    right-hand side (the steps do not depend on the outputs after the first, which sets the
+    initial step: 121 outputs cost what 2 do), the quartic at tighter rtol one per step that
+    holds an output."""
+    case = z24[0].replace(method="erk", roots=False, linear_tail=False, t_transient=0.01)
+    rhs = {(rt, n): pyspline.simulate(case.replace(rtol=rt, atol=rt * 1e-2, n_out=n))
+           .stats["rhs_evals"] for rt in (1e-5, 1e-6) for n in (2, 121)}
+    assert rhs[1e-5, 121] == rhs[1e-5, 2], rhs
+    assert rhs[1e-6, 2] < rhs[1e-6, 121] <= rhs[1e-6, 2] + 120, rhs
+
+
+@pytest.mark.parametrize("name, rtol", [("physical_z24", None), ("paper_lx1e-4", None),
+                                        ("physical_z24", 1e-4)])   # 1e-4: the cubic interpolant
+def test_executable_matches_python_with_erk(name, rtol, exe, tmp_path):
     case = pyspline.load_case(CASES / f"{name}.nml", t_end=0.05, n_out=321, method="erk")
+    if rtol:
+        case = case.replace(rtol=rtol, atol=rtol * 1e-2)
     nml = tmp_path / f"{name}.nml"
     case.to_namelist(nml)
     out = tmp_path / "out.csv"
