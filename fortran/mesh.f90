@@ -239,10 +239,11 @@ contains
     real(wp), intent(out), dimension(nt, m%z) :: f, fx, fy, dn
     real(wp), intent(out) :: tm(nt)
     integer, parameter :: nblk = 64
-    real(wp) :: sp(nblk, m%z), cp(nblk, m%z)
-    real(wp) :: ex(nblk), ey(nblk), evx(nblk), evy(nblk), sumf(nblk), phi, dnj, ddnj, fj, cb
-    integer :: k0, nk, i, j, k, mj
-    cb = m%c_bulk
+    real(wp) :: sp(nblk, m%z), cp(nblk, m%z), md(nblk, m%z)
+    real(wp), dimension(nblk) :: ex, ey, evx, evy, q6, v6, sumf, dnb, fb
+    real(wp) :: phi, dnj, ddnj, fj, cb, km, cm, om, e, mj, ms
+    integer :: k0, nk, i, j, k
+    cb = m%c_bulk; km = m%k_m; cm = m%c_m; om = m%omega
     do k0 = 0, nt - 1, nblk
       nk = min(nblk, nt - k0)
       do i = 1, nk
@@ -254,24 +255,33 @@ contains
         ey(i) = y(2, k) + m%l_y - y(4, k)
         evx(i) = y(8, k) - y(10, k)
         evy(i) = y(9, k) - y(11, k)
+        q6(i) = y(6, k)
+        v6(i) = y(13, k)
+        md(i, :) = real(modes(1:m%z, k), wp)      ! the block's contact states as (i, j)
       end do
       do j = 2, m%z             ! tooth_angles' rotation by the pitch, for nk outputs at once
         sp(1:nk, j) = sp(1:nk, j-1)*m%cos_pitch + cp(1:nk, j-1)*m%sin_pitch
         cp(1:nk, j) = cp(1:nk, j-1)*m%cos_pitch - sp(1:nk, j-1)*m%sin_pitch
       end do
       sumf = 0.0_wp
-      do j = 1, m%z
+      do j = 1, m%z             ! branch-free over the block's outputs (the compiler vectorises)
+        e = m%spacing_error(j)
         do i = 1, nk
+          dnj = ex(i)*sp(i, j) - ey(i)*cp(i, j) + q6(i) + e                       ! eq11
+          ddnj = evx(i)*sp(i, j) - evy(i)*cp(i, j) + v6(i) + om*(ex(i)*cp(i, j) + ey(i)*sp(i, j))
+          ms = merge(1.0_wp, 0.0_wp, dnj > cb) - merge(1.0_wp, 0.0_wp, dnj < -cb)   ! Eq. 16
+          mj = merge(ms, md(i, j), md(i, j) == 2.0_wp)      ! 2: the state decides
+          md(i, j) = mj
+          dnb(i) = dnj
+          fb(i) = km*(dnj - sign(cb, mj)) + cm*ddnj   ! Eqs. 15, 17 (mj c_bulk: +-c_bulk exactly)
+        end do
+        do i = 1, nk            ! a loop of its own: so the force is not formed under a branch
           k = k0 + i
-          call eq11(ex(i), ey(i), evx(i), evy(i), y(6, k), y(13, k), m%omega, m%spacing_error(j), &
-               sp(i, j), cp(i, j), dnj, ddnj)
-          mj = modes(j, k)
-          if (mj == 2) mj = contact_state(dnj, cb)
-          fj = merge(m%k_m*(dnj - merge(cb, -cb, mj > 0)) + m%c_m*ddnj, 0.0_wp, mj /= 0)
+          fj = merge(fb(i), 0.0_wp, md(i, j) /= 0.0_wp)
           f(k, j) = fj
           fx(k, j) = fj*sp(i, j)
           fy(k, j) = fj*cp(i, j)
-          dn(k, j) = dnj
+          dn(k, j) = dnb(i)
           sumf(i) = sumf(i) + fj
         end do
       end do
