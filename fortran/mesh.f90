@@ -230,20 +230,24 @@ contains
   !> slices: Eqs. 8-9, 11, 15-17 and 19-22 as tooth_angles and mesh_eval evaluate them,
   !> operation for operation (run.f90's tooth_outputs checks the first and last output against
   !> mesh_eval), in blocks of nblk outputs, one pass per tooth (f(k, j) is contiguous in k; the
-  !> pitch rotation of tooth_angles runs over the block's outputs at once).
-  pure subroutine mesh_outputs(m, nt, t, y, modes, f, fx, fy, dn, tm)
+  !> pitch rotation of tooth_angles runs over the block's outputs at once). finite: whether every
+  !> value written to f, fx, fy and dn is finite (x*0 is 0 for a finite x, NaN otherwise),
+  !> formed while they are in registers, so the run's checks need not read them again.
+  pure subroutine mesh_outputs(m, nt, t, y, modes, f, fx, fy, dn, tm, finite)
     type(model_t), intent(in) :: m
     integer, intent(in) :: nt
     real(wp), intent(in) :: t(nt), y(:, :)
     integer, intent(in) :: modes(:, :)
     real(wp), intent(out), dimension(nt, m%z) :: f, fx, fy, dn
     real(wp), intent(out) :: tm(nt)
+    logical, intent(out) :: finite
     integer, parameter :: nblk = 64
     real(wp) :: sp(nblk, m%z), cp(nblk, m%z), md(nblk, m%z)
-    real(wp), dimension(nblk) :: ex, ey, evx, evy, q6, v6, sumf, dnb, fb
-    real(wp) :: phi, dnj, ddnj, fj, cb, km, cm, om, e, mj, ms
+    real(wp), dimension(nblk) :: ex, ey, evx, evy, q6, v6, sumf, dnb, fb, fin
+    real(wp) :: phi, dnj, ddnj, fj, fxj, fyj, cb, km, cm, om, e, mj, ms
     integer :: k0, nk, i, j, k
     cb = m%c_bulk; km = m%k_m; cm = m%c_m; om = m%omega
+    fin = 0.0_wp
     do k0 = 0, nt - 1, nblk
       nk = min(nblk, nt - k0)
       do i = 1, nk
@@ -279,14 +283,18 @@ contains
           k = k0 + i
           fj = merge(fb(i), 0.0_wp, md(i, j) /= 0.0_wp)
           f(k, j) = fj
-          fx(k, j) = fj*sp(i, j)
-          fy(k, j) = fj*cp(i, j)
+          fxj = fj*sp(i, j)
+          fyj = fj*cp(i, j)
+          fx(k, j) = fxj
+          fy(k, j) = fyj
           dn(k, j) = dnb(i)
           sumf(i) = sumf(i) + fj
+          fin(i) = fin(i) + (fj*0.0_wp + fxj*0.0_wp) + (fyj*0.0_wp + dnb(i)*0.0_wp)
         end do
       end do
       tm(k0+1:k0+nk) = m%r_b*sumf(1:nk)
     end do
+    finite = all(fin == 0.0_wp)
   end subroutine mesh_outputs
 
   !> Eq. 16: contact state of a tooth pair, +1 drive flank (dn > c), -1 back flank (dn < -c), 0 free.
