@@ -232,7 +232,8 @@ contains
   !> mesh_eval), in blocks of nblk outputs, one pass per tooth (f(k, j) is contiguous in k; the
   !> pitch rotation of tooth_angles runs over the block's outputs at once). finite: whether every
   !> value written to f, fx, fy and dn is finite (x*0 is 0 for a finite x, NaN otherwise),
-  !> formed while they are in registers, so the run's checks need not read them again.
+  !> formed while they are in registers, so the run's checks need not read them again (.false.
+  !> also where a free tooth's unused force is not finite: then the checks read them).
   pure subroutine mesh_outputs(m, nt, t, y, modes, f, fx, fy, dn, tm, finite)
     type(model_t), intent(in) :: m
     integer, intent(in) :: nt
@@ -244,7 +245,7 @@ contains
     integer, parameter :: nblk = 64
     real(wp) :: sp(nblk, m%z), cp(nblk, m%z), md(nblk, m%z)
     real(wp), dimension(nblk) :: ex, ey, evx, evy, q6, v6, sumf, dnb, fb, fin
-    real(wp) :: phi, dnj, ddnj, fj, fxj, fyj, cb, km, cm, om, e, mj, ms
+    real(wp) :: phi, dnj, ddnj, fj, cb, km, cm, om, e, mj, ms
     integer :: k0, nk, i, j, k
     cb = m%c_bulk; km = m%k_m; cm = m%c_m; om = m%omega
     fin = 0.0_wp
@@ -278,18 +279,18 @@ contains
           md(i, j) = mj
           dnb(i) = dnj
           fb(i) = km*(dnj - sign(cb, mj)) + cm*ddnj   ! Eqs. 15, 17 (mj c_bulk: +-c_bulk exactly)
+          ! F is fb or 0, F_x F sin, F_y F cos: all finite if these are (dn holds sin and cos)
+          fin(i) = fin(i) + (dnj*0.0_wp + fb(i)*0.0_wp) + ((fb(i)*sp(i, j))*0.0_wp + &
+               (fb(i)*cp(i, j))*0.0_wp)
         end do
         do i = 1, nk            ! a loop of its own: so the force is not formed under a branch
           k = k0 + i
           fj = merge(fb(i), 0.0_wp, md(i, j) /= 0.0_wp)
           f(k, j) = fj
-          fxj = fj*sp(i, j)
-          fyj = fj*cp(i, j)
-          fx(k, j) = fxj
-          fy(k, j) = fyj
+          fx(k, j) = fj*sp(i, j)
+          fy(k, j) = fj*cp(i, j)
           dn(k, j) = dnb(i)
           sumf(i) = sumf(i) + fj
-          fin(i) = fin(i) + (fj*0.0_wp + fxj*0.0_wp) + (fyj*0.0_wp + dnb(i)*0.0_wp)
         end do
       end do
       tm(k0+1:k0+nk) = m%r_b*sumf(1:nk)
