@@ -244,7 +244,7 @@ contains
     logical, intent(out) :: finite
     integer, parameter :: nblk = 64
     real(wp) :: sp(nblk, m%z), cp(nblk, m%z), md(nblk, m%z)
-    real(wp), dimension(nblk) :: ex, ey, evx, evy, q6, v6, sumf, dnb, fb, fin
+    real(wp), dimension(nblk) :: ex, ey, evx, evy, q6, v6, sumf, fb, fin
     real(wp) :: phi, dnj, ddnj, fj, cb, km, cm, om, e, mj, ms
     integer :: k0, nk, i, j, k
     cb = m%c_bulk; km = m%k_m; cm = m%c_m; om = m%omega
@@ -277,7 +277,7 @@ contains
           ms = merge(1.0_wp, 0.0_wp, dnj > cb) - merge(1.0_wp, 0.0_wp, dnj < -cb)   ! Eq. 16
           mj = merge(ms, md(i, j), md(i, j) == 2.0_wp)      ! 2: the state decides
           md(i, j) = mj
-          dnb(i) = dnj
+          dn(k0+i, j) = dnj
           fb(i) = km*(dnj - sign(cb, mj)) + cm*ddnj   ! Eqs. 15, 17 (mj c_bulk: +-c_bulk exactly)
           ! F is fb or 0, F_x F sin, F_y F cos: all finite if these are (dn holds sin and cos)
           fin(i) = fin(i) + (dnj*0.0_wp + fb(i)*0.0_wp) + ((fb(i)*sp(i, j))*0.0_wp + &
@@ -289,7 +289,6 @@ contains
           f(k, j) = fj
           fx(k, j) = fj*sp(i, j)
           fy(k, j) = fj*cp(i, j)
-          dn(k, j) = dnb(i)
           sumf(i) = sumf(i) + fj
         end do
       end do
