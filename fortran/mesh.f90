@@ -232,8 +232,7 @@ contains
   !> mesh_eval), in blocks of nblk outputs, one pass per tooth (f(k, j) is contiguous in k; the
   !> pitch rotation of tooth_angles runs over the block's outputs at once). finite: whether every
   !> value written to f, fx, fy and dn is finite (x*0 is 0 for a finite x, NaN otherwise),
-  !> formed while they are in registers, so the run's checks need not read them again (.false.
-  !> also where a free tooth's unused force is not finite: then the checks read them).
+  !> formed while they are in registers, so the run's checks need not read them again.
   pure subroutine mesh_outputs(m, nt, t, y, modes, f, fx, fy, dn, tm, finite)
     type(model_t), intent(in) :: m
     integer, intent(in) :: nt
@@ -243,10 +242,10 @@ contains
     real(wp), intent(out) :: tm(nt)
     logical, intent(out) :: finite
     integer, parameter :: nblk = 64
-    real(wp) :: sp(nblk, m%z), cp(nblk, m%z), md(nblk, m%z)
-    real(wp), dimension(nblk) :: ex, ey, evx, evy, q6, v6, sumf, fb, fin
-    real(wp) :: phi, dnj, ddnj, fj, cb, km, cm, om, e, mj, ms
-    integer :: k0, nk, i, j, k
+    real(wp) :: sp(nblk, m%z), cp(nblk, m%z)
+    real(wp), dimension(nblk) :: ex, ey, evx, evy, sumf, fin
+    real(wp) :: phi, dnj, ddnj, fj, fxj, fyj, cb, km, cm, om
+    integer :: k0, nk, i, j, k, mi
     cb = m%c_bulk; km = m%k_m; cm = m%c_m; om = m%omega
     fin = 0.0_wp
     do k0 = 0, nt - 1, nblk
@@ -260,36 +259,28 @@ contains
         ey(i) = y(2, k) + m%l_y - y(4, k)
         evx(i) = y(8, k) - y(10, k)
         evy(i) = y(9, k) - y(11, k)
-        q6(i) = y(6, k)
-        v6(i) = y(13, k)
-        md(i, :) = real(modes(1:m%z, k), wp)      ! the block's contact states as (i, j)
       end do
       do j = 2, m%z             ! tooth_angles' rotation by the pitch, for nk outputs at once
         sp(1:nk, j) = sp(1:nk, j-1)*m%cos_pitch + cp(1:nk, j-1)*m%sin_pitch
         cp(1:nk, j) = cp(1:nk, j-1)*m%cos_pitch - sp(1:nk, j-1)*m%sin_pitch
       end do
       sumf = 0.0_wp
-      do j = 1, m%z             ! branch-free over the block's outputs (the compiler vectorises)
-        e = m%spacing_error(j)
+      do j = 1, m%z    ! scalar: a branch-free form the compiler vectorises measured slower
         do i = 1, nk
-          dnj = ex(i)*sp(i, j) - ey(i)*cp(i, j) + q6(i) + e                       ! eq11
-          ddnj = evx(i)*sp(i, j) - evy(i)*cp(i, j) + v6(i) + om*(ex(i)*cp(i, j) + ey(i)*sp(i, j))
-          ms = merge(1.0_wp, 0.0_wp, dnj > cb) - merge(1.0_wp, 0.0_wp, dnj < -cb)   ! Eq. 16
-          mj = merge(ms, md(i, j), md(i, j) == 2.0_wp)      ! 2: the state decides
-          md(i, j) = mj
-          dn(k0+i, j) = dnj
-          fb(i) = km*(dnj - sign(cb, mj)) + cm*ddnj   ! Eqs. 15, 17 (mj c_bulk: +-c_bulk exactly)
-          ! F is fb or 0, F_x F sin, F_y F cos: all finite if these are (dn holds sin and cos)
-          fin(i) = fin(i) + (dnj*0.0_wp + fb(i)*0.0_wp) + ((fb(i)*sp(i, j))*0.0_wp + &
-               (fb(i)*cp(i, j))*0.0_wp)
-        end do
-        do i = 1, nk            ! a loop of its own: so the force is not formed under a branch
           k = k0 + i
-          fj = merge(fb(i), 0.0_wp, md(i, j) /= 0.0_wp)
+          call eq11(ex(i), ey(i), evx(i), evy(i), y(6, k), y(13, k), om, m%spacing_error(j), &
+               sp(i, j), cp(i, j), dnj, ddnj)
+          mi = modes(j, k)
+          if (mi == 2) mi = contact_state(dnj, cb)
+          fj = merge(km*(dnj - merge(cb, -cb, mi > 0)) + cm*ddnj, 0.0_wp, mi /= 0)
+          fxj = fj*sp(i, j)
+          fyj = fj*cp(i, j)
           f(k, j) = fj
-          fx(k, j) = fj*sp(i, j)
-          fy(k, j) = fj*cp(i, j)
+          fx(k, j) = fxj
+          fy(k, j) = fyj
+          dn(k, j) = dnj
           sumf(i) = sumf(i) + fj
+          fin(i) = fin(i) + (dnj*0.0_wp + fj*0.0_wp) + (fxj*0.0_wp + fyj*0.0_wp)
         end do
       end do
       tm(k0+1:k0+nk) = m%r_b*sumf(1:nk)
