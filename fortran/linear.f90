@@ -193,23 +193,20 @@ contains
   end subroutine tail_state
 
   !> The tail at the ascending scaled times taus(i) (>= its start) into ys(:, i), as tail_state
-  !> (bit for bit) at every nanchor-th time (the anchors); between those, when the times are
-  !> uniformly spaced (h, to the round-off of their computation), the motion about the
-  !> equilibrium, x = ys - y*, m steps after its anchor x_a as P^m x_a with the real step matrix
-  !> P = Re(V diag(exp(lambda h)) V^-1) and its powers P^m = P P^(m-1) (m < nanchor): all of
-  !> them in one matrix product of the stacked powers and the anchors (no chain of dependent
-  !> n x n products per time; instead of n complex exponentials and an n x n complex product
-  !> per time). Each power adds round-off of order n eps |P| |P^(m-1)|, at most nanchor - 1 of
-  !> them (about 1e-13 of the motion; tests/fortran/test_linear.f90).
+  !> (bit for bit) at every nanchor-th time; between those, when the times are uniformly spaced
+  !> (h, to the round-off of their computation), the motion about the equilibrium,
+  !> x = ys - y*, advanced by the real step matrix P = Re(V diag(exp(lambda h)) V^-1):
+  !> one real n x n product per time instead of n complex exponentials and an n x n complex
+  !> product. Each step adds round-off of order n eps |P| |x|, at most nanchor - 1 steps from
+  !> an exact anchor (about 1e-13 of the motion; tests/fortran/test_linear.f90).
   subroutine tail_states(tl, taus, ys)
     type(tail_t), intent(in) :: tl
     real(wp), intent(in) :: taus(:)
     real(wp), intent(out) :: ys(:, :)
     integer, parameter :: nanchor = 32
     complex(wp) :: vh(tl%n, tl%n)
-    real(wp) :: p(tl%n, tl%n), pm(tl%n, tl%n), h
-    real(wp), allocatable :: q(:, :), xa(:, :), xb(:, :)
-    integer :: i, j, n, nt, na, a, mi
+    real(wp) :: p(tl%n, tl%n), x(tl%n), xn(tl%n), h
+    integer :: i, j, n, nt
     logical :: uniform
     n = tl%n
     nt = size(taus)
@@ -218,38 +215,24 @@ contains
       h = (taus(nt) - taus(1))/(nt - 1)
       uniform = all(abs(taus(2:) - taus(:nt-1) - h) <= 16*epsilon(h)*abs(taus(nt)))
     end if
-    if (.not. uniform) then
-      do i = 1, nt
-        call tail_state(tl, taus(i), ys(:, i))
+    if (uniform) then
+      do j = 1, n
+        vh(:, j) = tl%v(:, j)*exp(tl%lam(j)*h)
       end do
-      return
+      p = real(matmul(vh, tl%w))
     end if
-    do j = 1, n
-      vh(:, j) = tl%v(:, j)*exp(tl%lam(j)*h)
-    end do
-    p = real(matmul(vh, tl%w))
-    allocate(q(n*(nanchor - 1), n))     ! the powers P^m stacked: rows (m - 1) n + 1 .. m n
-    pm = p
-    q(1:n, :) = p
-    do mi = 2, nanchor - 1
-      pm = matmul(p, pm)
-      q((mi - 1)*n + 1:mi*n, :) = pm
-    end do
-    na = (nt - 1)/nanchor + 1           ! the anchors: times 1, 1 + nanchor, ...
-    allocate(xa(n, na))
-    do a = 1, na
-      xa(:, a) = real(matmul(tl%v, tl%c*exp(tl%lam*(taus((a - 1)*nanchor + 1) - tl%tau0))))
-    end do
-    xb = matmul(q, xa)                  ! column a: the nanchor - 1 times after anchor a
     do i = 1, nt
-      a = (i - 1)/nanchor + 1
-      mi = mod(i - 1, nanchor)
-      ys(:, i) = tl%held
-      if (mi == 0) then
-        ys(tl%idx(1:n), i) = tl%ystar + xa(:, a)
+      if (uniform .and. mod(i - 1, nanchor) /= 0) then
+        xn = 0.0_wp
+        do j = 1, n                    ! P x by columns (n ~ 14: no library call)
+          xn = xn + p(:, j)*x(j)
+        end do
+        x = xn
       else
-        ys(tl%idx(1:n), i) = tl%ystar + xb((mi - 1)*n + 1:mi*n, a)
+        x = real(matmul(tl%v, tl%c*exp(tl%lam*(taus(i) - tl%tau0))))
       end if
+      ys(:, i) = tl%held
+      ys(tl%idx(1:n), i) = tl%ystar + x
     end do
   end subroutine tail_states
 
