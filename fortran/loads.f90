@@ -39,10 +39,10 @@ contains
   !> The flank a tooth is in contact on at one output: 0 free (F_j = 0, Eqs. 15-17: |dn_j| <=
   !> c_j), else the sign of dn_j (+1: dn_j > c_j, -1: dn_j < -c_j; the sign of the elastic
   !> force, docs/model.md section 1; for a sliced face the face centre's).
-  !> As a real (free: +-0) and branch-free, so that run_loads' pass over the outputs vectorises.
-  elemental real(wp) function tooth_flank(f, dn)
+  pure integer function tooth_flank(f, dn)
     real(wp), intent(in) :: f, dn
-    tooth_flank = merge(1.0_wp, -1.0_wp, dn > 0.0_wp)*merge(1.0_wp, 0.0_wp, f /= 0.0_wp)
+    tooth_flank = 0
+    if (f /= 0.0_wp) tooth_flank = merge(1, -1, dn > 0.0_wp)
   end function tooth_flank
 
   !> The drive flank: the flank every tooth is on at the static equilibrium under T_d (docs/
@@ -86,11 +86,9 @@ contains
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t(:), y(:, :), tooth(:, :, :), tm(:)
     real(wp), intent(out) :: loads(nload), tload(m%z, nload_tooth)
-    integer :: nt, i, j, k, b, drive, onsets, nb, nfree, nback, nons, klast
-    logical :: on
-    real(wp) :: acc(4)
-    integer, allocatable :: rev(:), kb(:)
-    real(wp), allocatable :: free_b(:, :), back_b(:, :), ons_b(:), fl(:)
+    integer :: nt, j, k, fl, prev, drive, onsets, nb, nfree, nback, nons
+    integer, allocatable :: rev(:)
+    real(wp), allocatable :: free_b(:, :), back_b(:, :), ons_b(:)
     real(wp) :: fs, tfm, speed, fpk
     nt = size(t)
     loads = 0.0_wp; tload = 0.0_wp
@@ -107,49 +105,27 @@ contains
       rev(k) = int(m%omega*(t(k) - t(1))/(2.0_wp*pi)) + 1
       if (rev(k) > nb) rev(k) = 0
     end do
-    ! rev is nondecreasing: revolution b holds the outputs kb(b)..kb(b+1)-1
-    allocate(kb(max(nb, 1) + 1), fl(nt))
-    kb = 1 + count(rev > 0)
-    do k = nt, 1, -1
-      if (rev(k) > 0) kb(rev(k)) = k
-    end do
-    do b = nb, 1, -1
-      kb(b) = min(kb(b), kb(b + 1))
-    end do
     free_b = 0.0_wp; back_b = 0.0_wp; ons_b = 0.0_wp
-    do j = 1, m%z        ! per tooth, branch-free passes over the outputs (the compiler vectorises;
-      ! tooth_flank is private, so it is inlined: a public function was a call per output)
-      acc = 0.0_wp      ! max |F| in 4 partial maxima (one would be a chain of dependent maxsd)
-      do k = 1, nt - 3, 4
-        do i = 1, 4
-          acc(i) = merge(abs(tooth(k+i-1, j, 1)), acc(i), abs(tooth(k+i-1, j, 1)) > acc(i))
-        end do
+    do j = 1, m%z        ! tooth_flank is private, so the compiler inlines it (a public one was a call)
+      prev = 0
+      fpk = 0.0_wp
+      nfree = 0; nback = 0; nons = 0
+      do k = 1, nt
+        fpk = max(fpk, abs(tooth(k, j, 1)))
+        fl = tooth_flank(tooth(k, j, 1), tooth(k, j, 4))
+        if (fl == 0) nfree = nfree + 1
+        if (fl == -drive) nback = nback + 1
+        if (rev(k) > 0) then
+          if (fl == 0) free_b(rev(k), j) = free_b(rev(k), j) + 1
+          if (fl == -drive) back_b(rev(k), j) = back_b(rev(k), j) + 1
+        end if
+        if (k > 1 .and. fl /= 0 .and. fl /= prev) then
+          nons = nons + 1
+          speed = max(speed, approach_speed(m, t(k - 1), y(:, k - 1), j))
+          if (rev(k) > 0) ons_b(rev(k)) = ons_b(rev(k)) + 1
+        end if
+        prev = fl
       end do
-      do k = nt - mod(nt, 4) + 1, nt
-        acc(1) = merge(abs(tooth(k, j, 1)), acc(1), abs(tooth(k, j, 1)) > acc(1))
-      end do
-      fpk = max(max(acc(1), acc(2)), max(acc(3), acc(4)))
-      fl = tooth_flank(tooth(:, j, 1), tooth(:, j, 4))
-      nfree = count(fl == 0.0_wp)
-      nback = count(fl == -drive)
-      nons = 0; klast = 0  ! onsets (in contact, and not as before) and the last one
-      do k = 2, nt
-        on = fl(k)*(fl(k) - fl(k - 1)) /= 0.0_wp
-        nons = nons + merge(1, 0, on)
-        klast = max(klast, merge(k, 0, on))
-      end do
-      do b = 1, nb
-        free_b(b, j) = count(fl(kb(b):kb(b+1)-1) == 0.0_wp)
-        back_b(b, j) = count(fl(kb(b):kb(b+1)-1) == -drive)
-      end do
-      if (nons > 0) then   ! the onsets: their closing speeds and revolutions
-        do k = 2, klast
-          if (fl(k) /= 0.0_wp .and. fl(k) /= fl(k - 1)) then
-            speed = max(speed, approach_speed(m, t(k - 1), y(:, k - 1), j))
-            if (rev(k) > 0) ons_b(rev(k)) = ons_b(rev(k)) + 1
-          end if
-        end do
-      end if
       tload(j, ilt_f_peak) = fpk
       tload(j, ilt_free) = nfree
       tload(j, ilt_back) = nback
@@ -279,7 +255,7 @@ contains
     real(wp), intent(in) :: y(:, :), tooth(:, :, :), tm(:), fs
     real(wp), intent(inout) :: free_b(:, :), back_b(:, :), ons_b(:)
     real(wp), intent(inout) :: loads(nload), tload(m%z, nload_tooth)
-    real(wp), allocatable :: sq(:), fmax(:), cnt(:), sqf(:), sqd(:), tfb(:), s2(:), am(:)
+    real(wp), allocatable :: sq(:), fmax(:), cnt(:), sqf(:), sqd(:), tfb(:)
     real(wp) :: nan
     integer :: nb, b, k, j
     nan = ieee_value(0.0_wp, ieee_quiet_nan)
@@ -293,23 +269,13 @@ contains
     if (nb < 2) return
     allocate(sq(nb), fmax(nb), cnt(nb), sqf(nb), sqd(nb), tfb(nb))
     sq = 0.0_wp; fmax = 0.0_wp; cnt = 0.0_wp; sqf = 0.0_wp; sqd = 0.0_wp; tfb = 0.0_wp
-    ! per output, over the teeth in their order (sum(tooth(k, :, 1)**2), tooth by tooth, so
-    ! that the passes run along the contiguous outputs)
-    allocate(s2(size(rev)), am(size(rev)))
-    s2 = 0.0_wp; am = 0.0_wp
-    do j = 1, m%z
-      do k = 1, size(rev)
-        s2(k) = s2(k) + tooth(k, j, 1)**2
-        am(k) = merge(abs(tooth(k, j, 1)), am(k), abs(tooth(k, j, 1)) > am(k))
-      end do
-    end do
     do k = 1, size(rev)
       b = rev(k)
       if (b == 0) cycle
       sq(b) = sq(b) + tm(k)**2
       cnt(b) = cnt(b) + 1
-      fmax(b) = max(fmax(b), am(k))
-      sqf(b) = sqf(b) + s2(k)
+      fmax(b) = max(fmax(b), maxval(abs(tooth(k, :, 1))))
+      sqf(b) = sqf(b) + sum(tooth(k, :, 1)**2)
       sqd(b) = sqd(b) + y(6, k)**2
       if (size(tooth, 3) >= iq_tf) tfb(b) = max(tfb(b), maxval(tooth(k, :, iq_tf)))
     end do
