@@ -85,8 +85,9 @@ CASES = ("paper_lx1e-4", "paper_T100", "physical_lx1e-4")
 OUTPUT_TARGET_US = 0.1     # per output time at Z = 16 (issue "Ahead of the strongest peer")
 
 
-def output_cost(case, repeat=15):
-    """Wall seconds per output time: the case's run against a run that integrates the same way
+def output_cost(case, repeat=15, clock=time.perf_counter):
+    """Wall seconds per output time (clock=time.process_time: CPU seconds, steadier on a shared
+    host, which takes the core from a run): the case's run against a run that integrates the same way
     with few output times, alternating, repeat times each. Where the run takes the linear tail
     (paper_lx1e-4), the few-output run is the same case up to the output after the tail's start
     (the integration is what the case's run does, the tail's outputs are what is measured); else
@@ -107,9 +108,9 @@ def output_cost(case, repeat=15):
     many_s, few_s, step_s = [], [], []
     for _ in range(repeat):
         for c, acc in ((case, many_s), (few, few_s)):
-            t0 = time.perf_counter()
+            t0 = clock()
             res = simulate(c)
-            acc.append(time.perf_counter() - t0)
+            acc.append(clock() - t0)
         step_s.append(res.stats["core_wall_s"]/max(res.stats["steps"], 1))
     n = case["n_out"] - few["n_out"]
     per = sorted((a - b - extra*s)/n for a, b, s in zip(many_s, few_s, step_s))
@@ -117,9 +118,9 @@ def output_cost(case, repeat=15):
             statistics.median(few_s), few["n_out"])
 
 
-def format_output_cost(name, case, cost) -> str:
+def format_output_cost(name, case, cost, what="") -> str:
     med, lo, hi, many, few, n_few = cost
-    return (f"outputs {name} (Z = {case['z']}, n_out = {case['n_out']}): {med*1e6:.3f} us per "
+    return (f"outputs {name}{what} (Z = {case['z']}, n_out = {case['n_out']}): {med*1e6:.3f} us per "
             f"output time (range {lo*1e6:.3f}..{hi*1e6:.3f}; runs {many*1e3:.2f} ms against "
             f"{few*1e3:.2f} ms with {n_few}), target {OUTPUT_TARGET_US} us: ratio "
             f"{med*1e6/OUTPUT_TARGET_US:.1f}")

@@ -205,7 +205,9 @@ contains
     real(wp), intent(out) :: ys(:, :)
     integer, parameter :: nanchor = 32
     complex(wp) :: vh(tl%n, tl%n)
-    real(wp) :: p(tl%n, tl%n), x(tl%n), xn(tl%n), h
+    ! fixed size (nstate; the rows and columns past n zero, never used): the compiler keeps the
+    ! product's 14 sums in registers (with n's size they went through memory at every column)
+    real(wp) :: p(nstate, nstate), x(nstate), xn(nstate), h
     integer :: i, j, n, nt
     logical :: uniform
     n = tl%n
@@ -215,11 +217,12 @@ contains
       h = (taus(nt) - taus(1))/(nt - 1)
       uniform = all(abs(taus(2:) - taus(:nt-1) - h) <= 16*epsilon(h)*abs(taus(nt)))
     end if
+    p = 0.0_wp; x = 0.0_wp
     if (uniform) then
       do j = 1, n
         vh(:, j) = tl%v(:, j)*exp(tl%lam(j)*h)
       end do
-      p = real(matmul(vh, tl%w))
+      p(1:n, 1:n) = real(matmul(vh, tl%w))
     end if
     do i = 1, nt
       if (uniform .and. mod(i - 1, nanchor) /= 0) then
@@ -229,10 +232,10 @@ contains
         end do
         x = xn
       else
-        x = real(matmul(tl%v, tl%c*exp(tl%lam*(taus(i) - tl%tau0))))
+        x(1:n) = real(matmul(tl%v, tl%c*exp(tl%lam*(taus(i) - tl%tau0))))
       end if
       ys(:, i) = tl%held
-      ys(tl%idx(1:n), i) = tl%ystar + x
+      ys(tl%idx(1:n), i) = tl%ystar + x(1:n)
     end do
   end subroutine tail_states
 

@@ -238,19 +238,24 @@ contains
   !> slices: Eqs. 8-9, 11, 15-17 and 19-22 as tooth_angles and mesh_eval evaluate them,
   !> operation for operation (run.f90's tooth_outputs checks the first and last output against
   !> mesh_eval), in blocks of nblk outputs, one pass per tooth (f(k, j) is contiguous in k; the
-  !> pitch rotation of tooth_angles runs over the block's outputs at once).
-  pure subroutine mesh_outputs(m, nt, t, y, modes, f, fx, fy, dn, tm)
+  !> pitch rotation of tooth_angles runs over the block's outputs at once). finite: whether every
+  !> value written to f, fx, fy and dn is finite (x*0 is 0 for a finite x, NaN otherwise),
+  !> formed while they are in registers, so the run's checks need not read them again.
+  pure subroutine mesh_outputs(m, nt, t, y, modes, f, fx, fy, dn, tm, finite)
     type(model_t), intent(in) :: m
     integer, intent(in) :: nt
     real(wp), intent(in) :: t(nt), y(:, :)
     integer, intent(in) :: modes(:, :)
     real(wp), intent(out), dimension(nt, m%z) :: f, fx, fy, dn
     real(wp), intent(out) :: tm(nt)
+    logical, intent(out) :: finite
     integer, parameter :: nblk = 64
     real(wp) :: sp(nblk, m%z), cp(nblk, m%z)
-    real(wp) :: ex(nblk), ey(nblk), evx(nblk), evy(nblk), sumf(nblk), phi, dnj, ddnj, fj, cb
-    integer :: k0, nk, i, j, k, mj
-    cb = m%c_bulk
+    real(wp), dimension(nblk) :: ex, ey, evx, evy, sumf, fin
+    real(wp) :: phi, dnj, ddnj, fj, fxj, fyj, cb, km, cm, om
+    integer :: k0, nk, i, j, k, mi
+    cb = m%c_bulk; km = m%k_m; cm = m%c_m; om = m%omega
+    fin = 0.0_wp
     do k0 = 0, nt - 1, nblk
       nk = min(nblk, nt - k0)
       do i = 1, nk
@@ -268,23 +273,27 @@ contains
         cp(1:nk, j) = cp(1:nk, j-1)*m%cos_pitch - sp(1:nk, j-1)*m%sin_pitch
       end do
       sumf = 0.0_wp
-      do j = 1, m%z
+      do j = 1, m%z    ! scalar: a branch-free form the compiler vectorises measured slower
         do i = 1, nk
           k = k0 + i
-          call eq11(ex(i), ey(i), evx(i), evy(i), y(6, k), y(13, k), m%omega, m%spacing_error(j), &
+          call eq11(ex(i), ey(i), evx(i), evy(i), y(6, k), y(13, k), om, m%spacing_error(j), &
                sp(i, j), cp(i, j), dnj, ddnj)
-          mj = modes(j, k)
-          if (mj == 2) mj = contact_state(dnj, cb)
-          fj = merge(m%k_m*(dnj - merge(cb, -cb, mj > 0)) + m%c_m*ddnj, 0.0_wp, mj /= 0)
+          mi = modes(j, k)
+          if (mi == 2) mi = contact_state(dnj, cb)
+          fj = merge(km*(dnj - merge(cb, -cb, mi > 0)) + cm*ddnj, 0.0_wp, mi /= 0)
+          fxj = fj*sp(i, j)
+          fyj = fj*cp(i, j)
           f(k, j) = fj
-          fx(k, j) = fj*sp(i, j)
-          fy(k, j) = fj*cp(i, j)
+          fx(k, j) = fxj
+          fy(k, j) = fyj
           dn(k, j) = dnj
           sumf(i) = sumf(i) + fj
+          fin(i) = fin(i) + (dnj*0.0_wp + fj*0.0_wp) + (fxj*0.0_wp + fyj*0.0_wp)
         end do
       end do
       tm(k0+1:k0+nk) = m%r_b*sumf(1:nk)
     end do
+    finite = all(fin == 0.0_wp)
   end subroutine mesh_outputs
 
   !> Eq. 16: contact state of a tooth pair, +1 drive flank (dn > c), -1 back flank (dn < -c), 0 free.

@@ -68,16 +68,17 @@ contains
     real(wp) :: eps_lat, eps_th, closed, t_closed, cq(ntooth_q - 4)
     integer(8) :: c0, c1, rate
     integer :: nw
+    logical :: fin
     call system_clock(c0, rate)
     call auto_level(m, run, eps_lat, eps_th)
     call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-         face, tilt, present(nq), nw, cq)
+         face, tilt, present(nq), nw, cq, fin)
     if (ierr == err_ok .and. m%auto .and. m%thermal == thermal_coupled .and. nw >= iq_tf) then
       eps_th = backlash_estimate(m, maxval(abs(tooth(:, :, iq_tf))))
       if (eps_th > auto_tol(m)) then
         call set_thermal_level(run, thermal_coupled)
         call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-             face, tilt, present(nq), nw, cq)
+             face, tilt, present(nq), nw, cq, fin)
       end if
     end if
     if (present(nq)) then
@@ -93,7 +94,7 @@ contains
     end if
     closed = 0.0_wp; t_closed = 0.0_wp
     if (ierr == err_ok) call result_checks(run, t, y, tooth(:, :, 1:nw), tm, closed, t_closed, &
-         ierr, errmsg, sec_t, sec_y, lyap_t, lyap_g)
+         ierr, errmsg, sec_t, sec_y, lyap_t, lyap_g, fin)
     call system_clock(c1)
     stats(ist_core_wall) = real(c1 - c0, wp)/rate
     stats(ist_dof) = real(run%dof, wp)
@@ -110,20 +111,25 @@ contains
   !> and at the one-way thermal level, the samples where Eq. 2 with the flash temperature,
   !> c0 - kappa (T_M + T_f), is not positive: the coupled level would have stopped there with
   !> thermal interference (closed: their number, t_closed: the first time; a warning, see
-  !> run_warnings).
+  !> run_warnings). tooth_finite (optional): every value of tooth is known to be finite.
   subroutine result_checks(m, t, y, tooth, tm, closed, t_closed, ierr, errmsg, sec_t, sec_y, &
-       lyap_t, lyap_g)
+       lyap_t, lyap_g, tooth_finite)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t(:), y(:, :), tooth(:, :, :), tm(:)
     real(wp), intent(out) :: closed, t_closed
     integer, intent(inout) :: ierr
     character(len=*), intent(inout) :: errmsg
     real(wp), intent(in), optional :: sec_t(:), sec_y(:, :), lyap_t(:), lyap_g(:)
+    logical, intent(in), optional :: tooth_finite
     integer :: k, j, q, i, k1
+    logical :: known
     closed = 0.0_wp; t_closed = 0.0_wp
-    ! one contiguous pass over each array; the output-by-output search only to name a failure
+    known = .false.
+    if (present(tooth_finite)) known = tooth_finite
+    ! one contiguous pass over each array (tooth not again where the pass that wrote it found
+    ! every value finite: tooth_finite); the output-by-output search only to name a failure
     if (all_finite(size(t), t) .and. all_finite(size(y), y) .and. all_finite(size(tm), tm) .and. &
-         all_finite(size(tooth), tooth)) then
+         (known .or. all_finite(size(tooth), tooth))) then
       k1 = size(t) + 1
     else
       k1 = 1
@@ -223,9 +229,10 @@ contains
     end if
   end function run_warnings
 
-  !> One run of the model at the level m sets (lazy, nw, consts: run_case's nq, consts).
+  !> One run of the model at the level m sets (lazy, nw, consts: run_case's nq, consts; fin:
+  !> tooth_outputs' finite).
   subroutine run_level(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-       face, tilt, lazy, nw, consts)
+       face, tilt, lazy, nw, consts, fin)
     type(model_t), intent(in) :: m
     real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
     real(wp), intent(out) :: tm(m%n_out), stats(nstats)
@@ -236,12 +243,13 @@ contains
     logical, intent(in) :: lazy
     integer, intent(out) :: nw
     real(wp), intent(out) :: consts(ntooth_q - 4)
+    logical, intent(out) :: fin
     real(wp) :: y0(nstate)
     real(wp), allocatable :: ts(:), ysec(:, :)
     integer, allocatable :: modes(:, :)
     errmsg = ''
     stats = 0.0_wp
-    nw = ntooth_q; consts = 0.0_wp
+    nw = ntooth_q; consts = 0.0_wp; fin = .false.
     t = 0.0_wp; y = 0.0_wp
     allocate(modes(m%z*m%n_slices, m%n_out))
     call output_times(m, t)
@@ -252,9 +260,9 @@ contains
       tooth = 0.0_wp; tm = 0.0_wp
       return
     end if
-    call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt, lazy, nw, consts)
+    call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt, lazy, nw, consts, fin)
     if (ierr /= err_ok) then
-      tooth = 0.0_wp; tm = 0.0_wp; nw = ntooth_q; consts = 0.0_wp
+      tooth = 0.0_wp; tm = 0.0_wp; nw = ntooth_q; consts = 0.0_wp; fin = .false.
     end if
   contains
     subroutine integrate_level()
@@ -283,8 +291,10 @@ contains
   !> must agree with tooth_quantities (mesh_eval, the definition) to the bit at the first and the
   !> last output, else (a change to one and not the other) every output is formed by mesh_eval.
   !> lazy (optional): there, c_j, T_f, r_c1, r_c2 are not written but returned once in consts
-  !> (nw = 4 quantities written; else nw = ntooth_q, consts = 0).
-  subroutine tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt, lazy, nw, consts)
+  !> (nw = 4 quantities written; else nw = ntooth_q, consts = 0). finite (optional): there, whether
+  !> every value written to tooth is finite (mesh_outputs' finite); else .false. (not known).
+  subroutine tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt, lazy, nw, consts, &
+       finite)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t(:), y(:, :)
     integer, intent(in) :: modes(:, :)
@@ -295,10 +305,12 @@ contains
     logical, intent(in), optional :: lazy
     integer, intent(out), optional :: nw
     real(wp), intent(out), optional :: consts(ntooth_q - 4)
+    logical, intent(out), optional :: finite
     real(wp) :: row(m%z, ntooth_q), fs(m%n_slices, m%z), mt(2), cq(ntooth_q - 4)
     integer :: k, nq
-    logical :: lz
+    logical :: lz, fin
     ierr = err_ok
+    if (present(finite)) finite = .false.
     lz = .false.
     if (present(lazy)) lz = lazy
     nq = ntooth_q
@@ -306,11 +318,12 @@ contains
     if (.not. present(face) .and. m%n_slices == 1 .and. m%thermal < thermal_oneway) then
       cq = [m%c_bulk, 0.0_wp, m%r_pitch, m%r_pitch]     ! c_j, T_f, r_c1, r_c2
       if (lz) nq = 4
-      call bulk_tooth_outputs(m, t, y, modes, tooth, tm, cq, .not. lz)
+      call bulk_tooth_outputs(m, t, y, modes, tooth, tm, cq, .not. lz, fin)
       if (same_as_mesh(1) .and. same_as_mesh(size(t))) then
         if (present(nw)) then
           nw = nq; consts = cq
         end if
+        if (present(finite)) finite = fin .and. all(ieee_is_finite(cq))
         return
       end if
     end if
@@ -356,14 +369,15 @@ contains
   !> flash temperature (thermal none or bulk: T_f = 0, both contact radii on the pitch circle,
   !> c_j = c_bulk) or face slices: F, F_x, F_y and dn from spline_mesh's mesh_outputs (Eqs. 8-9,
   !> 11, 15-17, 19-22 as mesh_eval evaluates them), the constants cq (c_j, T_f, r_c1, r_c2)
-  !> filled in if fill.
-  subroutine bulk_tooth_outputs(m, t, y, modes, tooth, tm, cq, fill)
+  !> filled in if fill; finite: mesh_outputs' (every value it wrote is finite).
+  subroutine bulk_tooth_outputs(m, t, y, modes, tooth, tm, cq, fill, finite)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t(:), y(:, :), cq(ntooth_q - 4)
     integer, intent(in) :: modes(:, :)
     real(wp), intent(inout) :: tooth(:, :, :)
     real(wp), intent(out) :: tm(:)
     logical, intent(in) :: fill
+    logical, intent(out) :: finite
     integer :: q
     if (fill) then
       do q = 5, ntooth_q
@@ -371,7 +385,7 @@ contains
       end do
     end if
     call mesh_outputs(m, size(t), t, y, modes, tooth(:, :, 1), tooth(:, :, 2), tooth(:, :, 3), &
-         tooth(:, :, 4), tm)
+         tooth(:, :, 4), tm, finite)
   end subroutine bulk_tooth_outputs
 
   !> Every per-tooth quantity (order of spline_quantities tooth_q) and the meshing torque at one state y (SI):
