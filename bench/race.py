@@ -10,7 +10,9 @@ chaos_z24 no run agrees pointwise with another beyond its predictability horizon
 the statistics level when its T_m RMS and k_v quantiles (5, 50, 95 %) each lie within 3
 combined standard errors of the tightest run's (the standard errors by overlapping batch
 means over revolutions, as the core's Tm_rms_se; 3, as tests/test_stderr.py: the largest of
-four z-scores of runs that differ only by chance passes 2 about half the time).
+four z-scores of runs that differ only by chance passes 2 about half the time). Each timing
+round of this scene runs another realisation (PERTURB), and a setting is at the level when at
+most one of them misses it: judged on one run, a rung passed or missed by chance.
 
 pyspline runs every CVODE variant of speed.PYSPLINE_VARIANTS with and without root finding over
 a ladder of rtol; the peer (bench/numba_peer.py: numbalsoda's DOP853 and LSODA on a numba
@@ -38,6 +40,20 @@ SCENES = (
     ("chaos_z24, 0.5 s sampled", "chaos_z24", dict(lyapunov=False), ("statistics",)),
 )
 QUANTILES = (0.05, 0.5, 0.95)
+#: statistics level: timing round k runs realisation k, the start perturbed by dq0 = k PERTURB
+#: on D1 [m] (trajectories part within milliseconds, so each is another sample of the same
+#: statistics); a setting reaches the level when at most one realisation misses it (a single
+#: run passed or missed by chance: the largest of four z-scores)
+PERTURB = 1e-9
+
+
+def _realisation(case, k):
+    """Case of realisation k (0: the case itself)."""
+    if k == 0:
+        return case
+    dq = list(case["dq0"])
+    dq[4] += k * PERTURB
+    return case.replace(dq0=dq)
 
 
 def _case(name, fields, quick):
@@ -105,19 +121,22 @@ def race(quick=False, repeat=5, progress=print, cases=None):
         ref = simulate(case.replace(method="bdf", nonlinear="newton", roots=True, rtol=ref_rtol,
                                     atol=ref_rtol * 1e-2, max_steps=10**8))
         t_out = ref.t
-        params, y0 = _peer_fields(case), start_state(case)
+        params = _peer_fields(case)
+        cases = [_realisation(case, k) if stats_level else case for k in range(repeat)]
+        y0s = [start_state(c) for c in cases]
+        y0 = y0s[0]
         t_peer = np.r_[case["t0"], t_out] if t_out[0] > case["t0"] else t_out
 
-        def run(kind, kw):
-            """One timed run: (seconds, T_m, F)."""
+        def run(kind, kw, k=0):
+            """One timed run of realisation k: (seconds, T_m, F)."""
             if kind == "pyspline":
-                c = case.replace(**kw)
+                c = cases[k].replace(**kw)
                 t0 = time.perf_counter()
                 res = simulate(c)
                 return time.perf_counter() - t0, res.Tm, res.F
             mx = dict(mxstep=10**9) if kw["method"] == "dop853" else dict(mxstep=10**7)
             t0 = time.perf_counter()
-            y, ok, _ = peer.solve(params, y0, t_peer, rtol=kw["rtol"], atol=kw["atol"],
+            y, ok, _ = peer.solve(params, y0s[k], t_peer, rtol=kw["rtol"], atol=kw["atol"],
                                   method=kw["method"], **mx)
             wall = time.perf_counter() - t0
             if not ok:
@@ -136,29 +155,49 @@ def race(quick=False, repeat=5, progress=print, cases=None):
                          f"rtol 1e-13: F error {agree:.1e}")
         if stats_level:
             ref_stat, ref_se = statistics_of(case, t_out, ref.Tm)
+
+        def z_max(tm):
+            """The largest z-score of a run's statistics against the reference's."""
+            st, se = statistics_of(case, t_out, tm)
+            d, spread = np.abs(st - ref_stat), np.sqrt(se**2 + ref_se**2)
+            # a statistic constant over the revolutions (k_v's 5 % quantile is 0 where teeth
+            # rattle free) agrees when equal
+            z = np.where(d == 0, 0.0, d / np.where(spread > 0, spread, np.inf))
+            z[(d > 0) & (spread == 0)] = np.inf
+            return float(z.max()), float(st[0])
+
         recs = []
         for kind, label, kw, rt in settings:
-            rec = dict(scene=scene, side=kind, setting=label, rtol=rt, times=[])
+            rec = dict(scene=scene, side=kind, setting=label, rtol=rt, times=[], z=[])
             try:
                 wall, tm, F = run(kind, kw)
                 rec["times"].append(wall)
                 if stats_level:
-                    st, se = statistics_of(case, t_out, tm)
-                    d, spread = np.abs(st - ref_stat), np.sqrt(se**2 + ref_se**2)
-                    # a statistic constant over the revolutions (k_v's 5 % quantile is 0 where
-                    # teeth rattle free) agrees when equal
-                    z = np.where(d == 0, 0.0, d / np.where(spread > 0, spread, np.inf))
-                    z[(d > 0) & (spread == 0)] = np.inf
-                    rec.update(z_max=float(z.max()), err=float("nan"), tm_rms=float(st[0]))
+                    z, rms = z_max(tm)
+                    rec["z"].append(z)
+                    rec.update(err=float("nan"), tm_rms=rms)
                 else:
                     rec["err"] = float(np.abs(F - ref.F).max() / np.abs(ref.F).max())
             except Exception as exc:     # noqa: BLE001  (a failed run is kept, with its reason)
-                rec.update(err=float("nan"), z_max=float("nan"), failed=str(exc)[:100])
+                rec.update(err=float("nan"), failed=str(exc)[:100])
             recs.append(rec)
-        for _ in range(repeat - 1):       # further rounds: every setting once per round
+        for k in range(1, repeat):        # further rounds: every setting once per round
             for rec, (kind, label, kw, rt) in zip(recs, settings):
-                if "failed" not in rec:
-                    rec["times"].append(run(kind, kw)[0])
+                if "failed" in rec:
+                    continue
+                try:
+                    wall, tm, _ = run(kind, kw, k)
+                except Exception as exc:     # noqa: BLE001
+                    rec["failed"] = f"realisation {k}: {str(exc)[:80]}"
+                    continue
+                rec["times"].append(wall)
+                if stats_level:
+                    rec["z"].append(z_max(tm)[0])
+        for rec in recs:
+            zs = rec.pop("z")
+            rec["z_max"] = max(zs) if zs else float("nan")
+            rec["passed"] = sum(z <= 3.0 for z in zs) if zs else 0
+            rec["realisations"] = len(zs)
         for rec in recs:
             rec["median_s"] = statistics.median(rec["times"]) if rec["times"] else float("nan")
         runs += recs
@@ -166,7 +205,9 @@ def race(quick=False, repeat=5, progress=print, cases=None):
             def ok(r, acc=acc):
                 if "failed" in r:
                     return False
-                return r["z_max"] <= 3.0 if acc == "statistics" else r["err"] <= acc
+                if acc == "statistics":        # at most one realisation misses the level
+                    return r["passed"] >= max(1, r["realisations"] - 1)
+                return r["err"] <= acc
             best = {}
             for side in ("pyspline", "peer DOP853", "peer LSODA"):
                 cand = [r for r in recs if ok(r) and (r["side"] == side or
