@@ -122,15 +122,15 @@ def race(quick=False, repeat=5, progress=print, cases=None):
                                     atol=ref_rtol * 1e-2, max_steps=10**8))
         t_out = ref.t
         params = _peer_fields(case)
-        cases = [_realisation(case, k) if stats_level else case for k in range(repeat)]
-        y0s = [start_state(c) for c in cases]
+        reals = [_realisation(case, k) if stats_level else case for k in range(repeat)]
+        y0s = [start_state(c) for c in reals]
         y0 = y0s[0]
         t_peer = np.r_[case["t0"], t_out] if t_out[0] > case["t0"] else t_out
 
         def run(kind, kw, k=0):
             """One timed run of realisation k: (seconds, T_m, F)."""
             if kind == "pyspline":
-                c = cases[k].replace(**kw)
+                c = reals[k].replace(**kw)
                 t0 = time.perf_counter()
                 res = simulate(c)
                 return time.perf_counter() - t0, res.Tm, res.F
