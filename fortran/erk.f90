@@ -31,7 +31,7 @@ module spline_erk
   public :: integrator_t, erk_create, integrator_evolve, integrator_root_info, integrator_steps, &
        integrator_land_on_root, &
        integrator_restart, integrator_last_step, integrator_flag_name, integrator_name, &
-       add_counters, integrator_free, cvode_restart_fraction
+       add_counters, integrator_free, cvode_restart
 
   !> The SUNDIALS objects of one run: CVODE's (spline_solver::cvode_setup) or ERKStep's.
   type :: integrator_t
@@ -197,18 +197,28 @@ contains
     type(integrator_t), intent(inout) :: cv
     real(c_double), intent(in) :: tau
     real(wp), intent(inout) :: stats(nstats)
-    real(c_double) :: hl(1)
     if (cv%erk) then
       flag = FERKStepReset(cv%mem, tau, cv%sv)
       if (flag == 0 .and. cv%h_cross > 0.0_c_double) flag = FERKStepSetInitStep(cv%mem, cv%h_cross)
       cv%h_cross = 0.0_c_double
     else
       call add_counters(cv, stats)
-      flag = FCVodeGetLastStep(cv%mem, hl)
-      if (flag == 0) flag = FCVodeSetInitStep(cv%mem, cvode_restart_fraction*hl(1))
-      if (flag == 0) flag = FCVodeReInit(cv%mem, tau, cv%sv)
+      flag = cvode_restart(cv%mem, tau, cv%sv)
     end if
   end function integrator_restart
+
+  !> CVODE (mem) restarted at tau from sv after a contact switch: CVodeReInit, at order 1 with
+  !> cvode_restart_fraction of the step that crossed the switch (integrator_restart, and the
+  !> variational run of spline_variational).
+  integer(c_int) function cvode_restart(mem, tau, sv) result(flag)
+    type(c_ptr), intent(in) :: mem
+    real(c_double), intent(in) :: tau
+    type(N_Vector), intent(inout) :: sv
+    real(c_double) :: hl(1)
+    flag = FCVodeGetLastStep(mem, hl)
+    if (flag == 0) flag = FCVodeSetInitStep(mem, cvode_restart_fraction*hl(1))
+    if (flag == 0) flag = FCVodeReInit(mem, tau, sv)
+  end function cvode_restart
 
   integer(c_int) function integrator_last_step(cv, h) result(flag)
     type(integrator_t), intent(inout) :: cv

@@ -28,7 +28,7 @@ module spline_variational
   use spline_geometry, only: tooth_angles
   use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, integrated_states
   use spline_mesh, only: mesh_switch_functions
-  use spline_erk, only: cvode_restart_fraction
+  use spline_erk, only: cvode_restart
   implicit none
   private
   public :: rhs_jacobian, tangent_flow, variational_check
@@ -144,7 +144,7 @@ contains
     type(SUNMatrix), pointer :: amat
     type(SUNLinearSolver), pointer :: ls
     type(SUNNonlinearSolver), pointer :: nls
-    real(c_double) :: tau, tau1, tret(1), hl(1)
+    real(c_double) :: tau, tau1, tret(1)
     integer(c_int) :: flag, nroot
     integer(c_int), allocatable :: rootsfound(:)
     integer(c_long) :: cnt(1)
@@ -210,10 +210,8 @@ contains
           exit
         end if
         if (FCVodeGetNumSteps(mem, cnt) == 0) done = done + cnt(1)
-        stage = 'restarting at a contact switch'     ! as spline_erk::integrator_restart
-        flag = FCVodeGetLastStep(mem, hl)
-        if (flag == 0) flag = FCVodeSetInitStep(mem, cvode_restart_fraction*hl(1))
-        if (flag == 0) flag = FCVodeReInit(mem, tau, sv)
+        stage = 'restarting at a contact switch'
+        flag = cvode_restart(mem, tau, sv)
       else
         flag = 0
       end if
