@@ -19,6 +19,28 @@ def exe():
     return path
 
 
+def assert_executable_matches_python(case, exe, tmp_path):
+    """spline-dyn on `case` (written as a namelist) gives what pyspline.simulate gives, bit for
+    bit: t, D2, T_m and every tooth's F. Returns the CSV's header, its columns by name, its data
+    and the Result, for further checks."""
+    import subprocess
+
+    import numpy as np
+    import pyspline
+    nml = tmp_path / f"{case['name']}.nml"
+    case.to_namelist(nml)
+    out = tmp_path / "out.csv"
+    subprocess.run([exe, str(nml), "-o", str(out)], check=True, capture_output=True)
+    header, data = pyspline.core.read_csv(out)
+    res = pyspline.simulate(case)
+    col = {h.split(" [")[0]: i for i, h in enumerate(header)}
+    np.testing.assert_array_equal(data[:, col["t"]], res.t)
+    np.testing.assert_array_equal(data[:, col["D2"]], res.D2)
+    np.testing.assert_array_equal(data[:, col["Tm"]], res.Tm)
+    np.testing.assert_array_equal(data[:, col["F_1"]:col["F_1"] + case["z"]], res.tooth["F"])
+    return header, col, data, res
+
+
 PAPER = dict(k_m=2.3e5, m_1=2.0, m_2=2.0)
 
 #: Warnings a test module expects from the shipped cases it uses and declares with pytestmark

@@ -1,14 +1,13 @@
 """method = 'erk': ARKODE's ERKStep (Dormand-Prince 5(4), fortran/erk.f90) against the independent oracle,
 against CVODE at tight tolerance on every shipped case, converging as rtol tightens, with the
 contact switches located, and the executable equal to Python."""
-import subprocess
 
 import numpy as np
 import pytest
 
 import oracle
 import pyspline
-from conftest import CASES, PAPER
+from conftest import CASES, PAPER, assert_executable_matches_python
 
 SHIPPED = sorted(p.stem for p in CASES.glob("*.nml") if p.stem != "template")
 
@@ -105,17 +104,7 @@ def test_executable_matches_python_with_erk(name, rtol, exe, tmp_path):
     case = pyspline.load_case(CASES / f"{name}.nml", t_end=0.05, n_out=321, method="erk")
     if rtol:
         case = case.replace(rtol=rtol, atol=rtol * 1e-2)
-    nml = tmp_path / f"{name}.nml"
-    case.to_namelist(nml)
-    out = tmp_path / "out.csv"
-    subprocess.run([exe, str(nml), "-o", str(out)], check=True, capture_output=True)
-    header, data = pyspline.core.read_csv(out)
-    res = pyspline.simulate(case)
-    col = {h.split(" [")[0]: i for i, h in enumerate(header)}
-    np.testing.assert_array_equal(data[:, col["t"]], res.t)
-    np.testing.assert_array_equal(data[:, col["D2"]], res.D2)
-    np.testing.assert_array_equal(data[:, col["Tm"]], res.Tm)
-    np.testing.assert_array_equal(data[:, col["F_1"]:col["F_1"] + case["z"]], res.tooth["F"])
+    assert_executable_matches_python(case, exe, tmp_path)
 
 
 def test_erk_failure_names_arkode():
