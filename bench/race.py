@@ -128,7 +128,6 @@ def race(quick=False, repeat=5, progress=print, cases=None):
         params = _peer_fields(case)
         reals = [_realisation(case, k) if stats_level else case for k in range(repeat)]
         y0s = [start_state(c) for c in reals]
-        y0 = y0s[0]
         t_peer = np.r_[case["t0"], t_out] if t_out[0] > case["t0"] else t_out
 
         def run(kind, kw, k=0):
@@ -149,8 +148,8 @@ def race(quick=False, repeat=5, progress=print, cases=None):
             return wall, tm, F
 
         if peer is not None:      # compile the peer's RHS before any clock
-            peer.solve(params, y0, t_peer[:2], rtol=1e-6, atol=1e-8, method="dop853")
-            peer.solve(params, y0, t_peer[:2], rtol=1e-6, atol=1e-8, method="lsoda")
+            peer.solve(params, y0s[0], t_peer[:2], rtol=1e-6, atol=1e-8, method="dop853")
+            peer.solve(params, y0s[0], t_peer[:2], rtol=1e-6, atol=1e-8, method="lsoda")
             w, _, F_peer = run("peer", dict(method="dop853", rtol=1e-13, atol=1e-15)) \
                 if not stats_level else (0, None, None)
             if F_peer is not None:
@@ -180,13 +179,13 @@ def race(quick=False, repeat=5, progress=print, cases=None):
 
         recs = []
         for kind, label, kw, rt in settings:
-            rec = dict(scene=scene, side=kind, setting=label, rtol=rt, times=[], z=[])
+            rec = dict(scene=scene, side=kind, setting=label, rtol=rt, times=[], stats=[])
             try:
                 wall, tm, F = run(kind, kw)
                 rec["times"].append(wall)
                 if stats_level:
                     st = statistics_of(case, t_out, tm)[0]
-                    rec["z"].append(st)
+                    rec["stats"].append(st)
                     rec.update(err=float("nan"), tm_rms=float(st[0]))
                 else:
                     rec["err"] = float(np.abs(F - ref.F).max() / np.abs(ref.F).max())
@@ -204,9 +203,9 @@ def race(quick=False, repeat=5, progress=print, cases=None):
                     continue
                 rec["times"].append(wall)
                 if stats_level:
-                    rec["z"].append(statistics_of(case, t_out, tm)[0])
+                    rec["stats"].append(statistics_of(case, t_out, tm)[0])
         for rec in recs:
-            sts = rec.pop("z")
+            sts = rec.pop("stats")
             rec["z_max"] = z_max(sts) if sts else float("nan")
             rec["realisations"] = len(sts)
         for rec in recs:
