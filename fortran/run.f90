@@ -12,7 +12,7 @@ module spline_run
   use spline_solver, only: integrate
   use spline_quantities, only: nsolver_stats, nstats, ntooth_q, iq_tf, tooth_q, state_q, &
        ist_core_wall, ist_dof, ist_thermal_level, ist_eps_lateral, ist_eps_thermal, ist_closed, &
-       ist_closed_t
+       ist_closed_t, ist_roots_found
   use spline_fidelity, only: auto_level, auto_tol, backlash_estimate
   use spline_sections, only: section_count, section_times
   use spline_lyapunov, only: lyapunov_benettin, lyapunov_tangent
@@ -20,6 +20,9 @@ module spline_run
   implicit none
   private
   public :: run_case, output_times, tooth_outputs, tooth_quantities, run_warnings
+
+  !> rtol above which CVODE's located contact switches are warned (run_warnings)
+  real(wp), parameter :: restart_rtol = 1.0e-3_wp
 
 contains
 
@@ -212,14 +215,15 @@ contains
   end function all_finite
 
   !> Warnings about a finished run, one per line ('' if none), from its statistics: the
-  !> one-way flash temperature that would have closed the backlash (result_checks). The
+  !> one-way flash temperature that would have closed the backlash (result_checks); contact
+  !> switches located for CVODE at an rtol above restart_rtol (restart_warning). The
   !> executable prints them to stderr, Python raises pyspline.SplineWarning (api_warnings).
   function run_warnings(m, stats) result(text)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: stats(nstats)
     character(len=:), allocatable :: text
     character(len=32) :: buf
-    text = ''
+    text = restart_warning(m, stats)
     if (stats(ist_closed) > 0.0_wp) then
       write(buf, '(es12.5)') stats(ist_closed_t)
       text = text//'case '//trim(m%name)//': the one-way flash temperature closes the backlash '// &
@@ -228,6 +232,29 @@ contains
            'physical there (thermal = ''coupled'' stops at the interference)'//new_line('a')
     end if
   end function run_warnings
+
+  !> CVODE (method adams or bdf) restarts at order 1 after every contact switch it locates
+  !> (spline_erk::cvode_restart). Above restart_rtol that falsified a rattling drive: chaos_z24
+  !> with Adams or BDF and roots read its T_m RMS 2.3-2.5 N m against 3.5-3.7 (every method at
+  !> rtol <= 1e-3, ERK with roots and every method without roots from 1e-2), finding 2-3 times
+  !> the reference's switches (docs/performance.md, "Multistep restarts at loose tolerance";
+  !> tests/test_solver.py). Warned after a run that located a switch there.
+  function restart_warning(m, stats) result(text)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: stats(nstats)
+    character(len=:), allocatable :: text
+    character(len=16) :: buf
+    text = ''
+    if (m%erk .or. .not. m%roots .or. m%rtol <= restart_rtol .or. stats(ist_roots_found) < 1) &
+         return
+    write(buf, '(es10.3)') m%rtol
+    text = 'case '//trim(m%name)//': rtol = '//trim(adjustl(buf))//' with method = '''// &
+         trim(merge('bdf  ', 'adams', m%method_bdf == 1))//''' and '// &
+         itoa(nint(stats(ist_roots_found)))//' contact switches located: CVODE restarts at '// &
+         'order 1 after each, and above rtol 1e-3 that can falsify the impacts (chaos_z24 '// &
+         'read its T_m RMS a third low at rtol 1e-2, atol 1e-4, with 2-3 times the switches); '// &
+         'rtol <= 1e-3 or method = ''erk''?'//new_line('a')
+  end function restart_warning
 
   !> One run of the model at the level m sets (lazy, nw, consts: run_case's nq, consts; fin:
   !> tooth_outputs' finite).
