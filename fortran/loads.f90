@@ -108,8 +108,8 @@ contains
     real(wp), intent(out) :: loads(nload), tload(m%z, nload_tooth)
     integer :: nt, j, k, r, b, nb, nrun, nfree, nback, nons, on, back
     integer, allocatable :: rev(:), k0(:), fl(:), onk(:)
-    real(wp), allocatable :: f_max(:), f_sq(:), tf_max(:), free_b(:, :), back_b(:, :), ons_b(:)
-    real(wp) :: fs, tfm, speed, fpk, sp(max_teeth), cp(max_teeth)
+    real(wp), allocatable :: f_sq(:), tf_max(:), f_max_b(:), free_b(:, :), back_b(:, :), ons_b(:)
+    real(wp) :: fs, tfm, speed, fpk, frun, sp(max_teeth), cp(max_teeth)
     nt = size(t)
     loads = 0.0_wp; tload = 0.0_wp
     if (nt == 0) return
@@ -118,7 +118,7 @@ contains
     speed = 0.0_wp
     loads(il_revolutions) = m%omega*(t(nt) - t(1))/(2.0_wp*pi)
     nb = int(loads(il_revolutions))
-    allocate(rev(nt), k0(nt + 1), fl(nt), onk(nt), f_max(nt), f_sq(nt), tf_max(nt), &
+    allocate(rev(nt), k0(nt + 1), fl(nt), onk(nt), f_sq(nt), tf_max(nt), f_max_b(max(nb, 1)), &
          free_b(max(nb, 1), m%z), back_b(max(nb, 1), m%z), ons_b(max(nb, 1)))
     ! the revolution (batch) of each output, 0 outside the nb whole ones (batch_means); the
     ! runs of consecutive outputs in one revolution, k0(r) .. k0(r + 1) - 1 (a run is a
@@ -136,17 +136,22 @@ contains
     end do
     k0(nrun + 1) = nt + 1
     free_b = 0.0_wp; back_b = 0.0_wp; ons_b = 0.0_wp; onk = 0
-    f_max = 0.0_wp; f_sq = 0.0_wp; tf_max = 0.0_wp
+    f_max_b = 0.0_wp; f_sq = 0.0_wp; tf_max = 0.0_wp
     if (size(tooth, 3) >= iq_tf) tf_max = tooth(:, 1, iq_tf)
     do j = 1, m%z
-      ! per output k the flank of tooth j (fl); over the teeth 1..j the largest |F_j|, the sum
-      ! of F_j^2 (in the order of the teeth) and the largest T_f (batch_means, T_f max)
+      ! per output k the flank of tooth j (fl) and over the teeth 1..j the sum of F_j^2 (in the
+      ! order of the teeth); per run the largest |F_j|, over the teeth per revolution (f_max_b)
       fpk = 0.0_wp
-      do k = 1, nt
-        fl(k) = tooth_flank(tooth(k, j, 1), tooth(k, j, 4))
-        fpk = max(fpk, abs(tooth(k, j, 1)))
-        f_max(k) = max(f_max(k), abs(tooth(k, j, 1)))
-        f_sq(k) = f_sq(k) + tooth(k, j, 1)**2
+      do r = 1, nrun
+        frun = 0.0_wp
+        do k = k0(r), k0(r + 1) - 1
+          fl(k) = tooth_flank(tooth(k, j, 1), tooth(k, j, 4))
+          frun = max(frun, abs(tooth(k, j, 1)))
+          f_sq(k) = f_sq(k) + tooth(k, j, 1)**2
+        end do
+        fpk = max(fpk, frun)
+        b = rev(k0(r))
+        if (b > 0) f_max_b(b) = max(f_max_b(b), frun)
       end do
       tload(j, ilt_f_peak) = fpk
       if (size(tooth, 3) >= iq_tf .and. j > 1) then
@@ -216,7 +221,7 @@ contains
     if (loads(il_revolutions) > 0.0_wp) &
          loads(il_impacts_rev) = nint(sum(tload(:, ilt_onsets)))/loads(il_revolutions)
     loads(il_closing_speed) = speed
-    call batch_means(m, rev, k0(:nrun + 1), y, tm, fs, f_max, f_sq, tf_max, free_b, back_b, &
+    call batch_means(m, rev, k0(:nrun + 1), y, tm, fs, f_sq, tf_max, f_max_b, free_b, back_b, &
          ons_b, loads, tload)
     tfm = 0.0_wp                 ! T_f = 0 where the outputs stop before it (no flash temperature)
     if (size(tooth, 3) >= iq_tf) tfm = maxval(tf_max)
@@ -301,18 +306,18 @@ contains
   !> load-sharing factor max |F_j| / F_s and the largest T_f of the revolution (their means
   !> load_sharing_rev, Tf_max_rev: what an extreme is given instead); per tooth the fractions
   !> free and on the back flank (free_b, back_b: counts), the mean number of free teeth and
-  !> the contact onsets (ons_b) of the revolution; per output (run_loads) over the teeth the
-  !> largest |F_j| (f_max), the sum of F_j^2 (f_sq) and the largest T_f (tf_max, 0 without
-  !> T_f). The standard error of their mean by
-  !> std_error (overlapping batches of floor(sqrt(nb)) revolutions: in a chaotic run
-  !> consecutive revolutions are correlated); that of free_frac_max and back_frac_max is the
-  !> standard error of the tooth that has the largest. NaN with fewer than 2 batches (and for
-  !> k_v and the load sharing when T_d = 0).
-  pure subroutine batch_means(m, rev, k0, y, tm, fs, f_max, f_sq, tf_max, free_b, back_b, &
+  !> the contact onsets (ons_b) of the revolution. From run_loads also: the largest |F_j| of
+  !> each revolution (f_max_b); per output over the teeth the sum of F_j^2 (f_sq) and the
+  !> largest T_f (tf_max, 0 without T_f); the runs k0 of outputs in one revolution. The
+  !> standard error of their mean by std_error (overlapping batches of floor(sqrt(nb))
+  !> revolutions: in a chaotic run consecutive revolutions are correlated); that of
+  !> free_frac_max and back_frac_max is the standard error of the tooth that has the largest.
+  !> NaN with fewer than 2 batches (and for k_v and the load sharing when T_d = 0).
+  pure subroutine batch_means(m, rev, k0, y, tm, fs, f_sq, tf_max, f_max_b, free_b, back_b, &
        ons_b, loads, tload)
     type(model_t), intent(in) :: m
     integer, intent(in) :: rev(:), k0(:)
-    real(wp), intent(in) :: y(:, :), tm(:), fs, f_max(:), f_sq(:), tf_max(:)
+    real(wp), intent(in) :: y(:, :), tm(:), fs, f_sq(:), tf_max(:), f_max_b(:)
     real(wp), intent(inout) :: free_b(:, :), back_b(:, :), ons_b(:)
     real(wp), intent(inout) :: loads(nload), tload(m%z, nload_tooth)
     real(wp), allocatable :: sq(:), fmax(:), cnt(:), sqf(:), sqd(:), tfb(:)
@@ -328,14 +333,14 @@ contains
     tload(:, ilt_back_se) = nan
     if (nb < 2) return
     allocate(sq(nb), fmax(nb), cnt(nb), sqf(nb), sqd(nb), tfb(nb))
-    sq = 0.0_wp; fmax = 0.0_wp; cnt = 0.0_wp; sqf = 0.0_wp; sqd = 0.0_wp; tfb = 0.0_wp
+    sq = 0.0_wp; cnt = 0.0_wp; sqf = 0.0_wp; sqd = 0.0_wp; tfb = 0.0_wp
+    fmax = f_max_b
     do r = 1, size(k0) - 1      ! the runs k0(r) .. k0(r + 1) - 1 of outputs in one revolution
       b = rev(k0(r))
       if (b == 0) cycle
       cnt(b) = cnt(b) + (k0(r + 1) - k0(r))
       do k = k0(r), k0(r + 1) - 1
         sq(b) = sq(b) + tm(k)**2
-        fmax(b) = max(fmax(b), f_max(k))
         sqf(b) = sqf(b) + f_sq(k)
         sqd(b) = sqd(b) + y(6, k)**2
         tfb(b) = max(tfb(b), tf_max(k))
