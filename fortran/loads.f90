@@ -139,19 +139,28 @@ contains
     f_max_b = 0.0_wp; f_sq = 0.0_wp; tf_max = 0.0_wp
     if (size(tooth, 3) >= iq_tf) tf_max = tooth(:, 1, iq_tf)
     do j = 1, m%z
-      ! per output k the flank of tooth j (fl) and over the teeth 1..j the sum of F_j^2 (in the
-      ! order of the teeth); per run the largest |F_j|, over the teeth per revolution (f_max_b)
+      ! per run: the outputs tooth j is free and on the back flank, its largest |F_j| (over the
+      ! teeth per revolution f_max_b); per output its flank (fl) and over the teeth 1..j the sum
+      ! of F_j^2 (in the order of the teeth)
       fpk = 0.0_wp
       do r = 1, nrun
         frun = 0.0_wp
+        nfree = 0; nback = 0
         do k = k0(r), k0(r + 1) - 1
           fl(k) = tooth_flank(tooth(k, j, 1), tooth(k, j, 4))
+          nfree = nfree + merge(1, 0, fl(k) == 0)
+          nback = nback + merge(1, 0, fl(k) == back)
           frun = max(frun, abs(tooth(k, j, 1)))
           f_sq(k) = f_sq(k) + tooth(k, j, 1)**2
         end do
         fpk = max(fpk, frun)
+        tload(j, ilt_free) = tload(j, ilt_free) + nfree
+        tload(j, ilt_back) = tload(j, ilt_back) + nback
         b = rev(k0(r))
-        if (b > 0) f_max_b(b) = max(f_max_b(b), frun)
+        if (b == 0) cycle
+        f_max_b(b) = max(f_max_b(b), frun)
+        free_b(b, j) = free_b(b, j) + nfree
+        back_b(b, j) = back_b(b, j) + nback
       end do
       tload(j, ilt_f_peak) = fpk
       if (size(tooth, 3) >= iq_tf .and. j > 1) then
@@ -167,20 +176,6 @@ contains
         onk(k) = onk(k) + on
       end do
       tload(j, ilt_onsets) = nons
-      ! per run its outputs free and on the back flank
-      do r = 1, nrun
-        nfree = 0; nback = 0
-        do k = k0(r), k0(r + 1) - 1
-          nfree = nfree + merge(1, 0, fl(k) == 0)
-          nback = nback + merge(1, 0, fl(k) == back)
-        end do
-        tload(j, ilt_free) = tload(j, ilt_free) + nfree
-        tload(j, ilt_back) = tload(j, ilt_back) + nback
-        b = rev(k0(r))
-        if (b == 0) cycle
-        free_b(b, j) = free_b(b, j) + nfree
-        back_b(b, j) = back_b(b, j) + nback
-      end do
     end do
     ! the onsets per revolution, and the largest closing speed: approach_speed at the output
     ! before each onset (the tooth angles once per output)
