@@ -107,7 +107,7 @@ contains
     real(wp), intent(in) :: y(:, :)
     real(wp), intent(out) :: loads(nload), tload(m%z, nload_tooth)
     integer :: nt, j, k, r, b, nb, nrun, nfree, nback, nons, on, back
-    integer, allocatable :: rev(:), k0(:), fl(:), onk(:)
+    integer, allocatable :: k0(:), rev(:), fl(:), onk(:)
     real(wp), allocatable :: f_sq(:), tf_max(:), f_max_b(:), free_b(:, :), back_b(:, :), ons_b(:)
     real(wp) :: fs, tfm, speed, fpk, frun, sp(max_teeth), cp(max_teeth)
     nt = size(t)
@@ -118,26 +118,29 @@ contains
     speed = 0.0_wp
     loads(il_revolutions) = m%omega*(t(nt) - t(1))/(2.0_wp*pi)
     nb = int(loads(il_revolutions))
-    allocate(rev(nt), k0(nt + 1), fl(nt), onk(nt), f_sq(nt), tf_max(nt), f_max_b(max(nb, 1)), &
+    allocate(k0(nt + 1), rev(0:nt), fl(nt), onk(nt), f_sq(nt), f_max_b(max(nb, 1)), &
          free_b(max(nb, 1), m%z), back_b(max(nb, 1), m%z), ons_b(max(nb, 1)))
-    ! the revolution (batch) of each output, 0 outside the nb whole ones (batch_means); the
-    ! runs of consecutive outputs in one revolution, k0(r) .. k0(r + 1) - 1 (a run is a
-    ! revolution where t increases)
+    ! the runs of consecutive outputs in one revolution: outputs k0(r) .. k0(r + 1) - 1 in
+    ! revolution rev(r) = floor(omega (t_k - t_1) / 2 pi) + 1, 0 outside the nb whole ones
+    ! (the batches of batch_means; a run is a revolution where t increases)
+    nrun = 0
+    rev(0) = -1
     do k = 1, nt
-      rev(k) = int(m%omega*(t(k) - t(1))/(2.0_wp*pi)) + 1
-      if (rev(k) > nb .or. rev(k) < 1) rev(k) = 0
-    end do
-    nrun = 1
-    k0(1) = 1
-    do k = 2, nt
-      if (rev(k) == rev(k - 1)) cycle
+      b = int(m%omega*(t(k) - t(1))/(2.0_wp*pi)) + 1
+      if (b > nb .or. b < 1) b = 0
+      if (b == rev(nrun)) cycle
       nrun = nrun + 1
       k0(nrun) = k
+      rev(nrun) = b
     end do
     k0(nrun + 1) = nt + 1
     free_b = 0.0_wp; back_b = 0.0_wp; ons_b = 0.0_wp; onk = 0
-    f_max_b = 0.0_wp; f_sq = 0.0_wp; tf_max = 0.0_wp
-    if (size(tooth, 3) >= iq_tf) tf_max = tooth(:, 1, iq_tf)
+    f_max_b = 0.0_wp; f_sq = 0.0_wp
+    if (size(tooth, 3) >= iq_tf) then
+      tf_max = tooth(:, 1, iq_tf)
+    else
+      allocate(tf_max(0))
+    end if
     do j = 1, m%z
       ! per run: the outputs tooth j is free and on the back flank, its largest |F_j| (over the
       ! teeth per revolution f_max_b); per output its flank (fl) and over the teeth 1..j the sum
@@ -156,7 +159,7 @@ contains
         fpk = max(fpk, frun)
         tload(j, ilt_free) = tload(j, ilt_free) + nfree
         tload(j, ilt_back) = tload(j, ilt_back) + nback
-        b = rev(k0(r))
+        b = rev(r)
         if (b == 0) cycle
         f_max_b(b) = max(f_max_b(b), frun)
         free_b(b, j) = free_b(b, j) + nfree
@@ -180,7 +183,7 @@ contains
     ! the onsets per revolution, and the largest closing speed: approach_speed at the output
     ! before each onset (the tooth angles once per output)
     do r = 1, nrun
-      b = rev(k0(r))
+      b = rev(r)
       if (b > 0) ons_b(b) = ons_b(b) + sum(onk(k0(r):k0(r + 1) - 1))
     end do
     do k = 2, nt
@@ -216,10 +219,10 @@ contains
     if (loads(il_revolutions) > 0.0_wp) &
          loads(il_impacts_rev) = nint(sum(tload(:, ilt_onsets)))/loads(il_revolutions)
     loads(il_closing_speed) = speed
-    call batch_means(m, rev, k0(:nrun + 1), y, tm, fs, f_sq, tf_max, f_max_b, free_b, back_b, &
-         ons_b, loads, tload)
+    call batch_means(m, rev(1:nrun), k0(:nrun + 1), y, tm, fs, f_sq, tf_max, f_max_b, free_b, &
+         back_b, ons_b, loads, tload)
     tfm = 0.0_wp                 ! T_f = 0 where the outputs stop before it (no flash temperature)
-    if (size(tooth, 3) >= iq_tf) tfm = maxval(tf_max)
+    if (size(tf_max) > 0) tfm = maxval(tf_max)
     loads(il_tf_max) = tfm
     loads(il_tf_max_tooth) = 0.0_wp
     loads(il_tf_max_t) = -1.0_wp
@@ -294,16 +297,16 @@ contains
   end function stress_warnings
 
   !> Standard errors by batch means (e.g. Law & Kelton, Simulation Modeling and Analysis,
-  !> ch. 9.5): output k belongs to revolution rev(k) = floor(omega (t_k - t_1) / 2 pi) + 1
-  !> (run_loads; 0 outside the nb = floor(revolutions) whole ones, which are the batches). Per
-  !> batch b its value of each statistic that is a mean over the outputs (docs/model.md
+  !> ch. 9.5): output k belongs to revolution floor(omega (t_k - t_1) / 2 pi) + 1, the outputs
+  !> k0(r) .. k0(r + 1) - 1 of run r (run_loads) to revolution rev(r) (0 outside the nb =
+  !> floor(revolutions) whole ones, which are the batches). Per batch b its value of each statistic that is a mean over the outputs (docs/model.md
   !> section 15): the RMS of T_m, k_v = |T_m| / T_d, F_j (all teeth) and D_2; the
   !> load-sharing factor max |F_j| / F_s and the largest T_f of the revolution (their means
   !> load_sharing_rev, Tf_max_rev: what an extreme is given instead); per tooth the fractions
   !> free and on the back flank (free_b, back_b: counts), the mean number of free teeth and
   !> the contact onsets (ons_b) of the revolution. From run_loads also: the largest |F_j| of
   !> each revolution (f_max_b); per output over the teeth the sum of F_j^2 (f_sq) and the
-  !> largest T_f (tf_max, 0 without T_f); the runs k0 of outputs in one revolution. The
+  !> largest T_f (tf_max, empty without T_f). The
   !> standard error of their mean by std_error (overlapping batches of floor(sqrt(nb))
   !> revolutions: in a chaotic run consecutive revolutions are correlated); that of
   !> free_frac_max and back_frac_max is the standard error of the tooth that has the largest.
@@ -331,15 +334,15 @@ contains
     sq = 0.0_wp; cnt = 0.0_wp; sqf = 0.0_wp; sqd = 0.0_wp; tfb = 0.0_wp
     fmax = f_max_b
     do r = 1, size(k0) - 1      ! the runs k0(r) .. k0(r + 1) - 1 of outputs in one revolution
-      b = rev(k0(r))
+      b = rev(r)
       if (b == 0) cycle
       cnt(b) = cnt(b) + (k0(r + 1) - k0(r))
       do k = k0(r), k0(r + 1) - 1
         sq(b) = sq(b) + tm(k)**2
         sqf(b) = sqf(b) + f_sq(k)
         sqd(b) = sqd(b) + y(6, k)**2
-        tfb(b) = max(tfb(b), tf_max(k))
       end do
+      if (size(tf_max) > 0) tfb(b) = max(tfb(b), maxval(tf_max(k0(r):k0(r + 1) - 1)))
     end do
     if (any(cnt == 0.0_wp)) return          ! a revolution without outputs: no batches
     sq = sqrt(sq/cnt)
