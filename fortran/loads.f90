@@ -106,7 +106,7 @@ contains
     real(wp), intent(in), contiguous :: t(:), tooth(:, :, :), tm(:)
     real(wp), intent(in) :: y(:, :)
     real(wp), intent(out) :: loads(nload), tload(m%z, nload_tooth)
-    integer :: nt, j, k, r, b, nb, nrun, nfree, nback, nons, on, back
+    integer :: nt, j, k, r, b, kb, nb, nrun, nfree, nback, nons, on, back
     integer, allocatable :: k0(:), rev(:), fl(:), onk(:)
     real(wp), allocatable :: f_sq(:), tf_max(:), f_max_b(:), free_b(:, :), back_b(:, :), ons_b(:)
     real(wp) :: fs, tfm, speed, fpk, frun, sp(max_teeth), cp(max_teeth)
@@ -156,14 +156,26 @@ contains
           frun = max(frun, abs(tooth(k, j, 1)))
           f_sq(k) = f_sq(k) + tooth(k, j, 1)**2
         end do
+        ! its contact onsets in the run (output 1 is none; on the drive flank throughout, the
+        ! run has one at most at its first output); per output the teeth with one (onk)
+        kb = k0(r + 1) - 1
+        if (nfree + nback == 0) kb = k0(r)
+        nons = 0
+        do k = max(k0(r), 2), kb
+          on = merge(1, 0, contact_onset(fl(k), fl(k - 1)) /= 0)
+          nons = nons + on
+          onk(k) = onk(k) + on
+        end do
         fpk = max(fpk, frun)
         tload(j, ilt_free) = tload(j, ilt_free) + nfree
         tload(j, ilt_back) = tload(j, ilt_back) + nback
+        tload(j, ilt_onsets) = tload(j, ilt_onsets) + nons
         b = rev(r)
         if (b == 0) cycle
         f_max_b(b) = max(f_max_b(b), frun)
         free_b(b, j) = free_b(b, j) + nfree
         back_b(b, j) = back_b(b, j) + nback
+        ons_b(b) = ons_b(b) + nons
       end do
       tload(j, ilt_f_peak) = fpk
       if (size(tooth, 3) >= iq_tf .and. j > 1) then
@@ -171,21 +183,9 @@ contains
           tf_max(k) = max(tf_max(k), tooth(k, j, iq_tf))
         end do
       end if
-      ! its contact onsets (output 1 is none); per output the teeth with one (onk)
-      nons = 0
-      do k = 2, nt
-        on = merge(1, 0, contact_onset(fl(k), fl(k - 1)) /= 0)
-        nons = nons + on
-        onk(k) = onk(k) + on
-      end do
-      tload(j, ilt_onsets) = nons
     end do
-    ! the onsets per revolution, and the largest closing speed: approach_speed at the output
-    ! before each onset (the tooth angles once per output)
-    do r = 1, nrun
-      b = rev(r)
-      if (b > 0) ons_b(b) = ons_b(b) + sum(onk(k0(r):k0(r + 1) - 1))
-    end do
+    ! the largest closing speed: approach_speed at the output before each onset (the tooth
+    ! angles once per output)
     do k = 2, nt
       if (onk(k) == 0) cycle
       call tooth_angles(m%z, m%omega, t(k - 1), m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, &

@@ -63,7 +63,8 @@ program test_loads_count
 contains
 
   !> Random outputs of trial n: per tooth a flank that switches at random (free, +1, -1), F and dn
-  !> of that flank with exact zeros, -0 and dn = +-c among them; tooth 2 never loaded.
+  !> of that flank with exact zeros, -0 and dn = +-c among them; tooth 2 never loaded, tooth 3
+  !> switching rarely (whole revolutions on one flank).
   subroutine random_outputs(n, m, period, t, y, tooth, tm)
     integer, intent(in) :: n
     type(model_t), intent(in) :: m
@@ -91,7 +92,7 @@ contains
       fl = 0
       do k = 1, nt
         call random_number(r)
-        if (r(1) < 0.3_wp) fl = int(r(2)*3) - 1
+        if (r(1) < merge(0.02_wp, 0.3_wp, j == 3)) fl = int(r(2)*3) - 1   ! tooth 3: long spells
         if (j == 2) fl = 0
         select case (fl)
         case (0)
