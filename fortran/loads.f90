@@ -38,12 +38,22 @@ contains
 
   !> The flank a tooth is in contact on at one output: 0 free (F_j = 0, Eqs. 15-17: |dn_j| <=
   !> c_j), else the sign of dn_j (+1: dn_j > c_j, -1: dn_j < -c_j; the sign of the elastic
-  !> force, docs/model.md section 1; for a sliced face the face centre's).
-  pure integer function tooth_flank(f, dn)
+  !> force, docs/model.md section 1; for a sliced face the face centre's). Private, so inlined:
+  !> run_loads' loop over the outputs vectorises.
+  elemental integer function tooth_flank(f, dn)
     real(wp), intent(in) :: f, dn
-    tooth_flank = 0
-    if (f /= 0.0_wp) tooth_flank = merge(1, -1, dn > 0.0_wp)
+    integer :: s
+    s = merge(1, -1, dn > 0.0_wp)
+    tooth_flank = merge(0, s, f == 0.0_wp)
   end function tooth_flank
+
+  !> The flank a contact starts on at an output (a contact onset, an impact): fl, the tooth's
+  !> flank there, if it is in contact (fl /= 0) and was not on that flank at the output before
+  !> (fl_prev: free or the other flank); else 0.
+  elemental integer function contact_onset(fl, fl_prev)
+    integer, intent(in) :: fl, fl_prev
+    contact_onset = merge(fl, 0, fl /= fl_prev)
+  end function contact_onset
 
   !> The drive flank: the flank every tooth is on at the static equilibrium under T_d (docs/
   !> model.md section 1): -1 for T_d >= 0 (F_j = -T_d / (Z r_b) < 0), +1 for T_d < 0.
@@ -58,12 +68,21 @@ contains
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, y(nstate)
     integer, intent(in) :: j
-    real(wp) :: sp(max_teeth), cp(max_teeth), dn, ddn
+    real(wp) :: sp(max_teeth), cp(max_teeth)
     call tooth_angles(m%z, m%omega, t, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
-    call tooth_approach(y(1) + m%l_x - y(3), y(2) + m%l_y - y(4), y(8) - y(10), y(9) - y(11), &
-         y(6), y(13), m%omega, m%spacing_error(j), sp(j), cp(j), dn, ddn)
-    s = abs(ddn)
+    s = approach_rate(m, y, j, sp(j), cp(j))
   end function approach_speed
+
+  !> approach_speed of tooth j in state y at the tooth angle phi_j of sine sp and cosine cp.
+  pure real(wp) function approach_rate(m, y, j, sp, cp) result(s)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: y(nstate), sp, cp
+    integer, intent(in) :: j
+    real(wp) :: dn, ddn
+    call tooth_approach(y(1) + m%l_x - y(3), y(2) + m%l_y - y(4), y(8) - y(10), y(9) - y(11), &
+         y(6), y(13), m%omega, m%spacing_error(j), sp, cp, dn, ddn)
+    s = abs(ddn)
+  end function approach_rate
 
   !> The loads of a run from its outputs (t(k), SI states y(:, k), tooth(k, j, :) in the order
   !> of spline_quantities tooth_q, or only the first 4 (F, F_x, F_y, dn: a level without T_f,
@@ -84,52 +103,98 @@ contains
   !>   floor(sqrt(revolutions)) revolutions (std_error).
   pure subroutine run_loads(m, t, y, tooth, tm, loads, tload)
     type(model_t), intent(in) :: m
-    real(wp), intent(in) :: t(:), y(:, :), tooth(:, :, :), tm(:)
+    real(wp), intent(in), contiguous :: t(:), tooth(:, :, :), tm(:)
+    real(wp), intent(in) :: y(:, :)
     real(wp), intent(out) :: loads(nload), tload(m%z, nload_tooth)
-    integer :: nt, j, k, fl, prev, drive, onsets, nb, nfree, nback, nons
-    integer, allocatable :: rev(:)
-    real(wp), allocatable :: free_b(:, :), back_b(:, :), ons_b(:)
-    real(wp) :: fs, tfm, speed, fpk
+    integer :: nt, j, k, r, b, kb, nb, nrun, nfree, nback, nons, on, back
+    integer, allocatable :: k0(:), rev(:), fl(:), onk(:)
+    real(wp), allocatable :: f_sq(:), tf_max(:), f_max_b(:), free_b(:, :), back_b(:, :), ons_b(:)
+    real(wp) :: fs, tfm, speed, fpk, frun, sp(max_teeth), cp(max_teeth)
     nt = size(t)
     loads = 0.0_wp; tload = 0.0_wp
     if (nt == 0) return
-    drive = drive_flank(m)
+    back = -drive_flank(m)
     fs = abs(m%t_d)/(m%z*m%r_b)
-    onsets = 0
     speed = 0.0_wp
-    ! the revolution (batch) of each output, 0 past the last whole one (batch_means)
     loads(il_revolutions) = m%omega*(t(nt) - t(1))/(2.0_wp*pi)
     nb = int(loads(il_revolutions))
-    allocate(rev(nt), free_b(max(nb, 1), m%z), back_b(max(nb, 1), m%z), ons_b(max(nb, 1)))
+    allocate(k0(nt + 1), rev(0:nt), fl(nt), onk(nt), f_sq(nt), f_max_b(max(nb, 1)), &
+         free_b(max(nb, 1), m%z), back_b(max(nb, 1), m%z), ons_b(max(nb, 1)))
+    ! the runs of consecutive outputs in one revolution: outputs k0(r) .. k0(r + 1) - 1 in
+    ! revolution rev(r) = floor(omega (t_k - t_1) / 2 pi) + 1, 0 outside the nb whole ones
+    ! (the batches of batch_means; a run is a revolution where t increases)
+    nrun = 0
+    rev(0) = -1
     do k = 1, nt
-      rev(k) = int(m%omega*(t(k) - t(1))/(2.0_wp*pi)) + 1
-      if (rev(k) > nb) rev(k) = 0
+      b = int(m%omega*(t(k) - t(1))/(2.0_wp*pi)) + 1
+      if (b > nb .or. b < 1) b = 0
+      if (b == rev(nrun)) cycle
+      nrun = nrun + 1
+      k0(nrun) = k
+      rev(nrun) = b
     end do
-    free_b = 0.0_wp; back_b = 0.0_wp; ons_b = 0.0_wp
-    do j = 1, m%z        ! tooth_flank is private, so the compiler inlines it (a public one was a call)
-      prev = 0
+    k0(nrun + 1) = nt + 1
+    free_b = 0.0_wp; back_b = 0.0_wp; ons_b = 0.0_wp; onk = 0
+    f_max_b = 0.0_wp; f_sq = 0.0_wp
+    if (size(tooth, 3) >= iq_tf) then
+      tf_max = tooth(:, 1, iq_tf)
+    else
+      allocate(tf_max(0))
+    end if
+    do j = 1, m%z
+      ! per run: the outputs tooth j is free and on the back flank, its largest |F_j| (over the
+      ! teeth per revolution f_max_b); per output its flank (fl) and over the teeth 1..j the sum
+      ! of F_j^2 (in the order of the teeth)
       fpk = 0.0_wp
-      nfree = 0; nback = 0; nons = 0
-      do k = 1, nt
-        fpk = max(fpk, abs(tooth(k, j, 1)))
-        fl = tooth_flank(tooth(k, j, 1), tooth(k, j, 4))
-        if (fl == 0) nfree = nfree + 1
-        if (fl == -drive) nback = nback + 1
-        if (rev(k) > 0) then
-          if (fl == 0) free_b(rev(k), j) = free_b(rev(k), j) + 1
-          if (fl == -drive) back_b(rev(k), j) = back_b(rev(k), j) + 1
-        end if
-        if (k > 1 .and. fl /= 0 .and. fl /= prev) then
-          nons = nons + 1
-          speed = max(speed, approach_speed(m, t(k - 1), y(:, k - 1), j))
-          if (rev(k) > 0) ons_b(rev(k)) = ons_b(rev(k)) + 1
-        end if
-        prev = fl
+      do r = 1, nrun
+        frun = 0.0_wp
+        nfree = 0; nback = 0
+        do k = k0(r), k0(r + 1) - 1
+          fl(k) = tooth_flank(tooth(k, j, 1), tooth(k, j, 4))
+          nfree = nfree + merge(1, 0, fl(k) == 0)
+          nback = nback + merge(1, 0, fl(k) == back)
+          frun = max(frun, abs(tooth(k, j, 1)))
+          f_sq(k) = f_sq(k) + tooth(k, j, 1)**2
+        end do
+        ! its contact onsets in the run (output 1 is none; on the drive flank throughout, the
+        ! run has one at most at its first output); per output the teeth with one (onk)
+        kb = k0(r + 1) - 1
+        if (nfree + nback == 0) kb = k0(r)
+        nons = 0
+        do k = max(k0(r), 2), kb
+          on = merge(1, 0, contact_onset(fl(k), fl(k - 1)) /= 0)
+          nons = nons + on
+          onk(k) = onk(k) + on
+        end do
+        fpk = max(fpk, frun)
+        tload(j, ilt_free) = tload(j, ilt_free) + nfree
+        tload(j, ilt_back) = tload(j, ilt_back) + nback
+        tload(j, ilt_onsets) = tload(j, ilt_onsets) + nons
+        b = rev(r)
+        if (b == 0) cycle
+        f_max_b(b) = max(f_max_b(b), frun)
+        free_b(b, j) = free_b(b, j) + nfree
+        back_b(b, j) = back_b(b, j) + nback
+        ons_b(b) = ons_b(b) + nons
       end do
       tload(j, ilt_f_peak) = fpk
-      tload(j, ilt_free) = nfree
-      tload(j, ilt_back) = nback
-      tload(j, ilt_onsets) = nons
+      if (size(tooth, 3) >= iq_tf .and. j > 1) then
+        do k = 1, nt
+          tf_max(k) = max(tf_max(k), tooth(k, j, iq_tf))
+        end do
+      end if
+    end do
+    ! the largest closing speed: approach_speed at the output before each onset (the tooth
+    ! angles once per output)
+    do k = 2, nt
+      if (onk(k) == 0) cycle
+      call tooth_angles(m%z, m%omega, t(k - 1), m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, &
+           sp, cp)
+      do j = 1, m%z
+        if (contact_onset(tooth_flank(tooth(k, j, 1), tooth(k, j, 4)), &
+             tooth_flank(tooth(k - 1, j, 1), tooth(k - 1, j, 4))) /= 0) &
+             speed = max(speed, approach_rate(m, y(:, k - 1), j, sp(j), cp(j)))
+      end do
     end do
     if (fs > 0.0_wp) then
       tload(:, ilt_load_factor) = tload(:, ilt_f_peak)/fs
@@ -151,25 +216,20 @@ contains
     tload(:, ilt_back) = tload(:, ilt_back)/nt
     loads(il_free_max) = maxval(tload(:, ilt_free))
     loads(il_back_max) = maxval(tload(:, ilt_back))
-    onsets = nint(sum(tload(:, ilt_onsets)))
-    if (loads(il_revolutions) > 0.0_wp) loads(il_impacts_rev) = onsets/loads(il_revolutions)
+    if (loads(il_revolutions) > 0.0_wp) &
+         loads(il_impacts_rev) = nint(sum(tload(:, ilt_onsets)))/loads(il_revolutions)
     loads(il_closing_speed) = speed
-    call batch_means(m, rev, y, tooth, tm, fs, free_b, back_b, ons_b, loads, tload)
+    call batch_means(m, rev(1:nrun), k0(:nrun + 1), y, tm, fs, f_sq, tf_max, f_max_b, free_b, &
+         back_b, ons_b, loads, tload)
     tfm = 0.0_wp                 ! T_f = 0 where the outputs stop before it (no flash temperature)
-    if (size(tooth, 3) >= iq_tf) tfm = maxval(tooth(:, :, iq_tf))
+    if (size(tf_max) > 0) tfm = maxval(tf_max)
     loads(il_tf_max) = tfm
     loads(il_tf_max_tooth) = 0.0_wp
     loads(il_tf_max_t) = -1.0_wp
-    if (tfm > 0.0_wp) then
-      outer: do k = 1, nt
-        do j = 1, m%z
-          if (tooth(k, j, iq_tf) == tfm) then
-            loads(il_tf_max_tooth) = j
-            loads(il_tf_max_t) = t(k)
-            exit outer
-          end if
-        end do
-      end do outer
+    if (tfm > 0.0_wp) then       ! its first output, and there its first tooth
+      k = findloc(tf_max, tfm, 1)
+      loads(il_tf_max_tooth) = findloc(tooth(k, :, iq_tf), tfm, 1)
+      loads(il_tf_max_t) = t(k)
     end if
   end subroutine run_loads
 
@@ -237,27 +297,30 @@ contains
   end function stress_warnings
 
   !> Standard errors by batch means (e.g. Law & Kelton, Simulation Modeling and Analysis,
-  !> ch. 9.5): output k belongs to revolution rev(k) = floor(omega (t_k - t_1) / 2 pi) + 1
-  !> (run_loads; 0 past the nb = floor(revolutions) whole ones, which are the batches). Per
-  !> batch b its value of each statistic that is a mean over the outputs (docs/model.md
+  !> ch. 9.5): output k belongs to revolution floor(omega (t_k - t_1) / 2 pi) + 1, the outputs
+  !> k0(r) .. k0(r + 1) - 1 of run r (run_loads) to revolution rev(r) (0 outside the nb =
+  !> floor(revolutions) whole ones, which are the batches). Per batch b its value of each statistic that is a mean over the outputs (docs/model.md
   !> section 15): the RMS of T_m, k_v = |T_m| / T_d, F_j (all teeth) and D_2; the
   !> load-sharing factor max |F_j| / F_s and the largest T_f of the revolution (their means
   !> load_sharing_rev, Tf_max_rev: what an extreme is given instead); per tooth the fractions
   !> free and on the back flank (free_b, back_b: counts), the mean number of free teeth and
-  !> the contact onsets (ons_b) of the revolution. The standard error of their mean by
-  !> std_error (overlapping batches of floor(sqrt(nb)) revolutions: in a chaotic run
-  !> consecutive revolutions are correlated); that of free_frac_max and back_frac_max is the
-  !> standard error of the tooth that has the largest. NaN with fewer than 2 batches (and for
-  !> k_v and the load sharing when T_d = 0).
-  pure subroutine batch_means(m, rev, y, tooth, tm, fs, free_b, back_b, ons_b, loads, tload)
+  !> the contact onsets (ons_b) of the revolution. From run_loads also: the largest |F_j| of
+  !> each revolution (f_max_b); per output over the teeth the sum of F_j^2 (f_sq) and the
+  !> largest T_f (tf_max, empty without T_f). The
+  !> standard error of their mean by std_error (overlapping batches of floor(sqrt(nb))
+  !> revolutions: in a chaotic run consecutive revolutions are correlated); that of
+  !> free_frac_max and back_frac_max is the standard error of the tooth that has the largest.
+  !> NaN with fewer than 2 batches (and for k_v and the load sharing when T_d = 0).
+  pure subroutine batch_means(m, rev, k0, y, tm, fs, f_sq, tf_max, f_max_b, free_b, back_b, &
+       ons_b, loads, tload)
     type(model_t), intent(in) :: m
-    integer, intent(in) :: rev(:)
-    real(wp), intent(in) :: y(:, :), tooth(:, :, :), tm(:), fs
+    integer, intent(in) :: rev(:), k0(:)
+    real(wp), intent(in) :: y(:, :), tm(:), fs, f_sq(:), tf_max(:), f_max_b(:)
     real(wp), intent(inout) :: free_b(:, :), back_b(:, :), ons_b(:)
     real(wp), intent(inout) :: loads(nload), tload(m%z, nload_tooth)
     real(wp), allocatable :: sq(:), fmax(:), cnt(:), sqf(:), sqd(:), tfb(:)
     real(wp) :: nan
-    integer :: nb, b, k, j
+    integer :: nb, b, k, j, r
     nan = ieee_value(0.0_wp, ieee_quiet_nan)
     nb = int(loads(il_revolutions))
     loads(il_batches) = nb
@@ -268,16 +331,18 @@ contains
     tload(:, ilt_back_se) = nan
     if (nb < 2) return
     allocate(sq(nb), fmax(nb), cnt(nb), sqf(nb), sqd(nb), tfb(nb))
-    sq = 0.0_wp; fmax = 0.0_wp; cnt = 0.0_wp; sqf = 0.0_wp; sqd = 0.0_wp; tfb = 0.0_wp
-    do k = 1, size(rev)
-      b = rev(k)
+    sq = 0.0_wp; cnt = 0.0_wp; sqf = 0.0_wp; sqd = 0.0_wp; tfb = 0.0_wp
+    fmax = f_max_b
+    do r = 1, size(k0) - 1      ! the runs k0(r) .. k0(r + 1) - 1 of outputs in one revolution
+      b = rev(r)
       if (b == 0) cycle
-      sq(b) = sq(b) + tm(k)**2
-      cnt(b) = cnt(b) + 1
-      fmax(b) = max(fmax(b), maxval(abs(tooth(k, :, 1))))
-      sqf(b) = sqf(b) + sum(tooth(k, :, 1)**2)
-      sqd(b) = sqd(b) + y(6, k)**2
-      if (size(tooth, 3) >= iq_tf) tfb(b) = max(tfb(b), maxval(tooth(k, :, iq_tf)))
+      cnt(b) = cnt(b) + (k0(r + 1) - k0(r))
+      do k = k0(r), k0(r + 1) - 1
+        sq(b) = sq(b) + tm(k)**2
+        sqf(b) = sqf(b) + f_sq(k)
+        sqd(b) = sqd(b) + y(6, k)**2
+      end do
+      if (size(tf_max) > 0) tfb(b) = max(tfb(b), maxval(tf_max(k0(r):k0(r + 1) - 1)))
     end do
     if (any(cnt == 0.0_wp)) return          ! a revolution without outputs: no batches
     sq = sqrt(sq/cnt)
@@ -311,16 +376,16 @@ contains
   !> m = 1 (n < 4) is sd(x) / sqrt(n).
   pure real(wp) function std_error(x) result(se)
     real(wp), intent(in) :: x(:)
-    real(wp) :: mean, xb, ss
-    integer :: n, m, i
+    real(wp) :: mean, ss, xb(size(x))
+    integer :: n, m, l
     n = size(x)
     m = int(sqrt(real(n, wp)))
     mean = sum(x)/n
-    ss = 0.0_wp
-    do i = 1, n - m + 1
-      xb = sum(x(i:i + m - 1))/m
-      ss = ss + (xb - mean)**2
+    xb = 0.0_wp                  ! the batch sums x_i + ... + x_(i+m-1), added in this order
+    do l = 0, m - 1
+      xb(1:n - m + 1) = xb(1:n - m + 1) + x(1 + l:n - m + 1 + l)
     end do
+    ss = sum((xb(1:n - m + 1)/m - mean)**2)
     se = sqrt(real(m, wp)*ss/(real(n - m, wp)*real(n - m + 1, wp)))
   end function std_error
 
