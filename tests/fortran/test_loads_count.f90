@@ -17,6 +17,7 @@ program test_loads_count
        il_sharing_rev, il_tf_rev, il_free_mean_se, il_impacts_rev_se, il_free_max_se, &
        il_back_max_se, ilt_f_peak, ilt_free, ilt_back, ilt_onsets, ilt_free_se, ilt_back_se
   use spline_loads, only: run_loads, drive_flank, approach_speed
+  use spline_errors, only: itoa
   use check, only: check_true, check_done, default_case_model
   implicit none
   integer, parameter :: ntrial = 400, nquant = 10
@@ -265,13 +266,5 @@ contains
   real(wp) function nan()
     nan = ieee_value(0.0_wp, ieee_quiet_nan)
   end function nan
-
-  function itoa(i) result(s)
-    integer, intent(in) :: i
-    character(len=:), allocatable :: s
-    character(len=12) :: buf
-    write(buf, '(i0)') i
-    s = trim(buf)
-  end function itoa
 
 end program test_loads_count
