@@ -299,9 +299,9 @@ contains
   !> Standard errors by batch means (e.g. Law & Kelton, Simulation Modeling and Analysis,
   !> ch. 9.5): output k belongs to revolution floor(omega (t_k - t_1) / 2 pi) + 1, the outputs
   !> k0(r) .. k0(r + 1) - 1 of run r (run_loads) to revolution rev(r) (0 outside the nb =
-  !> floor(revolutions) whole ones, which are the batches). Per batch b its value of each statistic that is a mean over the outputs (docs/model.md
-  !> section 15): the RMS of T_m, k_v = |T_m| / T_d, F_j (all teeth) and D_2; the
-  !> load-sharing factor max |F_j| / F_s and the largest T_f of the revolution (their means
+  !> floor(revolutions) whole ones, which are the batches). Per batch b its value of each
+  !> statistic that is a mean over the outputs (docs/model.md section 15): the RMS of T_m,
+  !> k_v = |T_m| / T_d, F_j (all teeth) and D_2; the load-sharing factor max |F_j| / F_s and the largest T_f of the revolution (their means
   !> load_sharing_rev, Tf_max_rev: what an extreme is given instead); per tooth the fractions
   !> free and on the back flank (free_b, back_b: counts), the mean number of free teeth and
   !> the contact onsets (ons_b) of the revolution. From run_loads also: the largest |F_j| of
