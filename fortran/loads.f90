@@ -301,8 +301,8 @@ contains
   !> k0(r) .. k0(r + 1) - 1 of run r (run_loads) to revolution rev(r) (0 outside the nb =
   !> floor(revolutions) whole ones, which are the batches). Per batch b its value of each
   !> statistic that is a mean over the outputs (docs/model.md section 15): the RMS of T_m,
-  !> k_v = |T_m| / T_d, F_j (all teeth) and D_2; the load-sharing factor max |F_j| / F_s and the largest T_f of the revolution (their means
-  !> load_sharing_rev, Tf_max_rev: what an extreme is given instead); per tooth the fractions
+  !> k_v = |T_m| / T_d, F_j (all teeth) and D_2; the load-sharing factor max |F_j| / F_s and
+  !> the largest T_f of the revolution (their means load_sharing_rev, Tf_max_rev: what an extreme is given instead); per tooth the fractions
   !> free and on the back flank (free_b, back_b: counts), the mean number of free teeth and
   !> the contact onsets (ons_b) of the revolution. From run_loads also: the largest |F_j| of
   !> each revolution (f_max_b); per output over the teeth the sum of F_j^2 (f_sq) and the
