@@ -296,21 +296,21 @@ contains
     end function hint
   end function stress_warnings
 
-  !> Standard errors by batch means (e.g. Law & Kelton, Simulation Modeling and Analysis,
-  !> ch. 9.5): output k belongs to revolution floor(omega (t_k - t_1) / 2 pi) + 1, the outputs
-  !> k0(r) .. k0(r + 1) - 1 of run r (run_loads) to revolution rev(r) (0 outside the nb =
+  !> Standard errors by batch means (e.g. Law & Kelton, Simulation Modeling and Analysis, ch.
+  !> 9.5): output k belongs to revolution floor(omega (t_k - t_1) / 2 pi) + 1, the outputs k0(r)
+  !> .. k0(r + 1) - 1 of run r (run_loads) to revolution rev(r) (0 outside the nb =
   !> floor(revolutions) whole ones, which are the batches). Per batch b its value of each
-  !> statistic that is a mean over the outputs (docs/model.md section 15): the RMS of T_m,
-  !> k_v = |T_m| / T_d, F_j (all teeth) and D_2; the load-sharing factor max |F_j| / F_s and
-  !> the largest T_f of the revolution (their means load_sharing_rev, Tf_max_rev: what an extreme is given instead); per tooth the fractions
-  !> free and on the back flank (free_b, back_b: counts), the mean number of free teeth and
-  !> the contact onsets (ons_b) of the revolution. From run_loads also: the largest |F_j| of
-  !> each revolution (f_max_b); per output over the teeth the sum of F_j^2 (f_sq) and the
-  !> largest T_f (tf_max, empty without T_f). The
-  !> standard error of their mean by std_error (overlapping batches of floor(sqrt(nb))
-  !> revolutions: in a chaotic run consecutive revolutions are correlated); that of
-  !> free_frac_max and back_frac_max is the standard error of the tooth that has the largest.
-  !> NaN with fewer than 2 batches (and for k_v and the load sharing when T_d = 0).
+  !> statistic that is a mean over the outputs (docs/model.md section 15): the RMS of T_m, k_v =
+  !> |T_m| / T_d, F_j (all teeth) and D_2; the load-sharing factor max |F_j| / F_s and the
+  !> largest T_f of the revolution (their means load_sharing_rev, Tf_max_rev: what an extreme is
+  !> given instead); per tooth the fractions free and on the back flank (free_b, back_b: counts),
+  !> the mean number of free teeth and the contact onsets (ons_b) of the revolution. From
+  !> run_loads also: the largest |F_j| of each revolution (f_max_b); per output over the teeth
+  !> the sum of F_j^2 (f_sq) and the largest T_f (tf_max, empty without T_f). The standard error
+  !> of their mean by std_error (overlapping batches of floor(sqrt(nb)) revolutions: in a chaotic
+  !> run consecutive revolutions are correlated); that of free_frac_max and back_frac_max is the
+  !> standard error of the tooth that has the largest. NaN with fewer than 2 batches (and for k_v
+  !> and the load sharing when T_d = 0).
   pure subroutine batch_means(m, rev, k0, y, tm, fs, f_sq, tf_max, f_max_b, free_b, back_b, &
        ons_b, loads, tload)
     type(model_t), intent(in) :: m
