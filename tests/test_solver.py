@@ -124,4 +124,4 @@ def test_executable_prints_the_restart_warning(exe, tmp_path):
     with pytest.warns(pyspline.SplineWarning, match="restarts at order 1") as rec:
         pyspline.simulate(case)
     said = [str(w.message) for w in rec if "restarts at order 1" in str(w.message)]
-    assert said and said[0] in run.stderr
+    assert len(said) == 1 and f"spline-dyn: warning: {said[0]}" in run.stderr.splitlines()
