@@ -209,6 +209,11 @@ contains
            'forces; goal = ''statistics'' reads statistics, whose error is their standard error: '// &
            'set accuracy = 0 or goal = ''trajectory'''); return
     end if
+    if (option_index(goal_values, c%goal) == 2 .and. c%check) then
+      call fail('check', '= .true. estimates the error of the trajectory''s tooth forces; goal = '// &
+           '''statistics'' does not resolve the trajectory (its statistics carry standard errors): '// &
+           'set check = .false. or goal = ''trajectory'''); return
+    end if
     if (.not. ranges('lyapunov_interval', 'lyapunov_d0')) return  ! d0 = 0: chosen from rtol
     if ((c%lyapunov .or. option_index(section_values, c%section) > 1) .and. c%speed_rpm <= 0.0_wp) then
       call fail('speed_rpm', 'must be positive for a Poincare section or a Lyapunov exponent '// &

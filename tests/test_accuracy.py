@@ -79,6 +79,9 @@ def test_accuracy_and_statistics_goal_exclude_each_other():
     with pytest.raises(pyspline.CaseError, match=r"field accuracy = 1\.000E-04 is the error of "
                        r"the trajectory.*goal = 'statistics'"):
         pyspline.load_case(CASES / "paper_lx1e-4.nml", accuracy=1e-4, goal="statistics").model
+    with pytest.raises(pyspline.CaseError, match=r"field check = \.true\. estimates the error "
+                       r"of the trajectory.*goal = 'statistics' does not resolve"):
+        pyspline.load_case(CASES / "paper_lx1e-4.nml", check=True, goal="statistics").model
     with pytest.raises(pyspline.CaseError, match="field accuracy must not be negative"):
         pyspline.load_case(CASES / "paper_lx1e-4.nml", accuracy=-1e-4).model
 
@@ -114,3 +117,10 @@ def test_executable_gives_the_accuracy_run_of_python(exe, tmp_path):
     for name in ("F_error_est", "F_error_t_s", "rtol_used"):
         got = float(re.search(rf"stats\.{name} \[.*\] = +(\S+)", text).group(1))
         assert got == res.stats[name], name
+
+
+def test_statistics_goal_warns_of_the_exponent():
+    case = pyspline.load_case(CASES / "chaos_z24.nml", t_end=0.302, n_out=5, goal="statistics")
+    with pytest.warns(pyspline.SplineWarning, match=r"goal = 'statistics' with lyapunov = "
+                      r"\.true\.: the exponent is not one of the statistics"):
+        pyspline.simulate(case)
