@@ -124,3 +124,12 @@ def test_statistics_goal_warns_of_the_exponent():
     with pytest.warns(pyspline.SplineWarning, match=r"goal = 'statistics' with lyapunov = "
                       r"\.true\.: the exponent is not one of the statistics"):
         pyspline.simulate(case)
+
+
+def test_sweep_points_carry_their_estimates():
+    case = short("paper_lx1e-4").replace(accuracy=1e-5)
+    ds = pyspline.sweep(case, l_x=[5e-5, 1e-4])
+    one = pyspline.simulate(case.replace(l_x=1e-4))
+    assert ds["F_error_est"].sel(l_x=1e-4).item() == one.stats["F_error_est"]
+    assert (ds["F_error_est"] > 0).all() and (ds["F_error_est"] <= 1e-5).all()
+    assert one.to_xarray().attrs["stat_F_error_est"] == one.stats["F_error_est"]
