@@ -186,8 +186,6 @@ def test_bad_field(field, match):
 
 
 def test_bad_range_and_follow():
-    with pytest.raises(pyspline.CaseError, match="start and stop must be finite and differ"):
-        pyspline.continuation(RESONANCE, "t_d", 30, 30, progress=False)
     with pytest.raises(pyspline.CaseError, match=r"guess has shape \(6,\): a state has 14"):
         pyspline.continuation(RESONANCE, "t_d", 30, 31, guess=np.zeros(6), progress=False)
     with pytest.raises(pyspline.CaseError, match="speed_rpm = 0.0: the shaft does not turn"):
@@ -198,6 +196,48 @@ def test_bad_range_and_follow():
         pyspline.sweep(RESONANCE, speed_rpm=[1, 2], t_d=[1, 2], follow="up", progress=False)
     with pytest.raises(pyspline.CaseError, match="follow must be one of up, down, both"):
         pyspline.sweep(RESONANCE, speed_rpm=[1, 2], follow="sideways", progress=False)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(stop=30.0), r"stop = 30.0: start and stop must differ"),
+    (dict(stop=np.nan), r"stop = nan: must be finite"),
+    (dict(stop="x"), r"stop = 'x': not a number"),
+    (dict(ds=0.0), r"ds = 0.0: must be > 0"),
+    (dict(ds=-0.1), r"ds = -0.1: must be > 0"),
+    (dict(ds=np.nan), r"ds = nan: must be finite"),
+    (dict(ds_min=0.5, ds_max=0.25), r"ds_min = 0.5: greater than ds_max = 0.25"),
+    (dict(max_points=0), r"max_points = 0: a whole number >= 1"),
+    (dict(max_points=2.5), r"max_points = 2.5: a whole number >= 1"),
+    (dict(max_angle=0.0), r"max_angle = 0.0: must be > 0"),
+    (dict(tol=0.0), r"tol = 0.0: must be > 0"),
+    (dict(tol=-1e-7), r"tol = -1e-07: must be > 0"),
+    (dict(tol=np.nan), r"tol = nan: must be finite"),
+    (dict(n="1"), r"n = '1': the shaft revolutions of the period must be a whole number"),
+    (dict(n=0), r"n = 0: the shaft revolutions"),
+])
+def test_bad_arguments_name_themselves(kwargs, match):
+    """Each bad argument: a CaseError naming it and why, before anything runs."""
+    args = dict(stop=31.0) | kwargs
+    stop = args.pop("stop")
+    with pytest.raises(pyspline.CaseError, match=r"continuation in t_d: " + match):
+        pyspline.continuation(RESONANCE, "t_d", 30.0, stop, progress=False, **args)
+
+
+def test_field_values_outside_their_range():
+    """A stop outside the field's valid range names the stop (not a difference step's value);
+    a speed of 0 has no forcing period; a ripple order that does not repeat in one revolution
+    is refused at the stop as at the start; periodic_orbit refuses tol = nan."""
+    with pytest.raises(pyspline.CaseError, match=r"stop = 0 is not a valid value of speed_rpm: "
+                       r".*speed_rpm = 0.0: the shaft does not turn"):
+        pyspline.continuation(RESONANCE, "speed_rpm", 2300, 0.0, progress=False)
+    with pytest.raises(pyspline.CaseError, match=r"stop = 1e\+07 is not a valid value of "
+                       r"speed_rpm: .*speed_rpm"):
+        pyspline.continuation(RESONANCE, "speed_rpm", 2300, 1e7, progress=False)
+    with pytest.raises(pyspline.CaseError, match=r"stop = 1.5 is not a valid value of "
+                       r"ripple_order\(1\): .*ripple_order = 1.5 .* does not repeat within n = 1"):
+        pyspline.continuation(RESONANCE, "ripple_order(1)", 1.0, 1.5, progress=False)
+    with pytest.raises(pyspline.CaseError, match=r"tol = nan: the scaled residual to reach"):
+        pyspline.periodic_orbit(RESONANCE, tol=float("nan"))
 
 
 def test_corrector_failure_says_where():
