@@ -21,8 +21,9 @@ Writes into --out DIR:
                                unstable dashed, special points marked; with --sweep N the
                                runs of a follow-up and follow-down sweep of N points over it
   DIR/sweep.nc                 with --sweep N: that sweep
-Prints one line per special point. Exit status: README's (CaseError 2, SolverError 3; a
-corrector that fails, OrbitError: 1).
+Prints one line per special point. Exit status: README's (CaseError 2, SolverError 3); 1 when
+the branch could not be followed to --stop (the points so far are written, with where and why
+it stopped: attrs['status'] and the last line on stderr) or no orbit was found at --start.
 
 example: pyspline continue cases/physical_ripple.nml --field speed_rpm --start 5000 --stop 7000
 """
@@ -39,16 +40,19 @@ def cmd_continue(args, fixed, exit_code) -> int:
         case = load_case(args.case, **fixed(args.fix))
         command = " ".join(["pyspline", "continue", args.case, f"--field={args.field}",
                             f"--start={args.start:g}", f"--stop={args.stop:g}", f"--n={args.n}"])
+        name, index = parse_field(case, args.field)
+        if args.sweep < 0 or args.sweep == 1:
+            raise CaseError(f"--sweep {args.sweep}: the follow sweep's number of points, >= 2 "
+                            "(0: no sweep)")
+        if args.sweep and index is not None:
+            raise CaseError(f"--sweep: a follow sweep runs whole fields; {args.field} is "
+                            "one element of an array field")
         ds = continuation(case, args.field, args.start, args.stop, n=args.n, ds=args.ds,
                           max_points=args.max_points, tol=args.tol, progress=not args.quiet,
                           command=command)
         sw = None
         if args.sweep:
             from .sweep import sweep
-            name, index = parse_field(case, args.field)
-            if index is not None:
-                raise CaseError(f"--sweep: a follow sweep runs whole fields; {args.field} is "
-                                "one element of an array field")
             sw = sweep(case, progress=not args.quiet, follow="both", spectrum=False,
                        **{name: np.linspace(args.start, args.stop, args.sweep)})
     except SplineError as exc:
@@ -74,8 +78,13 @@ def cmd_continue(args, fixed, exit_code) -> int:
     path = out / "frequency_response.png"
     frequency_response(ds, args.measure, sweep=sw, path=path,
                        title=f"{case.name}: {MEASURES[args.measure][0]} of the periodic orbits "
-                             f"vs {label}" + (", follow sweeps up and down" if sw else ""))
+                             f"vs {label}" + (", follow sweeps up and down" if sw else "")
+                             + ("" if ds.attrs["status"] == "complete" else
+                                f" (stopped at {label} = {float(ds[label][-1]):.6g})"))
     print(f"wrote {path}")
+    if ds.attrs["status"] != "complete":
+        print(f"stopped: {ds.attrs['status']}", file=sys.stderr)
+        return 1
     return 0
 
 

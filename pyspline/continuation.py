@@ -110,7 +110,7 @@ class _Problem:
         # scaling and the difference step of dF/dp do not depend on the band's width
         self.p0, self.pscale = float(start), 0.1 * max(abs(float(start)), abs(float(stop)))
         self.t0 = t0
-        self.models = {}
+        self.models, self.log = {}, []
         self.d0 = _scale(self.model(self.p0))
         self.rtol = case["rtol"]
         self.h = self.rtol ** (1 / 3)
@@ -281,10 +281,15 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     guess : the orbit's state (14,), SI, at t0 for `start` (default: periodic_orbit's, the end
         of a settled run of the case at `start`).
     ds, ds_min, ds_max : arclength steps in the units of u = (z, q): the section state scaled
-        by Eq. 25 and q the field over |stop - start|. A step whose corrector needs <= 2
-        iterations grows 1.5x, one that needs >= 4 shrinks; a failed one halves; below ds_min:
-        OrbitError saying where and the residual reached. max_angle [rad]: a step whose
-        tangent turns more than twice it is halved; the next step is scaled to turn by about it.
+        by Eq. 25 and q = (p - start) / (max(|start|, |stop|) / 10), the same whatever the
+        band's width. A step whose corrector needs <= 2 iterations grows 1.5x, one that needs
+        >= 4 shrinks; a failed one halves (a run of the map that fails, a point outside the
+        field's valid range or a converged point further from its predictor than the step,
+        i.e. on another branch, fail it); below ds_min the other monodromy, then the other
+        integrator (ERK, or BDF for ERK) are tried (attrs['fallbacks']); when they fail too,
+        the branch so far is returned with attrs['status'] saying where and why, and a
+        SplineWarning. max_angle [rad]: a step whose tangent turns more than twice it is
+        halved; the next step is scaled to turn by about it.
     tol : the corrector's scaled residual max |P^n(y) - y| (default 100 rtol).
     margin : stable means every |mu| < 1 - margin.
     switch : at a period doubling continue the doubled branch (n -> 2n) from it along the
@@ -298,7 +303,12 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     multipliers (mu_real, mu_imag, mu_abs; dim 'multiplier', largest modulus first), stable,
     closest_approach, switches, residual, iterations; dim 'special': type, the field's value,
     branch, the critical multiplier, Tm_pp, F_max, y0. attrs: case, field, start, stop, n,
-    timing."""
+    timing, status ('complete', or where and why it stopped), fallbacks.
+
+    CaseError naming the argument for bad input: start == stop, a start or stop outside the
+    field's valid range, a non-finite or non-positive ds, ds_min, ds_max, max_angle or tol,
+    ds_min > ds_max, max_points < 1, n not a whole number >= 1. OrbitError when no orbit is
+    found at the start."""
     from tqdm import tqdm
     base = load_case(case)
     name, index = parse_field(base, field)
@@ -357,6 +367,7 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
                       "points; attrs['status'])", SplineWarning, stacklevel=2)
     return continuation_dataset(base, prob, label, branches, specials, margin, k, dict(
         start=start, stop=stop, n=n, tol=tol, wall_s=wall, monodromy=monodromy, status=status,
+        fallbacks="; ".join(prob.log) or "none",
         command=command or f"pyspline.continuation({base.name!r}, {label!r}, {start:g}, "
                            f"{stop:g}, n={n})"))
 
@@ -423,6 +434,8 @@ def _follow(br, u0, tau0, q_end, ds, ds_min, ds_max, max_angle, max_points, ibra
                 if not fallbacks:
                     return pts, _where(br, pred, ds, f"after point {len(pts)} of branch {ibranch}")
                 _use(prob, *fallbacks.pop(0))
+                prob.log.append(f"{prob.name} = {a['p']:.6g}: {prob.how} monodromy, method "
+                                f"{prob.case['method']} ({getattr(br, 'last_error', '')})")
                 ds, on_fallback = min(ds_max, 64 * ds_min), 5
             continue
         u, F, J, M, y, it, hist = res

@@ -2,6 +2,7 @@
 the closed-form forced response of the linear full-contact drive, the closed-form speed at
 which that response first opens a tooth (grazing), folds of the backlash resonance with a
 multiplier at +1 and the hysteresis of follow-up / follow-down sweeps between them, the CLI."""
+import re
 import subprocess
 import sys
 import warnings
@@ -240,15 +241,34 @@ def test_field_values_outside_their_range():
         pyspline.periodic_orbit(RESONANCE, tol=float("nan"))
 
 
-def test_corrector_failure_says_where():
-    """A corrector allowed no Newton step cannot converge off the start: the step halves
-    down to ds_min, then OrbitError names where, the residual reached and its history."""
+def test_corrector_failure_keeps_the_branch_and_says_where(tmp_path):
+    """A corrector allowed no Newton step cannot converge off the start: the step halves down
+    to ds_min with every fallback (the other monodromy, then the other integrator), and the
+    branch so far comes back with its status naming where, the residual reached and its
+    history, and a SplineWarning; the CLI writes what it has, says where it stopped, exits 1."""
     case, *_ = linear_scene(2.0)
-    with pytest.raises(pyspline.OrbitError, match=r"continuation in speed_rpm: the corrector did "
-                       r"not converge after point 1 of branch 0, near speed_rpm = 26.*arclength step down to "
-                       r".*scaled residual .*wanted 1e-09\), history"):
-        pyspline.continuation(case, "speed_rpm", 2600, 3800, progress=False, max_corrector=0,
-                              ds_min=0.01)
+    where = (r"continuation in speed_rpm: the corrector did not converge after point 1 of branch "
+             r"0, near speed_rpm = 26.*arclength step down to .*scaled residual .*wanted "
+             r"1e-09\), history")
+    with pytest.warns(pyspline.SplineWarning, match=where + r".*the branch so far is returned "
+                      r"\(1 points"):
+        ds = pyspline.continuation(case, "speed_rpm", 2600, 3800, progress=False,
+                                   max_corrector=0, ds_min=0.04, ds_max=0.05)
+    assert re.search(where, ds.attrs["status"]) and ds.attrs["n_points"] == 1
+    assert float(ds.speed_rpm[0]) == 2600 and ds.residual[0] <= 1e-9
+    assert ds.attrs["fallbacks"].count("speed_rpm = 2600: ") == 3, ds.attrs["fallbacks"]
+    path = tmp_path / "scene.nml"
+    path.write_text(case.replace(ripple_amp=[0.3, 0, 0, 0]).text())
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2600",
+              "--stop", "3800", "--max-points", "3", "--out", "out", "--quiet")
+    assert run.returncode == 1, run.stderr
+    assert "stopped: max_points = 3 reached at speed_rpm = " in run.stderr
+    assert "3 points on 1 branch(es)" in run.stdout
+    assert (tmp_path / "out" / "frequency_response.png").stat().st_size > 10_000
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2600",
+              "--stop", "3800", "--sweep", "-1", "--out", "out2", "--quiet")
+    assert run.returncode == 2 and "--sweep -1: the follow sweep's number of points" in \
+        run.stderr and not (tmp_path / "out2").exists(), run.stderr
 
 
 def test_neimark_sacker_pair_on_the_unit_circle():
