@@ -110,7 +110,7 @@ class _Problem:
         # scaling and the difference step of dF/dp do not depend on the band's width
         self.p0, self.pscale = float(start), 0.1 * max(abs(float(start)), abs(float(stop)))
         self.t0 = t0
-        self.models, self.log = {}, []
+        self.models, self.log, self.jumps = {}, [], 0
         self.d0 = _scale(self.model(self.p0))
         self.rtol = case["rtol"]
         self.h = self.rtol ** (1 / 3)
@@ -303,7 +303,8 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     multipliers (mu_real, mu_imag, mu_abs; dim 'multiplier', largest modulus first), stable,
     closest_approach, switches, residual, iterations; dim 'special': type, the field's value,
     branch, the critical multiplier, Tm_pp, F_max, y0. attrs: case, field, start, stop, n,
-    timing, status ('complete', or where and why it stopped), fallbacks.
+    timing, status ('complete', or where and why it stopped), fallbacks, rejected_jumps (steps
+    whose corrector landed on another branch).
 
     CaseError naming the argument for bad input: start == stop, a start or stop outside the
     field's valid range, a non-finite or non-positive ds, ds_min, ds_max, max_angle or tol,
@@ -367,7 +368,7 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
                       "points; attrs['status'])", SplineWarning, stacklevel=2)
     return continuation_dataset(base, prob, label, branches, specials, margin, k, dict(
         start=start, stop=stop, n=n, tol=tol, wall_s=wall, monodromy=monodromy, status=status,
-        fallbacks="; ".join(prob.log) or "none",
+        fallbacks="; ".join(prob.log) or "none", rejected_jumps=prob.jumps,
         command=command or f"pyspline.continuation({base.name!r}, {label!r}, {start:g}, "
                            f"{stop:g}, n={n})"))
 
@@ -427,7 +428,7 @@ def _follow(br, u0, tau0, q_end, ds, ds_min, ds_max, max_angle, max_points, ibra
             br.last_hist, br.last_error = res[6], (
                 f"the corrector went {np.linalg.norm(res[0] - pred):.3g} from a predictor "
                 f"{ds:.3g} along the branch (another branch)")
-            res = None
+            res, prob.jumps = None, prob.jumps + 1
         if res is None:
             ds /= 2
             if ds < ds_min:
