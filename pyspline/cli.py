@@ -544,7 +544,7 @@ def _add_sweep_and_plot(sub) -> None:
                    help="change a field of the case (e.g. t_end=0.5)")
     r.set_defaults(func=cmd_plot)
     add_merge(sub)
-    from .continuation import add_continue
+    from .contcli import add_continue
     add_continue(sub, _fixed, exit_code)
 
 
