@@ -19,22 +19,28 @@ T_f is only reported, which this peer does not do), 'coupled' (T_B = T_M + T_fj 
 flash temperature, Eqs. 3-7, 12-13, solved per tooth by fixed-point iteration to 2 ulp as the
 oracle does, bisection fallback for teeth that do not converge in 60 iterations).
 
-Speed: the phase of tooth j is not re-evaluated with sin/cos per tooth: with a = omega t +
-theta_0 - alpha, sin phi_j = sin a cos(2 pi j/Z) + cos a sin(2 pi j/Z) (and likewise cos), the
-cos/sin(2 pi j/Z) are precomputed in `data`. One sin and one cos per call, a loop over teeth,
-no allocation.
+Two compiled right-hand sides. The fast one (every thermal level but 'coupled', with spacing
+errors) is the race's: every constant folded into the scaled units of Eq. 25 when the case is
+packed, the tooth phases as two dot products with precomputed cos/sin(2 pi j/Z) (one sin and one
+cos per call), the tooth loop branch-free (max/min for the dead zone) and compiled with fastmath,
+no allocation (see the block above _rhs_fast_py). The general one (every level, the coupled
+iteration; no spacing errors) keeps the SI form with the scaling applied per state. Measured in
+CPU time on one run (issue 34; DOP853 at equal rtol, paper_lx1e-4 and physical_z24) the general
+RHS took 1.4x and 1.9x the fast one's time.
 
 Scaling (Eq. 25): numbalsoda takes one scalar atol, so `solve` integrates the scaled system
 u = q / l, u' = q' / (l w), tau = w t (l = c0, w = shaft speed unless the case sets l_ref,
 w_ref), exactly as the project's CVODE integration does: atol is on the scaled states, i.e.
-atol*l [m] on lengths and atol*l*w [m/s] on velocities. The scaling is done inside the compiled
-RHS (a multiply per state); with l = w = 1 the same function is the plain SI right-hand side.
+atol*l [m] on lengths and atol*l*w [m/s] on velocities.
 
-Public functions:
-  make_rhs(params, scaled=True) -> (cfunc, data)     numbalsoda-compatible RHS and its data
-  solve(params, y0, t_eval, rtol=1e-8, atol=1e-10, mxstep=1_000_000, scaled=True)
-                                        -> (y, success, n_rhs)   y in SI, shape (len(t_eval), 14)
-  rhs_eval(params, t, y, scaled=False) -> dy/dt        one call of the compiled RHS (for tests)
+Public names:
+  Setup(params, scaled=True, kind=None)      a case packed once: .integrate(y0, t_eval, rtol,
+                                             atol, method, mxstep) -> (u scaled, ok);
+                                             .forces(t_eval, u) -> (T_m, F) in SI (the race)
+  make_rhs(params, scaled=True, kind=None) -> (cfunc, data)   numbalsoda-compatible RHS, data
+  solve(params, y0, t_eval, rtol=1e-8, atol=1e-10, mxstep=1_000_000, scaled=True,
+        method='lsoda', kind=None)   -> (y, success, n_rhs)   y in SI, shape (len(t_eval), 14)
+  rhs_eval(params, t, y, scaled=False, kind=None) -> dy/dt    one call of the compiled RHS (tests)
   load_case(path_or_dict, **overrides) -> dict         case fields with the core's defaults
 """
 import ctypes
@@ -52,7 +58,7 @@ if str(ROOT / "tests") not in sys.path:
     sys.path.insert(0, str(ROOT / "tests"))
 import oracle  # noqa: E402
 
-__all__ = ["make_rhs", "solve", "rhs_eval", "load_case", "DEFAULTS", "lsoda_sig",
+__all__ = ["Setup", "make_rhs", "solve", "rhs_eval", "load_case", "DEFAULTS", "lsoda_sig",
            "COMPILE_SECONDS"]
 
 # numbalsoda's RHS signature: void f(double t, double *u, double *du, double *data)
