@@ -89,6 +89,24 @@ def _one_line(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {' '.join(str(exc).split())}"
 
 
+def check_out_dir(path, option: str = "--out") -> Path:
+    """An output directory of a command, checked before anything is computed: a directory or a
+    new path under a writable directory; else CaseError naming the path and why (exit 2)."""
+    import os
+    p = Path(path)
+    if p.exists() and not p.is_dir():
+        raise CaseError(f"{option} {p}: exists and is not a directory (an output directory is "
+                        "wanted)")
+    parent = p
+    while not parent.exists():          # the nearest part of the path that exists
+        parent = parent.parent
+    if not parent.is_dir():
+        raise CaseError(f"{option} {p}: cannot be made: {parent} is not a directory")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise CaseError(f"{option} {p}: cannot write there ({parent} is not writable)")
+    return p
+
+
 _RESULT_KEY = "pyspline_case"     #: the member that marks an .npz written by `pyspline run`
 
 
@@ -575,6 +593,8 @@ def main(argv=None) -> int:
     with warnings.catch_warnings():
         warnings.showwarning = _show_warning
         try:
+            if getattr(args, "out", None) is not None:    # every command that writes
+                check_out_dir(args.out)
             return args.func(args)
         except KeyboardInterrupt:
             print("interrupted", file=sys.stderr)
