@@ -52,7 +52,7 @@ def _check_values(path, values: dict, z: int) -> None:
             raise CaseError(f"summary {path}: {name} has {x.size} values, {want} expected")
         bad = np.isinf(x) if group in ("loads", "tooth_loads") else ~np.isfinite(x)
         if bad.any():
-            raise CaseError(f"summary {path}: {name} = {x[bad][0]!r} is not finite")
+            raise CaseError(f"summary {path}: {name} = {float(x[bad][0])} is not finite")
 
 
 def read_summary(path) -> dict:
