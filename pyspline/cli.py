@@ -324,12 +324,17 @@ def _assignments(items, what) -> dict:
 
 
 def _fixed(items) -> dict:
-    """--fix FIELD=VALUE pairs -> {field: typed value}."""
+    """--fix FIELD=VALUE pairs -> {field: typed value}; an array field takes a comma list
+    (--fix ripple_amp=0.1,0,0,0; a per-tooth list may be shorter: the first teeth)."""
+    from .case import defaults
     out = {}
     for k, v in _assignments(items, "--fix").items():
         vals = parse_values(k, v)
+        if isinstance(defaults()[k], list):
+            out[k] = vals.tolist()
+            continue
         if len(vals) != 1:
-            raise CaseError(f"--fix {k}={v}: one value expected")
+            raise CaseError(f"--fix {k}={v}: one value expected ({k} is no array field)")
         out[k] = vals[0].item()
     return out
 
@@ -399,7 +404,7 @@ def cmd_sweep(args) -> int:
     print(f"{a['n_points']} points: {a['n_ok']} ran, {a['n_failed']} failed, "
           f"{a['n_missing']} missing; {a['n_computed']} computed now, {a['n_reused']} reused "
           f"from {out / POINTS_DIR}/")
-    if "chaotic" in ds:
+    if "chaotic" in ds and a["n_ok"]:
         n_chaos = int((ds["chaotic"] == 1).sum())
         print(f"{n_chaos} of {a['n_ok']} points chaotic (Lyapunov exponent positive beyond its "
               "spread): read their statistics, sections and spectra, not their trajectories")

@@ -221,7 +221,7 @@ def test_design_table_equals_single_runs(tmp_path):
     with pytest.raises(pyspline.CaseError, match="unknown field 'l_z'"):
         table.write_text("l_z\n1\n")
         pyspline.sweep(base, table=table, progress=False)
-    with pytest.raises(TypeError, match="not both"):
+    with pytest.raises(pyspline.CaseError, match="not both"):
         pyspline.sweep(base, table={"l_x": [0.0]}, l_x=[1e-4], progress=False)
 
 
