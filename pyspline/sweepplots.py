@@ -90,8 +90,9 @@ def _bifurcation_points(ax, x, y, per, counts=True, ms=9) -> list:
     """Scatter y (n, n_points) against x (n,) on ax, coloured by period class; legend handles."""
     cls = _period_class(per)
     handles = []
+    drawn = np.isfinite(y).any(axis=1)      # a point that did not run has nothing to show
     for c in (0, 1, 2, 3, 4, 5):
-        rows = cls == c
+        rows = (cls == c) & drawn
         if not rows.any():
             continue
         xs = np.repeat(x[rows], y.shape[1])
@@ -319,6 +320,9 @@ def waterfall(ds, speed: str = "speed_rpm", freq: str = "freq_hz", amp: str = "a
     dark = style == "map"
     if dark:
         rr = np.broadcast_to(rpm[:, None], a.shape)
+        if len(rpm) == 1:               # one speed: a band of +- 2 % around it
+            half = 0.02 * max(abs(rpm[0]), 1.0)
+            f, a, rr = np.vstack([f, f]), np.vstack([a, a]), np.vstack([rr - half, rr + half])
         mesh = ax.pcolormesh(f, rr, np.clip(a, top * floor, None), shading="nearest",
                              norm=LogNorm(vmin=top * floor, vmax=top), cmap="magma",
                              rasterized=True)
