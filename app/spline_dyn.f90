@@ -20,7 +20,8 @@ program spline_dyn
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use spline_kinds, only: wp
   use spline_errors, only: err_ok, err_case, err_interrupted, err_exit_code, msglen, err_names
-  use spline_case, only: case_t, case_read_file, case_parse, case_name_of, case_write_text
+  use spline_case, only: case_t, case_read_file, case_parse, case_name_of, case_write_text, &
+       c_file_kind
   use spline_model, only: model_t, model_from_case, model_warnings, nstate, nkterms, kterm_names
   use spline_run, only: run_case, run_warnings
   use spline_quantities, only: nstats, stat_q, state_q, iq_tf, ntooth_q, tooth_q, nout_q, output_q, nload, &
@@ -52,13 +53,6 @@ program spline_dyn
       import :: c_char
       character(kind=c_char), intent(in) :: path(*)
     end subroutine c_unlink
-    integer(c_int) function c_file_kind(path, size, errbuf, errlen) bind(C, name='spline_file_kind')
-      import :: c_char, c_int, c_long_long
-      character(kind=c_char), intent(in) :: path(*)
-      integer(c_long_long), intent(out) :: size
-      character(kind=c_char), intent(out) :: errbuf(*)
-      integer(c_int), value :: errlen
-    end function c_file_kind
     integer(c_int) function c_getpid() bind(C, name='spline_getpid')
       import :: c_int
     end function c_getpid
