@@ -287,6 +287,9 @@ def cmd_merge(args) -> int:
     import shlex
     import sys
     paths = _main_paths(args.summaries)
+    if not paths:
+        raise CaseError(f"merge: no summary in {', '.join(args.summaries)} (a directory stands "
+                        "for its *.summary files)")
     fields = [f for f in (args.fields or "").split(",") if f.strip()] or None
     cmd = " ".join(shlex.quote(a) for a in ["pyspline", "merge", *args.summaries,
                                             f"--out={args.out}"])

@@ -224,10 +224,7 @@ def _foreign_files(out: Path) -> list[str]:
 
 def cmd_reproduce(args) -> int:
     from .paper import reproduce
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        print(f"error: reproduce --out {out}: not a directory", file=sys.stderr)
-        return 2
+    out = Path(args.out)          # a directory or a new path: main's check_out_dir
     foreign = _foreign_files(out)
     if foreign:
         print(f"error: reproduce --out {out}: {', '.join(foreign)} exist(s) and were not written "
