@@ -31,7 +31,8 @@ module spline_api
   use spline_orbits, only: period_map, map_and_monodromy
   implicit none
   private
-  public :: api_load_file, api_load_fields, api_load_text, api_model_size, api_simulate
+  public :: api_load_file, api_load_fields, api_load_text, api_read_text, api_model_size
+  public :: api_simulate
   public :: api_rhs, api_rhs_mesh, api_start_state, api_loads
   public :: api_output_times, api_model_info, api_defaults, api_names, api_tooth_stiffness
   public :: api_field_hint, api_warnings, api_period_map, api_map_monodromy, api_lyapunov
@@ -108,6 +109,24 @@ contains
     if (ie == err_ok) call load_model(c, model, sizes, warn, ie, errmsg)
     ierr = ie
   end subroutine api_load_text
+
+  !> Read a case from namelist text, without validating or building it (pyspline merge: the
+  !> case of a spline-dyn summary, also of a run its values failed); its fields as
+  !> api_load_file returns them.
+  subroutine api_read_text(text, nv, nc, values, chars, ierr, errmsg)
+    character(len=*), intent(in) :: text
+    integer(c_int), intent(in) :: nv, nc
+    real(c_double), intent(out) :: values(nv)
+    integer(c_int), intent(out) :: chars(nc)
+    integer(c_int), intent(out) :: ierr
+    character(len=msglen), intent(out) :: errmsg
+    type(case_t) :: c
+    integer :: ie
+    values = 0; chars = iachar(' ')
+    call case_read_text(text, c, ie, errmsg)
+    if (ie == err_ok) call fields_out(c, values, chars, ie, errmsg)
+    ierr = ie
+  end subroutine api_read_text
 
   !> The fields of c as api_load_file returns them (characters as byte values 0..255).
   subroutine fields_out(c, values, chars, ierr, errmsg)

@@ -23,7 +23,7 @@ module spline_case
   private
   public :: case_t, case_read_file, case_read_text, case_parse, case_write_text, case_validate
   public :: case_name_of, case_suggest, case_field, case_field_meta, case_check_file, case_output_bytes
-  public :: case_run_times
+  public :: case_run_times, c_file_kind   ! c_file_kind: also spline-dyn's output checks
   public :: namelen, nripple, ndof_case, thermal_values, method_values, nonlinear_values, start_values, &
        fidelity_values, section_values, option_index, nfields, max_case_bytes, max_output_bytes, &
        lyapunov_method_values, goal_values

@@ -107,6 +107,24 @@ def _one_line(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {' '.join(str(exc).split())}"
 
 
+def check_out_dir(path, option: str = "--out") -> Path:
+    """An output directory of a command, checked before anything is computed: a directory or a
+    new path under a writable directory; else CaseError naming the path and why (exit 2)."""
+    import os
+    p = Path(path)
+    if p.exists() and not p.is_dir():
+        raise CaseError(f"{option} {p}: exists and is not a directory (an output directory is "
+                        "wanted)")
+    parent = p
+    while not parent.exists():          # the nearest part of the path that exists
+        parent = parent.parent
+    if not parent.is_dir():
+        raise CaseError(f"{option} {p}: cannot be made: {parent} is not a directory")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise CaseError(f"{option} {p}: cannot write there ({parent} is not writable)")
+    return p
+
+
 _RESULT_KEY = "pyspline_case"     #: the member that marks an .npz written by `pyspline run`
 
 
@@ -224,10 +242,7 @@ def _foreign_files(out: Path) -> list[str]:
 
 def cmd_reproduce(args) -> int:
     from .paper import reproduce
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        print(f"error: reproduce --out {out}: not a directory", file=sys.stderr)
-        return 2
+    out = Path(args.out)          # a directory or a new path: main's check_out_dir
     foreign = _foreign_files(out)
     if foreign:
         print(f"error: reproduce --out {out}: {', '.join(foreign)} exist(s) and were not written "
@@ -324,12 +339,17 @@ def _assignments(items, what) -> dict:
 
 
 def _fixed(items) -> dict:
-    """--fix FIELD=VALUE pairs -> {field: typed value}."""
+    """--fix FIELD=VALUE pairs -> {field: typed value}; an array field takes a comma list
+    (--fix ripple_amp=0.1,0,0,0; a per-tooth list may be shorter: the first teeth)."""
+    from .case import defaults
     out = {}
     for k, v in _assignments(items, "--fix").items():
         vals = parse_values(k, v)
+        if isinstance(defaults()[k], list):
+            out[k] = vals.tolist()
+            continue
         if len(vals) != 1:
-            raise CaseError(f"--fix {k}={v}: one value expected")
+            raise CaseError(f"--fix {k}={v}: one value expected ({k} is no array field)")
         out[k] = vals[0].item()
     return out
 
@@ -399,7 +419,7 @@ def cmd_sweep(args) -> int:
     print(f"{a['n_points']} points: {a['n_ok']} ran, {a['n_failed']} failed, "
           f"{a['n_missing']} missing; {a['n_computed']} computed now, {a['n_reused']} reused "
           f"from {out / POINTS_DIR}/")
-    if "chaotic" in ds:
+    if "chaotic" in ds and a["n_ok"]:
         n_chaos = int((ds["chaotic"] == 1).sum())
         print(f"{n_chaos} of {a['n_ok']} points chaotic (Lyapunov exponent positive beyond its "
               "spread): read their statistics, sections and spectra, not their trajectories")
@@ -593,6 +613,8 @@ def main(argv=None) -> int:
     with warnings.catch_warnings():
         warnings.showwarning = _show_warning
         try:
+            if getattr(args, "out", None) is not None:    # every command that writes
+                check_out_dir(args.out)
             return args.func(args)
         except KeyboardInterrupt:
             print("interrupted", file=sys.stderr)

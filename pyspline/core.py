@@ -262,7 +262,8 @@ class Result:
         per-tooth F, Fx, Fy, dn, c, Tf, rc1, rc2 (time, tooth); the loads (``loads``: per
         tooth on the tooth dim, the scalars without a dim); section_t and the states on the
         section section_x1 .. section_vD3 (section_point); lyapunov_log_growth
-        (renormalisation, with coordinate lyapunov_t [s]). attrs: case (namelist text), name, level, pyspline_version, the
+        (renormalisation, with coordinate lyapunov_t [s]); a sliced face (n_slices > 1): face
+        (time, tooth, slice) [N] and tilt (time, moment: M_x, M_y) [N m]. attrs: case (namelist text), name, level, pyspline_version, the
         exponent as lyapunov_exponent [1/s], and the run statistics as stat_<name>."""
         import xarray as xr
         from . import __version__
@@ -286,6 +287,16 @@ class Result:
                 a = _attrs(n)
                 a["long_name"] += " on the Poincare section"
                 data["section_" + n] = ("section_point", sec[:, i], a)
+        if self.face is not None:               # a sliced face (n_slices > 1)
+            data["face"] = (("time", "tooth", "slice"), self.face,
+                            {"long_name": "load of each slice of each tooth's face",
+                             "units": "N"})
+            data["tilt"] = (("time", "moment"), self.tilt,
+                            {"long_name": "tilting moment on spline 1 (M_x, M_y)",
+                             "units": "N m"})
+            coords["slice"] = ("slice", np.arange(1, self.face.shape[2] + 1),
+                               {"long_name": "face slice number"})
+            coords["moment"] = ("moment", np.array(["M_x", "M_y"]))
         attrs = {"case": self.case.text(), "name": self.case.name,
                  "pyspline_version": __version__}
         if self.stats:
