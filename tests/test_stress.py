@@ -116,3 +116,40 @@ def test_executable_prints_the_same_stress_warnings(exe, tmp_path):
     shown = re.search(r"shear at pitch \[MPa\]:\s+(\S+)\s+(\S+)\s+(\S+)", run.stdout).groups()
     np.testing.assert_allclose([float(v) for v in shown],
                                [res.loads[n] * 1e-6 for n in LIMITS], atol=0.006)
+
+
+def flash_messages(fields) -> tuple[list[str], ps.Result]:
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        res = ps.simulate(fields)
+        res.loads                                   # the loads' warnings: when first read
+    return [str(w.message) for w in rec if issubclass(w.category, ps.SplineWarning)
+            and "contact temperature T_M + T_f" in str(w.message)], res
+
+
+def test_flash_temperature_beyond_scuffing_and_tempering_warns(exe, tmp_path):
+    """The contact temperature of Blok's criterion, T_B = T_M + max T_f (Eq. 1), beyond 400 degC
+    (the top of typical scuffing temperatures) warns of scuffing, beyond 650 degC (steel's
+    tempering range) more strongly; the calibrated paper_T100 is silent. One-way, T_f is
+    proportional to f_m (Eq. 3, the loads do not see it), so f_m is chosen here to put T_B at
+    500 and 2000 degC from the calibrated run; the executable prints the same lines."""
+    case = ps.load_case(CASES / "paper_T100.nml", thermal="oneway", t_end=0.02, n_out=161)
+    msgs, res = flash_messages(case)
+    tf0, f_m0, t_m = res.loads["Tf_max"], case["f_m"], case["t_bulk"]
+    assert msgs == [] and 0 < t_m + tf0 < 400
+    for target, words in ((500.0, "exceeds 400 degC, the top of typical scuffing temperatures"),
+                          (2000.0, "exceeds 650 degC, past steel's tempering range")):
+        fields = case.replace(f_m=f_m0 * (target - t_m) / tf0)
+        msgs, res = flash_messages(fields)
+        assert len(msgs) == 1 and words in msgs[0], msgs
+        assert res.loads["Tf_max"] == pytest.approx(target - t_m, rel=1e-9)
+        assert f"T_M + T_f = {t_m:.1f} + {target - t_m:.1f} degC" in msgs[0], msgs
+        assert f"tooth {int(res.loads['Tf_max_tooth'])} at t" in msgs[0]
+    path = tmp_path / "hot.nml"
+    fields.to_namelist(path)
+    run = subprocess.run([exe, str(path), "-o", str(tmp_path / "out.csv")], capture_output=True,
+                         text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    prefix = "spline-dyn: warning: "
+    assert [ln[len(prefix):] for ln in run.stderr.splitlines()
+            if ln.startswith(prefix) and "contact temperature T_M + T_f" in ln] == msgs
