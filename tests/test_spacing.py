@@ -260,3 +260,33 @@ def test_seeded_errors_are_reproducible_with_mean_zero(z, seed):
     assert not np.allclose(e, other)
     if z == 1000:                                      # uniform: about half the teeth past amp/2
         assert 0.3 < (np.abs(e) > 0.5 * amp).mean() < 0.7
+
+
+def test_the_errors_in_use_read_back_from_info_result_dataset_and_summary(exe, tmp_path):
+    """The spacing errors a run uses, the given list plus the seeded ones (docs/model.md section
+    11, tests/oracle.py from the document), read back from Model.info(), the Result, its
+    Dataset and spline-dyn's summary, exactly (17 digits in the summary)."""
+    given = [1e-6, -2e-6, 0.5e-6]
+    case = pyspline.load_case(dict(PAPER, name="inuse", spacing_error=given,
+                                   spacing_error_amp=3e-6, spacing_error_seed=42, t_end=0.002,
+                                   n_out=5))
+    expected = oracle.random_spacing_errors(16, 3e-6, 42)
+    expected[:3] += given
+    e = case.model.info()["spacing_error"]
+    np.testing.assert_allclose(e, expected, rtol=0, atol=1e-21)
+    res = pyspline.simulate(case)
+    np.testing.assert_array_equal(res.spacing_error, e)
+    ds = res.to_xarray()
+    np.testing.assert_array_equal(ds["spacing_error"].values, e)
+    assert ds["spacing_error"].dims == ("tooth",) and ds["spacing_error"].attrs["units"] == "m"
+    path = tmp_path / "inuse.nml"
+    case.to_namelist(path)
+    subprocess.run([exe, str(path), "--summary", str(tmp_path / "inuse.summary")], check=True,
+                   capture_output=True, timeout=120)
+    from pyspline.batch import read_summary
+    summary = read_summary(tmp_path / "inuse.summary")
+    np.testing.assert_array_equal(summary["values"]["model.spacing_error"], e)
+    assert summary["units"]["model.spacing_error"] == "m"
+    # without errors: zeros, one per tooth
+    np.testing.assert_array_equal(pyspline.load_case(dict(PAPER, name="none")).model.info()[
+        "spacing_error"], np.zeros(16))

@@ -122,7 +122,6 @@ def flash_messages(fields) -> tuple[list[str], ps.Result]:
     with warnings.catch_warnings(record=True) as rec:
         warnings.simplefilter("always")
         res = ps.simulate(fields)
-        res.loads                                   # the loads' warnings: when first read
     return [str(w.message) for w in rec if issubclass(w.category, ps.SplineWarning)
             and "contact temperature T_M + T_f" in str(w.message)], res
 
