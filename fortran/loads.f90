@@ -287,8 +287,9 @@ contains
       line = ''
       tb = m%t_bulk + loads(il_tf_max)
       if (.not. loads(il_tf_max) > 0.0_wp .or. .not. tb > scuffing_temp) return
-      line = 'case '//trim(m%name)//': contact temperature T_M + T_f = '//ftoa(m%t_bulk, '(f0.1)')// &
-           ' + '//ftoa(loads(il_tf_max), '(f0.1)')//' degC (Eq. 1, the largest T_f, tooth '// &
+      line = 'case '//trim(m%name)//': contact temperature T_M + T_f = '// &
+           ftoa(m%t_bulk, '(f12.1)')//' + '//ftoa(loads(il_tf_max), '(f12.1)')// &
+           ' degC (Eq. 1, the largest T_f, tooth '// &
            itoa(nint(loads(il_tf_max_tooth)))//' at t = '//ftoa(loads(il_tf_max_t), '(es10.3)')// &
            ' s, f_m = '//ftoa(m%f_m, '(es10.3)')//') exceeds '
       if (tb > tempering_temp) then

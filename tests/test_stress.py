@@ -146,3 +146,5 @@ def test_flash_temperature_beyond_scuffing_and_tempering_warns(exe, tmp_path):
         assert f"T_M + T_f = {t_m:.1f} + {target - t_m:.1f} degC" in msgs[0], msgs
         assert f"tooth {int(res.loads['Tf_max_tooth'])} at t" in msgs[0]
     assert exe_warnings(exe, fields, tmp_path, FLASH)[0] == msgs
+    msgs, _ = stress_messages(fields.replace(t_bulk=0.0), FLASH)      # no bulk rise: '0.0 + '
+    assert len(msgs) == 1 and "T_M + T_f = 0.0 + " in msgs[0], msgs
