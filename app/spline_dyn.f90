@@ -425,6 +425,7 @@ contains
       do i2 = 1, nload_tooth
         call put('tooth_loads.'//load_tooth_q(i2)%name, load_tooth_q(i2)%unit, tload(:, i2))
       end do
+      call put('model.spacing_error', 'm', m%spacing_error(1:m%z))   ! in use: list + seeded
       nt = m%n_out
       call put('run.t_first', 's', t(1:min(1, nt)))
       call extremes('Tm', output_q(itm)%unit, tm)

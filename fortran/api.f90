@@ -14,7 +14,7 @@
 module spline_api
   use, intrinsic :: iso_c_binding, only: c_double, c_int
   use spline_kinds, only: wp
-  use spline_errors, only: err_ok, err_case, nerr, err_names, msglen
+  use spline_errors, only: err_ok, err_case, nerr, err_names, msglen, itoa
   use spline_case, only: case_t, case_read_file, case_read_text, case_suggest, case_field, &
        case_field_meta
   use spline_case_values, only: case_value_sizes, case_to_values, case_from_values
@@ -448,18 +448,25 @@ contains
   !> [m], pitch radius [m], shaft speed omega [rad/s], the scales of Eq. 25 l_ref [m] and
   !> w_ref [rad/s], the backlash at the bulk temperature [m], kappa [m/degC] (Eq. 2), the
   !> k_m used [N/m], 1 if it is computed (Eq. 18), the thermal level (0 none .. 3 coupled);
-  !> and the Eq. 18 terms (order of api_names('kterms')).
-  subroutine api_model_info(model, nb, info, terms, ierr, errmsg)
-    integer(c_int), intent(in) :: nb
+  !> and the Eq. 18 terms (order of api_names('kterms')); the tooth spacing errors in use e_j
+  !> of teeth 1 .. z [m] (the list plus the seeded ones, docs/model.md section 11).
+  subroutine api_model_info(model, nb, z, info, terms, spacing, ierr, errmsg)
+    integer(c_int), intent(in) :: nb, z
     integer(c_int), intent(in) :: model(nb)
-    real(c_double), intent(out) :: info(ninfo), terms(nkterms)
+    real(c_double), intent(out) :: info(ninfo), terms(nkterms), spacing(z)
     integer(c_int), intent(out) :: ierr
     character(len=msglen), intent(out) :: errmsg
     type(model_t) :: m
     integer :: ie
-    info = 0; terms = 0
+    info = 0; terms = 0; spacing = 0
     call unpack(model, m, ie, errmsg)
+    if (ie == err_ok .and. z /= m%z) then
+      ie = err_case
+      errmsg = 'case '//trim(m%name)//': api_model_info for '//itoa(z)//' teeth, the model has '// &
+           itoa(m%z)
+    end if
     if (ie == err_ok) then
+      spacing = m%spacing_error(1:z)
       info = [m%r_b, m%r_pitch, m%omega, m%l_ref, m%w_ref, m%c_bulk, m%kappa, m%k_m, &
            merge(1.0_wp, 0.0_wp, m%k_m_computed), real(m%thermal, wp), m%c_m, m%m_e]
       terms = m%k_terms

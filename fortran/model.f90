@@ -36,11 +36,12 @@ module spline_model
   !> as N/m is 1000 times, on top of such a fit 1e4 is passed.
   real(wp), parameter :: k_m_warn_ratio = 1.0e4_wp
   !> Plausibility limits of model_warnings (docs/model.md section 12, "Plausibility warnings"):
-  !> the supports' share of the offset beyond the backlash; the static shaft wind-up [rad]
+  !> the offset the supports leave at the mesh over the static tooth deflection (load-sharing
+  !> factor 1.1); the static shaft wind-up [rad]
   !> (a solid steel shaft at 300 MPa shear twists 2 tau L / (G d) = 0.0075 L/d rad: 0.2 rad at
   !> L/d = 27; an elastomer coupling 5-10 deg at its rated torque); the static tooth deflection
   !> as a fraction of the module (a tooth at a 1000 MPa root bending stress deflects ~1.6 %).
-  real(wp), parameter :: support_limit = 0.5_wp, windup_limit = 0.2_wp
+  real(wp), parameter :: support_limit = 0.1_wp, windup_limit = 0.2_wp
   real(wp), parameter :: deflection_limit = 0.05_wp
 
   type :: model_t
@@ -337,27 +338,36 @@ contains
          'Run as given'//new_line('a')
   end function separation_warning
 
-  !> The offset beyond the backlash, |l| - c, is taken by the mesh and the supports in series
-  !> (not with a floating spline, k_p = 0, or frozen lateral motion, dof = 3): the mesh's lateral
-  !> stiffness with all Z teeth in contact is K = sum_j k_m sin^2(phi_j) = Z k_m / 2 (Eqs. 11,
-  !> 19-21), the supports' k_s = k_p1 k_p2 / (k_p1 + k_p2) (Eq. 23); the supports take the share
-  !> K / (K + k_s). Warned above support_limit.
+  !> Supports too soft for the offset to reach the teeth. Under torque every tooth is on its
+  !> drive flank and the mesh resists a lateral offset from zero, the backlash taken up by the
+  !> twist, with K = sum_j k_m sin^2(phi_j) = Z k_m / 2 (Eqs. 11, 19-21) in series with the
+  !> supports' k_s = k_p1 k_p2 / (k_p1 + k_p2) (Eq. 23): the offset left at the mesh is
+  !> e = |l| k_s / (K + k_s) (docs/model.md section 11, static full contact). What decides the
+  !> load sharing is e against the static tooth deflection delta = F0 / k_m, F0 = |T_d| / (Z r_b):
+  !> the tooth loads are F0 (1 + (e / delta) sin(phi_j - psi)) while e <= delta (load-sharing
+  !> factor 1 + e / delta), and teeth unload beyond it. Warned when the offset would unload teeth
+  !> on rigid supports, |l| > delta, but the supports leave e <= support_limit delta (not with a
+  !> floating spline, k_p = 0, frozen lateral motion, dof = 3, or no drive torque).
   function support_warning(m) result(text)
     type(model_t), intent(in) :: m
     character(len=:), allocatable :: text
-    real(wp) :: l, k_mesh, k_s, share
+    real(wp) :: l, k_mesh, k_s, e, delta
     text = ''
     l = hypot(m%l_x, m%l_y)
-    if (m%dof /= 7 .or. l <= m%c_bulk .or. min(m%k_p1, m%k_p2) <= 0.0_wp) return
+    if (m%dof /= 7 .or. min(m%k_p1, m%k_p2) <= 0.0_wp .or. m%t_d == 0.0_wp) return
     k_mesh = m%z*m%k_m/2.0_wp
     k_s = 1.0_wp/(1.0_wp/m%k_p1 + 1.0_wp/m%k_p2)
-    share = k_mesh/(k_mesh + k_s)
-    if (share <= support_limit) return
+    e = l*k_s/(k_mesh + k_s)
+    delta = abs(m%t_d)/(m%z*m%r_b*m%k_m)
+    if (l <= delta .or. e > support_limit*delta) return
     text = 'case '//trim(m%name)//': fields k_p1 = '//num(m%k_p1)//', k_p2 = '//num(m%k_p2)// &
          ' N/m: the supports (in series '//num(k_s)//' N/m, the mesh Z k_m / 2 = '//num(k_mesh)// &
-         ' N/m) take '//num(100.0_wp*share)//' % of the offset beyond the backlash, |l| - c = '// &
-         num(l - m%c_bulk)//' m (limit '//itoa(nint(100.0_wp*support_limit))//' %): the '// &
-         'teeth barely see the misalignment. Run as given'//new_line('a')
+         ' N/m) leave e = '//num(e)//' m of the offset |l| = '//num(l)//' m at the mesh, '// &
+         num(100.0_wp*e/delta)//' % of the static tooth deflection |T_d| / (Z r_b k_m) = '// &
+         num(delta)//' m (limit '//itoa(nint(100.0_wp*support_limit))//' %): the teeth barely '// &
+         'see the misalignment: it raises the static load-sharing factor to 1 + e / delta = '// &
+         num(1.0_wp + e/delta)// &
+         '. Run as given'//new_line('a')
   end function support_warning
 
   !> Static wind-up of the shafts, T_d / k_t1 and T_L / k_t2, above windup_limit (not for a

@@ -9,10 +9,11 @@ import numpy as np
 import pytest
 
 import pyspline
-from conftest import CASES, DEMONSTRATION_SCENES, PAPER_SHAFTS, assert_executable_matches_python
+from conftest import (CASES, DEMONSTRATION_SCENES, PAPER_SHAFTS, PAPER_SUPPORTS,
+                      assert_executable_matches_python)
 from pyspline.cli import _summary
 
-pytestmark = [PAPER_SHAFTS, DEMONSTRATION_SCENES]
+pytestmark = [PAPER_SHAFTS, PAPER_SUPPORTS, DEMONSTRATION_SCENES]
 
 SHIPPED = sorted(p.stem for p in CASES.glob("*.nml") if p.stem != "template")
 #: the chaotic scenes' trajectories part from any other run's within milliseconds (exponent
