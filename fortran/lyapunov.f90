@@ -9,6 +9,7 @@ module spline_lyapunov
   use spline_solver, only: integrate
   use spline_quantities, only: nsolver_stats
   use spline_variational, only: tangent_flow
+  use spline_integrator, only: lib_log_t
   implicit none
   private
   public :: lyapunov_count, lyapunov_benettin, lyapunov_tangent
@@ -43,6 +44,7 @@ contains
     real(wp) :: y(nstate), yp(nstate), t0, t1, ys(nstate), yps(nstate), dv(nstate), d, g
     real(wp) :: tout(1), y1(nstate, 1), yp1(nstate, 1), st(nsolver_stats)
     integer :: idx(nstate), n, k, i, modes(m%z*m%n_slices, 1)
+    type(lib_log_t) :: msgs         !< the integrator's warnings over every interval
     call integrated_states(m, idx, n)
     mm = m
     y = y_start
@@ -58,7 +60,7 @@ contains
       mm%t0 = t0
       tout = t1
       call integrate(mm, y, 1, tout, y1, modes, st, ierr, errmsg, interruptible, y0b=yp, &
-           youtb=yp1)
+           youtb=yp1, msgs=msgs)
       if (ierr /= err_ok) return
       call to_scaled(m, y1(:, 1), ys)
       call to_scaled(m, yp1(:, 1), yps)
@@ -98,6 +100,7 @@ contains
     type(model_t) :: mm
     real(wp) :: y(nstate), y1(nstate), phi(nstate, 1), t1, d, g
     integer :: idx(nstate), n, k
+    type(lib_log_t) :: msgs         !< the integrator's warnings over every interval
     call integrated_states(m, idx, n)
     mm = m
     y = y_start
@@ -108,7 +111,7 @@ contains
     lt = 0.0_wp; lg = 0.0_wp
     do k = 1, size(lt)
       t1 = min(t_start + k*m%lyap_dt, m%t_end)
-      call tangent_flow(mm, t1, y, 1, phi, y1, ierr, errmsg, interruptible)
+      call tangent_flow(mm, t1, y, 1, phi, y1, ierr, errmsg, interruptible, msgs=msgs)
       if (ierr /= err_ok) return
       d = norm2(phi(1:n, 1))
       if (.not. (d > 0.0_wp)) then       ! the tangent died out: start afresh

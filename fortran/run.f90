@@ -69,6 +69,7 @@ contains
     real(wp), intent(out), optional :: consts(ntooth_q - 4)
     type(model_t) :: run
     real(wp) :: eps_lat, eps_th, closed, t_closed, cq(ntooth_q - 4)
+    character(len=len(errmsg)) :: warn
     integer(8) :: c0, c1, rate
     integer :: nw
     logical :: fin
@@ -89,10 +90,15 @@ contains
     end if
     if (present(lyap_t)) then
       lyap_t = 0.0_wp; lyap_g = 0.0_wp
+      warn = errmsg                          ! the integrator's warnings (success), joined below
       if (ierr == err_ok .and. m%lyapunov .and. m%lyap_tangent) then
         call lyapunov_tangent(run, t(1), y(:, 1), lyap_t, lyap_g, ierr, errmsg, interruptible)
       else if (ierr == err_ok .and. m%lyapunov) then
         call lyapunov_benettin(run, t(1), y(:, 1), lyap_t, lyap_g, ierr, errmsg, interruptible)
+      end if
+      if (ierr == err_ok .and. m%lyapunov .and. len_trim(warn) > 0) then
+        if (len_trim(errmsg) > 0) warn = trim(warn)//new_line('a')//errmsg
+        errmsg = warn
       end if
     end if
     closed = 0.0_wp; t_closed = 0.0_wp
