@@ -491,8 +491,8 @@ contains
     character(len=:), allocatable :: text
     text = ''
     if (log%nwarn == 0) return
-    text = 'case '//trim(name)//': the integrator warned '//itoa(log%nwarn)//' time(s) in this '// &
-         'run (its steps may have become too small to resolve the motion); the first: '// &
+    text = 'case '//trim(name)//': SUNDIALS warned '//itoa(log%nwarn)//' time(s) in this run '// &
+         '(the steps may have become too small to resolve the motion); the first, from '// &
          trim(log%first)
   end function integrator_warnings
 
@@ -506,8 +506,8 @@ contains
     call c_f_pointer(udata, log)
     if (error_code > 0) then
       log%nwarn = log%nwarn + 1
-      if (log%nwarn == 1) log%first = '['//c_string(module)//' WARNING in '//c_string(function)// &
-           '] '//c_string(msg)
+      if (log%nwarn == 1) log%first = c_string(module)//' in '//c_string(function)//': '// &
+           c_string(msg)
     else
       log%err = c_string(msg)
     end if
