@@ -37,7 +37,7 @@ module spline_integrator
   use fsunlinsol_band_mod, only: FSUNLinSol_Band
   use fsunnonlinsol_fixedpoint_mod, only: FSUNNonlinSol_FixedPoint
   use spline_kinds, only: wp
-  use spline_errors, only: msglen, itoa
+  use spline_errors, only: msglen, itoa, ftoa
   use spline_model, only: model_t
   use spline_quantities, only: nstats => nsolver_stats, ist_steps, ist_rhs_evals, ist_jac_evals, &
        ist_lin_rhs_evals, ist_err_test_fails, ist_nonlin_conv_fails, ist_root_fn_evals
@@ -460,9 +460,9 @@ contains
     name = integrator_name(cv)
     write(at, '(es12.5)') tau/m%w_ref
     if (flag == CV_TOO_MUCH_WORK .and. cv%wall_bound) then
-      write(errmsg, '(a,g0,a)') head//' took longer than its wall-time bound max_seconds = ', &
-           cv%max_seconds, ' s, at t = '//at//' s, after '//itoa(int(integrator_steps_done(cv)))// &
-           ' '//name//' steps: the map does not settle in that time (a rattling or chaotic drive?)'
+      errmsg = head//' took longer than its wall-time bound max_seconds = '// &
+           ftoa(cv%max_seconds, '(es9.2)')//' s, at t = '//at//' s, after '// &
+           itoa(int(integrator_steps_done(cv)))//' '//name//' steps
     else if (flag == CV_TOO_MUCH_WORK .and. cv%total_bound) then
       errmsg = head//' took max_total_steps = '//itoa(int(cv%max_total_steps))//' '//name// &
            ' steps in all by t = '//at//' s (flag CV_TOO_MUCH_WORK): raise max_total_steps, '// &
