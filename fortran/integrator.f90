@@ -462,7 +462,7 @@ contains
     if (flag == CV_TOO_MUCH_WORK .and. cv%wall_bound) then
       errmsg = head//' took longer than its wall-time bound max_seconds = '// &
            ftoa(cv%max_seconds, '(es9.2)')//' s, at t = '//at//' s, after '// &
-           itoa(int(integrator_steps_done(cv)))//' '//name//' steps
+           itoa(int(integrator_steps_done(cv)))//' '//name//' steps'
     else if (flag == CV_TOO_MUCH_WORK .and. cv%total_bound) then
       errmsg = head//' took max_total_steps = '//itoa(int(cv%max_total_steps))//' '//name// &
            ' steps in all by t = '//at//' s (flag CV_TOO_MUCH_WORK): raise max_total_steps, '// &
