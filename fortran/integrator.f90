@@ -100,8 +100,9 @@ contains
 
   !> The SUNDIALS context and the state vector on the caller's array yr (a target that outlives
   !> the run); the run's name in messages and its work bounds, the case's; the wall clock
-  !> started, max_seconds (optional, > 0) its bound. flag /= 0: the first failure, stage names it.
-  subroutine integrator_open(m, run, yr, cv, flag, stage, max_seconds)
+  !> started (or at the system_clock count wall_start, optional: a bound over several runs),
+  !> max_seconds (optional, > 0) its bound. flag /= 0: the first failure, stage names it.
+  subroutine integrator_open(m, run, yr, cv, flag, stage, max_seconds, wall_start)
     type(model_t), intent(in) :: m
     character(len=*), intent(in) :: run
     real(c_double), intent(inout), target :: yr(:)
@@ -109,11 +110,13 @@ contains
     integer(c_int), intent(out) :: flag
     character(len=*), intent(out) :: stage
     real(wp), intent(in), optional :: max_seconds
+    integer(8), intent(in), optional :: wall_start
     cv%run = run
     cv%max_steps = m%max_steps
     cv%max_total_steps = m%max_total_steps
     if (present(max_seconds)) cv%max_seconds = max_seconds
     call system_clock(cv%clock0, cv%rate)
+    if (present(wall_start)) cv%clock0 = wall_start
     stage = 'creating the SUNDIALS context'
     flag = sundials_context_new(cv%sunctx)
     if (flag /= 0) return
@@ -131,20 +134,19 @@ contains
   !> Create CVODE on cv%sv at tau: the case's method (Adams or BDF, stability limit detection),
   !> tolerances and step bound, SUNDIALS' messages to lib_handler, the right-hand side rhs (user
   !> data udata), the (non)linear solver: m%newton: Newton with a dense matrix (CVODE's
-  !> difference Jacobian), or with jac (optional) the Jacobian function in a band matrix of
+  !> difference Jacobian; jac = c_null_funptr), or the Jacobian function jac in a band matrix of
   !> half-width band; else fixed-point iteration (no Anderson acceleration); nroot > 0: the root
   !> functions roots. flag /= 0: the first failure; stage names the step.
-  subroutine cvode_create(m, tau, nroot, rhs, roots, udata, cv, flag, stage, jac, band)
+  subroutine cvode_create(m, tau, nroot, rhs, roots, jac, band, udata, cv, flag, stage)
     type(model_t), intent(in) :: m
     real(c_double), intent(in) :: tau
     integer(c_int), intent(in) :: nroot
-    type(c_funptr), value :: rhs, roots
+    type(c_funptr), value :: rhs, roots, jac   ! by value: no address constant to relocate
+    integer, intent(in) :: band
     type(c_ptr), intent(in) :: udata
     type(integrator_t), intent(inout), target :: cv
     integer(c_int), intent(out) :: flag
     character(len=*), intent(out) :: stage
-    type(c_funptr), value, optional :: jac     ! by value: no address constant to relocate
-    integer, intent(in), optional :: band
     integer(c_long) :: nn
     cv%newton = m%newton
     cv%roots = nroot > 0
@@ -166,7 +168,7 @@ contains
     if (flag /= 0) return
     stage = 'attaching the (non)linear solver'
     flag = -1
-    if (m%newton .and. present(jac)) then
+    if (m%newton .and. c_associated(jac)) then
       ! a band of half-width band holds a block-diagonal Jacobian (spline_variational)
       cv%amat => FSUNBandMatrix(nn, int(band, c_long), int(band, c_long), cv%sunctx)
       if (associated(cv%amat)) cv%ls => FSUNLinSol_Band(cv%sv, cv%amat, cv%sunctx)

@@ -69,9 +69,10 @@ contains
   !> SUNDIALS' messages are never printed (spline_integrator::lib_handler): a failure's text
   !> joins errmsg; its warnings, counted in msgs (optional: one log across the runs of a caller),
   !> are errmsg on success (spline_integrator::integrator_warnings; '' if none).
-  !> max_seconds (optional, > 0): the run's wall-time bound (a map run's).
+  !> max_seconds (optional, > 0): the run's wall-time bound (a map run's), counted from the
+  !> system_clock count wall_start (optional; default: the run's start).
   subroutine integrate(m, y0, nt, tout, yout, modes_out, stats, ierr, errmsg, interruptible, &
-       tsec, ysec, y0b, youtb, msgs, max_seconds)
+       tsec, ysec, y0b, youtb, msgs, max_seconds, wall_start)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: y0(nstate)
     integer, intent(in) :: nt
@@ -88,6 +89,7 @@ contains
     real(wp), intent(out), optional :: youtb(nstate, nt)
     type(lib_log_t), intent(inout), optional :: msgs
     real(wp), intent(in), optional :: max_seconds
+    integer(8), intent(in), optional :: wall_start
     type(solver_ctx_t), target :: ctx
     type(integrator_t), target :: cv
     real(c_double), allocatable, target :: yr(:)   !< CVODE's state vector (the copies' integrated states)
@@ -102,13 +104,13 @@ contains
 
     call start_run()
     if (present(msgs)) cv%log = msgs
-    call integrator_open(m, 'the run', yr, cv, flag, stage, max_seconds)
+    call integrator_open(m, 'the run', yr, cv, flag, stage, max_seconds, wall_start)
     if (flag == 0 .and. m%erk) then
       call erk_create(m, tau, nroot, c_funloc(rhs_cb), c_funloc(roots_cb), c_loc(ctx), cv, &
            flag, stage)
     else if (flag == 0) then
-      call cvode_create(m, tau, nroot, c_funloc(rhs_cb), c_funloc(roots_cb), c_loc(ctx), cv, &
-           flag, stage)
+      call cvode_create(m, tau, nroot, c_funloc(rhs_cb), c_funloc(roots_cb), c_null_funptr, 0, &
+           c_loc(ctx), cv, flag, stage)
     end if
     call schedule_tail_checks()
     if (flag /= 0) then

@@ -183,7 +183,7 @@ contains
     ! LU costs (1 + ntan) n^3 instead of ((1 + ntan) n)^3 at every restart (a rattling drive
     ! restarts thousands of times a revolution)
     if (flag == 0) call cvode_create(m, tau, nroot, c_funloc(tan_rhs_cb), c_funloc(tan_roots_cb), &
-         c_loc(ctx), cv, flag, stage, c_funloc(tan_jac_cb), n - 1)
+         c_funloc(tan_jac_cb), n - 1, c_loc(ctx), cv, flag, stage)
     do while (flag == 0 .and. tau < tau1)
       ! max_steps and max_total_steps over the run (its one output interval), across restarts
       stage = 'integrating'
