@@ -264,23 +264,27 @@ contains
     real(c_double), intent(in) :: tau, tout
     integer(8), intent(in) :: done_k
     real(c_double), intent(out) :: tret(1)
-    integer(8) :: done, allow, now
+    integer(8) :: done, allow, now, chunk
     done = integrator_steps_done(cv)
     allow = min(cv%max_steps - (done - done_k), cv%max_total_steps - done)
     cv%total_bound = cv%max_total_steps - done <= cv%max_steps - (done - done_k)
     tret = tau
     flag = CV_TOO_MUCH_WORK
     if (allow <= 0) return
-    if (cv%max_seconds > 0.0_wp) then
+    if (cv%max_seconds <= 0.0_wp) then
+      flag = integrator_evolve(cv, allow, tout, tret)
+      return
+    end if
+    ! the clock read between calls of at most wall_chunk steps; the caller sees one call
+    do
       call system_clock(now)
       cv%wall_bound = real(now - cv%clock0, wp) >= cv%max_seconds*cv%rate
       if (cv%wall_bound) return
-      ! the clock is read between calls: a call takes at most wall_chunk steps
-      allow = min(allow, wall_chunk)
-    end if
-    flag = integrator_evolve(cv, allow, tout, tret)
-    if (flag == CV_TOO_MUCH_WORK .and. allow == wall_chunk .and. cv%max_seconds > 0.0_wp) &
-         flag = CV_SUCCESS           ! the chunk's bound, not the case's: the caller calls again
+      chunk = min(allow, wall_chunk)
+      flag = integrator_evolve(cv, chunk, tout, tret)
+      if (flag /= CV_TOO_MUCH_WORK .or. chunk == allow) return
+      allow = allow - chunk
+    end do
   end function integrator_advance
 
   !> Integrate towards tout (normal mode: the state there, interpolated) within allow steps.
