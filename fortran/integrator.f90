@@ -189,8 +189,7 @@ contains
     if (flag == 0 .and. m%stald .and. m%method_bdf == 1) flag = FCVodeSetStabLimDet(cv%mem, 1)
     if (flag == 0 .and. nroot > 0) then
       stage = 'setting up root finding'
-      flag = FCVodeRootInit(cv%mem, nroot, roots)
-      if (flag == 0) flag = FCVodeSetNoInactiveRootWarn(cv%mem)
+      flag = root_init(cv, nroot, roots)
     end if
   end subroutine cvode_create
 
@@ -247,10 +246,24 @@ contains
          m%rtol >= cubic_rtol))
     if (flag == 0 .and. nroot > 0) then
       stage = 'setting up root finding'
-      flag = FERKStepRootInit(cv%mem, nroot, roots)
-      if (flag == 0) flag = FERKStepSetNoInactiveRootWarn(cv%mem)
+      flag = root_init(cv, nroot, roots)
     end if
   end subroutine erk_create
+
+  !> Root finding on the nroot functions roots (none: nroot = 0), without the warning about
+  !> functions that are zero at the start (a switch function can stay at zero: a free tooth's).
+  integer(c_int) function root_init(cv, nroot, roots) result(flag)
+    type(integrator_t), intent(inout) :: cv
+    integer(c_int), intent(in) :: nroot
+    type(c_funptr), value :: roots
+    if (cv%erk) then
+      flag = FERKStepRootInit(cv%mem, nroot, roots)
+      if (flag == 0 .and. nroot > 0) flag = FERKStepSetNoInactiveRootWarn(cv%mem)
+    else
+      flag = FCVodeRootInit(cv%mem, nroot, roots)
+      if (flag == 0 .and. nroot > 0) flag = FCVodeSetNoInactiveRootWarn(cv%mem)
+    end if
+  end function root_init
 
   !> Integrate from tau towards tout (normal mode: the state there, interpolated) within the
   !> work bounds: max_steps since the step count done_k (integrator_steps_done at the last
@@ -324,13 +337,12 @@ contains
     if (.not. (t1 < troot)) return
     cv%h_cross = h(1)
     flag = FERKStepGetDky(cv%mem, t1, 0_c_int, cv%sv)    ! the step's start: its own state
-    if (flag == 0) flag = FERKStepRootInit(cv%mem, 0_c_int, c_null_funptr)
+    if (flag == 0) flag = root_init(cv, 0_c_int, c_null_funptr)
     if (flag == 0) flag = FERKStepReset(cv%mem, t1, cv%sv)
     if (flag == 0) flag = FERKStepSetStopTime(cv%mem, troot)
     if (flag == 0) flag = FERKStepEvolve(cv%mem, troot, cv%sv, tret, ARK_NORMAL)
     if (flag == ARK_TSTOP_RETURN) flag = 0
-    if (flag == 0) flag = FERKStepRootInit(cv%mem, cv%nroot, cv%groots)
-    if (flag == 0) flag = FERKStepSetNoInactiveRootWarn(cv%mem)
+    if (flag == 0) flag = root_init(cv, cv%nroot, cv%groots)
   end function integrator_land_on_root
 
   integer(c_int) function integrator_root_info(cv, rootsfound) result(flag)
