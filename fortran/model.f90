@@ -8,10 +8,11 @@ module spline_model
   use spline_errors, only: err_ok, err_case, err_thermal, itoa, ftoa
   use spline_case, only: case_t, case_validate, case_run_times, namelen, option_index, thermal_values, &
        method_values, nonlinear_values, start_values, fidelity_values, section_values, nripple, &
-       lyapunov_method_values
+       lyapunov_method_values, goal_values
   use spline_geometry, only: iso4156_radii, pitch_rotation, tooth_angles
   use spline_stiffness, only: spline_mesh_stiffness_fillet
   use spline_thermal, only: backlash_coefficient, thermal_backlash
+  use spline_accuracy, only: accuracy_settings
   implicit none
   private
   public :: model_t, model_from_case, set_thermal_level, model_magic, model_warnings
@@ -29,7 +30,7 @@ module spline_model
   integer, parameter :: stiffness_nquad = 32   !< Gauss points: converged to 1e-15 from 16 on
   !> Marks a model_t built by this build's constructor (layout version in the last digits):
   !> a copy handed back from outside is checked against it.
-  integer, parameter :: model_magic = 517730008
+  integer, parameter :: model_magic = 517730009
   !> A given k_m this many times below Eq. 18 draws a warning (model_warnings): the paper's
   !> calibrated 2.54e5 N/m is ~7600 times below for its spline, a deliberate fit; N/mm read
   !> as N/m is 1000 times, on top of such a fit 1e4 is passed.
@@ -61,6 +62,10 @@ module spline_model
     logical  :: stald = .false.
     logical  :: linear_tail = .true.        !< closed-form tail in proven full contact (spline_linear)
     real(wp) :: rtol, atol
+    !> the case's accuracy target (0: none), an error estimate asked for (accuracy or check),
+    !> goal = 'statistics' (spline_accuracy)
+    real(wp) :: accuracy = 0.0_wp
+    logical  :: estimate = .false., goal_statistics = .false.
     integer  :: max_steps, max_total_steps, n_out
     real(wp) :: t0, t_end, t_transient
     logical  :: start_equilibrium = .true.
@@ -115,7 +120,7 @@ contains
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
     real(wp) :: rf1, rf2, ra2, rho_f, r_bore, r_rim
-    integer :: j
+    integer :: j, k
 
     call case_validate(c, ierr, errmsg)
     if (ierr /= err_ok) return
@@ -137,8 +142,12 @@ contains
     m%roots = c%roots; m%stald = c%stald; m%linear_tail = c%linear_tail; m%dq0 = c%dq0; m%dv0 = c%dv0
     m%dof = c%dof; m%fidelity_tol = c%fidelity_tol
     m%auto = option_index(fidelity_values, c%fidelity) == 2
-    m%method_bdf = merge(1, 0, chosen_method(c) == 1)
-    m%erk = chosen_method(c) == 3
+    k = chosen_method(c)        ! the integrator, roots and tolerances an accuracy or goal picks
+    call accuracy_settings(c, k, m%roots, m%rtol, m%atol)
+    m%accuracy = c%accuracy; m%goal_statistics = option_index(goal_values, c%goal) == 2
+    m%estimate = (c%accuracy > 0.0_wp .or. c%check) .and. .not. m%goal_statistics
+    m%method_bdf = merge(1, 0, k == 1)
+    m%erk = k == 3
     select case (option_index(nonlinear_values, c%nonlinear))
     case (1)
       m%newton = .true.
@@ -151,7 +160,7 @@ contains
     m%section = option_index(section_values, c%section) - 1
     m%lyapunov = c%lyapunov
     m%lyap_tangent = option_index(lyapunov_method_values, c%lyapunov_method) == 2
-    m%lyap_d0 = lyapunov_separation(c%lyapunov_d0, c%rtol)
+    m%lyap_d0 = lyapunov_separation(c%lyapunov_d0, m%rtol)
     if (m%omega > 0.0_wp) m%lyap_dt = c%lyapunov_interval*2.0_wp*pi/m%omega
 
     ! geometry (docs/model.md sections 2 and 12, Eq. 9)

@@ -65,12 +65,30 @@ def _summary(res, warned: int | None = None) -> str:
         f"{100 * ld['stress_ratio']:.0f} % of the typical allowable (docs/model.md section 15)",
         f"  trust:  {ld['revolutions']:.1f} revolutions; T_m RMS "
         f"{_pm(float(np.sqrt(np.mean(res.Tm ** 2))), ld['Tm_rms_se'], '.4g')} N m"
-        + ("" if ld["batches"] >= 2 else " (no standard errors: fewer than 2 whole revolutions)")]
+        + ("" if ld["batches"] >= 2 else " (no standard errors: fewer than 2 whole revolutions)")
+        + _accuracy_note(res)]
     if warned is not None:
         lines.append("  input:  " + ("no plausibility warning" if not warned else
                                      f"{warned} plausibility warning{'s' * (warned > 1)} "
                                      "(the warning: lines)"))
     return "\n".join(lines)
+
+
+def _accuracy_note(res) -> str:
+    """The trust line's words on the numerical error (docs/accuracy.md): the error estimate of
+    the tooth forces against a tighter run, or the statistics goal's settings."""
+    s = res.stats
+    if res.case["goal"] == "statistics":
+        return (f"; goal statistics: ERK without root finding at rtol {s['rtol_used']:.0e}, "
+                "statistics unbiased (chaos_z24), the trajectory not resolved")
+    if s["F_error_est"] < 0 and s["F_parted_t_s"] < 0:
+        return ""
+    note = (f"; F error est {s['F_error_est']:.2g} up to t = {s['F_error_t_s']:.4g} s"
+            if s["F_error_est"] >= 0 else "; F error not estimated")
+    if s["F_parted_t_s"] >= 0:
+        note += f" (a tighter run parts at t = {s['F_parted_t_s']:.4g} s: chaos?)"
+    acc = res.case["accuracy"]
+    return note + (f" (accuracy {acc:.2g}, rtol {s['rtol_used']:.2g})" if acc > 0 else "")
 
 
 #: exit status of each failure (README, "Errors and exit codes"; spline-dyn's err_exit_code)
