@@ -55,12 +55,21 @@ class Orbit:
     method: str = "exact"    #: how M was computed: 'exact' or 'fd'
 
 
+def _wall(model, max_seconds) -> float:
+    """The core's wall-time bound for max_seconds (> 0; inf: none, 0 to the core)."""
+    if isinstance(max_seconds, bool) or not isinstance(max_seconds, (int, float, np.number)) \
+            or not max_seconds > 0:
+        raise CaseError(f"case {model.case.name}: max_seconds = {max_seconds!r}: the wall-time "
+                        "bound of a map run must be a number of seconds > 0 (math.inf: none)")
+    return 0.0 if np.isinf(max_seconds) else float(max_seconds)
+
+
 def _period_map(model, t0: float, t1: float, ys: np.ndarray, max_seconds: float = MAP_SECONDS
                 ) -> tuple[np.ndarray, np.ndarray]:
     """The core's map of the columns of ys (14, k), SI: (their states at t1, the mask of the
     integrated states). SolverError when the runs take more than max_seconds in all."""
     y1, mask, ierr, msg = _api.api_period_map(model.bytes, t0, t1, np.asfortranarray(ys),
-                                              max_seconds)
+                                              _wall(model, max_seconds))
     run_outcome(ierr, msg)
     if not np.isfinite(y1).all():
         raise SolverError(f"case {model.case.name}: the period map from t = {t0} s to {t1} s "
@@ -84,7 +93,8 @@ def map_and_monodromy(model, t0: float, t1: float, y: np.ndarray, saltation: boo
     (spline_variational::tangent_flow) with the saltation matrix at every root-located contact
     switch (saltation=False leaves it out: wrong wherever a switch is crossed, kept to show
     it); free (14,) bool, the integrated states (the torsional six at dof 3). One run, bounded
-    in steps by the case's max_steps and max_total_steps and in wall time by max_seconds.
+    in steps by the case's max_steps and max_total_steps and in wall time by max_seconds
+    (math.inf: none).
     CaseError for the thermal level coupled (not covered), SolverError when the run fails or
     meets a bound (the message names it)."""
     if isinstance(model, Case):
@@ -94,7 +104,8 @@ def map_and_monodromy(model, t0: float, t1: float, y: np.ndarray, saltation: boo
         raise CaseError(f"case {model.case.name}: y (shape {y.shape}) must be a state of "
                         f"{NSTATE} finite SI values ({', '.join(STATE_QUANTITIES)})")
     y1, phi, mask, _nsw, ierr, msg = _api.api_map_monodromy(model.bytes, float(t0), float(t1), y,
-                                                            int(bool(saltation)), max_seconds)
+                                                            int(bool(saltation)),
+                                                            _wall(model, max_seconds))
     run_outcome(ierr, msg)
     if not np.isfinite(y1).all() or not np.isfinite(phi).all():
         raise SolverError(f"case {model.case.name}: the variational run from t = {t0} s to {t1} s "

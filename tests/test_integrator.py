@@ -5,6 +5,7 @@ map runs are bounded in steps and in wall time, and a run that meets a bound nam
 
 The warning scene: physical_z24 started at t0 = 9.99e5 s, where the scaled time is about 3e8
 and a step of a few 1e-9 no longer changes it: CVODE and ERKStep warn "t + h = t"."""
+import math
 import os
 import re
 import subprocess
@@ -152,6 +153,9 @@ def test_map_runs_bounded_in_wall_time(z24):
                                               np.repeat(y0[:, None], 3, axis=1), max_seconds=s)):
         with pytest.raises(pyspline.SolverError, match=r"wall-time bound max_seconds = 1.00E-09 s"):
             call(1e-9)
+        for bad in (0.0, -1.0, math.nan, "60", None):
+            with pytest.raises(pyspline.CaseError, match="max_seconds"):
+                call(bad)
 
 
 def test_wall_bound_leaves_the_numbers_unchanged(z24):
@@ -159,9 +163,10 @@ def test_wall_bound_leaves_the_numbers_unchanged(z24):
     between them): the map and its monodromy are the same to the bit."""
     case, y0, period = z24
     long = case.replace(t_end=12 * period, max_steps=10 ** 6)   # more steps than a chunk
-    runs = [orbits.map_and_monodromy(long, 0.0, 10 * period, y0, max_seconds=s) for s in (0.0, 1e6)]
+    runs = [orbits.map_and_monodromy(long, 0.0, 10 * period, y0, max_seconds=s)
+            for s in (math.inf, 1e6)]
     np.testing.assert_array_equal(runs[0][0], runs[1][0])
     np.testing.assert_array_equal(runs[0][1], runs[1][1])
     maps = [orbits._period_map(pyspline.load(long), 0.0, 10 * period, y0[:, None], max_seconds=s)[0]
-            for s in (0.0, 1e6)]
+            for s in (math.inf, 1e6)]
     np.testing.assert_array_equal(maps[0], maps[1])
