@@ -214,6 +214,7 @@ program spline_dyn
     call die(errmsg, ierr)       ! a failed point is a result: die writes its summary
   end if
   call check_interrupt()
+  call print_warnings(trim(errmsg))            ! the integrator's (SUNDIALS') warnings, counted
   call print_warnings(run_warnings(m, stats))
   allocate(tload(m%z, nload_tooth))
   call run_loads(m, t, y, tooth, tm, loads, tload)

@@ -357,11 +357,12 @@ contains
 
   !> The period map of a loaded model (spline_orbits::period_map): y1(:, k) the SI state at
   !> t1 of the run from y0(:, k) at t0; mask(i) = 1 for the states its level integrates.
-  !> Called without the GIL; a SIGINT stops it (ierr 4).
-  subroutine api_period_map(model, nb, t0, t1, nc, y0, y1, mask, ierr, errmsg)
+  !> max_seconds (> 0): the call's wall-time bound. On success errmsg holds the integrator's
+  !> warnings ('' if none). Called without the GIL; a SIGINT stops it (ierr 4).
+  subroutine api_period_map(model, nb, t0, t1, nc, y0, y1, mask, ierr, errmsg, max_seconds)
     integer(c_int), intent(in) :: nb, nc
     integer(c_int), intent(in) :: model(nb)
-    real(c_double), intent(in) :: t0, t1, y0(14, nc)
+    real(c_double), intent(in) :: t0, t1, y0(14, nc), max_seconds
     real(c_double), intent(out) :: y1(14, nc)
     integer(c_int), intent(out) :: mask(14), ierr
     character(len=msglen), intent(out) :: errmsg
@@ -370,7 +371,8 @@ contains
     y1 = 0; mask = 0
     call unpack(model, m, ie, errmsg)
     if (ie == err_ok) then
-      call period_map(m, t0, t1, y0, y1, mk, ie, errmsg, interruptible=.true.)
+      call period_map(m, t0, t1, y0, y1, mk, ie, errmsg, interruptible=.true., &
+           max_seconds=max_seconds)
       mask = mk
     end if
     ierr = ie
@@ -379,11 +381,13 @@ contains
   !> The period map and its monodromy from the variational equations with the saltation
   !> matrices (spline_orbits::map_and_monodromy; salt = 0: without them): y1 the SI state at
   !> t1, phi(1:k, 1:k) dP/dy0 over the k integrated states (mask) in the scaled states of
-  !> Eq. 25, nswitch the contact switches located. Called without the GIL.
-  subroutine api_map_monodromy(model, nb, t0, t1, y0, salt, y1, phi, mask, nswitch, ierr, errmsg)
+  !> Eq. 25, nswitch the contact switches located; max_seconds (> 0) the run's wall-time bound.
+  !> On success errmsg holds the integrator's warnings. Called without the GIL.
+  subroutine api_map_monodromy(model, nb, t0, t1, y0, salt, y1, phi, mask, nswitch, ierr, &
+       errmsg, max_seconds)
     integer(c_int), intent(in) :: nb, salt
     integer(c_int), intent(in) :: model(nb)
-    real(c_double), intent(in) :: t0, t1, y0(14)
+    real(c_double), intent(in) :: t0, t1, y0(14), max_seconds
     real(c_double), intent(out) :: y1(14), phi(14, 14)
     integer(c_int), intent(out) :: mask(14), nswitch, ierr
     character(len=msglen), intent(out) :: errmsg
@@ -393,7 +397,7 @@ contains
     call unpack(model, m, ie, errmsg)
     if (ie == err_ok) then
       call map_and_monodromy(m, t0, t1, y0, y1, phi, mk, ns, ie, errmsg, interruptible=.true., &
-           saltation=salt /= 0)
+           saltation=salt /= 0, max_seconds=max_seconds)
       mask = mk
       nswitch = ns
     end if

@@ -9,6 +9,7 @@ module spline_lyapunov
   use spline_solver, only: integrate
   use spline_quantities, only: nsolver_stats
   use spline_variational, only: tangent_flow
+  use spline_integrator, only: lib_log_t
   implicit none
   private
   public :: lyapunov_count, lyapunov_benettin, lyapunov_tangent
@@ -32,7 +33,7 @@ contains
   !> iterations, so their difference carries no independent solver noise (integrated apart, a
   !> separation of 1e-8 at rtol 1e-8 measured that noise: tests/test_chaos.py). Both restart at
   !> every renormalisation. The frozen states of the torsional level (dof 3) are left out of d.
-  subroutine lyapunov_benettin(m, t_start, y_start, lt, lg, ierr, errmsg, interruptible)
+  subroutine lyapunov_benettin(m, t_start, y_start, lt, lg, ierr, errmsg, interruptible, msgs)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t_start, y_start(nstate)
     real(wp), intent(out) :: lt(:), lg(:)
@@ -43,6 +44,9 @@ contains
     real(wp) :: y(nstate), yp(nstate), t0, t1, ys(nstate), yps(nstate), dv(nstate), d, g
     real(wp) :: tout(1), y1(nstate, 1), yp1(nstate, 1), st(nsolver_stats)
     integer :: idx(nstate), n, k, i, modes(m%z*m%n_slices, 1)
+    type(lib_log_t), intent(inout), optional :: msgs   !< SUNDIALS' warnings, over every interval
+    type(lib_log_t) :: lib
+    if (present(msgs)) lib = msgs
     call integrated_states(m, idx, n)
     mm = m
     y = y_start
@@ -58,7 +62,7 @@ contains
       mm%t0 = t0
       tout = t1
       call integrate(mm, y, 1, tout, y1, modes, st, ierr, errmsg, interruptible, y0b=yp, &
-           youtb=yp1)
+           youtb=yp1, msgs=lib)
       if (ierr /= err_ok) return
       call to_scaled(m, y1(:, 1), ys)
       call to_scaled(m, yp1(:, 1), yps)
@@ -81,6 +85,7 @@ contains
       call from_scaled(m, yps, yp)
       t0 = t1
     end do
+    if (present(msgs)) msgs = lib
   end subroutine lyapunov_benettin
 
   !> Largest Lyapunov exponent by Benettin's method on the tangent (no finite separation): a
@@ -88,7 +93,7 @@ contains
   !> with) integrated beside the state by the variational equations, with the saltation matrix
   !> at every located contact switch (spline_variational::tangent_flow); after each interval of
   !> lyap_dt, ln |v| is added to g and v renormalised to 1. Same outputs as lyapunov_benettin.
-  subroutine lyapunov_tangent(m, t_start, y_start, lt, lg, ierr, errmsg, interruptible)
+  subroutine lyapunov_tangent(m, t_start, y_start, lt, lg, ierr, errmsg, interruptible, msgs)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t_start, y_start(nstate)
     real(wp), intent(out) :: lt(:), lg(:)
@@ -98,6 +103,9 @@ contains
     type(model_t) :: mm
     real(wp) :: y(nstate), y1(nstate), phi(nstate, 1), t1, d, g
     integer :: idx(nstate), n, k
+    type(lib_log_t), intent(inout), optional :: msgs   !< SUNDIALS' warnings, over every interval
+    type(lib_log_t) :: lib
+    if (present(msgs)) lib = msgs
     call integrated_states(m, idx, n)
     mm = m
     y = y_start
@@ -108,7 +116,7 @@ contains
     lt = 0.0_wp; lg = 0.0_wp
     do k = 1, size(lt)
       t1 = min(t_start + k*m%lyap_dt, m%t_end)
-      call tangent_flow(mm, t1, y, 1, phi, y1, ierr, errmsg, interruptible)
+      call tangent_flow(mm, t1, y, 1, phi, y1, ierr, errmsg, interruptible, msgs=lib)
       if (ierr /= err_ok) return
       d = norm2(phi(1:n, 1))
       if (.not. (d > 0.0_wp)) then       ! the tangent died out: start afresh
@@ -122,6 +130,7 @@ contains
       y = y1
       mm%t0 = t1
     end do
+    if (present(msgs)) msgs = lib
   end subroutine lyapunov_tangent
 
 end module spline_lyapunov

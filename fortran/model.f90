@@ -57,7 +57,7 @@ module spline_model
     real(wp) :: fidelity_tol = 1.0e-3_wp
     real(wp) :: t_bulk, f_m, u_flash, eta_hertz
     integer  :: method_bdf = 1              !< 1 = BDF, 0 = Adams (CVODE)
-    logical  :: erk = .false.               !< ARKODE ERKStep instead of CVODE (spline_erk)
+    logical  :: erk = .false.               !< ARKODE ERKStep instead of CVODE (spline_integrator)
     logical  :: newton = .true.             !< Newton + dense solver, else fixed-point iteration
     logical  :: roots = .false.
     logical  :: stald = .false.

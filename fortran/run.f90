@@ -19,6 +19,7 @@ module spline_run
   use spline_fidelity, only: auto_level, auto_tol, backlash_estimate
   use spline_sections, only: section_count, section_times
   use spline_lyapunov, only: lyapunov_benettin, lyapunov_tangent
+  use spline_integrator, only: lib_log_t, integrator_warnings
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -72,6 +73,7 @@ contains
     real(wp), intent(out), optional :: consts(ntooth_q - 4)
     type(model_t) :: run
     real(wp) :: eps_lat, eps_th, closed, t_closed, cq(ntooth_q - 4), est(3)
+    type(lib_log_t) :: lib                   !< SUNDIALS' warnings over the call's runs
     integer(8) :: c0, c1, rate
     integer :: nw, i
     logical :: fin
@@ -96,14 +98,17 @@ contains
     if (present(lyap_t)) then
       lyap_t = 0.0_wp; lyap_g = 0.0_wp
       if (ierr == err_ok .and. m%lyapunov .and. m%lyap_tangent) then
-        call lyapunov_tangent(run, t(1), y(:, 1), lyap_t, lyap_g, ierr, errmsg, interruptible)
+        call lyapunov_tangent(run, t(1), y(:, 1), lyap_t, lyap_g, ierr, errmsg, interruptible, &
+             lib)
       else if (ierr == err_ok .and. m%lyapunov) then
-        call lyapunov_benettin(run, t(1), y(:, 1), lyap_t, lyap_g, ierr, errmsg, interruptible)
+        call lyapunov_benettin(run, t(1), y(:, 1), lyap_t, lyap_g, ierr, errmsg, interruptible, &
+             lib)
       end if
     end if
     closed = 0.0_wp; t_closed = 0.0_wp
     if (ierr == err_ok) call result_checks(run, t, y, tooth(:, :, 1:nw), tm, closed, t_closed, &
          ierr, errmsg, sec_t, sec_y, lyap_t, lyap_g, fin)
+    if (ierr == err_ok) errmsg = integrator_warnings(lib, m%name)
     call system_clock(c1)
     stats(ist_core_wall) = real(c1 - c0, wp)/rate
     stats(ist_dof) = real(run%dof, wp)
@@ -119,13 +124,13 @@ contains
     !> its flash temperature's estimate exceeds auto_tol).
     subroutine run_once()
     call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-         face, tilt, present(nq), nw, cq, fin)
+         face, tilt, present(nq), nw, cq, fin, lib)
     if (ierr == err_ok .and. m%auto .and. m%thermal == thermal_coupled .and. nw >= iq_tf) then
       eps_th = backlash_estimate(m, maxval(abs(tooth(:, :, iq_tf))))
       if (eps_th > auto_tol(m)) then
         call set_thermal_level(run, thermal_coupled)
         call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-             face, tilt, present(nq), nw, cq, fin)
+             face, tilt, present(nq), nw, cq, fin, lib)
       end if
     end if
     end subroutine run_once
@@ -318,7 +323,7 @@ contains
   end function accuracy_warning
 
   !> CVODE (method adams or bdf) restarts at order 1 after every contact switch it locates
-  !> (spline_erk::cvode_restart). Above restart_rtol that falsified a rattling drive: chaos_z24
+  !> (spline_integrator::integrator_restart). Above restart_rtol that falsified a rattling drive: chaos_z24
   !> with Adams or BDF and roots read its T_m RMS 2.3-2.7 N m against 3.5-3.8 (every method at
   !> rtol <= 1e-3, ERK with roots and every method without roots from 1e-2), finding 2-3 times
   !> the reference's switches (docs/performance.md, "Multistep restarts at loose tolerance";
@@ -343,7 +348,7 @@ contains
   !> One run of the model at the level m sets (lazy, nw, consts: run_case's nq, consts; fin:
   !> tooth_outputs' finite).
   subroutine run_level(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-       face, tilt, lazy, nw, consts, fin)
+       face, tilt, lazy, nw, consts, fin, lib)
     type(model_t), intent(in) :: m
     real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
     real(wp), intent(out) :: tm(m%n_out), stats(nstats)
@@ -355,6 +360,7 @@ contains
     integer, intent(out) :: nw
     real(wp), intent(out) :: consts(ntooth_q - 4)
     logical, intent(out) :: fin
+    type(lib_log_t), intent(inout), optional :: lib   !< SUNDIALS' warnings, counted on
     real(wp) :: y0(nstate)
     real(wp), allocatable :: ts(:), ysec(:, :)
     integer, allocatable :: modes(:, :)
@@ -384,12 +390,12 @@ contains
     if (present(sec_t)) then
       call section_times(m, sec_t)
       call integrate(m, y0, m%n_out, t, y, modes, stats(1:nsolver_stats), ierr, errmsg, &
-           interruptible, sec_t, sec_y)
+           interruptible, sec_t, sec_y, msgs=lib)
     else
       allocate(ts(section_count(m)), ysec(nstate, section_count(m)))
       call section_times(m, ts)
       call integrate(m, y0, m%n_out, t, y, modes, stats(1:nsolver_stats), ierr, errmsg, &
-           interruptible, ts, ysec)
+           interruptible, ts, ysec, msgs=lib)
     end if
     end subroutine integrate_level
   end subroutine run_level

@@ -1,23 +1,15 @@
-!> Time integration with CVODE (SUNDIALS 6.4, Fortran 2003 interface) of the scaled system of
-!> Eq. 25, with optional root finding on the contact switches of Eq. 16; or with ARKODE's
-!> ERKStep (method = 'erk'), made and driven through spline_erk.
+!> The state run: time integration of the scaled system of Eq. 25 with CVODE or ARKODE's
+!> ERKStep (method = 'erk'), made and driven through the integrator layer (spline_integrator),
+!> with optional root finding on the contact switches of Eq. 16, outputs, sections and the
+!> linear tail.
 !>
-!> Reentrant: all run state sits in a solver_ctx_t local to `integrate`, which CVODE hands to
-!> the callbacks as their user data. No module variable changes during a run. The SUNDIALS
-!> objects are made in cvode_setup and freed in spline_erk::integrator_free; every SUNDIALS
-!> return value is checked. Version-specific calls (context creation) are in sundials_context_new.
+!> Reentrant: all run state sits in a solver_ctx_t and an integrator_t local to `integrate`;
+!> the integrator hands the context to the callbacks as their user data. No module variable
+!> changes during a run.
 module spline_solver
   use, intrinsic :: iso_c_binding
-  use fcvode_mod
-  use fsundials_context_mod
-  use fsundials_nvector_mod
-  use fsundials_matrix_mod
-  use fsundials_linearsolver_mod
-  use fnvector_serial_mod
-  use fsunmatrix_dense_mod
-  use fsunlinsol_dense_mod
-  use fsundials_nonlinearsolver_mod
-  use fsunnonlinsol_fixedpoint_mod
+  use fcvode_mod, only: CV_ROOT_RETURN
+  use fsundials_nvector_mod, only: N_Vector, FN_VGetArrayPointer
   use spline_sigint, only: sigint_watch, sigint_unwatch, sigint_count
   use spline_kinds, only: wp, pi
   use spline_errors, only: err_ok, err_solver, err_interrupted, msglen
@@ -25,10 +17,11 @@ module spline_solver
   use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, integrated_states
   use spline_mesh, only: mesh_switch_functions, coupling_stats_t
   use spline_linear, only: tail_t, tail_possible, tail_try, tail_state, tail_states
-  use spline_erk, only: integrator_t, erk_create, integrator_evolve, integrator_root_info, &
-       integrator_steps, integrator_restart, integrator_last_step, integrator_flag_name, &
-       integrator_name, add_counters, integrator_free, integrator_land_on_root
-  use spline_quantities, only: nstats => nsolver_stats, ist_steps, ist_roots_found, &
+  use spline_integrator, only: integrator_t, lib_log_t, integrator_open, cvode_create, &
+       erk_create, integrator_advance, integrator_root_info, integrator_land_on_root, &
+       integrator_restart, integrator_steps_done, integrator_last_step, integrator_fail_text, &
+       integrator_warnings, add_counters, integrator_free
+  use spline_quantities, only: nstats => nsolver_stats, ist_roots_found, &
        ist_last_step, ist_mode_resyncs, ist_coupling_residual, ist_coupling_iterations, &
        ist_linear_tail_t
   implicit none
@@ -50,7 +43,6 @@ module spline_solver
     integer(c_int) :: sigint0 = 0           !< SIGINT count when the run began
     integer :: cb_ierr = err_ok             !< first error raised inside a callback
     character(len=msglen) :: cb_msg = ''
-    character(len=msglen) :: cvode_msg = '' !< CVODE's own last error text
   end type solver_ctx_t
 
 contains
@@ -74,8 +66,13 @@ contains
   !> Once every tooth is proven to stay in contact on one flank for ever, the remaining outputs
   !> and sections are the closed-form solution; stats(ist_linear_tail_t) is the time the tail
   !> began (-1: none).
+  !> SUNDIALS' messages are never printed (spline_integrator::lib_handler): a failure's text
+  !> joins errmsg; its warnings, counted in msgs (optional: one log across the runs of a caller),
+  !> are errmsg on success (spline_integrator::integrator_warnings; '' if none).
+  !> max_seconds (optional, > 0): the run's wall-time bound (a map run's), counted from the
+  !> system_clock count wall_start (optional; default: the run's start).
   subroutine integrate(m, y0, nt, tout, yout, modes_out, stats, ierr, errmsg, interruptible, &
-       tsec, ysec, y0b, youtb)
+       tsec, ysec, y0b, youtb, msgs, max_seconds, wall_start)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: y0(nstate)
     integer, intent(in) :: nt
@@ -90,8 +87,11 @@ contains
     real(wp), intent(out), optional :: ysec(:, :)
     real(wp), intent(in), optional :: y0b(nstate)
     real(wp), intent(out), optional :: youtb(nstate, nt)
+    type(lib_log_t), intent(inout), optional :: msgs
+    real(wp), intent(in), optional :: max_seconds
+    integer(8), intent(in), optional :: wall_start
     type(solver_ctx_t), target :: ctx
-    type(integrator_t) :: cv
+    type(integrator_t), target :: cv
     real(c_double), allocatable, target :: yr(:)   !< CVODE's state vector (the copies' integrated states)
     real(c_double) :: tau                          !< where the integration stands (scaled time)
     real(c_double) :: tau_chk, dchk                !< next linear-tail check, and their spacing
@@ -99,12 +99,19 @@ contains
     integer :: k, nroots, nresync   !< output; switches located; missed switches resynchronised
     integer :: ks, nsec             !< next section to store; sections
     logical :: use_tail, fresh      !< the linear tail is tried; CVODE has just (re)started
-    logical :: total_bound          !< the work bound met is max_total_steps (else max_steps)
     character(len=40) :: stage
     type(tail_t) :: tail
 
     call start_run()
-    call cvode_setup(m, ctx, yr, tau, nroot, cv, flag, stage)
+    if (present(msgs)) cv%log = msgs
+    call integrator_open(m, 'the run', yr, cv, flag, stage, max_seconds, wall_start)
+    if (flag == 0 .and. m%erk) then
+      call erk_create(m, tau, nroot, c_funloc(rhs_cb), c_funloc(roots_cb), c_loc(ctx), cv, &
+           flag, stage)
+    else if (flag == 0) then
+      call cvode_create(m, tau, nroot, c_funloc(rhs_cb), c_funloc(roots_cb), c_null_funptr, 0, &
+           c_loc(ctx), cv, flag, stage)
+    end if
     call schedule_tail_checks()
     if (flag /= 0) then
       call fail(flag, tau, trim(stage))
@@ -120,6 +127,8 @@ contains
     call collect_stats()
     if (ctx%watch) call sigint_unwatch()
     call integrator_free(cv)
+    if (present(msgs)) msgs = cv%log
+    if (ierr == err_ok) errmsg = integrator_warnings(cv%log, m%name)
 
   contains
 
@@ -183,26 +192,15 @@ contains
       integer, intent(in) :: k
       real(c_double) :: tau_out, tau_to, tret(1)
       integer(c_int) :: flag
-      integer(8) :: done, done_k, allow
+      integer(8) :: done_k
       going = .false.
       tau_out = tout(k)*m%w_ref
-      done_k = steps_done()
+      done_k = integrator_steps_done(cv)
       do while (tau < tau_out)
-        ! Work bounds across restarts (each a new CVode call, counting from 0): max_steps per
-        ! output interval, max_total_steps over the run.
-        done = steps_done()
-        allow = min(m%max_steps - (done - done_k), m%max_total_steps - done)
-        total_bound = m%max_total_steps - done <= m%max_steps - (done - done_k)
-        if (allow <= 0) then
-          call fail_work(tau)
-          return
-        end if
+        ! work bounds across restarts: max_steps per output interval, max_total_steps over the
+        ! run (spline_integrator::integrator_advance)
         tau_to = next_stop(tau_out)
-        flag = integrator_evolve(cv, allow, tau_to, tret)
-        if (flag == CV_TOO_MUCH_WORK) then
-          call fail_work(tret(1))
-          return
-        end if
+        flag = integrator_advance(cv, tau, tau_to, done_k, tret)
         if (flag < 0) then
           call fail(flag, tret(1), 'integrating')
           return
@@ -322,15 +320,8 @@ contains
       ks = nsec + 1
     end function take_linear_tail
 
-    !> CVODE steps taken so far in this run (over all restarts).
-    integer(8) function steps_done() result(n)
-      integer(c_long) :: cnt(1)
-      n = nint(stats(ist_steps), 8)
-      if (integrator_steps(cv, cnt) == 0) n = n + cnt(1)
-    end function steps_done
-
     !> Restart the integrator at tau (a contact switch: the right-hand side's branch changed;
-    !> spline_erk::integrator_restart); .false. if it failed (ierr, errmsg set).
+    !> spline_integrator::integrator_restart); .false. if it failed (ierr, errmsg set).
     logical function restart_cvode(what) result(ok)
       character(len=*), intent(in) :: what
       integer(c_int) :: flag
@@ -353,29 +344,10 @@ contains
       stats(ist_coupling_iterations) = ctx%cstats%max_iterations
     end subroutine collect_stats
 
-    !> The run hit a work bound: name the field that sets it.
-    subroutine fail_work(tau)
-      real(c_double), intent(in) :: tau
-      if (ierr /= err_ok) return
-      call fail(CV_TOO_MUCH_WORK, tau, 'integrating')
-      if (ctx%cb_ierr /= err_ok .or. ierr /= err_solver) return
-      if (total_bound) then
-        write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': the run took max_total_steps = ', &
-             m%max_total_steps, ' '//integrator_name(cv)//' steps in all by t = ', tau/m%w_ref, ' s (flag '// &
-             'CV_TOO_MUCH_WORK): raise max_total_steps, or find why the steps are so small'
-      else
-        write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': '//integrator_name(cv)// &
-             ' took max_steps = ', &
-             m%max_steps, ' steps between two output times without reaching the next, at t = ', &
-             tau/m%w_ref, ' s (flag CV_TOO_MUCH_WORK): raise max_steps or n_out'
-      end if
-    end subroutine fail_work
-
     subroutine fail(flag, tau, what)
       integer(c_int), intent(in) :: flag
       real(c_double), intent(in) :: tau
       character(len=*), intent(in) :: what
-      character(len=:), allocatable :: fname
       if (ierr /= err_ok) return
       ierr = err_solver
       if (ctx%cb_ierr /= err_ok) then
@@ -389,91 +361,10 @@ contains
              tau/m%w_ref, ' s'
         return
       end if
-      fname = integrator_flag_name(cv, flag)
-      write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': '//integrator_name(cv)// &
-           ' failed while '//what// &
-           ' with flag '//fname//' (', flag, ') at t = ', tau/m%w_ref, ' s'
-      if (len_trim(ctx%cvode_msg) > 0) errmsg = trim(errmsg)//': '//trim(ctx%cvode_msg)
+      call integrator_fail_text(cv, m, flag, tau, what, errmsg)
     end subroutine fail
 
   end subroutine integrate
-
-  !> Create CVODE for the run of ctx on the state vector yr at tau, with its tolerances,
-  !> (non)linear solver, step bound and, when the contact states are frozen, nroot root
-  !> functions. Each SUNDIALS call is checked in turn: flag /= 0 is the first failure, stage
-  !> names the step. cv holds what was made (integrator_free frees it, whatever failed).
-  subroutine cvode_setup(m, ctx, yr, tau, nroot, cv, flag, stage)
-    type(model_t), intent(in) :: m
-    type(solver_ctx_t), intent(inout), target :: ctx
-    real(c_double), intent(inout), target :: yr(:)
-    real(c_double), intent(in) :: tau
-    integer(c_int), intent(in) :: nroot
-    type(integrator_t), intent(out) :: cv
-    integer(c_int), intent(out) :: flag
-    character(len=*), intent(out) :: stage
-    cv%newton = m%newton .and. .not. m%erk
-    cv%roots = ctx%frozen
-    stage = 'creating the SUNDIALS context'
-    flag = sundials_context_new(cv%sunctx)
-    if (flag == 0) then
-      stage = 'creating the state vector'
-      cv%sv => FN_VMake_Serial(int(size(yr), c_long), yr, cv%sunctx)
-      if (.not. associated(cv%sv)) flag = -1
-    end if
-    if (flag == 0 .and. m%erk) then
-      call erk_create(m, tau, nroot, c_funloc(rhs_cb), c_funloc(roots_cb), c_funloc(err_cb), &
-           c_loc(ctx), cv, flag, stage)
-      return
-    end if
-    if (flag == 0) then
-      stage = 'creating CVODE'
-      if (m%method_bdf == 1) then
-        cv%mem = FCVodeCreate(CV_BDF, cv%sunctx)
-      else
-        cv%mem = FCVodeCreate(CV_ADAMS, cv%sunctx)
-      end if
-      if (.not. c_associated(cv%mem)) flag = -1
-    end if
-    if (flag == 0) then
-      stage = 'initialising CVODE'
-      flag = FCVodeInit(cv%mem, c_funloc(rhs_cb), tau, cv%sv)
-    end if
-    if (flag == 0) flag = FCVodeSetUserData(cv%mem, c_loc(ctx))
-    if (flag == 0) flag = FCVodeSetErrHandlerFn(cv%mem, c_funloc(err_cb), c_loc(ctx))
-    if (flag == 0) then
-      stage = 'setting the tolerances'
-      flag = FCVodeSStolerances(cv%mem, real(m%rtol, c_double), real(m%atol, c_double))
-    end if
-    if (flag == 0) then
-      stage = 'attaching the (non)linear solver'
-      if (m%newton) then
-        cv%amat => FSUNDenseMatrix(int(size(yr), c_long), int(size(yr), c_long), cv%sunctx)
-        if (associated(cv%amat)) cv%ls => FSUNLinSol_Dense(cv%sv, cv%amat, cv%sunctx)
-        if (associated(cv%ls)) then
-          flag = FCVodeSetLinearSolver(cv%mem, cv%ls, cv%amat)
-        else
-          flag = -1
-        end if
-      else
-        cv%nls => FSUNNonlinSol_FixedPoint(cv%sv, 0, cv%sunctx)   ! functional iteration, no Anderson acceleration
-        if (associated(cv%nls)) then
-          flag = FCVodeSetNonlinearSolver(cv%mem, cv%nls)
-        else
-          flag = -1
-        end if
-      end if
-    end if
-    if (flag == 0) then
-      stage = 'setting the solver options'
-      flag = FCVodeSetMaxNumSteps(cv%mem, int(m%max_steps, c_long))
-    end if
-    if (flag == 0 .and. m%stald .and. m%method_bdf == 1) flag = FCVodeSetStabLimDet(cv%mem, 1)
-    if (flag == 0 .and. ctx%frozen) then
-      stage = 'setting up root finding'
-      flag = FCVodeRootInit(cv%mem, nroot, c_funloc(roots_cb))
-      if (flag == 0) flag = FCVodeSetNoInactiveRootWarn(cv%mem)
-    end if
-  end subroutine cvode_setup
 
   !> A SIGINT arrived since the run began (only for runs that watch).
   logical function interrupted(ctx)
@@ -481,12 +372,6 @@ contains
     interrupted = .false.
     if (ctx%watch) interrupted = sigint_count() /= ctx%sigint0
   end function interrupted
-
-  !> SUNDIALS 6.x context (SUNDIALS 7 takes SUN_COMM_NULL here): the one version-specific call.
-  integer(c_int) function sundials_context_new(sunctx) result(flag)
-    type(c_ptr), intent(out) :: sunctx
-    flag = FSUNContext_Create(c_null_ptr, sunctx)
-  end function sundials_context_new
 
   !> Contact states from the sign of the switch functions. Counts the switches
   !> whose stored state disagreed clearly (beyond round-off) with the state: a missed switch.
@@ -651,34 +536,5 @@ contains
     yf = ctx%ys_full(:, c)
     yf(ctx%idx(1:ctx%n)) = v((c - 1)*ctx%n + 1:c*ctx%n)
   end function copy_state
-
-  !> CVODE's own error text, kept for the exception instead of being printed to stderr.
-  subroutine err_cb(error_code, module, function, msg, udata) bind(C)
-    integer(c_int), value :: error_code
-    type(c_ptr), value :: module, function, msg, udata
-    type(solver_ctx_t), pointer :: ctx
-    call c_f_pointer(udata, ctx)
-    ctx%cvode_msg = c_string(msg)
-  end subroutine err_cb
-
-  function c_string(p) result(s)
-    type(c_ptr), intent(in) :: p
-    character(len=:), allocatable :: s
-    character(kind=c_char), pointer :: chars(:)
-    integer :: n
-    interface
-      integer(c_size_t) function strlen(str) bind(C, name='strlen')
-        import :: c_ptr, c_size_t
-        type(c_ptr), value :: str
-      end function strlen
-    end interface
-    if (.not. c_associated(p)) then
-      s = ''; return
-    end if
-    n = int(strlen(p))
-    call c_f_pointer(p, chars, [n])
-    allocate(character(len=n) :: s)
-    s = transfer(chars, s)
-  end function c_string
 
 end module spline_solver

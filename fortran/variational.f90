@@ -7,20 +7,17 @@
 !> and the contact states only: it is written here in closed form (rhs_jacobian) from Eqs.
 !> 11, 15-17 and 19-24. Everything is in the scaled states and time of Eq. 25. The thermal level
 !> coupled (the tooth force depends on itself through the flash temperature) is not covered.
-!> Reentrant: the run's state sits in a context local to tangent_flow, handed to CVODE as user
-!> data; every SUNDIALS return is checked.
+!> The run is CVODE's (the case's method and solver) made and driven through the integrator
+!> layer (spline_integrator), as the state run's is: same set-up, work bounds, messages and
+!> restart after a located switch. Reentrant: the run's state sits in a context and an
+!> integrator_t local to tangent_flow, the context handed to CVODE as user data.
 module spline_variational
   use, intrinsic :: iso_c_binding
-  use fcvode_mod
-  use fsundials_context_mod
-  use fsundials_nvector_mod
-  use fsundials_matrix_mod
-  use fsundials_linearsolver_mod
-  use fnvector_serial_mod
-  use fsunmatrix_band_mod
-  use fsunlinsol_band_mod
-  use fsundials_nonlinearsolver_mod
-  use fsunnonlinsol_fixedpoint_mod
+  use fcvode_mod, only: CV_ROOT_RETURN
+  use fsundials_nvector_mod, only: N_Vector, FN_VGetArrayPointer
+  use fsundials_matrix_mod, only: SUNMatrix
+  use fsunmatrix_band_mod, only: FSUNBandMatrix_Data, FSUNBandMatrix_LDim, &
+       FSUNBandMatrix_StoredUpperBandwidth
   use spline_sigint, only: sigint_watch, sigint_unwatch, sigint_count
   use spline_kinds, only: wp, max_teeth
   use spline_errors, only: err_ok, err_case, err_solver, err_interrupted, msglen
@@ -28,7 +25,9 @@ module spline_variational
   use spline_geometry, only: tooth_angles
   use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, integrated_states
   use spline_mesh, only: mesh_switch_functions
-  use spline_erk, only: cvode_restart
+  use spline_integrator, only: integrator_t, lib_log_t, integrator_open, cvode_create, &
+       integrator_advance, integrator_root_info, integrator_restart, integrator_fail_text, &
+       integrator_warnings, integrator_free
   implicit none
   private
   public :: rhs_jacobian, tangent_flow, variational_check
@@ -126,8 +125,11 @@ contains
   !> kept to show it matters). CVODE's method, (non)linear solver and tolerances are the case's;
   !> the tangents are in its error control. y1: the SI state at t1; phi: the tangents there.
   !> nswitch (optional): the switches located. ierr: err_case (variational_check), err_solver,
-  !> err_interrupted; errmsg says why.
-  subroutine tangent_flow(m, t1, y0, ntan, phi, y1, ierr, errmsg, interruptible, saltation, nswitch)
+  !> err_interrupted; errmsg says why. On success errmsg holds SUNDIALS' warnings, counted in
+  !> msgs (optional: across a caller's runs), as spline_solver::integrate's; max_seconds
+  !> (optional, > 0): the run's wall-time bound.
+  subroutine tangent_flow(m, t1, y0, ntan, phi, y1, ierr, errmsg, interruptible, saltation, &
+       nswitch, msgs, max_seconds)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t1, y0(nstate)
     integer, intent(in) :: ntan
@@ -137,20 +139,16 @@ contains
     character(len=*), intent(out) :: errmsg
     logical, intent(in), optional :: interruptible, saltation
     integer, intent(out), optional :: nswitch
+    type(lib_log_t), intent(inout), optional :: msgs
+    real(wp), intent(in), optional :: max_seconds
     type(tan_ctx_t), target :: ctx
+    type(integrator_t), target :: cv
     real(c_double), allocatable, target :: yr(:)
-    type(c_ptr) :: sunctx, mem
-    type(N_Vector), pointer :: sv
-    type(SUNMatrix), pointer :: amat
-    type(SUNLinearSolver), pointer :: ls
-    type(SUNNonlinearSolver), pointer :: nls
     real(c_double) :: tau, tau1, tret(1)
     integer(c_int) :: flag, nroot
     integer(c_int), allocatable :: rootsfound(:)
-    integer(c_long) :: cnt(1)
-    integer(8) :: done
     integer :: n, k, nsw
-    logical :: salt, total_bound
+    logical :: salt
     character(len=48) :: stage
     salt = .true.
     if (present(saltation)) salt = saltation
@@ -179,39 +177,30 @@ contains
     call sync_modes(ctx, tau, yr)
     if (present(interruptible)) ctx%watch = interruptible
     if (ctx%watch) ctx%sigint0 = sigint_watch()
-    sunctx = c_null_ptr; mem = c_null_ptr
-    sv => null(); amat => null(); ls => null(); nls => null()
-    done = 0
-    total_bound = .false.
-    call setup(flag)
+    if (present(msgs)) cv%log = msgs
+    call integrator_open(m, 'the variational run', yr, cv, flag, stage, max_seconds)
+    ! Newton: the exact block-diagonal Jacobian (tan_jac_cb) in a band of half-width n - 1; its
+    ! LU costs (1 + ntan) n^3 instead of ((1 + ntan) n)^3 at every restart (a rattling drive
+    ! restarts thousands of times a revolution)
+    if (flag == 0) call cvode_create(m, tau, nroot, c_funloc(tan_rhs_cb), c_funloc(tan_roots_cb), &
+         c_funloc(tan_jac_cb), n - 1, c_loc(ctx), cv, flag, stage)
     do while (flag == 0 .and. tau < tau1)
-      ! max_steps per CVode call (each restart counts from 0), max_total_steps over the run:
-      ! restarts at switches that chatter (a grazing touch) must not go on without bound
-      if (done >= int(m%max_total_steps, 8)) then
-        total_bound = .true.
-        flag = CV_TOO_MUCH_WORK
-        exit
-      end if
-      total_bound = int(m%max_total_steps, 8) - done <= int(m%max_steps, 8)
-      flag = FCVodeSetMaxNumSteps(mem, int(min(int(m%max_steps, 8), &
-           int(m%max_total_steps, 8) - done), c_long))
-      if (flag /= 0) exit
+      ! max_steps and max_total_steps over the run (its one output interval), across restarts
       stage = 'integrating'
-      flag = FCVode(mem, tau1, sv, tret, CV_NORMAL)
+      flag = integrator_advance(cv, tau, tau1, 0_8, tret)
       if (flag < 0) exit
       tau = tret(1)
       if (flag == CV_ROOT_RETURN) then
         stage = 'reading the roots found'
-        flag = FCVodeGetRootInfo(mem, rootsfound)
+        flag = integrator_root_info(cv, rootsfound)
         if (flag /= 0) exit
         call switch(rootsfound)
         if (ctx%cb_ierr /= err_ok) then
           flag = -1
           exit
         end if
-        if (FCVodeGetNumSteps(mem, cnt) == 0) done = done + cnt(1)
         stage = 'restarting at a contact switch'
-        flag = cvode_restart(mem, tau, sv)
+        flag = integrator_restart(cv, tau)
       else
         flag = 0
       end if
@@ -228,66 +217,11 @@ contains
     end if
     if (present(nswitch)) nswitch = nsw
     if (ctx%watch) call sigint_unwatch()
-    if (c_associated(mem)) call FCVodeFree(mem)
-    if (associated(ls)) flag = FSUNLinSolFree(ls)
-    if (associated(nls)) flag = FSUNNonlinSolFree(nls)
-    if (associated(amat)) call FSUNMatDestroy(amat)
-    if (associated(sv)) call FN_VDestroy(sv)
-    if (c_associated(sunctx)) flag = FSUNContext_Free(sunctx)
+    call integrator_free(cv)
+    if (present(msgs)) msgs = cv%log
+    if (ierr == err_ok) errmsg = integrator_warnings(cv%log, m%name)
 
   contains
-
-    !> CVODE on yr at tau: the case's method, tolerances and (non)linear solver (Newton with
-    !> the exact block-diagonal Jacobian, tan_jac_cb, in a band matrix), root finding on the
-    !> contact switches.
-    subroutine setup(flag)
-      integer(c_int), intent(out) :: flag
-      integer(c_long) :: nn
-      nn = int(size(yr), c_long)
-      stage = 'creating the SUNDIALS context'
-      flag = FSUNContext_Create(c_null_ptr, sunctx)
-      if (flag /= 0) return
-      stage = 'creating the state vector'
-      sv => FN_VMake_Serial(nn, yr, sunctx)
-      flag = -1
-      if (.not. associated(sv)) return
-      stage = 'creating CVODE'
-      if (m%method_bdf == 1) then
-        mem = FCVodeCreate(CV_BDF, sunctx)
-      else
-        mem = FCVodeCreate(CV_ADAMS, sunctx)
-      end if
-      if (.not. c_associated(mem)) return
-      stage = 'initialising CVODE'
-      flag = FCVodeInit(mem, c_funloc(tan_rhs_cb), tau, sv)
-      if (flag == 0) flag = FCVodeSetUserData(mem, c_loc(ctx))
-      if (flag == 0) flag = FCVodeSStolerances(mem, real(m%rtol, c_double), real(m%atol, c_double))
-      if (flag /= 0) return
-      stage = 'attaching the (non)linear solver'
-      flag = -1
-      if (m%newton) then
-        ! block diagonal (tan_jac_cb): a band of half-width n - 1 holds it, and its LU costs
-        ! (1 + ntan) n^3 instead of ((1 + ntan) n)^3 at every restart (a rattling drive restarts
-        ! thousands of times a revolution)
-        amat => FSUNBandMatrix(nn, int(n - 1, c_long), int(n - 1, c_long), sunctx)
-        if (.not. associated(amat)) return
-        ls => FSUNLinSol_Band(sv, amat, sunctx)
-        if (.not. associated(ls)) return
-        flag = FCVodeSetLinearSolver(mem, ls, amat)
-        if (flag == 0) flag = FCVodeSetJacFn(mem, c_funloc(tan_jac_cb))
-      else
-        nls => FSUNNonlinSol_FixedPoint(sv, 0, sunctx)
-        if (.not. associated(nls)) return
-        flag = FCVodeSetNonlinearSolver(mem, nls)
-      end if
-      if (flag /= 0) return
-      stage = 'setting the solver options'
-      if (m%stald .and. m%method_bdf == 1) flag = FCVodeSetStabLimDet(mem, 1)
-      if (flag /= 0) return
-      stage = 'setting up root finding'
-      flag = FCVodeRootInit(mem, nroot, c_funloc(tan_roots_cb))
-      if (flag == 0) flag = FCVodeSetNoInactiveRootWarn(mem)
-    end subroutine setup
 
     !> Flip the contact states of the contacts whose switch was located, one at a time, each
     !> with its saltation matrix applied to the tangents.
@@ -311,7 +245,6 @@ contains
 
     subroutine fail(flag)
       integer(c_int), intent(in) :: flag
-      character(len=:), allocatable :: fname
       ierr = err_solver
       if (ctx%cb_ierr /= err_ok) then
         ierr = ctx%cb_ierr
@@ -320,19 +253,8 @@ contains
         ierr = err_interrupted
         write(errmsg, '(a,es12.5,a)') 'case '//trim(m%name)//': interrupted (SIGINT) at t = ', &
              tau/m%w_ref, ' s'
-      else if (flag == CV_TOO_MUCH_WORK .and. total_bound) then
-        write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': the variational run took '// &
-             'max_total_steps = ', m%max_total_steps, ' CVODE steps in all by t = ', tau/m%w_ref, &
-             ' s (flag CV_TOO_MUCH_WORK): raise max_total_steps, or find why the steps are so small'
-      else if (flag == CV_TOO_MUCH_WORK) then
-        write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': the variational run took '// &
-             'max_steps = ', m%max_steps, ' CVODE steps without reaching its end, at t = ', &
-             tau/m%w_ref, ' s (flag CV_TOO_MUCH_WORK): raise max_steps'
       else
-        fname = FCVodeGetReturnFlagName(int(flag, c_long))
-        write(errmsg, '(a,i0,a,es12.5,a)') 'case '//trim(m%name)//': CVODE failed in the '// &
-             'variational run while '//trim(stage)//' with flag '//fname//' (', flag, &
-             ') at t = ', tau/m%w_ref, ' s'
+        call integrator_fail_text(cv, m, flag, tau, trim(stage), errmsg)
       end if
     end subroutine fail
 

@@ -62,6 +62,14 @@ def raise_for(ierr: int, errmsg) -> None:
         raise _errors().get(int(ierr), SplineError)(decode(errmsg))
 
 
+def run_outcome(ierr: int, errmsg) -> None:
+    """A run's (ierr, message): the exception, or on success the message's lines (the
+    integrator's warnings, counted over the run: spline_integrator::integrator_warnings) as
+    SplineWarning."""
+    raise_for(ierr, errmsg)
+    _warn(errmsg)
+
+
 def level_name(dof: int, thermal: str) -> str:
     """A model level of the fidelity ladder, e.g. '7-DOF coupled'."""
     return f"{dof}-DOF {thermal}"
@@ -339,7 +347,7 @@ def simulate(case) -> Result:
         _api.api_simulate(model.bytes, model.z, model.n_out, len(q), len(s), model.n_section,
                           model.n_lyapunov, nft, model.n_slices, tooth)
     wall = time.perf_counter() - t0
-    raise_for(ierr, msg)
+    run_outcome(ierr, msg)
     y = ycol.T                # (nt, 14), a view of the core's columns (no transposed copy)
     st = {n: (float(v) if unit else int(v)) for (n, unit, _), v in zip(s, stats)}  # counts: int
     st["wall_s"] = wall

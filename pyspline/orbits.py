@@ -17,10 +17,13 @@ from fractions import Fraction
 import numpy as np
 
 from .case import Case
-from .core import STATE_QUANTITIES, Result, _api, load, raise_for, simulate
+from .core import STATE_QUANTITIES, Result, _api, load, run_outcome, simulate
 from .errors import CaseError, SolverError, SplineError, SplineWarning
 
 NSTATE = 14
+#: wall-time bound [s] of one call of the core's map (a map_and_monodromy run, or all the runs of
+#: one _period_map call); its step bounds are the case's max_steps and max_total_steps
+MAP_SECONDS = 60.0
 
 
 class OrbitError(SplineError):
@@ -52,11 +55,22 @@ class Orbit:
     method: str = "exact"    #: how M was computed: 'exact' or 'fd'
 
 
-def _period_map(model, t0: float, t1: float, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _wall(model, max_seconds) -> float:
+    """The core's wall-time bound for max_seconds (> 0; inf: none, 0 to the core)."""
+    if isinstance(max_seconds, bool) or not isinstance(max_seconds, (int, float, np.number)) \
+            or not max_seconds > 0:
+        raise CaseError(f"case {model.case.name}: max_seconds = {max_seconds!r}: the wall-time "
+                        "bound of a map run must be a number of seconds > 0 (math.inf: none)")
+    return 0.0 if np.isinf(max_seconds) else float(max_seconds)
+
+
+def _period_map(model, t0: float, t1: float, ys: np.ndarray, max_seconds: float = MAP_SECONDS
+                ) -> tuple[np.ndarray, np.ndarray]:
     """The core's map of the columns of ys (14, k), SI: (their states at t1, the mask of the
-    integrated states)."""
-    y1, mask, ierr, msg = _api.api_period_map(model.bytes, t0, t1, np.asfortranarray(ys))
-    raise_for(ierr, msg)
+    integrated states). SolverError when the runs take more than max_seconds in all."""
+    y1, mask, ierr, msg = _api.api_period_map(model.bytes, t0, t1, np.asfortranarray(ys),
+                                              _wall(model, max_seconds))
+    run_outcome(ierr, msg)
     if not np.isfinite(y1).all():
         raise SolverError(f"case {model.case.name}: the period map from t = {t0} s to {t1} s "
                           "gave a non-finite state (the model left its range)")
@@ -69,8 +83,8 @@ def _scale(model) -> np.ndarray:
     return np.r_[np.full(7, info["l_ref"]), np.full(7, info["l_ref"] * info["w_ref"])]
 
 
-def map_and_monodromy(model, t0: float, t1: float, y: np.ndarray, saltation: bool = True
-                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def map_and_monodromy(model, t0: float, t1: float, y: np.ndarray, saltation: bool = True,
+                      max_seconds: float = MAP_SECONDS) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The period map from t0 to t1 and its monodromy, from the core's variational equations.
 
     model: a loaded model (pyspline.load) or a Case. y: (14,) SI state at t0. Returns (y1, M,
@@ -78,8 +92,11 @@ def map_and_monodromy(model, t0: float, t1: float, y: np.ndarray, saltation: boo
     scaled states of Eq. 25 (l_ref, l_ref w_ref), the tangents integrated beside the state
     (spline_variational::tangent_flow) with the saltation matrix at every root-located contact
     switch (saltation=False leaves it out: wrong wherever a switch is crossed, kept to show
-    it); free (14,) bool, the integrated states (the torsional six at dof 3). One run.
-    CaseError for the thermal level coupled (not covered), SolverError when the run fails."""
+    it); free (14,) bool, the integrated states (the torsional six at dof 3). One run, bounded
+    in steps by the case's max_steps and max_total_steps and in wall time by max_seconds
+    (math.inf: none).
+    CaseError for the thermal level coupled (not covered), SolverError when the run fails or
+    meets a bound (the message names it)."""
     if isinstance(model, Case):
         model = load(model)
     y = np.asarray(y, dtype=float)
@@ -87,8 +104,9 @@ def map_and_monodromy(model, t0: float, t1: float, y: np.ndarray, saltation: boo
         raise CaseError(f"case {model.case.name}: y (shape {y.shape}) must be a state of "
                         f"{NSTATE} finite SI values ({', '.join(STATE_QUANTITIES)})")
     y1, phi, mask, _nsw, ierr, msg = _api.api_map_monodromy(model.bytes, float(t0), float(t1), y,
-                                                            int(bool(saltation)))
-    raise_for(ierr, msg)
+                                                            int(bool(saltation)),
+                                                            _wall(model, max_seconds))
+    run_outcome(ierr, msg)
     if not np.isfinite(y1).all() or not np.isfinite(phi).all():
         raise SolverError(f"case {model.case.name}: the variational run from t = {t0} s to {t1} s "
                           "gave a non-finite state or monodromy (the model left its range)")

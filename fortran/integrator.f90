@@ -1,0 +1,572 @@
+!> The integrator layer: the SUNDIALS objects of one run (SUNDIALS 6.4, Fortran 2003 interface)
+!> and every call on them, for the state run (spline_solver::integrate) and the variational run
+!> (spline_variational::tangent_flow) alike: CVODE (Adams or BDF, fixed-point or Newton with a
+!> dense or a band Jacobian; cvode_create) and ARKODE's ERKStep (erk_create), their work bounds
+!> (max_steps between outputs, max_total_steps over the run, a wall-time bound on request:
+!> integrator_advance), failure messages (integrator_fail_text), root finding and the restart
+!> after a located switch (integrator_land_on_root, integrator_restart), counters, and
+!> SUNDIALS' own messages (lib_handler: never printed; an error's text joins the error
+!> message, warnings are counted and reported with the first one, integrator_warnings).
+!> Reentrant: everything a run changes sits in its integrator_t (the caller's, a target); the
+!> message handler's user data is that run's log, never a module variable.
+!>
+!> ERKStep (method = 'erk') is an explicit one-step Runge-Kutta pair (Dormand-Prince 5(4), 7
+!> stages, ARKODE_DORMAND_PRINCE_7_4_5) for the scaled system of Eq. 25. Chosen by measurement over Fehlberg's 13-stage 7(8) pair
+!> (with switches located, at the defaults): physical_z24 F error 1.6e-5 with 68 700 RHS calls
+!> at rtol 1e-8 against 4.7e-5 with 117 700; paper_lx1e-4 2.4e-9 with 7 500 against 8.9e-8 with
+!> 7 200. The impacts bound the steps there, not the order. A contact switch (root finding) restarts it for
+!> nothing: ERKStepReset keeps its step size and counters, where CVODE restarts at order 1 with
+!> a small step. ERKStep uses the same right-hand side and root functions as CVODE (C function
+!> pointers and user data). Every SUNDIALS return is checked. ERKStep's dense output is its Hermite
+!> interpolant of degree 4 (one right-hand side per step interpolated), of degree 3 (none) at
+!> rtol >= 1e-5 (cubic_rtol).
+module spline_integrator
+  use, intrinsic :: iso_c_binding
+  use fcvode_mod
+  use farkode_mod, only: ARK_NORMAL, ARK_ROOT_RETURN, ARK_TSTOP_RETURN, ARKODE_DORMAND_PRINCE_7_4_5
+  use farkode_erkstep_mod
+  use fsundials_context_mod
+  use fsundials_nvector_mod
+  use fnvector_serial_mod, only: FN_VEnableFusedOps_Serial, FN_VMake_Serial
+  use fsundials_matrix_mod
+  use fsundials_linearsolver_mod
+  use fsundials_nonlinearsolver_mod
+  use fsunmatrix_dense_mod, only: FSUNDenseMatrix
+  use fsunlinsol_dense_mod, only: FSUNLinSol_Dense
+  use fsunmatrix_band_mod, only: FSUNBandMatrix
+  use fsunlinsol_band_mod, only: FSUNLinSol_Band
+  use fsunnonlinsol_fixedpoint_mod, only: FSUNNonlinSol_FixedPoint
+  use spline_kinds, only: wp
+  use spline_errors, only: msglen, itoa, ftoa
+  use spline_model, only: model_t
+  use spline_quantities, only: nstats => nsolver_stats, ist_steps, ist_rhs_evals, ist_jac_evals, &
+       ist_lin_rhs_evals, ist_err_test_fails, ist_nonlin_conv_fails, ist_root_fn_evals
+  implicit none
+  private
+  public :: integrator_t, lib_log_t, integrator_open, cvode_create, erk_create, integrator_advance, &
+       integrator_root_info, integrator_land_on_root, integrator_restart, integrator_steps_done, &
+       integrator_last_step, integrator_fail_text, integrator_warnings, add_counters, &
+       integrator_free
+
+  !> SUNDIALS' own messages of a run (lib_handler), kept instead of printed: the last error's
+  !> text, and the warnings (how many, the first one's text).
+  type :: lib_log_t
+    integer :: nwarn = 0
+    character(len=msglen) :: first = ''
+    character(len=msglen) :: err = ''
+  end type lib_log_t
+
+  !> The SUNDIALS objects of one run (CVODE's or ERKStep's), its work bounds and its messages.
+  type :: integrator_t
+    logical :: erk = .false.                !< ARKODE ERKStep, else CVODE
+    logical :: newton = .false.             !< CVODE with Newton iteration (Jacobian counters)
+    logical :: roots = .false.              !< root functions in use (their counter)
+    integer(c_int) :: nroot = 0             !< ERKStep: the root functions, to switch them back on
+    type(c_funptr) :: groots = c_null_funptr
+    type(c_ptr) :: sunctx = c_null_ptr
+    type(c_ptr) :: mem = c_null_ptr         !< CVODE or ERKStep
+    type(N_Vector), pointer :: sv => null() !< the state vector, on the caller's array
+    type(SUNMatrix), pointer :: amat => null()
+    type(SUNLinearSolver), pointer :: ls => null()
+    type(SUNNonlinearSolver), pointer :: nls => null()
+    !> ERKStep: the step that crossed the last located switch, to restart with after it
+    real(c_double) :: h_cross = 0.0_c_double
+    !> the run in messages: 'the run' (spline_solver) or 'the variational run'
+    character(len=24) :: run = 'the run'
+    integer(8) :: max_steps = 0, max_total_steps = 0   !< the case's work bounds
+    integer(8) :: steps0 = 0                !< CVODE steps before its last CVodeReInit
+    logical :: total_bound = .false.        !< the work bound met is max_total_steps
+    real(wp) :: max_seconds = 0.0_wp        !< wall-time bound (s) of the run; 0: none
+    integer(8) :: clock0 = 0, rate = 1      !< system_clock at the start, its rate
+    logical :: wall_bound = .false.         !< the run stopped at max_seconds
+    type(lib_log_t) :: log                  !< SUNDIALS' messages (lib_handler's user data)
+  end type integrator_t
+
+  !> failed error tests allowed on one step (ARKODE's default 7 gave up on paper_lx1e-4)
+  integer(c_int), parameter :: max_err_test_fails = 30
+  !> dense output: Hermite of degree 4 (one right-hand side per step that is interpolated) where
+  !> rtol < cubic_rtol, of degree 3 (none) where looser (spline_integrator::erk_create)
+  real(wp), parameter :: cubic_rtol = 1.0e-5_wp
+  !> CVODE's first step after a contact switch, as a fraction of the step that crossed it. Its
+  !> own estimate (CVodeReInit) chattered at loose tolerances: chaos_z24 with roots at rtol
+  !> 3e-2 found 867 726 switches where tight runs find 11 200 (2.8 s; BDF at 1e-2, 4.2 s). With
+  !> 0.1: 16 900 switches in 0.15 s; with 0.01 it chattered again; with 1 (order 1 on a step
+  !> sized for a higher order) BDF on physical_z24 took 15-20 % longer. docs/performance.md.
+  real(c_double), parameter :: cvode_restart_fraction = 0.1_c_double
+  !> steps per integrator call in a run with a wall-time bound (the clock is read between calls)
+  integer(8), parameter :: wall_chunk = 20000
+
+contains
+
+  !> The SUNDIALS context and the state vector on the caller's array yr (a target that outlives
+  !> the run); the run's name in messages and its work bounds, the case's; the wall clock
+  !> started (or at the system_clock count wall_start, optional: a bound over several runs),
+  !> max_seconds (optional, > 0) its bound. flag /= 0: the first failure, stage names it.
+  subroutine integrator_open(m, run, yr, cv, flag, stage, max_seconds, wall_start)
+    type(model_t), intent(in) :: m
+    character(len=*), intent(in) :: run
+    real(c_double), intent(inout), target :: yr(:)
+    type(integrator_t), intent(inout) :: cv
+    integer(c_int), intent(out) :: flag
+    character(len=*), intent(out) :: stage
+    real(wp), intent(in), optional :: max_seconds
+    integer(8), intent(in), optional :: wall_start
+    cv%run = run
+    cv%max_steps = m%max_steps
+    cv%max_total_steps = m%max_total_steps
+    if (present(max_seconds)) cv%max_seconds = max_seconds
+    call system_clock(cv%clock0, cv%rate)
+    if (present(wall_start)) cv%clock0 = wall_start
+    stage = 'creating the SUNDIALS context'
+    flag = sundials_context_new(cv%sunctx)
+    if (flag /= 0) return
+    stage = 'creating the state vector'
+    cv%sv => FN_VMake_Serial(int(size(yr), c_long), yr, cv%sunctx)
+    if (.not. associated(cv%sv)) flag = -1
+  end subroutine integrator_open
+
+  !> SUNDIALS 6.x context (SUNDIALS 7 takes SUN_COMM_NULL here): the one version-specific call.
+  integer(c_int) function sundials_context_new(sunctx) result(flag)
+    type(c_ptr), intent(out) :: sunctx
+    flag = FSUNContext_Create(c_null_ptr, sunctx)
+  end function sundials_context_new
+
+  !> Create CVODE on cv%sv at tau: the case's method (Adams or BDF, stability limit detection),
+  !> tolerances and step bound, SUNDIALS' messages to lib_handler, the right-hand side rhs (user
+  !> data udata), the (non)linear solver: m%newton: Newton with a dense matrix (CVODE's
+  !> difference Jacobian; jac = c_null_funptr), or the Jacobian function jac in a band matrix of
+  !> half-width band; else fixed-point iteration (no Anderson acceleration); nroot > 0: the root
+  !> functions roots. flag /= 0: the first failure; stage names the step.
+  subroutine cvode_create(m, tau, nroot, rhs, roots, jac, band, udata, cv, flag, stage)
+    type(model_t), intent(in) :: m
+    real(c_double), intent(in) :: tau
+    integer(c_int), intent(in) :: nroot
+    type(c_funptr), value :: rhs, roots, jac   ! by value: no address constant to relocate
+    integer, intent(in) :: band
+    type(c_ptr), intent(in) :: udata
+    type(integrator_t), intent(inout), target :: cv
+    integer(c_int), intent(out) :: flag
+    character(len=*), intent(out) :: stage
+    integer(c_long) :: nn
+    cv%newton = m%newton
+    cv%roots = nroot > 0
+    nn = FN_VGetLength(cv%sv)
+    stage = 'creating CVODE'
+    cv%mem = FCVodeCreate(merge(CV_BDF, CV_ADAMS, m%method_bdf == 1), cv%sunctx)
+    flag = -1
+    if (.not. c_associated(cv%mem)) return
+    flag = FCVodeSetErrHandlerFn(cv%mem, c_funloc(lib_handler), c_loc(cv%log))
+    if (flag == 0) then
+      stage = 'initialising CVODE'
+      flag = FCVodeInit(cv%mem, rhs, tau, cv%sv)
+    end if
+    if (flag == 0) flag = FCVodeSetUserData(cv%mem, udata)
+    if (flag == 0) then
+      stage = 'setting the tolerances'
+      flag = FCVodeSStolerances(cv%mem, real(m%rtol, c_double), real(m%atol, c_double))
+    end if
+    if (flag /= 0) return
+    stage = 'attaching the (non)linear solver'
+    flag = -1
+    if (m%newton .and. c_associated(jac)) then
+      ! a band of half-width band holds a block-diagonal Jacobian (spline_variational)
+      cv%amat => FSUNBandMatrix(nn, int(band, c_long), int(band, c_long), cv%sunctx)
+      if (associated(cv%amat)) cv%ls => FSUNLinSol_Band(cv%sv, cv%amat, cv%sunctx)
+      if (associated(cv%ls)) flag = FCVodeSetLinearSolver(cv%mem, cv%ls, cv%amat)
+      if (flag == 0) flag = FCVodeSetJacFn(cv%mem, jac)
+    else if (m%newton) then
+      cv%amat => FSUNDenseMatrix(nn, nn, cv%sunctx)
+      if (associated(cv%amat)) cv%ls => FSUNLinSol_Dense(cv%sv, cv%amat, cv%sunctx)
+      if (associated(cv%ls)) flag = FCVodeSetLinearSolver(cv%mem, cv%ls, cv%amat)
+    else
+      cv%nls => FSUNNonlinSol_FixedPoint(cv%sv, 0, cv%sunctx)
+      if (associated(cv%nls)) flag = FCVodeSetNonlinearSolver(cv%mem, cv%nls)
+    end if
+    if (flag == 0) then
+      stage = 'setting the solver options'
+      flag = FCVodeSetMaxNumSteps(cv%mem, int(m%max_steps, c_long))
+    end if
+    if (flag == 0 .and. m%stald .and. m%method_bdf == 1) flag = FCVodeSetStabLimDet(cv%mem, 1)
+    if (flag == 0 .and. nroot > 0) then
+      stage = 'setting up root finding'
+      flag = root_init(cv, nroot, roots)
+    end if
+  end subroutine cvode_create
+
+  !> Create ERKStep on cv%sv at tau with the model's tolerances and step bound, its table,
+  !> SUNDIALS' messages to lib_handler, the right-hand side rhs (user data udata) and, nroot > 0,
+  !> the root functions roots. flag /= 0: the first failure; stage names the step.
+  subroutine erk_create(m, tau, nroot, rhs, roots, udata, cv, flag, stage)
+    type(model_t), intent(in) :: m
+    real(c_double), intent(in) :: tau
+    integer(c_int), intent(in) :: nroot
+    type(c_funptr), value :: rhs, roots   ! by value: no address constant to relocate
+    type(c_ptr), intent(in) :: udata
+    type(integrator_t), intent(inout), target :: cv
+    integer(c_int), intent(out) :: flag
+    character(len=*), intent(out) :: stage
+    type(c_ptr) :: ud
+    ud = udata
+    cv%erk = .true.
+    cv%roots = nroot > 0
+    cv%nroot = nroot
+    cv%groots = roots
+    stage = 'creating ARKODE ERKStep'
+    ! the stage sums, the solution and its error estimate as one loop each, not one vector
+    ! operation per term (N_VLinearCombination; the same operations in the same order: results
+    ! bit for bit); before ERKStep clones its vectors from cv%sv
+    flag = FN_VEnableFusedOps_Serial(cv%sv, 1_c_int)
+    if (flag == 0) then
+      cv%mem = FERKStepCreate(rhs, tau, cv%sv, cv%sunctx)
+      if (.not. c_associated(cv%mem)) flag = -1
+    end if
+    if (flag == 0) flag = FERKStepSetErrHandlerFn(cv%mem, c_funloc(lib_handler), c_loc(cv%log))
+    if (flag == 0) flag = FERKStepSetUserData(cv%mem, ud)
+    if (flag == 0) then
+      stage = 'setting the tolerances'
+      flag = FERKStepSStolerances(cv%mem, real(m%rtol, c_double), real(m%atol, c_double))
+    end if
+    if (flag == 0) then
+      stage = 'setting the solver options'
+      flag = FERKStepSetTableNum(cv%mem, ARKODE_DORMAND_PRINCE_7_4_5)
+    end if
+    if (flag == 0) flag = FERKStepSetMaxNumSteps(cv%mem, int(m%max_steps, c_long))
+    ! a contact switch inside a step (roots off) is a kink the order-5 error model does not
+    ! expect: the step must shrink by orders of magnitude, more than 7 failed tries allow
+    if (flag == 0) flag = FERKStepSetMaxErrTestFails(cv%mem, max_err_test_fails)
+    ! dense output (outputs, root finding): Hermite of degree 4 (the most for order 5), one
+    ! right-hand side per step that is interpolated (an output or the root functions in it); with
+    ! the 8th-order table degree 5 (two) gave the same F error for 60 % more right-hand sides.
+    ! Degree 3 (none) where rtol >= cubic_rtol: there the step's own error is the larger, with
+    ! Dormand-Prince (F error, degree 3 / degree 4, at rtol 1e-3, 1e-4, 1e-5: paper_lx1e-4 with
+    ! 6401 outputs 0.67, 1.05, 1.00 for 45, 42, 33 % fewer right-hand sides; physical_z24 with
+    ! roots 1.23, 1.81, 1.02 for 50, 46, 45 % fewer); tighter it is not (at 1e-6 to 1e-8 3.0, 3.3,
+    ! 4.5 and 1.6, 2.0, 1.6 times the error): docs/model.md section 8
+    if (flag == 0) flag = FERKStepSetInterpolantDegree(cv%mem, merge(3_c_int, 4_c_int, &
+         m%rtol >= cubic_rtol))
+    if (flag == 0 .and. nroot > 0) then
+      stage = 'setting up root finding'
+      flag = root_init(cv, nroot, roots)
+    end if
+  end subroutine erk_create
+
+  !> Root finding on the nroot functions roots (none: nroot = 0), without the warning about
+  !> functions that are zero at the start (a switch function can stay at zero: a free tooth's).
+  integer(c_int) function root_init(cv, nroot, roots) result(flag)
+    type(integrator_t), intent(inout) :: cv
+    integer(c_int), intent(in) :: nroot
+    type(c_funptr), value :: roots
+    if (cv%erk) then
+      flag = FERKStepRootInit(cv%mem, nroot, roots)
+      if (flag == 0 .and. nroot > 0) flag = FERKStepSetNoInactiveRootWarn(cv%mem)
+    else
+      flag = FCVodeRootInit(cv%mem, nroot, roots)
+      if (flag == 0 .and. nroot > 0) flag = FCVodeSetNoInactiveRootWarn(cv%mem)
+    end if
+  end function root_init
+
+  !> Integrate from tau towards tout (normal mode: the state there, interpolated) within the
+  !> work bounds: max_steps since the step count done_k (integrator_steps_done at the last
+  !> output), max_total_steps over the run, and the wall time max_seconds. A bound met returns
+  !> CV_TOO_MUCH_WORK (cv%total_bound, cv%wall_bound say which; integrator_fail_text names it),
+  !> tret the time reached. The returns of both integrators are CVODE's codes (ARK_ROOT_RETURN
+  !> becomes CV_ROOT_RETURN; success, CV_TOO_MUCH_WORK and the other failures have the same
+  !> values in both).
+  integer(c_int) function integrator_advance(cv, tau, tout, done_k, tret) result(flag)
+    type(integrator_t), intent(inout) :: cv
+    real(c_double), intent(in) :: tau, tout
+    integer(8), intent(in) :: done_k
+    real(c_double), intent(out) :: tret(1)
+    integer(8) :: done, allow, now, chunk
+    done = integrator_steps_done(cv)
+    allow = min(cv%max_steps - (done - done_k), cv%max_total_steps - done)
+    cv%total_bound = cv%max_total_steps - done <= cv%max_steps - (done - done_k)
+    tret = tau
+    flag = CV_TOO_MUCH_WORK
+    if (allow <= 0) return
+    if (cv%max_seconds <= 0.0_wp) then
+      flag = integrator_evolve(cv, allow, tout, tret)
+      return
+    end if
+    ! the clock read between calls of at most wall_chunk steps; the caller sees one call
+    do
+      call system_clock(now)
+      cv%wall_bound = real(now - cv%clock0, wp) >= cv%max_seconds*cv%rate
+      if (cv%wall_bound) return
+      chunk = min(allow, wall_chunk)
+      flag = integrator_evolve(cv, chunk, tout, tret)
+      if (flag /= CV_TOO_MUCH_WORK .or. chunk == allow) return
+      allow = allow - chunk
+    end do
+  end function integrator_advance
+
+  !> Integrate towards tout (normal mode: the state there, interpolated) within allow steps.
+  !> The returns of both are CVODE's codes (ARK_ROOT_RETURN becomes CV_ROOT_RETURN; success,
+  !> CV_TOO_MUCH_WORK and the other failures have the same values in both).
+  integer(c_int) function integrator_evolve(cv, allow, tout, tret) result(flag)
+    type(integrator_t), intent(inout) :: cv
+    integer(8), intent(in) :: allow
+    real(c_double), intent(in) :: tout
+    real(c_double), intent(out) :: tret(1)
+    if (cv%erk) then
+      flag = FERKStepSetMaxNumSteps(cv%mem, int(allow, c_long))
+      if (flag == 0) flag = FERKStepEvolve(cv%mem, tout, cv%sv, tret, ARK_NORMAL)
+      if (flag == ARK_ROOT_RETURN) flag = CV_ROOT_RETURN
+    else
+      flag = FCVodeSetMaxNumSteps(cv%mem, int(allow, c_long))
+      if (flag == 0) flag = FCVode(cv%mem, tout, cv%sv, tret, CV_NORMAL)
+    end if
+  end function integrator_evolve
+
+  !> ERKStep returned at a root troot: redo its last step from its start (tn - h) to land on
+  !> troot exactly (stop time), root functions off, contact states still the old ones. The state
+  !> there (cv%sv) is then the method's own, of its order, not the Hermite interpolant of the
+  !> step that crossed, whose error the step control does not see (restarting from it left an
+  !> F error of 4e-3 on physical_z24 at rtol 1e-9, with 648 switches; landed: 2e-5).
+  !> CVODE: nothing (its interpolant is of its own order).
+  integer(c_int) function integrator_land_on_root(cv, troot) result(flag)
+    type(integrator_t), intent(inout) :: cv
+    real(c_double), intent(in) :: troot
+    real(c_double) :: tn(1), h(1), tret(1), t1
+    flag = 0
+    if (.not. cv%erk) return
+    flag = FERKStepGetCurrentTime(cv%mem, tn)
+    if (flag == 0) flag = FERKStepGetLastStep(cv%mem, h)
+    if (flag /= 0) return
+    t1 = tn(1) - h(1)
+    if (.not. (t1 < troot)) return
+    cv%h_cross = h(1)
+    flag = FERKStepGetDky(cv%mem, t1, 0_c_int, cv%sv)    ! the step's start: its own state
+    if (flag == 0) flag = root_init(cv, 0_c_int, c_null_funptr)
+    if (flag == 0) flag = FERKStepReset(cv%mem, t1, cv%sv)
+    if (flag == 0) flag = FERKStepSetStopTime(cv%mem, troot)
+    if (flag == 0) flag = FERKStepEvolve(cv%mem, troot, cv%sv, tret, ARK_NORMAL)
+    if (flag == ARK_TSTOP_RETURN) flag = 0
+    if (flag == 0) flag = root_init(cv, cv%nroot, cv%groots)
+  end function integrator_land_on_root
+
+  integer(c_int) function integrator_root_info(cv, rootsfound) result(flag)
+    type(integrator_t), intent(inout) :: cv
+    integer(c_int), intent(inout) :: rootsfound(:)
+    if (cv%erk) then
+      flag = FERKStepGetRootInfo(cv%mem, rootsfound)
+    else
+      flag = FCVodeGetRootInfo(cv%mem, rootsfound)
+    end if
+  end function integrator_root_info
+
+  !> Steps taken in the run so far, over every restart.
+  integer(8) function integrator_steps_done(cv) result(n)
+    type(integrator_t), intent(in) :: cv
+    integer(c_long) :: cnt(1)
+    integer(c_int) :: flag
+    n = cv%steps0
+    if (.not. c_associated(cv%mem)) return
+    if (cv%erk) then
+      flag = FERKStepGetNumSteps(cv%mem, cnt)
+    else
+      flag = FCVodeGetNumSteps(cv%mem, cnt)
+    end if
+    if (flag == 0) n = n + cnt(1)
+  end function integrator_steps_done
+
+  !> Restart at tau from the state in cv%sv (a contact switch: the right-hand side's branch
+  !> changed). CVODE: its counters added to stats first (CVodeReInit zeroes them), then it
+  !> starts afresh at order 1 with cvode_restart_fraction of the step that crossed the switch.
+  !> ERKStep: ERKStepReset, counters kept, with the step that crossed (not the landing's
+  !> remainder, which its growth limit took several steps to recover).
+  integer(c_int) function integrator_restart(cv, tau, stats) result(flag)
+    type(integrator_t), intent(inout) :: cv
+    real(c_double), intent(in) :: tau
+    real(wp), intent(inout), optional :: stats(nstats)
+    if (cv%erk) then
+      flag = FERKStepReset(cv%mem, tau, cv%sv)
+      if (flag == 0 .and. cv%h_cross > 0.0_c_double) flag = FERKStepSetInitStep(cv%mem, cv%h_cross)
+      cv%h_cross = 0.0_c_double
+    else
+      cv%steps0 = integrator_steps_done(cv)
+      if (present(stats)) call add_counters(cv, stats)
+      flag = cvode_restart(cv%mem, tau, cv%sv)
+    end if
+  end function integrator_restart
+
+  !> CVODE (mem) restarted at tau from sv after a contact switch: CVodeReInit, at order 1 with
+  !> cvode_restart_fraction of the step that crossed the switch.
+  integer(c_int) function cvode_restart(mem, tau, sv) result(flag)
+    type(c_ptr), intent(in) :: mem
+    real(c_double), intent(in) :: tau
+    type(N_Vector), intent(inout) :: sv
+    real(c_double) :: hl(1)
+    flag = FCVodeGetLastStep(mem, hl)
+    if (flag == 0) flag = FCVodeSetInitStep(mem, cvode_restart_fraction*hl(1))
+    if (flag == 0) flag = FCVodeReInit(mem, tau, sv)
+  end function cvode_restart
+
+  integer(c_int) function integrator_last_step(cv, h) result(flag)
+    type(integrator_t), intent(inout) :: cv
+    real(c_double), intent(out) :: h(1)
+    if (cv%erk) then
+      flag = FERKStepGetLastStep(cv%mem, h)
+    else
+      flag = FCVodeGetLastStep(cv%mem, h)
+    end if
+  end function integrator_last_step
+
+  function integrator_flag_name(cv, flag) result(fname)
+    type(integrator_t), intent(in) :: cv
+    integer(c_int), intent(in) :: flag
+    character(len=:), allocatable :: fname
+    if (cv%erk) then
+      fname = FERKStepGetReturnFlagName(int(flag, c_long))
+      if (flag == CV_ROOT_RETURN) fname = 'ARK_ROOT_RETURN'
+    else
+      fname = FCVodeGetReturnFlagName(int(flag, c_long))
+    end if
+  end function integrator_flag_name
+
+  !> The integrator's name in messages.
+  pure function integrator_name(cv) result(name)
+    type(integrator_t), intent(in) :: cv
+    character(len=:), allocatable :: name
+    name = merge('ARKODE', 'CVODE ', cv%erk)
+    name = trim(name)
+  end function integrator_name
+
+  !> Add the counters since the last (re)initialisation to stats (positions ist_* of
+  !> spline_quantities). A counter that cannot be read (nonzero flag) adds nothing.
+  subroutine add_counters(cv, stats)
+    type(integrator_t), intent(inout) :: cv
+    real(wp), intent(inout) :: stats(nstats)
+    integer(c_long) :: cnt(1)
+    if (cv%erk) then
+      call add(ist_steps, FERKStepGetNumSteps(cv%mem, cnt))
+      call add(ist_rhs_evals, FERKStepGetNumRhsEvals(cv%mem, cnt))
+      call add(ist_err_test_fails, FERKStepGetNumErrTestFails(cv%mem, cnt))
+      if (cv%roots) call add(ist_root_fn_evals, FERKStepGetNumGEvals(cv%mem, cnt))
+      return
+    end if
+    call add(ist_steps, FCVodeGetNumSteps(cv%mem, cnt))
+    call add(ist_rhs_evals, FCVodeGetNumRhsEvals(cv%mem, cnt))
+    if (cv%newton) then
+      call add(ist_jac_evals, FCVodeGetNumJacEvals(cv%mem, cnt))
+      call add(ist_lin_rhs_evals, FCVodeGetNumLinRhsEvals(cv%mem, cnt))
+    end if
+    call add(ist_err_test_fails, FCVodeGetNumErrTestFails(cv%mem, cnt))
+    call add(ist_nonlin_conv_fails, FCVodeGetNumNonlinSolvConvFails(cv%mem, cnt))
+    if (cv%roots) call add(ist_root_fn_evals, FCVodeGetNumGEvals(cv%mem, cnt))
+  contains
+    subroutine add(i, flag)          ! the getter has filled cnt by the time this runs
+      integer, intent(in) :: i
+      integer(c_int), intent(in) :: flag
+      if (flag == 0) stats(i) = stats(i) + cnt(1)
+    end subroutine add
+  end subroutine add_counters
+
+  !> The message of a run that failed at tau with flag while doing what: the wall-time or work
+  !> bound met, naming the field or argument that sets it, or the integrator's flag with
+  !> SUNDIALS' own text (lib_handler). Callers report their callbacks' errors and SIGINT first.
+  subroutine integrator_fail_text(cv, m, flag, tau, what, errmsg)
+    type(integrator_t), intent(in) :: cv
+    type(model_t), intent(in) :: m
+    integer(c_int), intent(in) :: flag
+    real(c_double), intent(in) :: tau
+    character(len=*), intent(in) :: what
+    character(len=*), intent(out) :: errmsg
+    character(len=:), allocatable :: head, name
+    character(len=12) :: at
+    head = 'case '//trim(m%name)//': '//trim(cv%run)
+    name = integrator_name(cv)
+    write(at, '(es12.5)') tau/m%w_ref
+    if (flag == CV_TOO_MUCH_WORK .and. cv%wall_bound) then
+      errmsg = head//' took longer than its wall-time bound max_seconds = '// &
+           ftoa(cv%max_seconds, '(es9.2)')//' s, at t = '//at//' s, after '// &
+           itoa(int(integrator_steps_done(cv)))//' '//name//' steps'
+    else if (flag == CV_TOO_MUCH_WORK .and. cv%total_bound) then
+      errmsg = head//' took max_total_steps = '//itoa(int(cv%max_total_steps))//' '//name// &
+           ' steps in all by t = '//at//' s (flag CV_TOO_MUCH_WORK): raise max_total_steps, '// &
+           'or find why the steps are so small'
+    else if (flag == CV_TOO_MUCH_WORK .and. cv%run == 'the run') then
+      errmsg = 'case '//trim(m%name)//': '//name//' took max_steps = '//itoa(int(cv%max_steps))// &
+           ' steps between two output times without reaching the next, at t = '//at//' s (flag '// &
+           'CV_TOO_MUCH_WORK): raise max_steps or n_out'
+    else if (flag == CV_TOO_MUCH_WORK) then
+      errmsg = head//' took max_steps = '//itoa(int(cv%max_steps))//' '//name//' steps '// &
+           'without reaching its end, at t = '//at//' s (flag CV_TOO_MUCH_WORK): raise max_steps'
+    else
+      if (cv%run /= 'the run') name = name//' failed in '//trim(cv%run)
+      if (cv%run == 'the run') name = name//' failed'
+      errmsg = 'case '//trim(m%name)//': '//name//' while '//what//' with flag '// &
+           integrator_flag_name(cv, flag)//' ('//itoa(int(flag))//') at t = '//at//' s'
+      if (len_trim(cv%log%err) > 0) errmsg = trim(errmsg)//': '//trim(cv%log%err)
+    end if
+  end subroutine integrator_fail_text
+
+  !> The warnings SUNDIALS raised in the runs of log (one line; '' if none): how many, and the
+  !> first one's text. The executable prints it as a 'warning:' line, Python as a SplineWarning.
+  function integrator_warnings(log, name) result(text)
+    type(lib_log_t), intent(in) :: log
+    character(len=*), intent(in) :: name     !< the case's name
+    character(len=:), allocatable :: text
+    text = ''
+    if (log%nwarn == 0) return
+    text = 'case '//trim(name)//': SUNDIALS warned '//itoa(log%nwarn)//' time(s) in this run '// &
+         '(the steps may have become too small to resolve the motion); the first, from '// &
+         trim(log%first)
+  end function integrator_warnings
+
+  !> SUNDIALS' message handler (CVodeSetErrHandlerFn, ERKStepSetErrHandlerFn): nothing is
+  !> printed. An error's text is kept for the error message; a warning (error_code > 0, e.g.
+  !> CVODE's "t + h = t") is counted and the first one kept. udata: the run's lib_log_t.
+  subroutine lib_handler(error_code, module, function, msg, udata) bind(C)
+    integer(c_int), value :: error_code
+    type(c_ptr), value :: module, function, msg, udata
+    type(lib_log_t), pointer :: log
+    call c_f_pointer(udata, log)
+    if (error_code > 0) then
+      log%nwarn = log%nwarn + 1
+      if (log%nwarn == 1) log%first = c_string(module)//' in '//c_string(function)//': '// &
+           c_string(msg)
+    else
+      log%err = c_string(msg)
+    end if
+  end subroutine lib_handler
+
+  function c_string(p) result(s)
+    type(c_ptr), intent(in) :: p
+    character(len=:), allocatable :: s
+    character(kind=c_char), pointer :: chars(:)
+    integer :: n
+    interface
+      integer(c_size_t) function strlen(str) bind(C, name='strlen')
+        import :: c_ptr, c_size_t
+        type(c_ptr), value :: str
+      end function strlen
+    end interface
+    if (.not. c_associated(p)) then
+      s = ''; return
+    end if
+    n = int(strlen(p))
+    call c_f_pointer(p, chars, [n])
+    allocate(character(len=n) :: s)
+    s = transfer(chars, s)
+  end function c_string
+
+  !> Free what was made (the statistics read first: integrate's collect_stats).
+  subroutine integrator_free(cv)
+    type(integrator_t), intent(inout) :: cv
+    integer(c_int) :: flag
+    if (c_associated(cv%mem)) then
+      if (cv%erk) then
+        call FERKStepFree(cv%mem)
+      else
+        call FCVodeFree(cv%mem)
+      end if
+    end if
+    if (associated(cv%ls)) flag = FSUNLinSolFree(cv%ls)
+    if (associated(cv%nls)) flag = FSUNNonlinSolFree(cv%nls)
+    if (associated(cv%amat)) call FSUNMatDestroy(cv%amat)
+    if (associated(cv%sv)) call FN_VDestroy(cv%sv)
+    flag = FSUNContext_Free(cv%sunctx)
+  end subroutine integrator_free
+
+end module spline_integrator
