@@ -17,8 +17,10 @@ import numpy as np
 import pytest
 
 import pyspline
-from conftest import CASES
+from conftest import CASES, PAPER_SUPPORTS
 from pyspline import orbits
+
+pytestmark = [PAPER_SUPPORTS]   # expected warnings (conftest)
 
 T0 = 9.99e5
 SPAN = 1e-3
