@@ -53,8 +53,10 @@ if [ "$prefix" != system ] && { [ -z "$version" ] || ! built "${prefix:-$cache/s
   add_deb_src || true
   update=1   # the package lists, with the deb-src entry
 fi
+updated=0
+apt_update() { [ $updated = 1 ] || step "apt-get update" $SUDO apt-get update -qq; updated=1; }
 if [ $update = 1 ] || [ ${#need[@]} -gt 0 ]; then
-  step "apt-get update" $SUDO apt-get update -qq
+  apt_update
   version="$(sundials_version)"
 fi
 if [ ${#need[@]} -gt 0 ]; then step "apt-get install ${need[*]}" apt_install "${need[@]}"; fi
@@ -87,7 +89,10 @@ if [ "$prefix" != system ] && ! built "$prefix"; then
 fi
 setup_args=()
 if [ "$prefix" = system ]; then
-  step "apt-get install Debian's SUNDIALS" apt_install libsundials-dev libsundials-fortran-dev
+  if ! dpkg -s libsundials-fortran-dev >/dev/null 2>&1; then
+    apt_update
+    step "apt-get install Debian's SUNDIALS" apt_install libsundials-dev libsundials-fortran-dev
+  fi
 else
   setup_args=("-Csetup-args=-Dsundials_prefix=$prefix")
 fi
