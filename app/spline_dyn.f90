@@ -5,19 +5,23 @@
 !>          | --version | --help
 !> --summary FILE writes the per-run summary a sweep point keeps (write_summary: the statistics,
 !> the loads, T_m / k_v / F extremes and RMS, the Poincare section and the Benettin record,
-!> the case), no time series; with --summary and no -o no CSV is written. A run that fails
-!> after its case was read still writes its summary, with the error (pyspline merge).
+!> the case), no time series; with --summary and no -o no CSV is written. Every run asked for
+!> a summary writes one, a failed run too (a bad case, a failed build or run: the error, its
+!> kind and exit code, and the case if every --set was read; pyspline merge records it).
+!> -o and --summary take a regular file or a new path (never a FIFO, a device, a directory),
+!> once each, and never the same file (compared as files, not as strings).
 !> Errors and usage go to stderr, warnings as 'spline-dyn: warning: ...' lines; the exit status
 !> says what failed (spline_errors err_exit_code): 0 ok, 2 bad input or usage, 3 solver
 !> failure, 4 thermal interference, 130 interrupted (SIGINT). The output is checked before the
 !> run (writable, not the case file itself), written to a temporary name next to it and
 !> renamed when complete, so a failed or interrupted run leaves what was there untouched.
 program spline_dyn
-  use, intrinsic :: iso_c_binding, only: c_char, c_double, c_int, c_null_char
+  use, intrinsic :: iso_c_binding, only: c_char, c_double, c_int, c_long_long, c_null_char
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use spline_kinds, only: wp
   use spline_errors, only: err_ok, err_case, err_interrupted, err_exit_code, msglen, err_names
-  use spline_case, only: case_t, case_read_file, case_parse, case_name_of, case_write_text
+  use spline_case, only: case_t, case_read_file, case_parse, case_name_of, case_write_text, &
+       c_file_kind
   use spline_model, only: model_t, model_from_case, model_warnings, nstate, nkterms, kterm_names
   use spline_run, only: run_case, run_warnings
   use spline_quantities, only: nstats, stat_q, state_q, iq_tf, ntooth_q, tooth_q, nout_q, output_q, nload, &
@@ -85,7 +89,7 @@ program spline_dyn
   integer :: ierr, i, j, k, n, q, u, su, nargs, nsets, ios
   integer(8) :: c0, c1, rate
   integer(c_int) :: sigint0
-  logical :: have_out, have_summary, write_csv, options_done
+  logical :: have_out, have_summary, write_csv, options_done, have_case, summary_open
 
   ! arguments (any length: allocated from get_command_argument's length)
   nargs = command_argument_count()
@@ -93,6 +97,8 @@ program spline_dyn
   nsets = 0
   have_out = .false.
   have_summary = .false.
+  have_case = .false.
+  summary_open = .false.
   options_done = .false.
   i = 1
   do while (i <= nargs)
@@ -113,8 +119,7 @@ program spline_dyn
       case ('--summary')
         if (i == nargs) call usage_error(arg//' needs a file name')
         i = i + 1
-        summary = argument(i)
-        have_summary = .true.
+        call set_summary(argument(i))
       case ('--set')
         if (i == nargs) call usage_error('--set needs FIELD=VALUE')
         i = i + 1
@@ -130,8 +135,7 @@ program spline_dyn
           out = arg(10:)
           have_out = .true.
         else if (len(arg) > 10 .and. arg(1:min(10, len(arg))) == '--summary=') then
-          summary = arg(11:)
-          have_summary = .true.
+          call set_summary(arg(11:))
         else
           call usage_error('unknown option '//arg)
         end if
@@ -155,6 +159,22 @@ program spline_dyn
     out = trim(case_name_of(path))//'.csv'
   end if
 
+  ! the outputs, before anything else: a regular file or a new path, never the case file, not
+  ! each other; the summary opened (a temporary name next to it, renamed when complete) so
+  ! that whatever fails from here is recorded in it
+  if (write_csv) call check_output(out, 'the output', '-o')
+  if (have_summary) then
+    call check_output(summary, 'the summary', '--summary')
+    if (write_csv) then
+      if (c_same_file(summary//c_null_char, out//c_null_char) /= 0) &
+           call usage_error('the summary '//summary//' and the CSV '//out//' are the same file')
+    end if
+    stmp = temp_name(summary)
+    open(newunit=su, file=stmp, status='replace', action='write', iostat=ios, iomsg=iomsg)
+    if (ios /= 0) call die('cannot write the summary '//summary//': '//trim(iomsg), err_case)
+    summary_open = .true.
+  end if
+
   ! the case: the file, then the --set overrides, then validation and the model
   call case_read_file(path, c, ierr, errmsg)
   do j = 1, nsets
@@ -162,29 +182,15 @@ program spline_dyn
     call case_parse('&spline_case '//sets(j)%s//' /', c, ierr, errmsg, '--set '//sets(j)%s, &
          show_lines=.false.)
   end do
+  have_case = ierr == err_ok       ! the case as asked for (its values may still be refused)
   if (ierr == err_ok) call model_from_case(c, m, ierr, errmsg)
   if (ierr /= err_ok) call die(errmsg, ierr)
 
-  ! the output, before the run: never the case file, and writable (a temporary name next to
-  ! it, renamed when the CSV is complete)
+  ! the CSV, before the run: writable (a temporary name next to it, renamed when complete)
   if (write_csv) then
-    if (c_same_file(path//c_null_char, out//c_null_char) /= 0) &
-         call die('the output '//out//' is the case file '//path//': not overwritten '// &
-         '(give another -o)', err_case)
     tmp = temp_name(out)
     open(newunit=u, file=tmp, status='replace', action='write', iostat=ios, iomsg=iomsg)
     if (ios /= 0) call die('cannot write the output '//out//': '//trim(iomsg), err_case)
-  end if
-  if (have_summary) then
-    if (c_same_file(path//c_null_char, summary//c_null_char) /= 0) &
-         call die('the summary '//summary//' is the case file '//path//': not overwritten '// &
-         '(give another --summary)', err_case)
-    if (write_csv) then
-      if (summary == out) call usage_error('the summary and the CSV are the same file '//out)
-    end if
-    stmp = temp_name(summary)
-    open(newunit=su, file=stmp, status='replace', action='write', iostat=ios, iomsg=iomsg)
-    if (ios /= 0) call die('cannot write the summary '//summary//': '//trim(iomsg), err_case)
   end if
   ! From here a SIGINT is counted, not fatal (fortran/interrupt.c): the run stops at its next
   ! right-hand side, the temporary file is removed, and the exit status is 130.
@@ -205,19 +211,14 @@ program spline_dyn
   wall = real(c1 - c0, wp)/rate
   if (ierr /= err_ok) then
     if (write_csv) close(u, status='delete', iostat=ios)
-    if (have_summary .and. ierr /= err_interrupted) then    ! a failed point is a result
-      call write_summary(.false.)
-    else if (have_summary) then
-      close(su, status='delete', iostat=ios)
-    end if
-    call die(errmsg, ierr)
+    call die(errmsg, ierr)       ! a failed point is a result: die writes its summary
   end if
   call check_interrupt()
   call print_warnings(run_warnings(m, stats))
   allocate(tload(m%z, nload_tooth))
   call run_loads(m, t, y, tooth, tm, loads, tload)
   call print_warnings(stress_warnings(m, loads))
-  if (have_summary) call write_summary(.true.)
+  if (have_summary) call write_summary(.true., '', err_ok)
   if (.not. write_csv) then
     write(*, '(a)') 'case '//trim(m%name)//': '//summary
     call report_loads()
@@ -390,21 +391,29 @@ contains
   !> batch.py): '#' comments; lines NAME [UNIT] = VALUES, the numbers comma-separated with 17
   !> significant digits (every double reads back exactly; units of spline_quantities); lines
   !> NAME = 'TEXT'; then the case as a namelist (every field). ok: the run finished, else the
-  !> summary has the case and the error (ierr, errmsg) only. Written to a temporary name and
-  !> renamed when complete.
-  subroutine write_summary(ok)
+  !> summary has the error (msg, its kind and exit code from code), the --set options and the
+  !> case if every --set was read (have_case). Written to a temporary name and renamed when
+  !> complete.
+  subroutine write_summary(ok, msg, code)
     logical, intent(in) :: ok
+    character(len=*), intent(in) :: msg
+    integer, intent(in) :: code
     character(len=:), allocatable :: text
     integer, parameter :: itm = 2 + nstate, ikv = 3 + nstate, id2 = 6, ivd2 = 13
     integer :: i2, nt
+    summary_open = .false.
     ios = 0
     write(su, '(a)', iostat=ios) '# spline-dyn summary (pyspline '//version()//'): one run, '// &
          'SI units; NAME [UNIT] = VALUES (17 significant digits), then the case'
     write(su, '(a)', iostat=ios) "format = 'pyspline-summary 1'"
     write(su, '(a)', iostat=ios) 'case_file = '//quoted(path)
     if (.not. ok) then
-      write(su, '(a)', iostat=ios) 'error = '//quoted(trim(errmsg))
-      write(su, '(a)', iostat=ios) 'error_kind = '//quoted(trim(err_names(ierr)))
+      write(su, '(a)', iostat=ios) 'error = '//quoted(trim(msg))
+      write(su, '(a)', iostat=ios) 'error_kind = '//quoted(trim(err_names(code)))
+      write(su, '(a,i0)', iostat=ios) 'exit_code [] = ', err_exit_code(code)
+      do i2 = 1, nsets
+        write(su, '(a)', iostat=ios) 'set = '//quoted(sets(i2)%s)
+      end do
     else
       do i2 = 1, nstats
         call put('stats.'//stat_q(i2)%name, stat_q(i2)%unit, [stats(i2)])
@@ -416,6 +425,7 @@ contains
       do i2 = 1, nload_tooth
         call put('tooth_loads.'//load_tooth_q(i2)%name, load_tooth_q(i2)%unit, tload(:, i2))
       end do
+      call put('model.spacing_error', 'm', m%spacing_error(1:m%z))   ! in use: list + seeded
       nt = m%n_out
       call put('run.t_first', 's', t(1:min(1, nt)))
       call extremes('Tm', output_q(itm)%unit, tm)
@@ -430,8 +440,10 @@ contains
       call put('lyapunov.t', 's', lyap_t)
       call put('lyapunov.log_growth', '', lyap_g)
     end if
-    call case_write_text(c, text)
-    if (ios == 0) write(su, '(a)', advance='no', iostat=ios, iomsg=iomsg) text
+    if (have_case) then
+      call case_write_text(c, text)
+      if (ios == 0) write(su, '(a)', advance='no', iostat=ios, iomsg=iomsg) text
+    end if
     if (ios == 0) close(su, iostat=ios, iomsg=iomsg)
     if (ios /= 0) then
       close(su, status='delete', iostat=i2)
@@ -487,7 +499,6 @@ contains
     integer :: ios2
     if (c_sigint_count() == sigint0) return
     if (write_csv) close(u, status='delete', iostat=ios2)
-    if (have_summary) close(su, status='delete', iostat=ios2)
     call die('case '//trim(m%name)//': interrupted (SIGINT)', err_interrupted)
   end subroutine check_interrupt
 
@@ -529,11 +540,52 @@ contains
     stop 2, quiet=.true.
   end subroutine usage_error
 
-  !> Print the message to stderr and exit with the status of the error code (spline_errors).
+  !> --summary FILE: once.
+  subroutine set_summary(file)
+    character(len=*), intent(in) :: file
+    if (have_summary) call usage_error('--summary given twice ('''//summary//''' and '''// &
+         file//'''): one summary per run')
+    summary = file
+    have_summary = .true.
+  end subroutine set_summary
+
+  !> An output (what: 'the output', 'the summary'; opt: its option) is a regular file or a
+  !> new path, and not the case file: else exit 2, the node untouched.
+  subroutine check_output(file, what, opt)
+    character(len=*), intent(in) :: file, what, opt
+    character(kind=c_char) :: buf(256)
+    integer(c_long_long) :: nbytes
+    character(len=:), allocatable :: is
+    buf = c_null_char
+    select case (c_file_kind(file//c_null_char, nbytes, buf, int(size(buf), c_int)))
+    case (0, -1); is = ''
+    case (1); is = 'a directory'
+    case (2); is = 'a FIFO (named pipe)'
+    case (3); is = 'a character device'
+    case (4); is = 'a block device'
+    case (5); is = 'a socket'
+    case (-2); is = 'a dangling symbolic link'
+    case default; is = 'not a regular file'
+    end select
+    if (len(is) > 0) call die(what//' '//file//' is '//is//': '//opt// &
+         ' takes a regular file or a new path', err_case)
+    if (c_same_file(path//c_null_char, file//c_null_char) /= 0) &
+         call die(what//' '//file//' is the case file '//path//': not overwritten '// &
+         '(give another '//opt//')', err_case)
+  end subroutine check_output
+
+  !> Print the message to stderr and exit with the status of the error code (spline_errors);
+  !> an open summary records the error first (not an interrupt: its temporary file goes).
   subroutine die(msg, ierr)
     character(len=*), intent(in) :: msg
     integer, intent(in) :: ierr
     integer :: code
+    if (summary_open .and. ierr /= err_interrupted) then
+      call write_summary(.false., msg, ierr)
+    else if (summary_open) then
+      summary_open = .false.
+      close(su, status='delete', iostat=code)
+    end if
     write(error_unit, '(a)') 'spline-dyn: error: '//trim(msg)
     code = err_exit_code(ierr)
     stop code, quiet=.true.

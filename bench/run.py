@@ -93,7 +93,7 @@ def main(argv=None) -> int:
                    "rattle_z24 physical_z24; --quick: the two paper scenes)")
     p.add_argument("--rtol", type=float, help="bifurcation: tolerance (default: the case's)")
     p.add_argument("--repeats", type=int, help="continuation: interleaved runs per monodromy "
-                   "(default 3, --quick 1); bifurcation: run the whole sweep this many "
+                   "(default 3, --quick 1); race: timed rounds (default 5, --quick 2); bifurcation: run the whole sweep this many "
                    "times per executor, in rotating order; medians and ranges (default 1)")
     p.add_argument("--blocks", type=int, help="bifurcation: run the sweep as this many "
                    "interleaved blocks, the executors in rotating order (default 1: each "
@@ -108,14 +108,20 @@ def main(argv=None) -> int:
     p.add_argument("--quick", action="store_true", help="small sizes (for CI)")
     args = p.parse_args(argv)
     if args.what == "race":
+        import subprocess
         import race
-        rows, runs = race.race(quick=args.quick, repeat=2 if args.quick else 5,
-                               cases=args.cases)
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
+                                text=True, cwd=Path(__file__).resolve().parent).stdout.strip()
+        print(f"race at commit {commit or '?'}; {race.load()}", flush=True)
+        rows, runs = race.race(quick=args.quick, repeat=args.repeats or (2 if args.quick else 5),
+                               cases=args.cases, progress=lambda m: print(m, flush=True))
+        print(f"{race.load()} (at the end)")
         print("\n".join(race.format_rows(rows)))
         from speed import _write_csv
         Path(args.out).mkdir(parents=True, exist_ok=True)
         _write_csv(Path(args.out) / "race.csv", [
-            {k: v for k, v in r.items() if k != "times"} for r in runs])
+            {k: (" ".join(f"{x:.6g}" for x in v) if isinstance(v, list) else v)
+             for k, v in r.items()} for r in runs])
         print(f"wrote {args.out}/race.csv")
         return 0
     if args.what == "parallel":

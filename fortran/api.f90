@@ -14,7 +14,7 @@
 module spline_api
   use, intrinsic :: iso_c_binding, only: c_double, c_int
   use spline_kinds, only: wp
-  use spline_errors, only: err_ok, err_case, nerr, err_names, msglen
+  use spline_errors, only: err_ok, err_case, nerr, err_names, msglen, itoa
   use spline_case, only: case_t, case_read_file, case_read_text, case_suggest, case_field, &
        case_field_meta
   use spline_case_values, only: case_value_sizes, case_to_values, case_from_values
@@ -31,7 +31,8 @@ module spline_api
   use spline_orbits, only: period_map, map_and_monodromy
   implicit none
   private
-  public :: api_load_file, api_load_fields, api_load_text, api_model_size, api_simulate
+  public :: api_load_file, api_load_fields, api_load_text, api_read_text, api_model_size
+  public :: api_simulate
   public :: api_rhs, api_rhs_mesh, api_start_state, api_loads
   public :: api_output_times, api_model_info, api_defaults, api_names, api_tooth_stiffness
   public :: api_field_hint, api_warnings, api_period_map, api_map_monodromy, api_lyapunov
@@ -108,6 +109,24 @@ contains
     if (ie == err_ok) call load_model(c, model, sizes, warn, ie, errmsg)
     ierr = ie
   end subroutine api_load_text
+
+  !> Read a case from namelist text, without validating or building it (pyspline merge: the
+  !> case of a spline-dyn summary, also of a run its values failed); its fields as
+  !> api_load_file returns them.
+  subroutine api_read_text(text, nv, nc, values, chars, ierr, errmsg)
+    character(len=*), intent(in) :: text
+    integer(c_int), intent(in) :: nv, nc
+    real(c_double), intent(out) :: values(nv)
+    integer(c_int), intent(out) :: chars(nc)
+    integer(c_int), intent(out) :: ierr
+    character(len=msglen), intent(out) :: errmsg
+    type(case_t) :: c
+    integer :: ie
+    values = 0; chars = iachar(' ')
+    call case_read_text(text, c, ie, errmsg)
+    if (ie == err_ok) call fields_out(c, values, chars, ie, errmsg)
+    ierr = ie
+  end subroutine api_read_text
 
   !> The fields of c as api_load_file returns them (characters as byte values 0..255).
   subroutine fields_out(c, values, chars, ierr, errmsg)
@@ -429,18 +448,25 @@ contains
   !> [m], pitch radius [m], shaft speed omega [rad/s], the scales of Eq. 25 l_ref [m] and
   !> w_ref [rad/s], the backlash at the bulk temperature [m], kappa [m/degC] (Eq. 2), the
   !> k_m used [N/m], 1 if it is computed (Eq. 18), the thermal level (0 none .. 3 coupled);
-  !> and the Eq. 18 terms (order of api_names('kterms')).
-  subroutine api_model_info(model, nb, info, terms, ierr, errmsg)
-    integer(c_int), intent(in) :: nb
+  !> and the Eq. 18 terms (order of api_names('kterms')); the tooth spacing errors in use e_j
+  !> of teeth 1 .. z [m] (the list plus the seeded ones, docs/model.md section 11).
+  subroutine api_model_info(model, nb, z, info, terms, spacing, ierr, errmsg)
+    integer(c_int), intent(in) :: nb, z
     integer(c_int), intent(in) :: model(nb)
-    real(c_double), intent(out) :: info(ninfo), terms(nkterms)
+    real(c_double), intent(out) :: info(ninfo), terms(nkterms), spacing(z)
     integer(c_int), intent(out) :: ierr
     character(len=msglen), intent(out) :: errmsg
     type(model_t) :: m
     integer :: ie
-    info = 0; terms = 0
+    info = 0; terms = 0; spacing = 0
     call unpack(model, m, ie, errmsg)
+    if (ie == err_ok .and. z /= m%z) then
+      ie = err_case
+      errmsg = 'case '//trim(m%name)//': api_model_info for '//itoa(z)//' teeth, the model has '// &
+           itoa(m%z)
+    end if
     if (ie == err_ok) then
+      spacing = m%spacing_error(1:z)
       info = [m%r_b, m%r_pitch, m%omega, m%l_ref, m%w_ref, m%c_bulk, m%kappa, m%k_m, &
            merge(1.0_wp, 0.0_wp, m%k_m_computed), real(m%thermal, wp), m%c_m, m%m_e]
       terms = m%k_terms

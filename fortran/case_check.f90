@@ -9,7 +9,7 @@ module spline_case_check
   use spline_case_type, only: case_t, fields, nfields, field_index, ndof_case, nripple, &
        option_index, case_output_bytes, case_run_times, max_output_bytes, thermal_values, method_values, &
        nonlinear_values, start_values, fidelity_values, jacobian_values, section_values, &
-       lyapunov_method_values
+       lyapunov_method_values, goal_values
   use spline_case_text, only: num, size_text
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
@@ -25,7 +25,8 @@ contains
     x = [c%module_m, c%alpha_deg, c%b, c%s, c%c0, c%e_mod, c%nu, c%lambda_th, c%k_cond, c%rho, &
          c%c_heat, c%j_m, c%j_l, c%j_1, c%j_2, c%m_1, c%m_2, c%k_p1, c%k_p2, c%c_p1, c%c_p2, &
          c%k_t1, c%k_t2, c%c_t1, c%c_t2, c%k_m, c%c_m, c%t_d, c%t_l, c%speed_rpm, c%grav, &
-         c%l_x, c%l_y, c%t_bulk, c%f_m, c%u_flash, c%eta_hertz, c%rtol, c%atol, c%t0, c%t_end, &
+         c%l_x, c%l_y, c%t_bulk, c%f_m, c%u_flash, c%eta_hertz, c%rtol, c%atol, c%accuracy, &
+         c%t0, c%t_end, &
          c%t_transient, c%revolutions, c%transient_revolutions, c%outputs_per_revolution, &
          c%dq0, c%dv0, c%l_ref, c%w_ref, c%fidelity_tol, c%lyapunov_interval, c%lyapunov_d0, &
          c%fillet_radius, c%r_bore, c%r_rim, c%zeta_m, c%ripple_order, &
@@ -107,6 +108,7 @@ contains
 
     ! thermal, solver tolerances
     if (.not. ranges('t_bulk', 'atol')) return
+    if (.not. ranges('accuracy', 'accuracy')) return
     if (c%max_steps < 1) then; call fail('max_steps', 'must be at least 1'); return; end if
     if (c%max_total_steps < 1) then
       call fail('max_total_steps', 'must be at least 1'); return
@@ -201,6 +203,17 @@ contains
     if (.not. one_of(start_values, c%start, 'start')) return
     if (.not. one_of(section_values, c%section, 'section')) return
     if (.not. one_of(lyapunov_method_values, c%lyapunov_method, 'lyapunov_method')) return
+    if (.not. one_of(goal_values, c%goal, 'goal')) return
+    if (option_index(goal_values, c%goal) == 2 .and. c%accuracy > 0.0_wp) then
+      call fail('accuracy', '= '//num(c%accuracy)//' is the error of the trajectory''s tooth '// &
+           'forces; goal = ''statistics'' reads statistics, whose error is their standard error: '// &
+           'set accuracy = 0 or goal = ''trajectory'''); return
+    end if
+    if (option_index(goal_values, c%goal) == 2 .and. c%check) then
+      call fail('check', '= .true. estimates the error of the trajectory''s tooth forces; goal = '// &
+           '''statistics'' does not resolve the trajectory (its statistics carry standard errors): '// &
+           'set check = .false. or goal = ''trajectory'''); return
+    end if
     if (.not. ranges('lyapunov_interval', 'lyapunov_d0')) return  ! d0 = 0: chosen from rtol
     if ((c%lyapunov .or. option_index(section_values, c%section) > 1) .and. c%speed_rpm <= 0.0_wp) then
       call fail('speed_rpm', 'must be positive for a Poincare section or a Lyapunov exponent '// &

@@ -10,7 +10,7 @@ module spline_case_type
        case_name_of, option_index, case_output_bytes, case_run_times
   public :: namelen, optlen, nripple, ndof_case, max_case_bytes, max_output_bytes
   public :: thermal_values, method_values, nonlinear_values, start_values, fidelity_values, &
-       jacobian_values, section_values, lyapunov_method_values
+       jacobian_values, section_values, lyapunov_method_values, goal_values
 
   integer, parameter :: namelen = 128
   integer, parameter :: nripple = 4         !< torque-ripple orders a case can give
@@ -34,6 +34,8 @@ module spline_case_type
   character(len=optlen), parameter :: jacobian_values(1) = [character(len=optlen) :: 'dq']
   character(len=optlen), parameter :: section_values(3) = [character(len=optlen) :: &
        'none', 'shaft', 'tooth']
+  character(len=optlen), parameter :: goal_values(2) = [character(len=optlen) :: &
+       'trajectory', 'statistics']
   character(len=optlen), parameter :: lyapunov_method_values(2) = [character(len=optlen) :: &
        'copy', 'tangent']
 
@@ -63,6 +65,10 @@ module spline_case_type
     logical  :: roots = .true., stald = .false., linear_tail = .true.
     real(wp) :: rtol = 1.0e-8_wp, atol = 1.0e-10_wp
     integer  :: max_steps = 100000, max_total_steps = 20000000
+    !> Accuracy as an input (spline_accuracy, docs/accuracy.md): 0 keeps rtol, atol as given.
+    real(wp) :: accuracy = 0.0_wp
+    character(len=optlen) :: goal = 'trajectory'
+    logical  :: check = .false.
     real(wp) :: t0 = 0.0_wp, t_end = 0.1_wp, t_transient = 0.0_wp
     integer  :: n_out = 1001
     !> The run in shaft revolutions (0: t_end, t_transient, n_out as given); case_run_times.
@@ -108,7 +114,7 @@ module spline_case_type
     real(wp) :: lo = 0.0_wp, hi = 0.0_wp
     character(len=80) :: note = ''
   end type field_t
-  integer, parameter :: nfields = 86
+  integer, parameter :: nfields = 89
   real(wp), parameter :: inf_ = huge(1.0_wp)
   type(field_t), parameter :: fields(nfields) = [ &
        field_t('name', 'c', namelen, '', 'case name, used in messages (default: the file name)'), &
@@ -191,6 +197,11 @@ module spline_case_type
                'an absolute tolerance on the scaled states of Eq. 25, which are of order 1'), &
        field_t('max_steps', 'i', 1, '', 'CVODE steps allowed between two output times'), &
        field_t('max_total_steps', 'i', 1, '', 'CVODE steps allowed over the whole run'), &
+       field_t('accuracy', 'r', 1, '-', 'largest relative error of F_j accepted; 0: rtol, atol as '// &
+               'given', 'n', 1.0e-9_wp, 0.1_wp, 'a relative error of the tooth forces (0: rtol '// &
+               'and atol as given)'), &
+       field_t('goal', 'c', optlen, '', 'trajectory | statistics (cheapest unbiased settings)'), &
+       field_t('check', 'l', 1, '', 'estimate the error of F_j against a tighter run (F_error_est)'), &
        ! times: within a million seconds (11.6 days) of 0, where a double still resolves the
        ! tooth angle omega t to 1e-5 rad at the largest speed
        field_t('t0', 'r', 1, 's', 'start time', 'r', -1.0e6_wp, 1.0e6_wp, &

@@ -7,15 +7,18 @@
 !>  - torsional only (dof 3) leaves out the lateral motion. Its drivers are the misalignment
 !>    (l_x, l_y), the difference of the gravity sags g |m_1/k_p1 - m_2/k_p2|, a lateral start
 !>    offset, the unbalance (its static deflection m_u e omega^2 / k_p) and the angular
-!>    misalignment (gamma b / 2 at the face ends), and the first harmonic of the tooth spacing
-!>    errors, an eccentricity (2/Z) |sum_j e_j exp(2 pi i j/Z)| (docs/model.md section 11).
-!>    Without them every tooth sees the same dn_j, sum_j F_j sin(phi_j) = 0 (Z >= 3) and the
-!>    lateral states never move: dof 3 is then exact.
+!>    misalignment (gamma b / 2 at the face ends), and the lateral offset the tooth spacing
+!>    errors make (spacing_offset: from the static equilibrium, partial contact included; with
+!>    every tooth engaged only their first harmonic moves the centres, once teeth unload any
+!>    pattern does, docs/model.md section 11). Without them every tooth sees the same dn_j,
+!>    sum_j F_j sin(phi_j) = 0 (Z >= 3) and the lateral states never move: dof 3 is then exact.
 !>  - a temperature dT left out of Eq. 2 moves the backlash by kappa dT, kappa = 2 lambda s cos(alpha).
 module spline_fidelity
-  use spline_kinds, only: wp, pi
-  use spline_model, only: model_t, thermal_none, thermal_bulk, thermal_oneway, thermal_coupled, &
-       set_thermal_level
+  use spline_kinds, only: wp
+  use spline_model, only: model_t, ndof, thermal_none, thermal_bulk, thermal_oneway, &
+       thermal_coupled, set_thermal_level
+  use spline_dynamics, only: static_equilibrium
+  use spline_errors, only: err_ok, msglen
   implicit none
   private
   public :: static_tooth_load, lateral_estimate, backlash_estimate, auto_level, auto_tol
@@ -43,7 +46,7 @@ contains
     eps_lat = 0.0_wp; eps_th = 0.0_wp
     tol = auto_tol(m)
     if (.not. m%auto) return
-    eps_lat = lateral_estimate(m)
+    eps_lat = lateral_estimate(m, spacing_offset(m))
     if (m%dof == 7 .and. eps_lat <= tol) run%dof = 3
     if (m%thermal == thermal_bulk) then
       eps_th = backlash_estimate(m, m%t_bulk)
@@ -65,29 +68,47 @@ contains
   end function static_tooth_load
 
   !> Estimated relative tooth-force error of the torsional level: k_m e / F0, with e the lateral
-  !> excitation |(l_x, l_y)| + g |m_1/k_p1 - m_2/k_p2| + |lateral dq0|. Huge (never reduce) for a
-  !> lateral start velocity, a free lateral body (k_p = 0) or no load.
-  pure real(wp) function lateral_estimate(m) result(eps)
+  !> excitation |(l_x, l_y)| + g |m_1/k_p1 - m_2/k_p2| + |lateral dq0| + the unbalance's and
+  !> the tilt's (above) + e_sp, the spacing errors' offset (spacing_offset). Huge (never reduce)
+  !> for a lateral start velocity, a free lateral body (k_p = 0) or no load.
+  pure real(wp) function lateral_estimate(m, e_sp) result(eps)
     type(model_t), intent(in) :: m
-    real(wp) :: e, f0, es, ec
-    integer :: j
+    real(wp), intent(in) :: e_sp
+    real(wp) :: e, f0
     f0 = static_tooth_load(m)
     eps = huge(1.0_wp)
     if (f0 == 0.0_wp .or. m%k_p1 == 0.0_wp .or. m%k_p2 == 0.0_wp) return
     if (any(m%dv0(1:4) /= 0.0_wp)) return
     e = hypot(m%l_x, m%l_y) + m%grav*abs(m%m_1/m%k_p1 - m%m_2/m%k_p2) + norm2(m%dq0(1:4)) &
          + m%omega**2*(m%unbalance(1)/m%k_p1 + m%unbalance(2)/m%k_p2) &
-         + 0.5_wp*m%b*hypot(m%gamma_x, m%gamma_y)
-    if (m%spacing) then
-      es = 0.0_wp; ec = 0.0_wp
-      do j = 1, m%z
-        es = es + m%spacing_error(j)*sin(2.0_wp*pi*j/m%z)
-        ec = ec + m%spacing_error(j)*cos(2.0_wp*pi*j/m%z)
-      end do
-      e = e + 2.0_wp/m%z*hypot(es, ec)
-    end if
+         + 0.5_wp*m%b*hypot(m%gamma_x, m%gamma_y) + e_sp
     eps = m%k_m*e/f0
   end function lateral_estimate
+
+  !> The lateral offset of the centres, |(x1 - x2, y1 - y2)|, that the tooth spacing errors
+  !> make in the static equilibrium at t0 (spline_dynamics::static_equilibrium, with the errors
+  !> less without them): the lateral force of the set of teeth the errors leave engaged, against
+  !> the supports and the mesh. With every tooth engaged that is the errors' first harmonic,
+  !> k_m (E_s, -E_c) against K + k_s (docs/model.md section 11); once teeth unload, any pattern.
+  !> 0 without errors; huge (keep the lateral motion) where an equilibrium is not found.
+  real(wp) function spacing_offset(m) result(e)
+    type(model_t), intent(in) :: m
+    type(model_t) :: m0
+    real(wp) :: q(ndof), q0(ndof)
+    integer :: ierr
+    character(len=msglen) :: msg
+    e = 0.0_wp
+    if (.not. m%spacing) return
+    e = huge(1.0_wp)
+    msg = ''
+    call static_equilibrium(m, m%t0, q, ierr, msg)
+    if (ierr /= err_ok) return
+    m0 = m
+    m0%spacing = .false.; m0%spacing_error = 0.0_wp
+    call static_equilibrium(m0, m%t0, q0, ierr, msg)
+    if (ierr /= err_ok) return
+    e = hypot(q(1) - q(3) - q0(1) + q0(3), q(2) - q(4) - q0(2) + q0(4))
+  end function spacing_offset
 
   !> Estimated relative tooth-force error of leaving a temperature dtemp [degC] out of the
   !> backlash (Eq. 2): k_m kappa |dtemp| / F0. Huge with no load.

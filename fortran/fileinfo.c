@@ -5,6 +5,8 @@
  * Every function is reentrant; messages are strerror's text (as Python's os.strerror). */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <limits.h>
+#include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -49,12 +51,33 @@ int spline_file_kind(const char *path, long long *size, char *errbuf, int errlen
     return 6;
 }
 
-/* 1 if both names exist and are the same file (device and inode), else 0. */
+/* The canonical name of a path whose last part may not exist yet: realpath of its directory,
+ * then its last part; 0 on success, -1 if the directory cannot be resolved. */
+static int canonical(const char *path, char *out, size_t len)
+{
+    char dir[PATH_MAX], resolved[PATH_MAX];
+    const char *slash = strrchr(path, '/');
+    const char *base = slash ? slash + 1 : path;
+    size_t n = slash ? (size_t)(slash - path) : 0;
+    if (n >= sizeof dir) return -1;
+    if (slash == NULL) strcpy(dir, ".");
+    else if (n == 0) strcpy(dir, "/");
+    else { memcpy(dir, path, n); dir[n] = '\0'; }
+    if (realpath(dir, resolved) == NULL) return -1;
+    return snprintf(out, len, "%s/%s", resolved, base) < (int)len ? 0 : -1;
+}
+
+/* 1 if two names are the same file: both exist and have the same device and inode, or
+ * neither exists and both name the same new file (the same canonical name); else 0. */
 int spline_same_file(const char *a, const char *b)
 {
     struct stat sa, sb;
-    if (stat(a, &sa) != 0 || stat(b, &sb) != 0) return 0;
-    return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+    char ca[PATH_MAX + 1], cb[PATH_MAX + 1];
+    int ha = stat(a, &sa) == 0, hb = stat(b, &sb) == 0;
+    if (ha && hb) return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+    if (ha || hb) return 0;
+    if (canonical(a, ca, sizeof ca) != 0 || canonical(b, cb, sizeof cb) != 0) return 0;
+    return strcmp(ca, cb) == 0;
 }
 
 /* rename(2): 0, or -1 with the reason in errbuf. */

@@ -33,6 +33,15 @@ module spline_loads
   !> limit of good case-hardened gear steel (about 500 MPa, approximate) over a safety of 1.25.
   real(wp), parameter :: sigma_root_limit = 400.0e6_wp, sigma_flank_limit = 310.0e6_wp, &
        tau_pitch_limit = 345.0e6_wp
+  !> Limits of flash_warning [degC] on the contact temperature T_B = T_M + T_f (Eq. 1), the
+  !> temperature of Blok's criterion (scuffing when the bulk plus flash temperature of the
+  !> contact reaches a critical value of the oil and steel; T_f alone would pass a hot bulk):
+  !> scuffing_temp, the top of the scuffing temperatures of gear oils on steel (about 150-400
+  !> degC by the oil's FZG load stage in the flash-temperature method of ISO/TS 6336-20,
+  !> formerly ISO/TR 13989-1); tempering_temp, the top of steel's tempering range (150-650
+  !> degC, below the A1 transformation at 727 degC; solidus about 1400 degC), past which the
+  !> surface loses its hardness and the model its ground.
+  real(wp), parameter :: scuffing_temp = 400.0_wp, tempering_temp = 650.0_wp
 
 contains
 
@@ -258,7 +267,8 @@ contains
 
   !> Warnings about a run's loads (loads in the order of load_q, as run_loads makes them), one
   !> line each (blank if none): a nominal stress of tooth_stresses beyond its limit
-  !> (sigma_root_limit, sigma_flank_limit, tau_pitch_limit). The executable prints them to
+  !> (sigma_root_limit, sigma_flank_limit, tau_pitch_limit); the contact temperature beyond
+  !> scuffing_temp or tempering_temp (flash_warning). The executable prints them to
   !> stderr, Python raises pyspline.SplineWarning (api_warnings stage 2): the same words.
   function stress_warnings(m, loads) result(text)
     type(model_t), intent(in) :: m
@@ -267,8 +277,32 @@ contains
     text = over('root bending stress 6 F cos(alpha) h_f / (b t_f^2)', loads(il_sigma_root), &
          sigma_root_limit)//over('flank bearing stress F cos(alpha) / (b h_w)', &
          loads(il_sigma_flank), sigma_flank_limit)//over('shear stress at the pitch circle '// &
-         'F cos(alpha) / (b s)', loads(il_tau_pitch), tau_pitch_limit)
+         'F cos(alpha) / (b s)', loads(il_tau_pitch), tau_pitch_limit)//flash_warning()
   contains
+    !> T_B = T_M + max T_f (a run with flash temperature) beyond scuffing_temp, or, stronger,
+    !> beyond tempering_temp.
+    function flash_warning() result(line)
+      character(len=:), allocatable :: line
+      real(wp) :: tb
+      line = ''
+      tb = m%t_bulk + loads(il_tf_max)
+      if (.not. loads(il_tf_max) > 0.0_wp .or. .not. tb > scuffing_temp) return
+      line = 'case '//trim(m%name)//': contact temperature T_M + T_f = '// &
+           ftoa(m%t_bulk, '(f12.1)')//' + '//ftoa(loads(il_tf_max), '(f12.1)')// &
+           ' degC (Eq. 1, the largest T_f, tooth '// &
+           itoa(nint(loads(il_tf_max_tooth)))//' at t = '//ftoa(loads(il_tf_max_t), '(es10.3)')// &
+           ' s, f_m = '//ftoa(m%f_m, '(es10.3)')//') exceeds '
+      if (tb > tempering_temp) then
+        line = line//itoa(nint(tempering_temp))//' degC, past steel''s tempering range (A1 727 '// &
+             'degC, solidus about 1400 degC): the flank would lose its hardness or melt, Blok''s '// &
+             'flash temperature is outside its range; f_m, the load or the speed? Run as given'
+      else
+        line = line//itoa(nint(scuffing_temp))//' degC, the top of typical scuffing temperatures '// &
+             'of gear oils on steel (Blok''s criterion; ISO/TS 6336-20): scuffing likely. Run as given'
+      end if
+      line = line//new_line('a')
+    end function flash_warning
+
     function over(what, x, limit) result(line)
       character(len=*), intent(in) :: what
       real(wp), intent(in) :: x, limit

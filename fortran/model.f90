@@ -8,10 +8,11 @@ module spline_model
   use spline_errors, only: err_ok, err_case, err_thermal, itoa, ftoa
   use spline_case, only: case_t, case_validate, case_run_times, namelen, option_index, thermal_values, &
        method_values, nonlinear_values, start_values, fidelity_values, section_values, nripple, &
-       lyapunov_method_values
+       lyapunov_method_values, goal_values
   use spline_geometry, only: iso4156_radii, pitch_rotation, tooth_angles
   use spline_stiffness, only: spline_mesh_stiffness_fillet
   use spline_thermal, only: backlash_coefficient, thermal_backlash
+  use spline_accuracy, only: accuracy_settings
   implicit none
   private
   public :: model_t, model_from_case, set_thermal_level, model_magic, model_warnings
@@ -29,17 +30,18 @@ module spline_model
   integer, parameter :: stiffness_nquad = 32   !< Gauss points: converged to 1e-15 from 16 on
   !> Marks a model_t built by this build's constructor (layout version in the last digits):
   !> a copy handed back from outside is checked against it.
-  integer, parameter :: model_magic = 517730008
+  integer, parameter :: model_magic = 517730009
   !> A given k_m this many times below Eq. 18 draws a warning (model_warnings): the paper's
   !> calibrated 2.54e5 N/m is ~7600 times below for its spline, a deliberate fit; N/mm read
   !> as N/m is 1000 times, on top of such a fit 1e4 is passed.
   real(wp), parameter :: k_m_warn_ratio = 1.0e4_wp
   !> Plausibility limits of model_warnings (docs/model.md section 12, "Plausibility warnings"):
-  !> the supports' share of the offset beyond the backlash; the static shaft wind-up [rad]
+  !> the offset the supports leave at the mesh over the static tooth deflection (load-sharing
+  !> factor 1.1); the static shaft wind-up [rad]
   !> (a solid steel shaft at 300 MPa shear twists 2 tau L / (G d) = 0.0075 L/d rad: 0.2 rad at
   !> L/d = 27; an elastomer coupling 5-10 deg at its rated torque); the static tooth deflection
   !> as a fraction of the module (a tooth at a 1000 MPa root bending stress deflects ~1.6 %).
-  real(wp), parameter :: support_limit = 0.5_wp, windup_limit = 0.2_wp
+  real(wp), parameter :: support_limit = 0.1_wp, windup_limit = 0.2_wp
   real(wp), parameter :: deflection_limit = 0.05_wp
 
   type :: model_t
@@ -61,6 +63,10 @@ module spline_model
     logical  :: stald = .false.
     logical  :: linear_tail = .true.        !< closed-form tail in proven full contact (spline_linear)
     real(wp) :: rtol, atol
+    !> the case's accuracy target (0: none), an error estimate asked for (accuracy or check),
+    !> goal = 'statistics' (spline_accuracy)
+    real(wp) :: accuracy = 0.0_wp
+    logical  :: estimate = .false., goal_statistics = .false.
     integer  :: max_steps, max_total_steps, n_out
     real(wp) :: t0, t_end, t_transient
     logical  :: start_equilibrium = .true.
@@ -115,7 +121,7 @@ contains
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
     real(wp) :: rf1, rf2, ra2, rho_f, r_bore, r_rim
-    integer :: j
+    integer :: j, k
 
     call case_validate(c, ierr, errmsg)
     if (ierr /= err_ok) return
@@ -137,8 +143,12 @@ contains
     m%roots = c%roots; m%stald = c%stald; m%linear_tail = c%linear_tail; m%dq0 = c%dq0; m%dv0 = c%dv0
     m%dof = c%dof; m%fidelity_tol = c%fidelity_tol
     m%auto = option_index(fidelity_values, c%fidelity) == 2
-    m%method_bdf = merge(1, 0, chosen_method(c) == 1)
-    m%erk = chosen_method(c) == 3
+    k = chosen_method(c)        ! the integrator, roots and tolerances an accuracy or goal picks
+    call accuracy_settings(c, k, m%roots, m%rtol, m%atol)
+    m%accuracy = c%accuracy; m%goal_statistics = option_index(goal_values, c%goal) == 2
+    m%estimate = (c%accuracy > 0.0_wp .or. c%check) .and. .not. m%goal_statistics
+    m%method_bdf = merge(1, 0, k == 1)
+    m%erk = k == 3
     select case (option_index(nonlinear_values, c%nonlinear))
     case (1)
       m%newton = .true.
@@ -151,7 +161,7 @@ contains
     m%section = option_index(section_values, c%section) - 1
     m%lyapunov = c%lyapunov
     m%lyap_tangent = option_index(lyapunov_method_values, c%lyapunov_method) == 2
-    m%lyap_d0 = lyapunov_separation(c%lyapunov_d0, c%rtol)
+    m%lyap_d0 = lyapunov_separation(c%lyapunov_d0, m%rtol)
     if (m%omega > 0.0_wp) m%lyap_dt = c%lyapunov_interval*2.0_wp*pi/m%omega
 
     ! geometry (docs/model.md sections 2 and 12, Eq. 9)
@@ -328,27 +338,36 @@ contains
          'Run as given'//new_line('a')
   end function separation_warning
 
-  !> The offset beyond the backlash, |l| - c, is taken by the mesh and the supports in series
-  !> (not with a floating spline, k_p = 0, or frozen lateral motion, dof = 3): the mesh's lateral
-  !> stiffness with all Z teeth in contact is K = sum_j k_m sin^2(phi_j) = Z k_m / 2 (Eqs. 11,
-  !> 19-21), the supports' k_s = k_p1 k_p2 / (k_p1 + k_p2) (Eq. 23); the supports take the share
-  !> K / (K + k_s). Warned above support_limit.
+  !> Supports too soft for the offset to reach the teeth. Under torque every tooth is on its
+  !> drive flank and the mesh resists a lateral offset from zero, the backlash taken up by the
+  !> twist, with K = sum_j k_m sin^2(phi_j) = Z k_m / 2 (Eqs. 11, 19-21) in series with the
+  !> supports' k_s = k_p1 k_p2 / (k_p1 + k_p2) (Eq. 23): the offset left at the mesh is
+  !> e = |l| k_s / (K + k_s) (docs/model.md section 11, static full contact). What decides the
+  !> load sharing is e against the static tooth deflection delta = F0 / k_m, F0 = |T_d| / (Z r_b):
+  !> the tooth loads are F0 (1 + (e / delta) sin(phi_j - psi)) while e <= delta (load-sharing
+  !> factor 1 + e / delta), and teeth unload beyond it. Warned when the offset would unload teeth
+  !> on rigid supports, |l| > delta, but the supports leave e <= support_limit delta (not with a
+  !> floating spline, k_p = 0, frozen lateral motion, dof = 3, or no drive torque).
   function support_warning(m) result(text)
     type(model_t), intent(in) :: m
     character(len=:), allocatable :: text
-    real(wp) :: l, k_mesh, k_s, share
+    real(wp) :: l, k_mesh, k_s, e, delta
     text = ''
     l = hypot(m%l_x, m%l_y)
-    if (m%dof /= 7 .or. l <= m%c_bulk .or. min(m%k_p1, m%k_p2) <= 0.0_wp) return
+    if (m%dof /= 7 .or. min(m%k_p1, m%k_p2) <= 0.0_wp .or. m%t_d == 0.0_wp) return
     k_mesh = m%z*m%k_m/2.0_wp
     k_s = 1.0_wp/(1.0_wp/m%k_p1 + 1.0_wp/m%k_p2)
-    share = k_mesh/(k_mesh + k_s)
-    if (share <= support_limit) return
+    e = l*k_s/(k_mesh + k_s)
+    delta = abs(m%t_d)/(m%z*m%r_b*m%k_m)
+    if (l <= delta .or. e > support_limit*delta) return
     text = 'case '//trim(m%name)//': fields k_p1 = '//num(m%k_p1)//', k_p2 = '//num(m%k_p2)// &
          ' N/m: the supports (in series '//num(k_s)//' N/m, the mesh Z k_m / 2 = '//num(k_mesh)// &
-         ' N/m) take '//num(100.0_wp*share)//' % of the offset beyond the backlash, |l| - c = '// &
-         num(l - m%c_bulk)//' m (limit '//itoa(nint(100.0_wp*support_limit))//' %): the '// &
-         'teeth barely see the misalignment. Run as given'//new_line('a')
+         ' N/m) leave e = '//num(e)//' m of the offset |l| = '//num(l)//' m at the mesh, '// &
+         num(100.0_wp*e/delta)//' % of the static tooth deflection |T_d| / (Z r_b k_m) = '// &
+         num(delta)//' m (limit '//itoa(nint(100.0_wp*support_limit))//' %): the teeth barely '// &
+         'see the misalignment: it raises the static load-sharing factor to 1 + e / delta = '// &
+         num(1.0_wp + e/delta)// &
+         '. Run as given'//new_line('a')
   end function support_warning
 
   !> Static wind-up of the shafts, T_d / k_t1 and T_L / k_t2, above windup_limit (not for a

@@ -63,8 +63,10 @@ module spline_quantities
   integer, parameter, public :: ist_core_wall = nsolver_stats + 1, ist_dof = nsolver_stats + 2, &
        ist_thermal_level = nsolver_stats + 3, ist_eps_lateral = nsolver_stats + 4, &
        ist_eps_thermal = nsolver_stats + 5, ist_closed = nsolver_stats + 6, &
-       ist_closed_t = nsolver_stats + 7
-  integer, parameter :: nstats = nsolver_stats + 7
+       ist_closed_t = nsolver_stats + 7, ist_f_error = nsolver_stats + 8, &
+       ist_f_error_t = nsolver_stats + 9, ist_f_parted_t = nsolver_stats + 10, &
+       ist_rtol_used = nsolver_stats + 11
+  integer, parameter :: nstats = nsolver_stats + 11
   type(quantity_t), parameter :: stat_q(nstats) = [ &
        quantity_t('steps', '', 'CVODE steps (all restarts)'), &
        quantity_t('rhs_evals', '', 'right-hand-side evaluations of CVODE'), &
@@ -94,7 +96,15 @@ module spline_quantities
        quantity_t('backlash_closed', '', 'one-way samples (time, tooth) whose flash temperature &
             &closes the backlash (Eq. 2)'), &
        quantity_t('backlash_closed_t_s', 's', 'first time the one-way flash temperature closes &
-            &the backlash (Eq. 2)')]
+            &the backlash (Eq. 2)'), &
+       quantity_t('F_error_est', '-', 'estimated error of F_j: max |F_j - F_j of a tighter run| &
+            &/ max |F_j| up to F_error_t_s (-1: not estimated; docs/accuracy.md)'), &
+       quantity_t('F_error_t_s', 's', 'last output compared for F_error_est: the run''s end, &
+            &its linear tail, or before a tighter run parts from it (-1: none)'), &
+       quantity_t('F_parted_t_s', 's', 'first output where a tighter run''s F_j differ by over &
+            &0.1 max |F_j|: the trajectories part (chaos; -1: never, or not estimated)'), &
+       quantity_t('rtol_used', '-', 'relative tolerance of the run (the case''s, or what accuracy &
+            &or goal picked)')]
 
   !> The loads of a run (spline_loads::run_loads, docs/model.md section 15), per tooth: their
   !> positions in a run's tooth-load array (ilt_*) and the table.

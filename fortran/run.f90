@@ -12,7 +12,10 @@ module spline_run
   use spline_solver, only: integrate
   use spline_quantities, only: nsolver_stats, nstats, ntooth_q, iq_tf, tooth_q, state_q, &
        ist_core_wall, ist_dof, ist_thermal_level, ist_eps_lateral, ist_eps_thermal, ist_closed, &
-       ist_closed_t, ist_roots_found
+       ist_closed_t, ist_roots_found, ist_f_error, ist_f_error_t, ist_f_parted_t, ist_rtol_used, &
+       ist_linear_tail_t
+  use spline_accuracy, only: force_error, check_factor, max_tighten
+  use spline_case_text, only: num
   use spline_fidelity, only: auto_level, auto_tol, backlash_estimate
   use spline_sections, only: section_count, section_times
   use spline_lyapunov, only: lyapunov_benettin, lyapunov_tangent
@@ -68,22 +71,25 @@ contains
     integer, intent(out), optional :: nq
     real(wp), intent(out), optional :: consts(ntooth_q - 4)
     type(model_t) :: run
-    real(wp) :: eps_lat, eps_th, closed, t_closed, cq(ntooth_q - 4)
+    real(wp) :: eps_lat, eps_th, closed, t_closed, cq(ntooth_q - 4), est(3)
     integer(8) :: c0, c1, rate
-    integer :: nw
+    integer :: nw, i
     logical :: fin
     call system_clock(c0, rate)
     call auto_level(m, run, eps_lat, eps_th)
-    call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-         face, tilt, present(nq), nw, cq, fin)
-    if (ierr == err_ok .and. m%auto .and. m%thermal == thermal_coupled .and. nw >= iq_tf) then
-      eps_th = backlash_estimate(m, maxval(abs(tooth(:, :, iq_tf))))
-      if (eps_th > auto_tol(m)) then
-        call set_thermal_level(run, thermal_coupled)
-        call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-             face, tilt, present(nq), nw, cq, fin)
-      end if
-    end if
+    call run_once()
+    ! the error estimate (accuracy or check): a run with an accuracy target whose estimate misses
+    ! it, or parts from the tighter run, runs again at rtol / check_factor, max_tighten times
+    est = -1.0_wp
+    do i = 0, max_tighten
+      if (ierr /= err_ok .or. .not. m%estimate) exit
+      call estimate_error(run, t, tooth(:, :, 1), stats(ist_linear_tail_t), est, ierr, errmsg, &
+           interruptible)
+      if (ierr /= err_ok .or. m%accuracy == 0.0_wp .or. i == max_tighten .or. &
+           (est(1) <= m%accuracy .and. est(3) < 0.0_wp)) exit
+      run%rtol = run%rtol/check_factor; run%atol = run%atol/check_factor
+      call run_once()
+    end do
     if (present(nq)) then
       nq = nw; consts = cq
     end if
@@ -106,7 +112,59 @@ contains
     stats(ist_eps_thermal) = eps_th
     stats(ist_closed) = closed
     stats(ist_closed_t) = t_closed
+    stats(ist_f_error:ist_f_parted_t) = est
+    stats(ist_rtol_used) = run%rtol
+  contains
+    !> The run at run's level (a coupled case with fidelity = 'auto': one-way first, coupled if
+    !> its flash temperature's estimate exceeds auto_tol).
+    subroutine run_once()
+    call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
+         face, tilt, present(nq), nw, cq, fin)
+    if (ierr == err_ok .and. m%auto .and. m%thermal == thermal_coupled .and. nw >= iq_tf) then
+      eps_th = backlash_estimate(m, maxval(abs(tooth(:, :, iq_tf))))
+      if (eps_th > auto_tol(m)) then
+        call set_thermal_level(run, thermal_coupled)
+        call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
+             face, tilt, present(nq), nw, cq, fin)
+      end if
+    end if
+    end subroutine run_once
   end subroutine run_case
+
+  !> The error estimate of a run of m with tooth forces f at the outputs t (docs/accuracy.md):
+  !> m at rtol and atol / check_factor over the outputs up to the first after the run's linear
+  !> tail began (tail_t; beyond it the closed form carries the error it started from), its forces
+  !> compared by spline_accuracy's force_error. est = (F_error_est, F_error_t_s, F_parted_t_s) of
+  !> spline_quantities (-1: none).
+  subroutine estimate_error(m, t, f, tail_t, est, ierr, errmsg, interruptible)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t(:), f(:, :), tail_t
+    real(wp), intent(out) :: est(3)
+    integer, intent(out) :: ierr
+    character(len=*), intent(inout) :: errmsg
+    logical, intent(in), optional :: interruptible
+    type(model_t) :: b
+    real(wp), allocatable :: tb(:), yb(:, :), fb(:, :, :), tmb(:)
+    real(wp) :: stb(nstats), cq(ntooth_q - 4)
+    integer :: n, k, nw
+    logical :: fin, part
+    n = size(t)
+    if (tail_t > t(1)) n = min(n, count(t <= tail_t) + 1)
+    b = m
+    b%rtol = m%rtol/check_factor; b%atol = m%atol/check_factor
+    b%lyapunov = .false.; b%t_end = t(n); b%n_out = n
+    allocate(tb(n), yb(nstate, n), fb(n, m%z, ntooth_q), tmb(n))
+    call run_level(b, tb, yb, fb, tmb, stb, ierr, errmsg, interruptible, lazy=.true., nw=nw, &
+         consts=cq, fin=fin)
+    est = -1.0_wp
+    if (ierr /= err_ok) then
+      errmsg = 'the error estimate''s tighter run: '//errmsg; return
+    end if
+    call force_error(n, f(1:n, :), fb(:, :, 1), est(1), k, part)
+    if (k > 0) est(2) = t(k)
+    if (k == 0) est(1) = -1.0_wp
+    if (part) est(3) = t(k + 1)
+  end subroutine estimate_error
 
   !> The checks of a finished run: no output may be NaN or infinite (ierr = err_solver with a
   !> message naming the quantity, the tooth or state, and the time: the model left its range,
@@ -223,7 +281,7 @@ contains
     real(wp), intent(in) :: stats(nstats)
     character(len=:), allocatable :: text
     character(len=32) :: buf
-    text = restart_warning(m, stats)
+    text = restart_warning(m, stats)//accuracy_warning(m, stats)
     if (stats(ist_closed) > 0.0_wp) then
       write(buf, '(es12.5)') stats(ist_closed_t)
       text = text//'case '//trim(m%name)//': the one-way flash temperature closes the backlash '// &
@@ -232,6 +290,32 @@ contains
            'physical there (thermal = ''coupled'' stops at the interference)'//new_line('a')
     end if
   end function run_warnings
+
+  !> The warnings of accuracy and goal (docs/accuracy.md): a Lyapunov exponent asked with
+  !> goal = 'statistics' (its settings bias it); an estimate above the case's accuracy (after
+  !> max_tighten tightenings); a tighter run that parts from the run (chaos, or impacts the run
+  !> misses: its trajectory beyond is not resolved at these settings).
+  function accuracy_warning(m, stats) result(text)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: stats(nstats)
+    character(len=:), allocatable :: text
+    text = ''
+    if (m%goal_statistics .and. m%lyapunov) text = 'case '//trim(m%name)//': goal = '// &
+         '''statistics'' with lyapunov = .true.: the exponent is not one of the statistics its '// &
+         'settings keep (chaos_z24 read 1152 against 965 1/s, docs/accuracy.md); goal = '// &
+         '''trajectory'' for the exponent?'//new_line('a')
+    if (.not. m%estimate) return
+    if (m%accuracy > 0.0_wp .and. stats(ist_f_error) > m%accuracy) text = 'case '// &
+         trim(m%name)//': the estimated error of the tooth forces F_error_est = '// &
+         num(stats(ist_f_error))//' exceeds accuracy = '//num(m%accuracy)//' at rtol '// &
+         num(stats(ist_rtol_used))//' (tightened '//itoa(max_tighten)//' times)'//new_line('a')
+    if (stats(ist_f_parted_t) >= 0.0_wp) text = text//'case '//trim(m%name)//': a run at rtol '// &
+         num(stats(ist_rtol_used)/check_factor)//' parts from this one at t = '// &
+         num(stats(ist_f_parted_t))//' s (the tooth forces differ by over a tenth of the '// &
+         'largest): beyond it the trajectory is not predictable at these settings (chaos? read '// &
+         'its statistics: goal = ''statistics''); F_error_est covers the outputs before'// &
+         new_line('a')
+  end function accuracy_warning
 
   !> CVODE (method adams or bdf) restarts at order 1 after every contact switch it locates
   !> (spline_erk::cvode_restart). Above restart_rtol that falsified a rattling drive: chaos_z24

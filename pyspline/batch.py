@@ -16,15 +16,16 @@ has no Tm_spectrum.
 from __future__ import annotations
 
 import datetime
+import hashlib
 import re
-import tempfile
+import warnings
 from pathlib import Path
 
 import numpy as np
 
-from .case import defaults, load_case
+from .case import case_from_text, defaults
 from .dataset import MERGED, build_dataset, write_netcdf
-from .errors import BY_NAME, CaseError, SplineError
+from .errors import BY_NAME, CaseError, SplineError, SplineWarning
 from .sweep import (SWEEP_LOADS, _stat_names, _template, _version, lyapunov_summary,
                     point_hash, section_summary)
 
@@ -39,10 +40,32 @@ def _unquote(text: str) -> str:
     return text.replace("''", "'").replace("\\n", "\n")
 
 
+def _check_values(path, values: dict, z: int) -> None:
+    """Every array of a finished run's summary that merge reads has its shape (one value per
+    statistic, load and run value, Z per tooth, a section's and a Benettin record's arrays alike
+    long) and is finite (the loads may be NaN where the core gives none: a standard error of
+    fewer than 2 revolutions)."""
+    sizes = {"stats": 1, "run": 1, "loads": 1, "tooth_loads": z,
+             "section": len(values.get("section.t", ())),
+             "lyapunov": len(values.get("lyapunov.t", ()))}
+    for name, x in values.items():
+        group = name.split(".")[0]
+        want = sizes.get(group)
+        if want is None:                 # a line merge does not read
+            continue
+        if x.size != want:
+            raise CaseError(f"summary {path}: {name} has {x.size} values, {want} expected")
+        bad = np.isinf(x) if group in ("loads", "tooth_loads") else ~np.isfinite(x)
+        if bad.any():
+            raise CaseError(f"summary {path}: {name} = {float(x[bad][0])} is not finite")
+
+
 def read_summary(path) -> dict:
     """A summary file of spline-dyn: {'values': {name: float array}, 'units': {name: unit},
-    'case': the Case of the run (its namelist read by the core's reader), 'case_file',
-    'error' ('' if the run finished), 'error_class' ('' or the exception class name)}."""
+    'case': the Case of the run (its namelist read in memory by the core's reader; None if a
+    failed run wrote none), 'case_file', 'sets' (its --set options), 'error' ('' if the run
+    finished), 'error_class' ('' or the exception class name), 'path'}. Every error names
+    the file."""
     path = Path(path)
     try:
         lines = path.read_text(encoding="utf-8").splitlines()
@@ -50,7 +73,8 @@ def read_summary(path) -> dict:
         raise CaseError(f"summary {path}: cannot read it: {exc}") from None
     if f"format = '{FORMAT}'" not in lines[:5]:
         raise CaseError(f"summary {path}: not a summary of spline-dyn --summary ({FORMAT})")
-    values, units, text = {}, {}, {}
+    values, units, text, sets = {}, {}, {}, []
+    case_text = ""
     for k, line in enumerate(lines):
         if line.startswith("&"):
             case_text = "\n".join(lines[k:]) + "\n"
@@ -71,20 +95,30 @@ def read_summary(path) -> dict:
         if not m:
             raise CaseError(f"summary {path}, line {k + 1}: neither NAME [UNIT] = VALUES nor "
                             f"NAME = 'TEXT': {line[:60]!r}")
-        text[m.group(1)] = _unquote(m.group(2))
-    else:
-        case_text = ""
-    if not case_text:
-        raise CaseError(f"summary {path}: no case (&spline_case) at its end")
-    with tempfile.TemporaryDirectory() as tmp:     # the core's reader reads files
-        nml = Path(tmp) / "case.nml"
-        nml.write_text(case_text, encoding="utf-8")
-        case = load_case(nml)
-    case.source = text.get("case_file")
+        if m.group(1) == "set":
+            sets.append(_unquote(m.group(2)))
+        else:
+            text[m.group(1)] = _unquote(m.group(2))
     kind = text.get("error_kind", "")
+    error = text.get("error", "")
+    if kind and not error or error and kind not in BY_NAME:
+        raise CaseError(f"summary {path}: an error needs its message and one of the kinds "
+                        f"{', '.join(BY_NAME)} (error_kind = {kind!r})")
+    if not case_text and not error:
+        raise CaseError(f"summary {path}: no case (&spline_case) at its end")
+    case = None
+    if case_text:
+        try:
+            case = case_from_text(case_text, source=text.get("case_file"))
+            if not error:
+                case.model                   # a finished run's case is a valid one
+        except SplineError as exc:
+            raise CaseError(f"summary {path}: its case: {exc}") from None
+    if not error:
+        _check_values(path, values, case["z"])
     return dict(values=values, units=units, case=case, case_file=text.get("case_file", ""),
-                error=text.get("error", ""),
-                error_class=BY_NAME.get(kind, SplineError).__name__ if kind else "")
+                sets=sets, error=error, path=path,
+                error_class=BY_NAME[kind].__name__ if kind else "")
 
 
 def summary_point(summary: dict, options: dict) -> dict:
@@ -96,12 +130,15 @@ def summary_point(summary: dict, options: dict) -> dict:
     v = summary["values"]
 
     def one(name):
+        if name not in v:
+            raise CaseError(f"summary {summary['path']}: no {name} (a run that finished "
+                            "writes it)")
         return float(v[name][0])
 
     if options["section"] != "none":
-        section_summary(s, summary["case"], v["section.t"], v["section.D2"], v["section.vD2"],
-                        (one("run.D2_rms"), one("run.vD2_rms")))
-    if options["lyapunov"] and len(v["lyapunov.t"]):
+        section_summary(s, summary["case"], v.get("section.t", []), v.get("section.D2", []),
+                        v.get("section.vD2", []), (one("run.D2_rms"), one("run.vD2_rms")))
+    if options["lyapunov"] and len(v.get("lyapunov.t", ())):
         lt, lg = v["lyapunov.t"], v["lyapunov.log_growth"]
         t0 = one("run.t_first")
         lyapunov_summary(s, lt, lg, float(lg[-1] / (lt - t0)[-1]), t0)
@@ -121,7 +158,27 @@ def _scalar(x):
     return tuple(x) if isinstance(x, list) else x
 
 
-def merge(summaries, out=None, fields=None, command=None):
+def _column(values: list) -> np.ndarray:
+    """A coordinate along 'point' of values with gaps (None: a point without a case): numbers
+    with NaN, else text with ''."""
+    known = [v for v in values if v is not None]
+    if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in known):
+        return np.array([np.nan if v is None else v for v in values], dtype=float)
+    return np.array(["" if v is None else str(v) for v in values])
+
+
+def _recorded_once(caught: list, n: int) -> None:
+    """The warnings caught over n summaries, each distinct one once, with its count."""
+    counts: dict = {}
+    for w in caught:
+        key = (str(w.message), w.category)
+        counts[key] = counts.get(key, 0) + 1
+    for (msg, category), k in counts.items():
+        warnings.warn(category(f"{msg} ({k} of {n} summaries)" if n > 1 else msg),
+                      stacklevel=3)
+
+
+def merge(summaries, out=None, fields=None, command=None, mixed=False):
     """The sweep dataset of spline-dyn summary files (paths; `pyspline merge`), the same Dataset
     `pyspline.sweep` builds for the same points, without the spectrum of T_m.
 
@@ -131,48 +188,79 @@ def merge(summaries, out=None, fields=None, command=None):
         for ascending values); else dim 'point' (the summaries in the order given) with the
         fields as coordinates along it, like a design table.
     out : directory for DIR/sweep.nc (NetCDF-4), or None.
-    The points' section (shaft, tooth, none) and lyapunov must be the same in all summaries.
+    mixed : merge summaries of different cases (case names); refused by default.
+    A failed run is a failed point (error, error_class); one whose case was not read (its
+    file or a --set was refused) has no coordinates: the merge is then along 'point', its
+    coordinates NaN (''). The same point twice (by point hash) is refused. The points'
+    section and lyapunov must be the same in all summaries. The variable 'summary' names each
+    point's file. A plausibility warning of the cases is given once, with its count.
     """
     paths = [Path(p) for p in summaries]
     if not paths:
         raise CaseError("merge needs at least one summary file")
-    read = [read_summary(p) for p in paths]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", SplineWarning)
+        read = [read_summary(p) for p in paths]
+    _recorded_once([w for w in caught if issubclass(w.category, SplineWarning)], len(paths))
+    for w in caught:
+        if not issubclass(w.category, SplineWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     cases = [r["case"] for r in read]
+    have = [c for c in cases if c is not None]
+    names = sorted({c.name for c in have})
+    if len(names) > 1 and not mixed:
+        raise CaseError(f"the summaries are of {len(names)} cases ({', '.join(names[:4])}"
+                        f"{', ...' if len(names) > 4 else ''}): merge one case's points, or "
+                        "ask for it (--mixed, mixed=True)")
     options = {}
-    for key in ("section", "lyapunov"):
-        vals = {c[key] for c in cases}
+    for key, default in (("section", "shaft"), ("lyapunov", False)):
+        vals = {c[key] for c in have} or {default}
         if len(vals) > 1:
             raise CaseError(f"the summaries mix {key} = {', '.join(map(str, sorted(vals)))}: "
                             "merge points of one kind")
         options[key] = vals.pop()
     options["orders"] = None
     if fields is None:
-        fields = [f for f in defaults() if f != "name" and
-                  len({_scalar(c[f]) for c in cases}) > 1]
+        fields = [f for f in defaults() if (f != "name" or mixed) and
+                  len({_scalar(c[f]) for c in have}) > 1]
     else:
         fields = [f.strip().lower() for f in fields]
         for f in fields:
             if f not in defaults():
                 raise CaseError(f"unknown field '{f}' (see cases/template.nml)")
     for f in fields:
-        if isinstance(cases[0][f], list):
+        if have and isinstance(have[0][f], list):
             raise CaseError(f"field {f} differs between the summaries but has several values: "
                             "it cannot be a coordinate")
-    columns = {f: [c[f] for c in cases] for f in fields}
-    uniq = {f: sorted(set(v)) for f, v in columns.items()}
-    index_of = [tuple(uniq[f].index(c[f]) for f in fields) for c in cases]
+    columns = {f: [None if c is None else c[f] for c in cases] for f in fields}
+    hashes_of = [point_hash(c, options) if c is not None else
+                 hashlib.sha256(repr((r["case_file"], r["sets"])).encode()).hexdigest()[:16]
+                 for c, r in zip(cases, read)]
+    first: dict = {}
+    for h, p in zip(hashes_of, paths):
+        if h in first:
+            raise CaseError(f"summaries {first[h]} and {p} are the same point (hash {h}): "
+                            "merge each point once")
+        first[h] = p
     point_fields = None
-    if 1 <= len(fields) <= 2 and len(set(index_of)) == len(cases) == \
-            int(np.prod([len(u) for u in uniq.values()])):
+    if len(have) == len(cases):
+        uniq = {f: sorted(set(v)) for f, v in columns.items()}
+        index_of = [tuple(uniq[f].index(c[f]) for f in fields) for c in cases]
+    if len(have) == len(cases) and 1 <= len(fields) <= 2 and len(set(index_of)) == len(cases) \
+            == int(np.prod([len(u) for u in uniq.values()])):
         grid = {f: np.asarray(u) for f, u in uniq.items()}
     else:
         grid = {"point": np.arange(len(cases))}
-        point_fields = {f: np.asarray(v) for f, v in columns.items()}
+        point_fields = {f: _column(v) for f, v in columns.items()}
         index_of = [(i,) for i in range(len(cases))]
     keys = list(_template(options, _stat_names()))
-    points = {i: summary_point(r, options) for i, r in zip(index_of, read)}
-    hashes = {i: point_hash(c, options) for i, c in zip(index_of, cases)}
-    attrs = dict(case=cases[0].text(), pyspline_version=_version(),
+    points = {}
+    with warnings.catch_warnings():     # given once above
+        warnings.simplefilter("ignore", SplineWarning)
+        for i, r in zip(index_of, read):
+            points[i] = summary_point(r, options)
+    hashes = dict(zip(index_of, hashes_of))
+    attrs = dict(case=(have[0].text() if have else ""), pyspline_version=_version(),
                  command=command or f"pyspline.merge([{len(paths)} spline-dyn summaries])",
                  swept=" ".join(fields), section=options["section"],
                  lyapunov=int(options["lyapunov"]),
@@ -181,6 +269,10 @@ def merge(summaries, out=None, fields=None, command=None):
                  n_reused=0, out="" if out is None else str(out), n_computed=len(paths),
                  n_executor_errors=0, source="spline-dyn --summary")
     ds = build_dataset(grid, keys, points, hashes, options, attrs, point_fields)
+    files = np.full(tuple(len(v) for v in grid.values()), "", dtype=object)
+    for i, p in zip(index_of, paths):
+        files[i] = str(p)
+    ds["summary"] = (tuple(grid), files.astype(str), {"long_name": "the point's summary file"})
     if out is not None:
         write_netcdf(ds, Path(out) / MERGED)
     return ds
@@ -200,16 +292,22 @@ def cmd_merge(args) -> int:
     import shlex
     import sys
     paths = _main_paths(args.summaries)
+    if not paths:
+        raise CaseError(f"merge: no summary in {', '.join(args.summaries)} (a directory stands "
+                        "for its *.summary files)")
     fields = [f for f in (args.fields or "").split(",") if f.strip()] or None
     cmd = " ".join(shlex.quote(a) for a in ["pyspline", "merge", *args.summaries,
                                             f"--out={args.out}"])
-    ds = merge(paths, out=args.out, fields=fields, command=cmd)
+    ds = merge(paths, out=args.out, fields=fields, command=cmd, mixed=args.mixed)
     a = ds.attrs
     print(f"{a['n_points']} points from {len(paths)} summaries ({a['swept'] or 'no field'} "
           f"varying): {a['n_ok']} ran, {a['n_failed']} failed")
     if a["n_failed"]:
-        errors = [e for e in ds["error"].values.ravel() if e]
-        print(f"first error: {errors[0]}", file=sys.stderr)
+        failed = ds["error"].values.ravel() != ""
+        k = int(np.argmax(failed))
+        print(f"first error ({ds['summary'].values.ravel()[k]}): "
+              f"{ds['error_class'].values.ravel()[k]}: {ds['error'].values.ravel()[k]}",
+              file=sys.stderr)
     print(f"wrote {Path(args.out) / MERGED} (pyspline.open_sweep)")
     return 0
 
@@ -220,7 +318,9 @@ array task) into the sweep dataset DIR/sweep.nc, the one `pyspline sweep` writes
 points (without the spectrum of T_m, which needs the time series). The fields that differ
 between the runs' cases are the coordinates: one or two fields forming a full grid become its
 dims; anything else a dim 'point' with the fields as coordinates. A directory argument stands
-for every *.summary file in it.
+for every *.summary file in it. A failed run is a failed point (error, error_class; variable
+'summary' names each point's file); the same point twice, or summaries of different cases
+(unless --mixed), are refused; a plausibility warning is printed once, with its count.
 
 example: pyspline merge runs/*.summary --out out/lx
 """
@@ -236,4 +336,6 @@ def add_merge(sub) -> None:
     r.add_argument("--out", required=True, metavar="DIR", help="output directory")
     r.add_argument("--fields", metavar="F1,F2",
                    help="the varying fields (default: those that differ between the cases)")
+    r.add_argument("--mixed", action="store_true",
+                   help="merge summaries of different cases (refused by default)")
     r.set_defaults(func=cmd_merge)

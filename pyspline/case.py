@@ -273,6 +273,17 @@ def _coerce(label, key, value, default):
                         "number (1.8e308)") from None
 
 
+def case_from_text(text: str, source: str | None = None) -> Case:
+    """A case from namelist text held in memory, read by the core's reader (api_read_text) but
+    neither validated nor built (``.model`` does both); CaseError with the reader's message."""
+    rows, nv, nc = _layout()
+    values, chars, ierr, msg = _api.api_read_text(text.encode("utf-8"), nv, nc)
+    if ierr:
+        raise CaseError(decode(msg))
+    fields = _fields_of(values, chars)[0]
+    return Case(fields, source=source)
+
+
 def load_case(source, **overrides) -> Case:
     """Read a case: a namelist file path (group &spline_case), a dict of fields, or a Case.
     Keyword overrides replace fields. Any bad input raises CaseError naming the case (for a

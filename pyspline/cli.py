@@ -65,12 +65,30 @@ def _summary(res, warned: int | None = None) -> str:
         f"{100 * ld['stress_ratio']:.0f} % of the typical allowable (docs/model.md section 15)",
         f"  trust:  {ld['revolutions']:.1f} revolutions; T_m RMS "
         f"{_pm(float(np.sqrt(np.mean(res.Tm ** 2))), ld['Tm_rms_se'], '.4g')} N m"
-        + ("" if ld["batches"] >= 2 else " (no standard errors: fewer than 2 whole revolutions)")]
+        + ("" if ld["batches"] >= 2 else " (no standard errors: fewer than 2 whole revolutions)")
+        + _accuracy_note(res)]
     if warned is not None:
         lines.append("  input:  " + ("no plausibility warning" if not warned else
                                      f"{warned} plausibility warning{'s' * (warned > 1)} "
                                      "(the warning: lines)"))
     return "\n".join(lines)
+
+
+def _accuracy_note(res) -> str:
+    """The trust line's words on the numerical error (docs/accuracy.md): the error estimate of
+    the tooth forces against a tighter run, or the statistics goal's settings."""
+    s = res.stats
+    if res.case["goal"] == "statistics":
+        return (f"; goal statistics: ERK without root finding at rtol {s['rtol_used']:.0e}, "
+                "statistics unbiased (chaos_z24), the trajectory not resolved")
+    if s["F_error_est"] < 0 and s["F_parted_t_s"] < 0:
+        return ""
+    note = (f"; F error est {s['F_error_est']:.2g} up to t = {s['F_error_t_s']:.4g} s"
+            if s["F_error_est"] >= 0 else "; F error not estimated")
+    if s["F_parted_t_s"] >= 0:
+        note += f" (a tighter run parts at t = {s['F_parted_t_s']:.4g} s: chaos?)"
+    acc = res.case["accuracy"]
+    return note + (f" (accuracy {acc:.2g}, rtol {s['rtol_used']:.2g})" if acc > 0 else "")
 
 
 #: exit status of each failure (README, "Errors and exit codes"; spline-dyn's err_exit_code)
@@ -87,6 +105,24 @@ def exit_code(exc: BaseException) -> int:
 def _one_line(exc: BaseException) -> str:
     """An exception as one line: its class and its message, newlines folded."""
     return f"{type(exc).__name__}: {' '.join(str(exc).split())}"
+
+
+def check_out_dir(path, option: str = "--out") -> Path:
+    """An output directory of a command, checked before anything is computed: a directory or a
+    new path under a writable directory; else CaseError naming the path and why (exit 2)."""
+    import os
+    p = Path(path)
+    if p.exists() and not p.is_dir():
+        raise CaseError(f"{option} {p}: exists and is not a directory (an output directory is "
+                        "wanted)")
+    parent = p
+    while not parent.exists():          # the nearest part of the path that exists
+        parent = parent.parent
+    if not parent.is_dir():
+        raise CaseError(f"{option} {p}: cannot be made: {parent} is not a directory")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise CaseError(f"{option} {p}: cannot write there ({parent} is not writable)")
+    return p
 
 
 _RESULT_KEY = "pyspline_case"     #: the member that marks an .npz written by `pyspline run`
@@ -206,10 +242,7 @@ def _foreign_files(out: Path) -> list[str]:
 
 def cmd_reproduce(args) -> int:
     from .paper import reproduce
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        print(f"error: reproduce --out {out}: not a directory", file=sys.stderr)
-        return 2
+    out = Path(args.out)          # a directory or a new path: main's check_out_dir
     foreign = _foreign_files(out)
     if foreign:
         print(f"error: reproduce --out {out}: {', '.join(foreign)} exist(s) and were not written "
@@ -306,12 +339,17 @@ def _assignments(items, what) -> dict:
 
 
 def _fixed(items) -> dict:
-    """--fix FIELD=VALUE pairs -> {field: typed value}."""
+    """--fix FIELD=VALUE pairs -> {field: typed value}; an array field takes a comma list
+    (--fix ripple_amp=0.1,0,0,0; a per-tooth list may be shorter: the first teeth)."""
+    from .case import defaults
     out = {}
     for k, v in _assignments(items, "--fix").items():
         vals = parse_values(k, v)
+        if isinstance(defaults()[k], list):
+            out[k] = vals.tolist()
+            continue
         if len(vals) != 1:
-            raise CaseError(f"--fix {k}={v}: one value expected")
+            raise CaseError(f"--fix {k}={v}: one value expected ({k} is no array field)")
         out[k] = vals[0].item()
     return out
 
@@ -381,7 +419,7 @@ def cmd_sweep(args) -> int:
     print(f"{a['n_points']} points: {a['n_ok']} ran, {a['n_failed']} failed, "
           f"{a['n_missing']} missing; {a['n_computed']} computed now, {a['n_reused']} reused "
           f"from {out / POINTS_DIR}/")
-    if "chaotic" in ds:
+    if "chaotic" in ds and a["n_ok"]:
         n_chaos = int((ds["chaotic"] == 1).sum())
         print(f"{n_chaos} of {a['n_ok']} points chaotic (Lyapunov exponent positive beyond its "
               "spread): read their statistics, sections and spectra, not their trajectories")
@@ -526,7 +564,7 @@ def _add_sweep_and_plot(sub) -> None:
                    help="change a field of the case (e.g. t_end=0.5)")
     r.set_defaults(func=cmd_plot)
     add_merge(sub)
-    from .continuation import add_continue
+    from .contcli import add_continue
     add_continue(sub, _fixed, exit_code)
 
 
@@ -575,6 +613,8 @@ def main(argv=None) -> int:
     with warnings.catch_warnings():
         warnings.showwarning = _show_warning
         try:
+            if getattr(args, "out", None) is not None:    # every command that writes
+                check_out_dir(args.out)
             return args.func(args)
         except KeyboardInterrupt:
             print("interrupted", file=sys.stderr)

@@ -70,6 +70,32 @@ def parse_field(case: Case, field: str) -> tuple[str, int | None]:
     return name, None
 
 
+def check_arguments(case, label, start, stop, n, tol, **positive):
+    """(start, stop, tol) as floats, tol's default 100 rtol; CaseError naming the argument when
+    start or stop is not a finite number or they are equal, n not a whole number >= 1, tol or
+    one of `positive` (ds, ds_min, ds_max, ...) not a finite number > 0, ds_min > ds_max."""
+    def bad(arg, value, why):
+        raise CaseError(f"case {case.name}: continuation in {label}: {arg} = {value!r}: {why}")
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        bad("n", n, "the shaft revolutions of the period must be a whole number >= 1")
+    tol = 100 * case["rtol"] if tol is None else tol
+    out = {}
+    for arg, value in dict(start=start, stop=stop, tol=tol, **positive).items():
+        try:
+            out[arg] = float(value)
+        except (TypeError, ValueError):
+            bad(arg, value, "not a number")
+        if not np.isfinite(out[arg]):
+            bad(arg, value, "must be finite")
+        if arg not in ("start", "stop") and not out[arg] > 0:
+            bad(arg, value, "must be > 0")
+    if out["start"] == out["stop"]:
+        bad("stop", stop, "start and stop must differ")
+    if out.get("ds_min", 0) > out.get("ds_max", np.inf):
+        bad("ds_min", positive["ds_min"], f"greater than ds_max = {positive['ds_max']!r}")
+    return out["start"], out["stop"], out["tol"]
+
+
 def field_label(name: str, index) -> str:
     return name if index is None else f"{name}({index + 1})"
 
@@ -79,13 +105,23 @@ class _Problem:
 
     def __init__(self, case, name, index, n, start, stop, t0, monodromy="exact"):
         self.case, self.name, self.index, self.n = case, name, index, n
-        self.monodromy = map_and_monodromy if monodromy == "exact" else fd_monodromy
-        self.p0, self.pscale = float(start), abs(float(stop) - float(start))
+        self.set_monodromy(monodromy)
+        # a tenth of the field's magnitude is one unit of q, as l_ref is of the states: the
+        # scaling and the difference step of dF/dp do not depend on the band's width
+        self.p0, self.pscale = float(start), 0.1 * max(abs(float(start)), abs(float(stop)))
         self.t0 = t0
-        self.models = {}
+        self.models, self.log, self.jumps = {}, [], 0
         self.d0 = _scale(self.model(self.p0))
         self.rtol = case["rtol"]
         self.h = self.rtol ** (1 / 3)
+
+    def set_monodromy(self, monodromy):
+        self.how = monodromy
+        self.monodromy = map_and_monodromy if monodromy == "exact" else fd_monodromy
+
+    def set_method(self, method):
+        """The case's integrator ('adams', 'bdf', 'erk', ...): the models rebuilt."""
+        self.case, self.models = self.case.replace(method=method), {}
 
     def case_at(self, p: float) -> Case:
         if self.index is None:
@@ -95,6 +131,8 @@ class _Problem:
         return self.case.replace(**{self.name: v})
 
     def model(self, p: float):
+        """The loaded case at p; CaseError when p is outside the field's valid range or the
+        forcing does not repeat in the orbit's period there."""
         m = self.models.get(p)
         if m is None:
             if len(self.models) > 8:
@@ -102,7 +140,9 @@ class _Problem:
             with warnings.catch_warnings():     # the case's notes: said once, at the start
                 if self.models or hasattr(self, "d0"):
                     warnings.simplefilter("ignore", SplineWarning)
-                m = self.models[p] = load(self.case_at(p))
+                m = load(self.case_at(p))
+            forcing_periods(m.case, self.n)
+            self.models[p] = m
         return m
 
     def t1(self, p: float, n: int) -> float:
@@ -122,12 +162,19 @@ class _Problem:
         M = d[:, None] * Mp / d[None, :]
         F = (y1 - y)[free] / self.d0[free]
         hp = self.h * max(abs(p), self.pscale)
-        Fq = []
+        Fq = {}
         for pp in (p + hp, p - hp):
-            mm = self.model(pp)
+            try:
+                mm = self.model(pp)
+            except CaseError:       # the field's range ends within hp: one-sided
+                continue
             y1p, _, _ = _map_only(mm, self.t0, self.t1(pp, n), y)
-            Fq.append((y1p - y)[free] / self.d0[free])
-        J = np.c_[M - np.eye(len(M)), (Fq[0] - Fq[1]) / (2 * hp / self.pscale)]
+            Fq[pp] = (y1p - y)[free] / self.d0[free]
+        if not Fq:
+            raise CaseError(f"case {self.case.name}: {self.name} = {p:.6g}: no valid value "
+                            f"within {hp:.3g} of it for the difference dF/d{self.name}")
+        (pa, Fa), (pb, Fb) = (list(Fq.items()) + [(p, F)])[:2]
+        J = np.c_[M - np.eye(len(M)), (Fa - Fb) / ((pa - pb) / self.pscale)]
         return F, J, M, y
 
 
@@ -181,7 +228,8 @@ class _Branch:
         for it in range(self.max_corr + 1):
             try:
                 F, J, M, y = self.prob.evaluate(self.y_fixed, u, self.n)
-            except SolverError as exc:      # a run of the map failed: this step fails
+            except (SolverError, CaseError) as exc:   # a run of the map failed, or the
+                # point is outside the field's valid range: this step fails
                 self.last_hist = hist + [np.nan]
                 self.last_error = str(exc)
                 return None
@@ -233,10 +281,15 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     guess : the orbit's state (14,), SI, at t0 for `start` (default: periodic_orbit's, the end
         of a settled run of the case at `start`).
     ds, ds_min, ds_max : arclength steps in the units of u = (z, q): the section state scaled
-        by Eq. 25 and q the field over |stop - start|. A step whose corrector needs <= 2
-        iterations grows 1.5x, one that needs >= 4 shrinks; a failed one halves; below ds_min:
-        OrbitError saying where and the residual reached. max_angle [rad]: a step whose
-        tangent turns more than twice it is halved; the next step is scaled to turn by about it.
+        by Eq. 25 and q = (p - start) / (max(|start|, |stop|) / 10), the same whatever the
+        band's width. A step whose corrector needs <= 2 iterations grows 1.5x, one that needs
+        >= 4 shrinks; a failed one halves (a run of the map that fails, a point outside the
+        field's valid range or a converged point further from its predictor than the step,
+        i.e. on another branch, fail it); below ds_min the other monodromy, then the other
+        integrator (ERK, or BDF for ERK) are tried (attrs['fallbacks']); when they fail too,
+        the branch so far is returned with attrs['status'] saying where and why, and a
+        SplineWarning. max_angle [rad]: a step whose tangent turns more than twice it is
+        halved; the next step is scaled to turn by about it.
     tol : the corrector's scaled residual max |P^n(y) - y| (default 100 rtol).
     margin : stable means every |mu| < 1 - margin.
     switch : at a period doubling continue the doubled branch (n -> 2n) from it along the
@@ -250,28 +303,40 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     multipliers (mu_real, mu_imag, mu_abs; dim 'multiplier', largest modulus first), stable,
     closest_approach, switches, residual, iterations; dim 'special': type, the field's value,
     branch, the critical multiplier, Tm_pp, F_max, y0. attrs: case, field, start, stop, n,
-    timing."""
+    timing, status ('complete', or where and why it stopped), fallbacks, rejected_jumps (steps
+    whose corrector landed on another branch).
+
+    CaseError naming the argument for bad input: start == stop, a start or stop outside the
+    field's valid range, a non-finite or non-positive ds, ds_min, ds_max, max_angle or tol,
+    ds_min > ds_max, max_points < 1, n not a whole number >= 1. OrbitError when no orbit is
+    found at the start."""
     from tqdm import tqdm
     base = load_case(case)
     name, index = parse_field(base, field)
     label = field_label(name, index)
-    start, stop = float(start), float(stop)
-    if not (np.isfinite(start) and np.isfinite(stop)) or start == stop:
-        raise CaseError(f"case {base.name}: field {label}: start and stop must be finite and "
-                        f"differ, got {start:g}, {stop:g}")
+    start, stop, tol = check_arguments(base, label, start, stop, n, tol, ds=ds, ds_min=ds_min,
+                                       ds_max=ds_max, max_angle=max_angle, margin=margin)
+    for arg, whole, least in (("max_points", max_points, 1), ("max_corrector", max_corrector, 0)):
+        if isinstance(whole, bool) or not isinstance(whole, (int, np.integer)) or whole < least:
+            raise CaseError(f"case {base.name}: continuation in {label}: {arg} = {whole!r}: a "
+                            f"whole number >= {least}")
     if monodromy not in ("exact", "fd"):
         raise CaseError(f"case {base.name}: monodromy = {monodromy!r}: 'exact' (variational "
                         "equations) or 'fd' (central differences of the map)")
     wall0 = time.perf_counter()
     t0 = float(base["t0"])
     prob = _Problem(base, name, index, n, start, stop, t0, monodromy)
+    for arg, value in (("stop", stop), ("start", start)):
+        try:
+            prob.model(value)
+        except CaseError as exc:
+            raise CaseError(f"continuation in {label}: {arg} = {value:g} is not a valid value "
+                            f"of {label}: {exc}") from None
     c0 = prob.case_at(start)
-    forcing_periods(c0, n)
-    tol = 100 * base["rtol"] if tol is None else float(tol)
     orbit = periodic_orbit(c0, n=n, guess=guess, tol=tol, monodromy=monodromy)
     prob.free = _map_only(prob.model(start), t0, prob.t1(start, n), orbit.y0)[2]
     k = int(prob.free.sum())
-    branches, specials = [], []
+    branches, specials, status = [], [], "complete"
     bar = tqdm(total=max_points, desc=f"continue {label}", unit="point", disable=not progress,
                dynamic_ncols=True)
     try:
@@ -280,8 +345,12 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
         while todo and sum(len(b) for b in branches) < max_points:
             nb, u_start, tau0, y_fixed = todo.pop(0)
             br = _Branch(prob, nb, y_fixed, tol, max_corrector)
-            pts = _follow(br, u_start, tau0, np.sign(stop - start), ds, ds_min, ds_max, max_angle,
-                          max_points - sum(len(b) for b in branches), len(branches), bar)
+            pts, why = _follow(br, u_start, tau0, (stop - start) / prob.pscale, ds, ds_min,
+                               ds_max, max_angle, max_points - sum(len(b) for b in branches),
+                               len(branches), bar)
+            _use(prob, monodromy, base["method"])
+            if why != "complete" and status == "complete":
+                status = why
             branches.append(pts)
             if detect:
                 for a, b in zip(pts, pts[1:]):
@@ -294,8 +363,12 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     finally:
         bar.close()
     wall = time.perf_counter() - wall0
+    if status != "complete":
+        warnings.warn(f"{status}: the branch so far is returned ({sum(map(len, branches))} "
+                      "points; attrs['status'])", SplineWarning, stacklevel=2)
     return continuation_dataset(base, prob, label, branches, specials, margin, k, dict(
-        start=start, stop=stop, n=n, tol=tol, wall_s=wall, monodromy=monodromy,
+        start=start, stop=stop, n=n, tol=tol, wall_s=wall, monodromy=monodromy, status=status,
+        fallbacks="; ".join(prob.log) or "none", rejected_jumps=prob.jumps,
         command=command or f"pyspline.continuation({base.name!r}, {label!r}, {start:g}, "
                            f"{stop:g}, n={n})"))
 
@@ -309,9 +382,12 @@ def _doubled_start(sp, nb, y_fixed):
     return (2 * nb, sp["u"], tau, y_fixed)
 
 
-def _follow(br, u0, tau0, direction, ds, ds_min, ds_max, max_angle, max_points, ibranch, bar):
-    """The points of one branch from u0: predictor-corrector until the field leaves
-    [start, stop] (the last point put on its end), max_points, or a failure below ds_min."""
+def _follow(br, u0, tau0, q_end, ds, ds_min, ds_max, max_angle, max_points, ibranch, bar):
+    """The points of one branch from u0 and what ended it: predictor-corrector until q leaves
+    [0, q_end] (the last point put on its end: 'complete'), max_points, or a step that fails
+    below ds_min with every fallback (the other monodromy, then the other integrator): a
+    sentence saying where and why. A converged point further from its predictor than the step
+    itself is a jump to another branch: a rejected step."""
     prob = br.prob
     k = len(u0)
     e_q = np.eye(k)[-1]
@@ -320,7 +396,7 @@ def _follow(br, u0, tau0, direction, ds, ds_min, ds_max, max_angle, max_points, 
         if first is None:
             _fail(br, u0, ds, "at the start")
         u, F, J, M, y, it, hist = first
-        tau0 = direction * e_q
+        tau0 = np.sign(q_end) * e_q
         pts = [br.point(u, J, M, y, it, hist, tau0)]
         tau = pts[0]["tau"]
     else:                             # a doubled branch: off the point along tau0
@@ -330,12 +406,14 @@ def _follow(br, u0, tau0, direction, ds, ds_min, ds_max, max_angle, max_points, 
             warnings.warn(f"case {prob.case.name}: no period-{br.n} branch found next to the "
                           f"period doubling at {prob.name} = {prob.p_of(u0[-1]):.6g}",
                           SplineWarning, stacklevel=3)
-            return []
+            return [], "complete"
         u, F, J, M, y, it, hist = res
         pts = [br.point(u, J, M, y, it, hist, tau)]
         tau = pts[0]["tau"]
     bar.update(1)
-    lo, hi = min(0.0, np.sign(direction)), max(0.0, np.sign(direction))   # q in [0, 1]
+    lo, hi = min(0.0, q_end), max(0.0, q_end)
+    fallbacks = _fallbacks(prob)
+    primary, on_fallback = (prob.how, prob.case["method"]), 0
     while len(pts) < max_points:
         a = pts[-1]
         pred = a["u"] + ds * a["tau"]
@@ -346,10 +424,20 @@ def _follow(br, u0, tau0, direction, ds, ds_min, ds_max, max_angle, max_points, 
                 if abs(a["tau"][-1]) > 1e-3 else None
         else:
             res = br.correct(pred, a["tau"], a["tau"] @ pred)
+        if res is not None and end is None and np.linalg.norm(res[0] - pred) > ds:
+            br.last_hist, br.last_error = res[6], (
+                f"the corrector went {np.linalg.norm(res[0] - pred):.3g} from a predictor "
+                f"{ds:.3g} along the branch (another branch)")
+            res, prob.jumps = None, prob.jumps + 1
         if res is None:
             ds /= 2
             if ds < ds_min:
-                _fail(br, pred, ds, f"after point {len(pts)} of branch {ibranch}")
+                if not fallbacks:
+                    return pts, _where(br, pred, ds, f"after point {len(pts)} of branch {ibranch}")
+                _use(prob, *fallbacks.pop(0))
+                prob.log.append(f"{prob.name} = {a['p']:.6g}: {prob.how} monodromy, method "
+                                f"{prob.case['method']} ({getattr(br, 'last_error', '')})")
+                ds, on_fallback = min(ds_max, 64 * ds_min), 5
             continue
         u, F, J, M, y, it, hist = res
         new = br.point(u, J, M, y, it, hist, a["tau"])
@@ -360,10 +448,29 @@ def _follow(br, u0, tau0, direction, ds, ds_min, ds_max, max_angle, max_points, 
         pts.append(new)
         bar.update(1)
         if end is not None:
-            break
+            return pts, "complete"
+        if on_fallback:                 # a few points on the fallback, then the primary again
+            on_fallback -= 1
+            if not on_fallback:
+                _use(prob, *primary)
+                fallbacks = _fallbacks(prob)
         grow = 1.5 if it <= 2 else (0.6 if it >= 4 else 1.0)
         ds = max(ds_min, min(ds_max, ds * grow, ds * max_angle / max(angle, 1e-12)))
-    return pts
+    return pts, f"max_points = {max_points} reached at {prob.name} = {pts[-1]['p']:.6g}"
+
+
+def _fallbacks(prob):
+    """What a failed step tries next: the other monodromy, then the other integrator (ERK for
+    a CVODE method, BDF for ERK) with each monodromy."""
+    other = "fd" if prob.how == "exact" else "exact"
+    method = "bdf" if prob.case["method"] == "erk" else "erk"
+    return [(other, prob.case["method"]), (prob.how, method), (other, method)]
+
+
+def _use(prob, monodromy, method):
+    prob.set_monodromy(monodromy)
+    if method != prob.case["method"]:
+        prob.set_method(method)
 
 
 def _new_orbit(br, y, u):
@@ -375,16 +482,20 @@ def _new_orbit(br, y, u):
 
 
 def _fail(br, u, ds, where):
+    raise OrbitError(_where(br, u, ds, where) + ". Try a smaller ds or ds_min, a looser tol, or "
+                     "a range that stops short of it")
+
+
+def _where(br, u, ds, where):
+    """Where and why the corrector failed: the field's value, the residuals, the last error."""
     prob = br.prob
-    hist = getattr(br, "last_hist", [np.nan])
-    raise OrbitError(
+    hist = getattr(br, "last_hist", None) or [np.nan]
+    return (
         f"case {prob.case.name}: continuation in {prob.name}: the corrector did not converge "
         f"{where}, near {prob.name} = {prob.p_of(u[-1]):.6g} (period-{br.n} orbit), with the "
         f"arclength step down to {ds:.3g}: scaled residual {hist[-1]:.3g} (wanted "
         f"{br.tol:.3g}), history {', '.join(f'{v:.2g}' for v in hist)}"
-        + (f" (last failure: {br.last_error})" if getattr(br, "last_error", "") else "")
-        + ". Try a smaller ds or "
-        "ds_min, a looser tol, or a range that stops short of it")
+        + (f" (last failure: {br.last_error})" if getattr(br, "last_error", "") else ""))
 
 
 # --------------------------------------------------------------------------- special points
@@ -573,103 +684,3 @@ def _smooth(sp) -> bool:
 def _version():
     from . import __version__
     return __version__
-
-
-# --------------------------------------------------------------------------- command line
-
-CONTINUE_HELP = """\
-Follow the period-n orbit of CASE in one real field from --start to --stop by pseudo-arclength
-continuation, through stable and unstable parts; locate folds (a multiplier through +1),
-period doublings (through -1; the doubled branch is followed too), Neimark-Sacker points (a
-complex pair through the unit circle) and grazing (a tooth's contact sequence changes).
-
-Writes into --out DIR:
-  DIR/continuation.nc          the branch points and special points (xarray.open_dataset(
-                               path, engine='h5netcdf'); docs/continuation.md)
-  DIR/frequency_response.png   --measure (T_m peak-to-peak) against the field: stable solid,
-                               unstable dashed, special points marked; with --sweep N the
-                               runs of a follow-up and follow-down sweep of N points over it
-  DIR/sweep.nc                 with --sweep N: that sweep
-Prints one line per special point. Exit status: README's (CaseError 2, SolverError 3; a
-corrector that fails, OrbitError: 1).
-
-example: pyspline continue cases/physical_ripple.nml --field speed_rpm --start 5000 --stop 7000
-"""
-
-
-def cmd_continue(args, fixed, exit_code) -> int:
-    import sys
-    from pathlib import Path
-    from .dataset import write_netcdf
-    from .errors import SplineError
-    from .frplots import MEASURES, frequency_response
-    out = Path(args.out)
-    try:
-        case = load_case(args.case, **fixed(args.fix))
-        command = " ".join(["pyspline", "continue", args.case, f"--field={args.field}",
-                            f"--start={args.start:g}", f"--stop={args.stop:g}", f"--n={args.n}"])
-        ds = continuation(case, args.field, args.start, args.stop, n=args.n, ds=args.ds,
-                          max_points=args.max_points, tol=args.tol, progress=not args.quiet,
-                          command=command)
-        sw = None
-        if args.sweep:
-            from .sweep import sweep
-            name, index = parse_field(case, args.field)
-            if index is not None:
-                raise CaseError(f"--sweep: a follow sweep runs whole fields; {args.field} is "
-                                "one element of an array field")
-            sw = sweep(case, progress=not args.quiet, follow="both", spectrum=False,
-                       **{name: np.linspace(args.start, args.stop, args.sweep)})
-    except SplineError as exc:
-        print(f"error: {type(exc).__name__}: {' '.join(str(exc).split())}", file=sys.stderr)
-        return exit_code(exc)
-    write_netcdf(ds, out / "continuation.nc")
-    label = ds.attrs["field"]
-    print(f"{ds.attrs['n_points']} points on {ds.attrs['n_branches']} branch(es), "
-          f"{int(ds.stable.sum())} stable, in {ds.attrs['wall_s']:.1f} s")
-    for i in range(ds.sizes["special"]):
-        kind = str(ds.special_type.values[i])
-        mu = complex(ds.special_mu_real[i], ds.special_mu_imag[i])
-        what = (f"closest approach {float(ds.special_closest_approach[i]):.3g} m" if kind ==
-                "grazing" else f"critical multiplier {mu:.4f}")
-        print(f"{kind:16s} {label} = {float(ds[f'special_{label}'][i]):.6g}  period "
-              f"{int(ds.special_n[i])}  {what}  {MEASURES['Tm_pp'][0]} "
-              f"{float(ds.special_Tm_pp[i]):.4g} N m"
-              + ("" if ds.special_smooth[i] else "  (non-smooth: the multiplier jumped across)"))
-    print(f"wrote {out / 'continuation.nc'}")
-    if sw is not None:
-        write_netcdf(sw, out / "sweep.nc")
-        print(f"wrote {out / 'sweep.nc'}")
-    path = out / "frequency_response.png"
-    frequency_response(ds, args.measure, sweep=sw, path=path,
-                       title=f"{case.name}: {MEASURES[args.measure][0]} of the periodic orbits "
-                             f"vs {label}" + (", follow sweeps up and down" if sw else ""))
-    print(f"wrote {path}")
-    return 0
-
-
-def add_continue(sub, fixed, exit_code) -> None:
-    """The `continue` subcommand (pyspline/cli.py)."""
-    import argparse
-    r = sub.add_parser("continue", help="follow a periodic orbit in one field (pseudo-arclength "
-                       "continuation): continuation.nc and frequency_response.png in --out",
-                       description=CONTINUE_HELP,
-                       formatter_class=argparse.RawDescriptionHelpFormatter)
-    r.add_argument("case", metavar="CASE", help="case file (namelist)")
-    r.add_argument("--field", required=True, help="the field: speed_rpm, t_d, l_x, "
-                   "ripple_amp (its first element), ripple_amp(2), unbalance(1), ...")
-    r.add_argument("--start", type=float, required=True, help="the field's first value")
-    r.add_argument("--stop", type=float, required=True, help="the field's last value")
-    r.add_argument("--n", type=int, default=1, help="shaft revolutions of the period (default 1)")
-    r.add_argument("--ds", type=float, default=0.05, help="first arclength step (default 0.05)")
-    r.add_argument("--max-points", type=int, default=200, help="most branch points (200)")
-    r.add_argument("--tol", type=float, help="corrector residual, scaled (default 100 rtol)")
-    r.add_argument("--measure", choices=("Tm_pp", "F_max", "D2_pp"), default="Tm_pp",
-                   help="response measure of the figure (default Tm_pp)")
-    r.add_argument("--sweep", type=int, default=0, metavar="N",
-                   help="also a follow-up and follow-down sweep of N points, overlaid")
-    r.add_argument("--fix", action="append", metavar="FIELD=VALUE",
-                   help="change a field of the case (e.g. rtol=1e-9)")
-    r.add_argument("--out", default=".", metavar="DIR", help="output directory (default .)")
-    r.add_argument("--quiet", action="store_true", help="no progress bar")
-    r.set_defaults(func=lambda a: cmd_continue(a, fixed, exit_code))

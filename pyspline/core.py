@@ -138,14 +138,16 @@ class Model:
     def info(self) -> dict:
         """Derived quantities (SI): r_b, r_pitch, omega, the Eq. 25 scales l_ref and w_ref,
         c_bulk, kappa, the k_m used, k_m_computed, thermal_level, the c_m used, the tooth
-        pair's effective mass m_e, and the Eq. 18 terms as a dict 'k_terms' (k_h, k_b1, ..., k_m
-        of the geometry)."""
-        info, terms, ierr, msg = _api.api_model_info(self.bytes)
+        pair's effective mass m_e, the Eq. 18 terms as a dict 'k_terms' (k_h, k_b1, ..., k_m
+        of the geometry), and 'spacing_error', the tooth spacing errors in use e_j [m] of teeth
+        1 .. Z, shape (Z,): the case's list plus the seeded ones (docs/model.md section 11)."""
+        info, terms, spacing, ierr, msg = _api.api_model_info(self.bytes, self.z)
         raise_for(ierr, msg)
         out = {n: float(v) for (n, *_), v in zip(_names("info"), info)}
         out["k_m_computed"] = bool(out["k_m_computed"])
         out["thermal_level"] = int(out["thermal_level"])
         out["k_terms"] = {n: float(v) for (n, *_), v in zip(_names("kterms"), terms)}
+        out["spacing_error"] = spacing
         return out
 
 
@@ -160,6 +162,7 @@ def load(case) -> Model:
 QUANTITIES = {n: (d, u) for n, u, d in _names("outputs")}
 STATE_QUANTITIES = {n: (d, u) for n, u, d in _names("states")}
 TOOTH_QUANTITIES = {n: (d, u) for n, u, d in _names("tooth")}
+FIELDS = {n: (d, u) for n, u, d in _names("fields")}   #: the case fields: (description, unit)
 STATE_NAMES = tuple(STATE_QUANTITIES)[:len(STATE_QUANTITIES) // 2]   #: x1 .. D3 (positions)
 #: The loads of a run (spline_loads::run_loads, docs/model.md section 15): name -> (description,
 #: unit), the scalars and the per-tooth ones (arrays over the teeth).
@@ -219,6 +222,9 @@ class Result:
     #: (F_peak, load_factor, free_frac, back_frac, onsets); units: LOAD_QUANTITIES,
     #: TOOTH_LOAD_QUANTITIES
     loads: dict = None
+    #: the tooth spacing errors in use e_j (Z,) [m], the case's list plus the seeded ones
+    #: (Model.info()['spacing_error'])
+    spacing_error: np.ndarray = None
 
     F = _tooth_quantity("F")
     Fx = _tooth_quantity("Fx")
@@ -262,7 +268,8 @@ class Result:
         per-tooth F, Fx, Fy, dn, c, Tf, rc1, rc2 (time, tooth); the loads (``loads``: per
         tooth on the tooth dim, the scalars without a dim); section_t and the states on the
         section section_x1 .. section_vD3 (section_point); lyapunov_log_growth
-        (renormalisation, with coordinate lyapunov_t [s]). attrs: case (namelist text), name, level, pyspline_version, the
+        (renormalisation, with coordinate lyapunov_t [s]); a sliced face (n_slices > 1): face
+        (time, tooth, slice) [N] and tilt (time, moment: M_x, M_y) [N m]. attrs: case (namelist text), name, level, pyspline_version, the
         exponent as lyapunov_exponent [1/s], and the run statistics as stat_<name>."""
         import xarray as xr
         from . import __version__
@@ -277,6 +284,11 @@ class Result:
             data[n] = (("time", "tooth"), arr, _attrs(n))
         for n, v in (self.loads or {}).items():     # per tooth on the tooth dim, scalars 0-d
             data[n] = (("tooth",) if n in TOOTH_LOAD_QUANTITIES else (), v, _attrs(n))
+        if self.spacing_error is not None:
+            long, unit = FIELDS["spacing_error"]
+            data["spacing_error"] = ("tooth", self.spacing_error,
+                                     {"long_name": long + ", in use (the list plus the seeded)",
+                                      "units": unit})
         if self.section_t is not None and len(self.section_t):
             sec = np.asarray(self.section_y).reshape(-1, 14)
             data["section_t"] = ("section_point", self.section_t,
@@ -286,6 +298,16 @@ class Result:
                 a = _attrs(n)
                 a["long_name"] += " on the Poincare section"
                 data["section_" + n] = ("section_point", sec[:, i], a)
+        if self.face is not None:               # a sliced face (n_slices > 1)
+            data["face"] = (("time", "tooth", "slice"), self.face,
+                            {"long_name": "load of each slice of each tooth's face",
+                             "units": "N"})
+            data["tilt"] = (("time", "moment"), self.tilt,
+                            {"long_name": "tilting moment on spline 1 (M_x, M_y)",
+                             "units": "N m"})
+            coords["slice"] = ("slice", np.arange(1, self.face.shape[2] + 1),
+                               {"long_name": "face slice number"})
+            coords["moment"] = ("moment", np.array(["M_x", "M_y"]))
         attrs = {"case": self.case.text(), "name": self.case.name,
                  "pyspline_version": __version__}
         if self.stats:
@@ -334,7 +356,8 @@ def simulate(case) -> Result:
     return Result(case=model.case, t=t, y=y, tooth=per, Tm=tm, stats=st,
                   section_t=sec_t, section_y=sec_y, lyapunov=lyap,
                   face=face if model.n_slices else None, tilt=tilt if model.n_slices else None,
-                  loads=run_loads(model, t, y, tooth, tm))
+                  loads=run_loads(model, t, y, tooth, tm),
+                  spacing_error=model.info()["spacing_error"])
 
 
 def run_loads(model, t, y, tooth, tm) -> dict:

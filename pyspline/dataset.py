@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from .core import LOAD_QUANTITIES, QUANTITIES, TOOTH_QUANTITIES, _names, cf_units
+from .errors import CaseError
 
 __all__ = ["build_dataset", "field_meta", "open_sweep", "write_netcdf"]
 
@@ -175,11 +176,30 @@ def write_netcdf(ds, path) -> Path:
     return path
 
 
+#: what every sweep dataset has (build_dataset), and a continuation's does not
+_SWEEP_MARKS = ("error", "error_class", "point_hash")
+
+
 def open_sweep(path):
-    """Read a sweep written by `sweep` (DIR/sweep.nc or DIR) fully into memory."""
+    """Read a sweep written by `sweep` or `merge` (DIR/sweep.nc or DIR) fully into memory.
+    A path that is no such file (missing, unreadable, damaged, another netCDF such as a
+    continuation.nc) is a CaseError naming it."""
     import xarray as xr
     path = Path(path)
     if path.is_dir():
         path = path / MERGED
-    with xr.open_dataset(path, engine=ENGINE) as ds:
-        return ds.load()
+    if not path.is_file():
+        raise CaseError(f"open_sweep: {path} is no file" + (" (no sweep.nc in the directory)"
+                                                            if path.name == MERGED else ""))
+    try:
+        with xr.open_dataset(path, engine=ENGINE) as ds:
+            ds = ds.load()
+    except Exception as exc:     # h5py, h5netcdf, xarray: whatever the damage, name the file
+        raise CaseError(f"open_sweep: {path} cannot be read as a sweep (NetCDF-4): "
+                        f"{type(exc).__name__}: {exc}") from None
+    missing = [k for k in _SWEEP_MARKS if k not in ds]
+    if missing or "swept" not in ds.attrs:
+        raise CaseError(f"open_sweep: {path} is no sweep of pyspline (no "
+                        f"{', '.join(missing) or 'attribute swept'}; a continuation is read "
+                        "with xarray.open_dataset)")
+    return ds

@@ -176,6 +176,9 @@ def periodic_orbit(case, n: int = 1, guess=None, t0: float | None = None, tol: f
     t1 = t0 + period
     rtol = case["rtol"]
     tol = 100 * rtol if tol is None else float(tol)
+    if not (np.isfinite(tol) and tol > 0):
+        raise CaseError(f"case {case.name}: tol = {tol!r}: the scaled residual to reach must be "
+                        "a finite number > 0")
     scale = _scale(model)
     if monodromy not in ("exact", "fd"):
         raise CaseError(f"case {case.name}: monodromy = {monodromy!r}: 'exact' (variational "

@@ -103,14 +103,18 @@ def parse_values(field: str, spec: str) -> np.ndarray:
     return np.asarray([_typed(field, p) for p in spec.split(",")])
 
 
-def _as_values(field: str, values) -> np.ndarray:
-    """The swept values of `field` as a 1-D numpy array (any sequence or iterable)."""
+def _as_values(field: str, values, where: str = "sweep") -> np.ndarray:
+    """The swept values of `field` as a 1-D numpy array (any sequence or iterable); else a
+    CaseError naming the argument (`where`: 'sweep' or the design table)."""
     if isinstance(values, (str, bytes, Mapping)) or not hasattr(values, "__iter__"):
-        raise TypeError(f"sweep values of {field} must be a sequence, got {values!r}")
-    arr = np.asarray(values if isinstance(values, np.ndarray) else list(values))
+        raise CaseError(f"{where}: the values of {field} must be a sequence, got {values!r:.60}")
+    try:
+        arr = np.asarray(values if isinstance(values, np.ndarray) else list(values))
+    except ValueError as exc:            # ragged lists
+        raise CaseError(f"{where}: the values of {field} are no 1-D sequence: {exc}") from None
     if arr.ndim != 1 or arr.size == 0:
-        raise ValueError(f"sweep values of {field} must be a non-empty 1-D sequence, got shape "
-                         f"{arr.shape}")
+        raise CaseError(f"{where}: the values of {field} must be a non-empty 1-D sequence, got "
+                        f"shape {arr.shape}")
     return arr
 
 
@@ -141,8 +145,8 @@ def read_table(table) -> dict:
     a mapping {field: sequence} or a pandas DataFrame. Typed like the fields' defaults."""
     if isinstance(table, (str, os.PathLike)):
         import csv
-        try:
-            with open(table, newline="", encoding="utf-8") as f:
+        try:            # utf-8-sig: also Excel's "CSV UTF-8" (a byte-order mark first)
+            with open(table, newline="", encoding="utf-8-sig") as f:
                 rows = [r for r in csv.reader(f) if r and any(x.strip() for x in r)]
         except (OSError, UnicodeDecodeError) as exc:
             raise CaseError(f"design table {os.fspath(table)}: cannot read it: {exc}") from None
@@ -161,15 +165,19 @@ def read_table(table) -> dict:
             if h not in defaults():
                 raise CaseError(f"design table {os.fspath(table)}: unknown field '{h}' (see "
                                 "cases/template.nml)")
-        return {h: np.asarray([_typed(h, x) for x in v]) for h, v in columns.items()}
+        try:
+            return {h: np.asarray([_typed(h, x) for x in v]) for h, v in columns.items()}
+        except CaseError as exc:
+            raise CaseError(f"design table {os.fspath(table)}: {exc}") from None
     if hasattr(table, "columns") and hasattr(table, "to_dict"):      # a pandas DataFrame
         table = {str(c): table[c].to_numpy() for c in table.columns}
     if not isinstance(table, Mapping):
-        raise TypeError(f"a design table is a CSV path, a mapping or a DataFrame, not "
+        raise CaseError(f"table: a design table is a CSV path, a mapping or a DataFrame, not "
                         f"{type(table).__name__}")
-    out = {str(k).lower(): _as_values(k, v) for k, v in table.items()}
+    out = {str(k).lower(): _as_values(k, v, "table") for k, v in table.items()}
     if len({len(v) for v in out.values()}) > 1:
-        raise ValueError("the columns of a design table must have the same length")
+        raise CaseError("table: the columns of a design table must have the same length, got "
+                        + ", ".join(f"{k} {len(v)}" for k, v in out.items()))
     return out
 
 
@@ -464,14 +472,14 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
         raise CaseError(f"section must be one of {', '.join(SECTIONS)}, got {section!r}")
     if table is not None:
         if fields:
-            raise TypeError("give a design table or fields to sweep, not both")
+            raise CaseError("sweep: give a design table or fields to sweep, not both")
         fields = read_table(table)
         if not fields or not len(next(iter(fields.values()))):
-            raise CaseError("the design table has no fields or no rows")
+            raise CaseError("table: the design table has no fields or no rows")
     elif not fields:
-        raise TypeError("sweep needs at least one field to sweep, e.g. l_x=[0, 1e-4, 2e-4]")
+        raise CaseError("sweep: no field to sweep given, e.g. l_x=[0, 1e-4, 2e-4]")
     elif len(fields) > 2:
-        raise TypeError(f"sweep takes one or two fields, got {len(fields)}: {', '.join(fields)}")
+        raise CaseError(f"sweep takes one or two fields, got {len(fields)}: {', '.join(fields)}")
     known = defaults()
     grid = {}
     for name, values in fields.items():
@@ -484,7 +492,7 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
                             if key != "name" else "field name cannot be swept")
         grid[key] = _as_values(key, values)
     if len(grid) != len(fields):
-        raise TypeError("the same field is swept twice")
+        raise CaseError("sweep: the same field is swept twice")
     base = base.replace(section=section, lyapunov=bool(lyapunov))
     point_fields = None
     if table is not None:     # one dim 'point', the table's fields as its coordinates

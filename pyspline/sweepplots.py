@@ -90,8 +90,9 @@ def _bifurcation_points(ax, x, y, per, counts=True, ms=9) -> list:
     """Scatter y (n, n_points) against x (n,) on ax, coloured by period class; legend handles."""
     cls = _period_class(per)
     handles = []
+    drawn = np.isfinite(y).any(axis=1)      # a point that did not run has nothing to show
     for c in (0, 1, 2, 3, 4, 5):
-        rows = cls == c
+        rows = (cls == c) & drawn
         if not rows.any():
             continue
         xs = np.repeat(x[rows], y.shape[1])
@@ -319,6 +320,9 @@ def waterfall(ds, speed: str = "speed_rpm", freq: str = "freq_hz", amp: str = "a
     dark = style == "map"
     if dark:
         rr = np.broadcast_to(rpm[:, None], a.shape)
+        if len(rpm) == 1:               # one speed: a band of +- 2 % around it
+            half = 0.02 * max(abs(rpm[0]), 1.0)
+            f, a, rr = np.vstack([f, f]), np.vstack([a, a]), np.vstack([rr - half, rr + half])
         mesh = ax.pcolormesh(f, rr, np.clip(a, top * floor, None), shading="nearest",
                              norm=LogNorm(vmin=top * floor, vmax=top), cmap="magma",
                              rasterized=True)
@@ -391,7 +395,9 @@ def sweep_figures(ds, out) -> list[Path]:
     """The figures of a sweep dataset into directory `out`: bifurcation.png (and for a grid
     period_map.png), lyapunov.png (if computed), waterfall*.png (if speed_rpm was swept).
     The horizontal axis is the first swept field with numeric values (a field of text values,
-    e.g. thermal, becomes the panels or the map's other axis). Returns the paths written."""
+    e.g. thermal, becomes the panels or the map's other axis); points at a non-finite value of
+    a field are left out, and a sweep of which no point ran has no figures (a note on stderr).
+    Returns the paths written."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     names = list(ds["error"].dims)
@@ -402,6 +408,13 @@ def sweep_figures(ds, out) -> list[Path]:
     if not numeric:
         print(f"no figures: no swept field has numeric values ({', '.join(names)})",
               file=sys.stderr)
+        return written
+    for n in numeric:                   # a point at a NaN value has no place on an axis
+        ds = ds.isel({n: np.isfinite(ds[n].values.astype(float))})
+    empty = [n for n in names if not ds.sizes[n]]
+    if empty or not (ds["error"] == "").any():
+        print("no figures: " + (f"no finite value of {', '.join(empty)}" if empty else
+                                "no point ran (their errors are in sweep.nc)"), file=sys.stderr)
         return written
     x = numeric[0]
     other = [n for n in names if n != x]
@@ -477,10 +490,17 @@ def _waterfalls(ds, out, title_case) -> list[Path]:
 
     def size(d):                       # T_m's size, against which round-off is judged
         return float(np.nanmax(np.abs(d["Tm_rms"].values))) if "Tm_rms" in d else None
+
+    def ran(d):                        # the speeds with a spectrum (a point that ran)
+        return d.isel(speed_rpm=np.isfinite(d["Tm_spectrum"].values).any(axis=-1))
+
     if len(names) == 1:
         path = out / "waterfall.png"
-        waterfall(_waterfall_ds(ds), z=z, path=path, duration=duration, scale=size(ds),
-                  rtol=rtol,
+        if not ran(ds).sizes["speed_rpm"]:
+            print("no waterfall.png: no point has a spectrum of T_m (none ran)", file=sys.stderr)
+            return []
+        waterfall(_waterfall_ds(ran(ds)), z=z, path=path, duration=duration,
+                  scale=size(ran(ds)), rtol=rtol,
                   title=f"{title_case}: spectrum of T_m vs speed (dashed: shaft and "
                         "tooth-pass orders)")
         return [path]
@@ -490,8 +510,11 @@ def _waterfalls(ds, out, title_case) -> list[Path]:
     paths = []
     for i in pick:
         v = values[i]
-        sub = ds.isel({other: i})
+        sub = ran(ds.isel({other: i}).transpose("speed_rpm", ...))
         path = out / f"waterfall_{other}={_fmt(v)}.png"
+        if not sub.sizes["speed_rpm"]:
+            print(f"no {path.name}: no point has a spectrum of T_m (none ran)", file=sys.stderr)
+            continue
         waterfall(_waterfall_ds(sub), z=z, path=path, duration=duration, scale=size(sub),
                   rtol=rtol,
                   title=f"{title_case}, {other} = {_fmt(v)}: spectrum of T_m vs speed")

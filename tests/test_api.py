@@ -76,9 +76,10 @@ def test_cases_load_in_parallel_threads():
     y = base.model.start_state()
 
     def said(model, sizes):
-        info, terms, ierr, msg = core._api.api_model_info(model)
+        info, terms, spacing, ierr, msg = core._api.api_model_info(model, base.model.z)
         ydot, ierr2 = core._api.api_rhs(model, 1e-3, y)
-        return sizes.tolist(), info.tolist(), terms.tolist(), ydot.tolist(), int(ierr), int(ierr2)
+        return (sizes.tolist(), info.tolist(), terms.tolist(), spacing.tolist(), ydot.tolist(),
+                int(ierr), int(ierr2))
 
     alone = [said(*core._api.api_load_text(t, core._MODEL_BYTES)[:2]) for t in texts]
     bad = []

@@ -4,6 +4,7 @@ Slurm array script run locally, dask-jobqueue's job script rendered)."""
 import os
 import re
 import shlex
+import stat
 import subprocess
 
 import numpy as np
@@ -221,7 +222,7 @@ def test_design_table_equals_single_runs(tmp_path):
     with pytest.raises(pyspline.CaseError, match="unknown field 'l_z'"):
         table.write_text("l_z\n1\n")
         pyspline.sweep(base, table=table, progress=False)
-    with pytest.raises(TypeError, match="not both"):
+    with pytest.raises(pyspline.CaseError, match="not both"):
         pyspline.sweep(base, table={"l_x": [0.0]}, l_x=[1e-4], progress=False)
 
 
@@ -239,3 +240,131 @@ def test_dask_jobqueue_renders_the_documented_cluster():
         cluster.close()
     assert script.startswith("#!/usr/bin/env bash") and "#SBATCH --cpus-per-task=8" in script
     assert "distributed.cli.dask_worker" in script and "--nworkers 8" in script
+
+
+def dyn(exe, cwd, summary, *sets, expect=0):
+    """spline-dyn on CASE (SHORT) with --set options, writing `summary`; its exit status checked."""
+    run = subprocess.run([exe, str(CASE), "--summary", str(summary),
+                          *[f"--set={k}={v}" for k, v in SHORT.items()],
+                          *[f"--set={s}" for s in sets]], cwd=cwd, capture_output=True, text=True)
+    assert run.returncode == expect, run.stderr
+    return run
+
+
+def test_every_run_asked_writes_its_summary_and_merge_keeps_it(tmp_path, exe):
+    """A bad value (exit 2), thermal interference at the build (exit 4), a solver failure
+    (exit 3) and a --set the reader refuses (exit 2, no case) each write a summary with the
+    error, its class and exit code; merge records them as failed points beside the good one,
+    with the messages Python's own errors carry."""
+    runs = tmp_path / "runs"
+    runs.mkdir()
+    dyn(exe, runs, "0.summary")
+    dyn(exe, runs, "1.summary", "speed_rpm=-5", expect=2)
+    dyn(exe, runs, "2.summary", "thermal='bulk'", "t_bulk=3100", expect=4)
+    dyn(exe, runs, "3.summary", "max_steps=5", expect=3)
+    dyn(exe, runs, "4.summary", "speed_rpm=fast", expect=2)
+    sm = [read_summary(runs / f"{k}.summary") for k in range(5)]
+    assert [s["error_class"] for s in sm] == ["", "CaseError", "ThermalInterferenceError",
+                                              "SolverError", "CaseError"]
+    assert [s["values"].get("exit_code", [0])[0] for s in sm] == [0, 2, 4, 3, 2]
+    assert sm[1]["case"]["speed_rpm"] == -5.0 and sm[4]["case"] is None
+    assert sm[4]["sets"][-1] == "speed_rpm=fast" and "speed_rpm = fast" in sm[4]["error"]
+    for k, fields in ((1, dict(speed_rpm=-5.0)), (2, dict(thermal="bulk", t_bulk=3100.0)),
+                      (3, dict(max_steps=5))):
+        with pytest.raises(pyspline.SplineError) as err:
+            pyspline.simulate(pyspline.load_case(CASE, **SHORT, **fields))
+        assert sm[k]["error"] == str(err.value) and sm[k]["error_class"] == type(err.value).__name__
+    assert main(["merge", str(runs), "--out", str(tmp_path / "m")]) == 0
+    ds = pyspline.open_sweep(tmp_path / "m")
+    assert ds.attrs["n_points"] == 5 and ds.attrs["n_ok"] == 1 and ds.attrs["n_failed"] == 4
+    assert list(ds["error_class"].values) == [s["error_class"] for s in sm]
+    assert [os.path.basename(f) for f in ds["summary"].values] == [f"{k}.summary" for k in range(5)]
+    assert ds["speed_rpm"].values[1] == -5.0 and np.isnan(ds["speed_rpm"].values[4])
+    assert np.isfinite(ds["Tm_max"].values[0]) and np.isnan(ds["Tm_max"].values[1:]).all()
+
+
+def test_summary_takes_a_regular_file_or_a_new_path_once(tmp_path, exe):
+    """--summary and -o onto a FIFO, a character device (a null device of the test's own, as
+    root: never the system's) or a directory: exit 2, the node left as it was; a second
+    --summary: exit 2; the same file under two names: exit 2, nothing lost."""
+    fifo, dev = tmp_path / "fifo", tmp_path / "null"
+    os.mkfifo(fifo)
+    (tmp_path / "dir").mkdir()
+    nodes = [(fifo, "a FIFO"), (tmp_path / "dir", "a directory")]
+    if os.geteuid() == 0:
+        os.mknod(dev, 0o666 | stat.S_IFCHR, os.makedev(1, 3))
+        nodes.append((dev, "a character device"))
+    for opt in ("--summary", "-o"):
+        for node, what in nodes:
+            run = subprocess.run([exe, str(CASE), opt, str(node)], capture_output=True,
+                                 text=True, cwd=tmp_path, timeout=60)
+            assert run.returncode == 2 and f"{node} is {what}" in run.stderr, run.stderr
+    assert fifo.is_fifo() and (os.geteuid() != 0 or stat.S_ISCHR(dev.stat().st_mode))
+    for n in (fifo, dev):
+        n.unlink(missing_ok=True)
+    twice = subprocess.run([exe, str(CASE), "--summary", "a", "--summary=b"], cwd=tmp_path,
+                           capture_output=True, text=True)
+    assert twice.returncode == 2 and "--summary given twice" in twice.stderr
+    (tmp_path / "x.csv").write_text("kept\n")
+    for a, b in (("x.csv", "./x.csv"), ("y.csv", "./dir/../y.csv")):
+        same = subprocess.run([exe, str(CASE), "--summary", a, "-o", b], cwd=tmp_path,
+                              capture_output=True, text=True)
+        assert same.returncode == 2 and "are the same file" in same.stderr, same.stderr
+    assert (tmp_path / "x.csv").read_text() == "kept\n" and not (tmp_path / "y.csv").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["dir", "x.csv"]
+
+
+@pytest.fixture(scope="module")
+def good(tmp_path_factory, exe):
+    """Two finished runs' summaries (l_x = 0 and 1e-4) with a section."""
+    d = tmp_path_factory.mktemp("good")
+    for k, lx in enumerate(("0", "1e-4")):
+        dyn(exe, d, f"{k}.summary", f"l_x={lx}", "section='shaft'")
+    return d
+
+
+def edited(good, tmp_path, name, change):
+    """A copy of good/0.summary with change(lines) applied, as tmp_path/name."""
+    lines = (good / "0.summary").read_text().splitlines()
+    out = tmp_path / name
+    out.write_text("\n".join(change(lines)) + "\n")
+    return out
+
+
+def test_merge_refuses_duplicates_mixed_cases_and_damage_naming_the_file(tmp_path, good):
+    """The same point twice, summaries of two cases (unless mixed=True), a missing key, a NaN,
+    a section shorter than its times and an invalid case: CaseError naming the file."""
+    a, b = good / "0.summary", good / "1.summary"
+    with pytest.raises(pyspline.CaseError, match=r"0\.summary and .*dup\.summary are the same "
+                                                 r"point"):
+        merge([a, b, edited(good, tmp_path, "dup.summary", lambda ls: ls)])
+    other = edited(good, tmp_path, "other.summary",
+                   lambda ls: [re.sub(r"^(\s*NAME\s*=).*", r'\1"other",', x, flags=re.I)
+                               for x in ls])
+    with pytest.raises(pyspline.CaseError, match="2 cases .*--mixed"):
+        merge([a, b, other])
+    assert merge([a, b, other], mixed=True).attrs["n_ok"] == 3
+    damage = {
+        "missing": (lambda ls: [x for x in ls if not x.startswith("loads.Tm_rms_se ")],
+                    "no loads.Tm_rms_se"),
+        "nan": (lambda ls: [re.sub(r"^(run\.Tm_max \[N m\] =).*", r"\1 nan", x) for x in ls],
+                "run.Tm_max = nan is not finite"),
+        "short": (lambda ls: [re.sub(r"^(section\.D2 \[m\] = [^,]*),.*", r"\1", x) for x in ls],
+                  r"section.D2 has 1 values, \d+ expected"),
+        "case": (lambda ls: [re.sub(r"^(\s*SPEED_RPM\s*=).*", r"\1 -5,", x, flags=re.I)
+                             for x in ls], "its case: .*speed_rpm"),
+    }
+    for name, (change, why) in damage.items():
+        bad = edited(good, tmp_path, f"{name}.summary", change)
+        assert bad.read_text() != a.read_text(), name
+        with pytest.raises(pyspline.CaseError, match=rf"summary .*{name}\.summary: {why}"):
+            merge([bad, b])
+
+
+def test_merge_gives_each_warning_once_with_its_count(good):
+    """The paper's shafts draw one plausibility warning per case: merged, it is given once."""
+    with pytest.warns(pyspline.SplineWarning) as rec:
+        merge([good / "0.summary", good / "1.summary"])
+    msgs = [str(w.message) for w in rec if issubclass(w.category, pyspline.SplineWarning)]
+    assert len(msgs) == 1 and "winds its shaft" in msgs[0] and msgs[0].endswith(
+        "(2 of 2 summaries)"), msgs

@@ -150,3 +150,33 @@ def test_race_statistics_standard_error_is_the_cores():
     assert res.loads["batches"] == 10
     assert se[0] == pytest.approx(res.loads["Tm_rms_se"], rel=1e-9)
     assert se[0] > 0 and np.all(np.isfinite(stat)) and np.all(np.isfinite(se))
+
+
+def test_race_candidate_is_the_loosest_rung_that_passes_twice():
+    """The race takes, per family and accuracy, the loosest rtol rung that reaches the accuracy
+    and whose next tighter rung does too: a lucky pass just above a failing rung is skipped,
+    and a family that never passes twice has no candidate."""
+    import race
+    errs = [1e-4, 5e-7, 2e-6, 4e-7, 1e-7, 3e-9, 1e-9]
+    assert race._candidates(errs, (1e-6, 1e-8)) == {1e-6: 3, 1e-8: 5}
+    assert race._candidates([1e-4, np.inf, 1e-7, np.inf], (1e-6,)) == {}
+    rungs = np.log10(race.RUNGS)
+    assert rungs[0] == pytest.approx(-4) and rungs[-1] == pytest.approx(-12)
+    assert np.allclose(np.diff(rungs), -0.25)          # quarter decades, both sides alike
+
+
+def test_race_quick_times_the_peer_with_its_forces(tmp_path):
+    """A quick race of the paper scene: both sides reach each accuracy with a candidate timed
+    in every round, the peer's error from its own forces, and the ratio is of their medians."""
+    pytest.importorskip("numbalsoda")
+    import race
+    rows, runs = race.race(quick=True, repeat=2, progress=lambda m: None,
+                           cases=["paper_lx1e-4"])
+    assert [r["accuracy"] for r in rows] == [1e-6, 1e-8, 1e-6]
+    for r in rows:
+        for side in ("pyspline", "dop853"):
+            assert r[side]["err"] <= r["accuracy"] and len(r[side]["cpu_runs"]) == 2
+        fastest = min((b for b in (r["dop853"], r["lsoda"]) if b), key=lambda b: b["cpu_s"])
+        assert r["ratio"] == pytest.approx(fastest["cpu_s"] / r["pyspline"]["cpu_s"])
+    assert {r["kind"] for r in runs} == {"scan", "timed"}
+    assert race.format_rows(rows)[1].startswith("paper_lx1e-4, 1 s, 6401 outputs | F error")

@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 import pyspline
-from conftest import CASES, PAPER_SHAFTS, DEMONSTRATION_SCENES
+from conftest import CASES, PAPER_SHAFTS, PAPER_SUPPORTS, DEMONSTRATION_SCENES
 from test_stderr import obm_se
 
-pytestmark = [PAPER_SHAFTS, DEMONSTRATION_SCENES]   # expected warnings (conftest)
+pytestmark = [PAPER_SHAFTS, PAPER_SUPPORTS, DEMONSTRATION_SCENES]   # expected warnings (conftest)
 
 RTOLS = (1e-6, 1e-7)
 

@@ -2,6 +2,7 @@
 the closed-form forced response of the linear full-contact drive, the closed-form speed at
 which that response first opens a tooth (grazing), folds of the backlash resonance with a
 multiplier at +1 and the hysteresis of follow-up / follow-down sweeps between them, the CLI."""
+import re
 import subprocess
 import sys
 import warnings
@@ -186,8 +187,6 @@ def test_field_that_cannot_be_continued(field, match):
 
 
 def test_bad_range_and_follow():
-    with pytest.raises(pyspline.CaseError, match="start and stop must be finite and differ"):
-        pyspline.continuation(RESONANCE, "t_d", 30, 30, progress=False)
     with pytest.raises(pyspline.CaseError, match=r"guess has shape \(6,\): a state has 14"):
         pyspline.continuation(RESONANCE, "t_d", 30, 31, guess=np.zeros(6), progress=False)
     with pytest.raises(pyspline.CaseError, match="speed_rpm = 0.0: the shaft does not turn"):
@@ -200,15 +199,76 @@ def test_bad_range_and_follow():
         pyspline.sweep(RESONANCE, speed_rpm=[1, 2], follow="sideways", progress=False)
 
 
-def test_corrector_failure_says_where():
-    """A corrector allowed no Newton step cannot converge off the start: the step halves
-    down to ds_min, then OrbitError names where, the residual reached and its history."""
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(stop=30.0), r"stop = 30.0: start and stop must differ"),
+    (dict(stop=np.nan), r"stop = nan: must be finite"),
+    (dict(stop="x"), r"stop = 'x': not a number"),
+    (dict(ds=0.0), r"ds = 0.0: must be > 0"),
+    (dict(ds=-0.1), r"ds = -0.1: must be > 0"),
+    (dict(ds=np.nan), r"ds = nan: must be finite"),
+    (dict(ds_min=0.5, ds_max=0.25), r"ds_min = 0.5: greater than ds_max = 0.25"),
+    (dict(max_points=0), r"max_points = 0: a whole number >= 1"),
+    (dict(max_points=2.5), r"max_points = 2.5: a whole number >= 1"),
+    (dict(max_angle=0.0), r"max_angle = 0.0: must be > 0"),
+    (dict(tol=0.0), r"tol = 0.0: must be > 0"),
+    (dict(tol=-1e-7), r"tol = -1e-07: must be > 0"),
+    (dict(tol=np.nan), r"tol = nan: must be finite"),
+    (dict(n="1"), r"n = '1': the shaft revolutions of the period must be a whole number"),
+    (dict(n=0), r"n = 0: the shaft revolutions"),
+])
+def test_bad_arguments_name_themselves(kwargs, match):
+    """Each bad argument: a CaseError naming it and why, before anything runs."""
+    args = dict(stop=31.0) | kwargs
+    stop = args.pop("stop")
+    with pytest.raises(pyspline.CaseError, match=r"continuation in t_d: " + match):
+        pyspline.continuation(RESONANCE, "t_d", 30.0, stop, progress=False, **args)
+
+
+def test_field_values_outside_their_range():
+    """A stop outside the field's valid range names the stop (not a difference step's value);
+    a speed of 0 has no forcing period; a ripple order that does not repeat in one revolution
+    is refused at the stop as at the start; periodic_orbit refuses tol = nan."""
+    with pytest.raises(pyspline.CaseError, match=r"stop = 0 is not a valid value of speed_rpm: "
+                       r".*speed_rpm = 0.0: the shaft does not turn"):
+        pyspline.continuation(RESONANCE, "speed_rpm", 2300, 0.0, progress=False)
+    with pytest.raises(pyspline.CaseError, match=r"stop = 1e\+07 is not a valid value of "
+                       r"speed_rpm: .*speed_rpm"):
+        pyspline.continuation(RESONANCE, "speed_rpm", 2300, 1e7, progress=False)
+    with pytest.raises(pyspline.CaseError, match=r"stop = 1.5 is not a valid value of "
+                       r"ripple_order\(1\): .*ripple_order = 1.5 .* does not repeat within n = 1"):
+        pyspline.continuation(RESONANCE, "ripple_order(1)", 1.0, 1.5, progress=False)
+    with pytest.raises(pyspline.CaseError, match=r"tol = nan: the scaled residual to reach"):
+        pyspline.periodic_orbit(RESONANCE, tol=float("nan"))
+
+
+def test_corrector_failure_keeps_the_branch_and_says_where(tmp_path):
+    """A corrector allowed no Newton step cannot converge off the start: the step halves down
+    to ds_min with every fallback (the other monodromy, then the other integrator), and the
+    branch so far comes back with its status naming where, the residual reached and its
+    history, and a SplineWarning; the CLI writes what it has, says where it stopped, exits 1."""
     case, *_ = linear_scene(2.0)
-    with pytest.raises(pyspline.OrbitError, match=r"continuation in speed_rpm: the corrector did "
-                       r"not converge after point 1 of branch 0, near speed_rpm = 26.*arclength step down to "
-                       r".*scaled residual .*wanted 1e-09\), history"):
-        pyspline.continuation(case, "speed_rpm", 2600, 3800, progress=False, max_corrector=0,
-                              ds_min=0.01)
+    where = (r"continuation in speed_rpm: the corrector did not converge after point 1 of branch "
+             r"0, near speed_rpm = 26.*arclength step down to .*scaled residual .*wanted "
+             r"1e-09\), history")
+    with pytest.warns(pyspline.SplineWarning, match=where + r".*the branch so far is returned "
+                      r"\(1 points"):
+        ds = pyspline.continuation(case, "speed_rpm", 2600, 3800, progress=False,
+                                   max_corrector=0, ds_min=0.04, ds_max=0.05)
+    assert re.search(where, ds.attrs["status"]) and ds.attrs["n_points"] == 1
+    assert float(ds.speed_rpm[0]) == 2600 and ds.residual[0] <= 1e-9
+    assert ds.attrs["fallbacks"].count("speed_rpm = 2600: ") == 3, ds.attrs["fallbacks"]
+    path = tmp_path / "scene.nml"
+    path.write_text(case.replace(ripple_amp=[0.3, 0, 0, 0]).text())
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2600",
+              "--stop", "3800", "--max-points", "3", "--out", "out", "--quiet")
+    assert run.returncode == 1, run.stderr
+    assert "stopped: max_points = 3 reached at speed_rpm = " in run.stderr
+    assert "3 points on 1 branch(es)" in run.stdout
+    assert (tmp_path / "out" / "frequency_response.png").stat().st_size > 10_000
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2600",
+              "--stop", "3800", "--sweep", "-1", "--out", "out2", "--quiet")
+    assert run.returncode == 2 and "--sweep -1: the follow sweep's number of points" in \
+        run.stderr and not (tmp_path / "out2").exists(), run.stderr
 
 
 def test_neimark_sacker_pair_on_the_unit_circle():

@@ -10,9 +10,9 @@ import f90nml
 import pytest
 
 import pyspline
-from conftest import CASES, PAPER, PAPER_SHAFTS, DEMONSTRATION_SCENES
+from conftest import CASES, PAPER, PAPER_SHAFTS, PAPER_SUPPORTS, DEMONSTRATION_SCENES
 
-pytestmark = [PAPER_SHAFTS, DEMONSTRATION_SCENES]   # expected warnings (conftest)
+pytestmark = [PAPER_SHAFTS, PAPER_SUPPORTS, DEMONSTRATION_SCENES]   # expected warnings (conftest)
 
 
 @pytest.mark.parametrize("fields,words", [
@@ -405,7 +405,8 @@ def test_file_load_builds_the_model_its_fields_build(name):
                      n_lyapunov=sizes[3], n_slices=sizes[4]).items():
         object.__setattr__(text, k, v)
     y = built.start_state()
-    said = [((m.z, m.n_out, m.n_section, m.n_lyapunov, m.n_slices), m.info(),
+    said = [((m.z, m.n_out, m.n_section, m.n_lyapunov, m.n_slices),
+             dict(m.info(), spacing_error=m.info()["spacing_error"].tolist()),
              m.start_state().tolist(), m.rhs(1e-3, y).tolist()) for m in (built, fields, text)]
     assert said[0] == said[1] == said[2]
     assert built.case is case and case.model is built

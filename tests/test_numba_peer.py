@@ -1,6 +1,7 @@
 """The numba/numbalsoda peer (bench/numba_peer.py) against the independent numpy oracle
-(tests/oracle.py): the compiled RHS equals oracle.rhs to 1e-12 relative, and a short numbalsoda
-LSODA solve agrees with scipy's LSODA on the oracle RHS. Does not import pyspline."""
+(tests/oracle.py): both compiled RHS (the fast one and the general one) equal oracle.rhs to 1e-12
+relative, the forces the race times equal oracle.mesh's, and short numbalsoda LSODA and DOP853
+solves agree with scipy's LSODA on the oracle RHS. Does not import pyspline."""
 import sys
 import zlib
 from pathlib import Path
@@ -28,30 +29,61 @@ CASES = {
     "z7": dict(BASE, z=7, l_x=1e-4),
     "slow_z7": dict(BASE, z=7, speed_rpm=300.0, l_x=5e-5, l_y=5e-5, grav=0.0),
     "stiff": dict(BASE, k_m=5e8, l_x=1e-4),
+    "spacing": dict(BASE, l_x=5e-5, spacing_error=[3e-5, -2e-5, 0.0, 1e-5], spacing_error_amp=1e-5),
 }
+#: the cases the general RHS (kept for the coupled level) also runs: all but spacing errors
+GENERAL = sorted(set(CASES) - {"spacing"})
 
 
-@pytest.mark.parametrize("name", sorted(CASES))
-def test_peer_rhs_matches_oracle(name):
+@pytest.mark.parametrize("name,kind", [(n, None) for n in sorted(CASES)] +
+                         [(n, "general") for n in GENERAL if n != "coupled"])
+def test_peer_rhs_matches_oracle(name, kind):
+    """kind None: the fast RHS, or the general one for the coupled level."""
     case = numba_peer.load_case(dict(CASES[name], name=name))
     p = oracle.prepare(case)
     rng = np.random.default_rng(zlib.crc32(name.encode()))
     n_free = n_contact = 0
     for y in random_states(case["c0"], 60, rng):
         t = rng.uniform(0, 0.05)
-        f = numba_peer.rhs_eval(case, t, y)
+        f = numba_peer.rhs_eval(case, t, y, kind=kind)
         fo = oracle.rhs(t, y, p)
         np.testing.assert_allclose(f, fo, rtol=1e-12, atol=1e-12 * np.abs(fo).max())
         # the scaled form (Eq. 25) used by solve() is the same function in other units
         l, w = case["c0"], p.omega
         sc = np.r_[np.full(7, l), np.full(7, l * w)]
-        fs = numba_peer.rhs_eval(case, t * w, y / sc, scaled=True)
+        fs = numba_peer.rhs_eval(case, t * w, y / sc, scaled=True, kind=kind)
         np.testing.assert_allclose(fs * sc * w, fo, rtol=1e-12, atol=1e-12 * np.abs(fo).max())
         m = oracle.mesh(t, y, p)
         contact = np.abs(m["dn"]) > m["c"]
         n_contact += contact.sum()
         n_free += (~contact).sum()
     assert n_contact > 20 and n_free > 20       # both sides of the dead zone exercised
+
+
+@pytest.mark.parametrize("name", sorted(set(CASES) - {"coupled"}))
+def test_forces_match_oracle_mesh(name):
+    """The T_m and F_j the race times (Setup.forces, from scaled states) equal oracle.mesh's."""
+    case = numba_peer.load_case(dict(CASES[name], name=name))
+    p = oracle.prepare(case)
+    rng = np.random.default_rng(zlib.crc32(name.encode()) + 1)
+    ys = np.array(random_states(case["c0"], 40, rng))
+    ts = rng.uniform(0, 0.05, len(ys))
+    s = numba_peer.Setup(case)
+    tm, F = s.forces(ts, ys / s.scale)
+    ref = [oracle.mesh(t, y, p) for t, y in zip(ts, ys)]
+    Fo = np.array([m["F"] for m in ref])
+    assert np.count_nonzero(Fo) > 20 and np.count_nonzero(Fo == 0) > 20
+    np.testing.assert_allclose(F, Fo, rtol=1e-12, atol=1e-12 * np.abs(Fo).max())
+    tmo = np.array([m["Tm"] for m in ref])
+    np.testing.assert_allclose(tm, tmo, rtol=1e-12, atol=1e-12 * np.abs(tmo).max())
+
+
+def test_kinds_refuse_what_they_lack():
+    coupled = numba_peer.load_case(CASES["coupled"])
+    with pytest.raises(ValueError, match="coupled"):
+        numba_peer.make_rhs(coupled, kind="fast")
+    with pytest.raises(ValueError, match="spacing"):
+        numba_peer.make_rhs(numba_peer.load_case(CASES["spacing"]), kind="general")
 
 
 def test_thermal_interference_is_an_error():
@@ -70,7 +102,7 @@ def test_default_fields_match_template():
 
 
 @pytest.mark.parametrize("method", ["lsoda", "dop853"])
-@pytest.mark.parametrize("name", ["misaligned", "z7", "bulk", "coupled"])
+@pytest.mark.parametrize("name", ["misaligned", "z7", "bulk", "coupled", "spacing"])
 def test_peer_agrees_with_scipy_lsoda_on_oracle(name, method):
     """numbalsoda's LSODA and DOP853 on the numba RHS against scipy's LSODA on the oracle."""
     from scipy.integrate import solve_ivp

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 import pyspline
-from conftest import CASES, PAPER_SHAFTS
+from conftest import CASES, PAPER_SHAFTS, PAPER_SUPPORTS
 
-pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
+pytestmark = [PAPER_SHAFTS, PAPER_SUPPORTS]   # expected warnings (conftest)
 
 
 @pytest.mark.parametrize("name, kw", [

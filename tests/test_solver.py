@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 import pyspline
-from conftest import (CASES, DEMONSTRATION_SCENES, PAPER, PAPER_SHAFTS,
+from conftest import (CASES, DEMONSTRATION_SCENES, PAPER, PAPER_SHAFTS, PAPER_SUPPORTS,
                       assert_executable_matches_python)
 
-pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
+pytestmark = [PAPER_SHAFTS, PAPER_SUPPORTS]   # expected warnings (conftest)
 
 SHORT = dict(t_end=0.1, n_out=401)
 

@@ -10,7 +10,7 @@ import pytest
 
 import oracle
 import pyspline
-from conftest import PAPER, PAPER_SHAFTS
+from conftest import CASES as CONFTEST_CASES, PAPER, PAPER_SHAFTS
 
 pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
@@ -195,14 +195,46 @@ def test_a_shorter_list_gives_the_first_teeth_and_a_file_reads_the_same(tmp_path
     assert pyspline.load_case(path)["spacing_error"] == case["spacing_error"]
 
 
-@pytest.mark.parametrize("shape,dof", [(NO_FIRST, 3), (WITH_FIRST, 7)])
-def test_auto_fidelity_counts_the_errors_eccentricity(shape, dof):
-    """fidelity = 'auto' keeps the lateral motion when the errors' first harmonic moves the
-    centres, and drops it when they have none (every tooth then pushes the centres equally)."""
-    e = list(3e-6 * shape / np.abs(shape).max())
+@pytest.mark.parametrize("shape,amp,dof", [(NO_FIRST, 0.3e-6, 3), (NO_FIRST, 3e-6, 7),
+                                           (WITH_FIRST, 0.3e-6, 7), (WITH_FIRST, 3e-6, 7)])
+def test_auto_fidelity_counts_the_lateral_force_of_the_engaged_teeth(shape, amp, dof):
+    """fidelity = 'auto' keeps the lateral motion when the errors move the centres: always with
+    a first harmonic; without one only once teeth unload (3 um against the static tooth
+    deflection F0 / k_m = 1.4 um here: the engaged set pushes sideways), not while every
+    tooth is engaged (0.3 um: every tooth pushes the centres equally)."""
+    e = list(amp * shape / np.abs(shape).max())
     res = pyspline.simulate(dict(PAPER, name="auto", k_m=1e8, grav=0.0, spacing_error=e,
                                  fidelity="auto", t_end=0.002, n_out=3))
     assert res.stats["dof"] == dof
+
+
+#: the Z = 24 spline of physical_z24 aligned and without gravity (no other lateral driver), its
+#: spacing errors without a first harmonic in j, from its static equilibrium
+Z24_THETA = 2 * np.pi * np.arange(1, 25) / 24
+Z24_NO_FIRST = np.cos(2 * Z24_THETA) + 0.7 * np.sin(3 * Z24_THETA) + 0.4 * np.cos(5 * Z24_THETA + 1)
+
+
+@pytest.mark.parametrize("amp", [0.05e-6, 1e-6, 20e-6])
+def test_auto_fidelity_under_partial_engagement_keeps_what_the_loads_need(amp):
+    """Errors without a first harmonic: with every tooth engaged (0.05 um against a tooth
+    deflection of 0.21 um) dof 3 is exact and auto takes it; with 13 or 3 of the 24 teeth
+    engaged the engaged set pushes the centres sideways, dof 3's tooth loads are off by far
+    more than fidelity_tol within a quarter revolution, and auto keeps dof 7."""
+    assert abs(Z24_NO_FIRST @ np.exp(1j * Z24_THETA)) < 1e-13
+    base = pyspline.load_case(CONFTEST_CASES / "physical_z24.nml", l_x=0.0, grav=0.0,
+                              start="equilibrium",
+                              spacing_error=list(amp * Z24_NO_FIRST / np.abs(Z24_NO_FIRST).max()))
+    base = base.replace(t_end=15 / base["speed_rpm"], n_out=101)      # a quarter revolution
+    runs = {dof: pyspline.simulate(base.replace(dof=dof)) for dof in (3, 7)}
+    auto = pyspline.simulate(base.replace(fidelity="auto"))
+    f0 = base["t_d"] / (24 * base.model.info()["r_b"])
+    error = np.abs(runs[3].F - runs[7].F).max() / f0
+    engaged = int((runs[7].F[0] != 0).sum())
+    if engaged == 24:
+        assert auto.stats["dof"] == 3 and error < 1e-6
+    else:
+        assert engaged <= 13 and auto.stats["dof"] == 7 and error > 0.1
+        np.testing.assert_array_equal(auto.F, runs[7].F)
 
 
 def seeded_errors(**fields):
@@ -228,3 +260,33 @@ def test_seeded_errors_are_reproducible_with_mean_zero(z, seed):
     assert not np.allclose(e, other)
     if z == 1000:                                      # uniform: about half the teeth past amp/2
         assert 0.3 < (np.abs(e) > 0.5 * amp).mean() < 0.7
+
+
+def test_the_errors_in_use_read_back_from_info_result_dataset_and_summary(exe, tmp_path):
+    """The spacing errors a run uses, the given list plus the seeded ones (docs/model.md section
+    11, tests/oracle.py from the document), read back from Model.info(), the Result, its
+    Dataset and spline-dyn's summary, exactly (17 digits in the summary)."""
+    given = [1e-6, -2e-6, 0.5e-6]
+    case = pyspline.load_case(dict(PAPER, name="inuse", spacing_error=given,
+                                   spacing_error_amp=3e-6, spacing_error_seed=42, t_end=0.002,
+                                   n_out=5))
+    expected = oracle.random_spacing_errors(16, 3e-6, 42)
+    expected[:3] += given
+    e = case.model.info()["spacing_error"]
+    np.testing.assert_allclose(e, expected, rtol=0, atol=1e-21)
+    res = pyspline.simulate(case)
+    np.testing.assert_array_equal(res.spacing_error, e)
+    ds = res.to_xarray()
+    np.testing.assert_array_equal(ds["spacing_error"].values, e)
+    assert ds["spacing_error"].dims == ("tooth",) and ds["spacing_error"].attrs["units"] == "m"
+    path = tmp_path / "inuse.nml"
+    case.to_namelist(path)
+    subprocess.run([exe, str(path), "--summary", str(tmp_path / "inuse.summary")], check=True,
+                   capture_output=True, timeout=120)
+    from pyspline.batch import read_summary
+    summary = read_summary(tmp_path / "inuse.summary")
+    np.testing.assert_array_equal(summary["values"]["model.spacing_error"], e)
+    assert summary["units"]["model.spacing_error"] == "m"
+    # without errors: zeros, one per tooth
+    np.testing.assert_array_equal(pyspline.load_case(dict(PAPER, name="none")).model.info()[
+        "spacing_error"], np.zeros(16))

@@ -45,12 +45,13 @@ def full_contact(**kw):
     return ps.load_case(CASES / "template.nml", name="full", grav=0.0, c_m=0.0, **kw)
 
 
-def stress_messages(fields) -> tuple[list[str], ps.Result]:
+def stress_messages(fields, key="MPa at the peak load") -> tuple[list[str], ps.Result]:
+    """The run's SplineWarnings that contain key (the stresses', or another kind's), and it."""
     with warnings.catch_warnings(record=True) as rec:
         warnings.simplefilter("always")
         res = ps.simulate(fields)
     return [str(w.message) for w in rec if issubclass(w.category, ps.SplineWarning)
-            and "MPa at the peak load" in str(w.message)], res
+            and key in str(w.message)], res
 
 
 @pytest.mark.parametrize("kw", [{}, {"z": 24, "module_m": 1.25e-3, "s": 1.7e-3, "b": 0.012,
@@ -101,18 +102,49 @@ def test_shipped_physical_cases_warn_no_stress_but_the_torque_in_n_mm_does(path)
         assert res.loads["F_peak"][tooth - 1] == res.loads["F_peak"].max()
 
 
-def test_executable_prints_the_same_stress_warnings(exe, tmp_path):
-    case = ps.load_case(CASES / "physical_lx1e-4.nml", t_d=30700.0, t_l=30700.0, t_end=0.02)
-    py, res = stress_messages(case)
-    path = tmp_path / "nmm.nml"
+def exe_warnings(exe, case, tmp_path, key="MPa at the peak load"):
+    """spline-dyn's warning lines that contain key, without their prefix, and the run."""
+    path = tmp_path / "case.nml"
     case.to_namelist(path)
     run = subprocess.run([exe, str(path), "-o", str(tmp_path / "out.csv")], capture_output=True,
                          text=True, timeout=120)
     assert run.returncode == 0, run.stderr
     prefix = "spline-dyn: warning: "
-    lines = [ln[len(prefix):] for ln in run.stderr.splitlines()
-             if ln.startswith(prefix) and "MPa at the peak load" in ln]
+    return [ln[len(prefix):] for ln in run.stderr.splitlines()
+            if ln.startswith(prefix) and key in ln], run
+
+
+def test_executable_prints_the_same_stress_warnings(exe, tmp_path):
+    case = ps.load_case(CASES / "physical_lx1e-4.nml", t_d=30700.0, t_l=30700.0, t_end=0.02)
+    py, res = stress_messages(case)
+    lines, run = exe_warnings(exe, case, tmp_path)
     assert len(py) == 3 and lines == py
     shown = re.search(r"shear at pitch \[MPa\]:\s+(\S+)\s+(\S+)\s+(\S+)", run.stdout).groups()
     np.testing.assert_allclose([float(v) for v in shown],
                                [res.loads[n] * 1e-6 for n in LIMITS], atol=0.006)
+
+
+FLASH = "contact temperature T_M + T_f"
+
+
+def test_flash_temperature_beyond_scuffing_and_tempering_warns(exe, tmp_path):
+    """The contact temperature of Blok's criterion, T_B = T_M + max T_f (Eq. 1), beyond 400 degC
+    (the top of typical scuffing temperatures) warns of scuffing, beyond 650 degC (steel's
+    tempering range) more strongly; the calibrated paper_T100 is silent. One-way, T_f is
+    proportional to f_m (Eq. 3, the loads do not see it), so f_m is chosen here to put T_B at
+    500 and 2000 degC from the calibrated run; the executable prints the same lines."""
+    case = ps.load_case(CASES / "paper_T100.nml", thermal="oneway", t_end=0.02, n_out=161)
+    msgs, res = stress_messages(case, FLASH)
+    tf0, f_m0, t_m = res.loads["Tf_max"], case["f_m"], case["t_bulk"]
+    assert msgs == [] and 0 < t_m + tf0 < 400
+    for target, words in ((500.0, "exceeds 400 degC, the top of typical scuffing temperatures"),
+                          (2000.0, "exceeds 650 degC, past steel's tempering range")):
+        fields = case.replace(f_m=f_m0 * (target - t_m) / tf0)
+        msgs, res = stress_messages(fields, FLASH)
+        assert len(msgs) == 1 and words in msgs[0], msgs
+        assert res.loads["Tf_max"] == pytest.approx(target - t_m, rel=1e-9)
+        assert f"T_M + T_f = {t_m:.1f} + {target - t_m:.1f} degC" in msgs[0], msgs
+        assert f"tooth {int(res.loads['Tf_max_tooth'])} at t" in msgs[0]
+    assert exe_warnings(exe, fields, tmp_path, FLASH)[0] == msgs
+    msgs, _ = stress_messages(fields.replace(t_bulk=0.0), FLASH)      # no bulk rise: '0.0 + '
+    assert len(msgs) == 1 and "T_M + T_f = 0.0 + " in msgs[0], msgs

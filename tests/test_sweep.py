@@ -110,8 +110,16 @@ def test_failing_point_is_recorded(case, tmp_path):
 def test_bad_field_fails_at_once(case):
     with pytest.raises(pyspline.CaseError, match="unknown field 'lx'"):
         pyspline.sweep(case, progress=False, lx=[0.0, 1e-4])
-    with pytest.raises(TypeError):
-        pyspline.sweep(case, progress=False, l_x=1e-4)           # not a sequence
+    for values, why in ((1e-4, "must be a sequence"), ([], r"shape \(0,\)"),
+                        ([[0.0, 1e-4], [2e-4, 3e-4]], r"shape \(2, 2\)")):
+        with pytest.raises(pyspline.CaseError, match=f"sweep: the values of l_x .*{why}"):
+            pyspline.sweep(case, progress=False, l_x=values)
+    with pytest.raises(pyspline.CaseError, match="sweep: no field to sweep"):
+        pyspline.sweep(case, progress=False)
+    with pytest.raises(pyspline.CaseError, match="table: .* same length, got l_x 2, t_d 1"):
+        pyspline.sweep(case, progress=False, table={"l_x": [0.0, 1e-4], "t_d": [1.0]})
+    with pytest.raises(pyspline.CaseError, match="table: the values of t_d must be a sequence"):
+        pyspline.sweep(case, progress=False, table={"l_x": [0.0], "t_d": 1.0})
 
 
 # --------------------------------------------------------------------------- files
@@ -423,3 +431,101 @@ def test_result_to_xarray_roundtrip(case, tmp_path):
     ds.to_netcdf(path, engine="h5netcdf")
     with xr.open_dataset(path, engine="h5netcdf") as back:
         xr.testing.assert_identical(back.load(), ds)
+
+
+# --------------------------------------------------------------------------- bad input, empty sweeps
+
+def test_design_table_with_a_byte_order_mark_and_bad_cells_named(tmp_path):
+    """Excel's "CSV UTF-8" starts with a byte-order mark: its first field is read as such; a
+    cell that is no value names the table's path."""
+    table = tmp_path / "excel.csv"
+    table.write_text("l_x,t_d\n0,30\n1e-4,20\n", encoding="utf-8-sig")
+    assert table.read_bytes()[:3] == b"\xef\xbb\xbf"
+    cols = sw.read_table(table)
+    assert list(cols) == ["l_x", "t_d"] and cols["l_x"].tolist() == [0.0, 1e-4]
+    table.write_text("l_x\nwide\n")
+    with pytest.raises(pyspline.CaseError, match=rf"design table {table}: field l_x: 'wide'"):
+        sw.read_table(table)
+
+
+def test_open_sweep_refuses_what_is_no_sweep_naming_the_path(tmp_path):
+    """A continuation.nc (or any other netCDF), a damaged file and a missing one: CaseError
+    with the path, never a raw h5py error."""
+    other = tmp_path / "continuation.nc"
+    xr.Dataset({"Tm_pp": ("point", np.arange(3.0))}, attrs={"field": "speed_rpm"}).to_netcdf(
+        other, engine="h5netcdf")
+    with pytest.raises(pyspline.CaseError, match=f"{other} is no sweep of pyspline"):
+        pyspline.open_sweep(other)
+    damaged = tmp_path / "d" / "sweep.nc"
+    damaged.parent.mkdir()
+    damaged.write_bytes(b"\x89HDF\r\n\x1a\n" + bytes(200))
+    with pytest.raises(pyspline.CaseError, match=f"{damaged} cannot be read as a sweep"):
+        pyspline.open_sweep(damaged.parent)
+    with pytest.raises(pyspline.CaseError, match=f"{tmp_path / 'none'} is no file"):
+        pyspline.open_sweep(tmp_path / "none")
+
+
+def test_sweep_of_failed_points_writes_its_dataset_and_no_plot_crashes(tmp_path):
+    """speed_rpm = nan, nan: every point fails; the dataset is written, no figure is drawn (none
+    ran), exit 0 (failed cases are results). With one good speed beside a bad one, the
+    waterfall draws the speed that ran."""
+    from pyspline.cli import main
+    args = [str(CASES / "paper_lx1e-4.nml"), "--fix", "t_end=0.05", "--fix", "n_out=401",
+            "--quiet"]
+    assert main(["sweep", *args, "--set", "speed_rpm=nan,nan", "--out", str(tmp_path / "a")]) == 0
+    ds = pyspline.open_sweep(tmp_path / "a")
+    assert ds.attrs["n_failed"] == 2 and (ds["error_class"] == "CaseError").all()
+    assert sorted(p.name for p in (tmp_path / "a").iterdir()) == ["points", "sweep.nc"]
+    assert main(["sweep", *args, "--set", "speed_rpm=-5,6000", "--out", str(tmp_path / "b")]) == 0
+    assert pyspline.open_sweep(tmp_path / "b").attrs["n_ok"] == 1
+    _png(tmp_path / "b" / "waterfall.png")
+
+
+def test_fix_takes_array_fields():
+    """--fix ripple_amp=0.1,0,0,0 sets the array; a per-tooth list may be shorter; a scalar
+    field still takes one value."""
+    from pyspline.cli import _fixed
+    fixed = _fixed(["ripple_amp=0.1,0,0,0", "spacing_error=1e-6,-1e-6"])
+    assert fixed["ripple_amp"] == [0.1, 0.0, 0.0, 0.0]
+    case = pyspline.load_case(CASES / "paper_lx1e-4.nml", **fixed)
+    assert case["ripple_amp"] == [0.1, 0.0, 0.0, 0.0]
+    assert case["spacing_error"][:3] == [1e-6, -1e-6, 0.0]
+    with pytest.raises(pyspline.CaseError, match="one value expected"):
+        _fixed(["l_x=0,1e-4"])
+
+
+def test_to_xarray_carries_the_sliced_face():
+    """n_slices > 1: face (time, tooth, slice) and tilt (time, moment) as the Result has them."""
+    res = pyspline.simulate(pyspline.load_case(CASES / "physical_tilt.nml", t_end=0.01,
+                                               n_out=11))
+    ds = res.to_xarray()
+    assert ds["face"].dims == ("time", "tooth", "slice") and ds["face"].attrs["units"] == "N"
+    assert np.array_equal(ds["face"].values, res.face) and ds.sizes["slice"] == 8
+    assert np.array_equal(ds["tilt"].values, res.tilt) and ds["tilt"].attrs["units"] == "N m"
+    assert ds["moment"].values.tolist() == ["M_x", "M_y"]
+
+
+@pytest.mark.parametrize("command", [
+    ["run", "CASE"], ["sweep", "CASE", "--set", "l_x=0,1e-4"], ["merge", "x.summary"],
+    ["continue", "CASE", "--field", "speed_rpm", "--start", "10", "--stop", "20"],
+    ["sweep", "CASE", "--set", "l_x=0,1e-4", "--follow", "up"], ["plot", "CASE"]])
+def test_every_writing_command_checks_its_out_before_running(tmp_path, monkeypatch, capsys,
+                                                           command):
+    """--out onto a file, or under one (a path that cannot be made): exit 2 naming the path,
+    before anything is read or run."""
+    from pyspline import cli
+    def never(*a, **k):
+        raise AssertionError("ran before the output was checked")
+    monkeypatch.setattr(cli, "load_case", never)
+    monkeypatch.setattr(cli, "sweep", never)
+    monkeypatch.setattr(pyspline.core, "simulate", never)
+    monkeypatch.setattr(sys.modules["pyspline.batch"], "merge", never)
+    monkeypatch.setattr(sys.modules["pyspline.continuation"], "continuation", never)
+    afile = tmp_path / "afile"
+    afile.write_text("mine\n")
+    argv = [str(CASES / "paper_lx1e-4.nml") if a == "CASE" else a for a in command]
+    for out, why in ((afile, "exists and is not a directory"),
+                     (afile / "sub", f"cannot be made: {afile} is not a directory")):
+        assert cli.main([*argv, "--out", str(out)]) == 2
+        assert f"--out {out}: {why}" in capsys.readouterr().err
+    assert afile.read_text() == "mine\n"

@@ -48,7 +48,8 @@ def one(msgs, kind) -> str:
 
 def closed_forms(case) -> dict:
     """The numbers each warning tests, from the case's fields by the formulas of docs/model.md
-    (independent of the core's code): the supports' share of the offset, the shafts' wind-up,
+    (independent of the core's code): the offset the supports leave at the mesh over the static
+    tooth deflection (seen; inf where the warning does not apply), the shafts' wind-up,
     the largest tooth overlap at a start from rest, the static tooth deflection / module."""
     g = case.get
     with warnings.catch_warnings():
@@ -56,10 +57,14 @@ def closed_forms(case) -> dict:
         stiff = ps.mesh_stiffness(case)
         c = ps.load(case).info()["c_bulk"]
     z, alpha = g("z"), math.radians(g("alpha_deg"))
+    r_b = g("module_m") * z / 2 * math.cos(alpha)
     k_mesh = z * stiff["k_m_used"] / 2
     k_s = 1 / (1 / g("k_p1") + 1 / g("k_p2")) if min(g("k_p1"), g("k_p2")) > 0 else 0.0
     l = math.hypot(g("l_x"), g("l_y"))
-    share = k_mesh / (k_mesh + k_s) if (g("dof") == 7 and l > c and k_s > 0) else 0.0
+    # the offset the supports leave at the mesh, against the static tooth deflection
+    e = l * k_s / (k_mesh + k_s)
+    delta = abs(g("t_d")) / (z * r_b * stiff["k_m_used"])
+    seen = e / delta if (g("dof") == 7 and k_s > 0 and delta > 0 and l > delta) else math.inf
     windup = max(abs(g("t_d")) / g("k_t1") if g("k_t1") > 0 else 0.0,
                  abs(g("t_l")) / g("k_t2") if g("k_t2") > 0 else 0.0)
     overlap = -1.0
@@ -72,16 +77,15 @@ def closed_forms(case) -> dict:
                         for j in range(1, z + 1))]
         j = max(range(z), key=lambda i: dn[i])
         overlap = dn[j] - c
-    r_b = g("module_m") * z / 2 * math.cos(alpha)
     force = max(abs(g("t_d")), abs(g("t_l"))) / (z * r_b)
     deflection = force / stiff["k_m"] if stiff["k_m"] > 0 else 0.0
-    return dict(share=share, k_s=k_s, windup=windup, overlap=overlap, c=c, force=force,
+    return dict(seen=seen, e=e, delta=delta, l=l, k_s=k_s, windup=windup, overlap=overlap, c=c, force=force,
                 deflection=deflection, rel=deflection / g("module_m"))
 
 
 def expected_kinds(case) -> set[str]:
     f = closed_forms(case)
-    return {k for k, on in (("supports", f["share"] > 0.5), ("windup", f["windup"] > 0.2),
+    return {k for k, on in (("supports", f["seen"] <= 0.1), ("windup", f["windup"] > 0.2),
                             ("start", f["overlap"] > 0), ("load", f["rel"] > 0.05)) if on}
 
 
@@ -89,13 +93,45 @@ def test_supports_taking_the_offset():
     case = ps.load_case(EXAMPLE)
     f = closed_forms(case)
     msg = one(messages(EXAMPLE), "supports")
-    assert f["share"] > 0.999                              # 5e6 N/m against Z k_m / 2 ~ 8e9
+    assert f["seen"] < 0.1                                 # 5e6 N/m against Z k_m / 2 ~ 8e9
     for number in ("k_p1 = 5.000E+06", "k_p2 = 5.000E+06", f"{f['k_s']:.3E} N/m",
-                   f"{100 * f['share']:.3f} %", f"{80e-6 - 60e-6:.3E} m", "(limit 50 %)"):
+                   f"e = {f['e']:.3E} m", f"|l| = {f['l']:.3E} m", f"{100 * f['seen']:.4f} %",
+                   f"= {f['delta']:.3E} m", "(limit 10 %)", f"factor to 1 + e / delta = {1 + f['seen']:.4f}"):
         assert number in msg, (number, msg)
     assert "supports" not in kinds(messages(dict(EXAMPLE, k_p1=1e12, k_p2=1e12)))
-    assert "supports" not in kinds(messages(dict(EXAMPLE, l_x=50e-6)))   # within the backlash
+    assert "supports" not in kinds(messages(dict(EXAMPLE, l_x=0.4e-6)))  # below the deflection
     assert "supports" not in kinds(messages(dict(EXAMPLE, dof=3)))       # lateral frozen
+    assert "supports" not in kinds(messages(dict(EXAMPLE, t_d=0.0)))     # no static deflection
+    # within the backlash too: under torque the mesh resists the offset from zero
+    assert "supports" in kinds(messages(dict(EXAMPLE, l_x=50e-6)))
+
+
+#: The issue's aero spline from its equilibrium (the start warning aside), stiff shafts: on the
+#: paper's 5e6 N/m supports and on 2e8 N/m, the issue's, where the run's load-sharing factor is
+#: 4.6 with 17 of 26 teeth free.
+AERO = dict(EXAMPLE, name="aero", start="equilibrium", k_t1=1e5, k_t2=1e5, t_end=0.02,
+            n_out=801)
+
+
+@pytest.mark.parametrize("k_p", [5e6, 2e8])
+def test_support_warning_agrees_with_the_runs_load_sharing(k_p):
+    """The support warning says the teeth barely see the misalignment exactly when the run's
+    load-sharing factor is near 1: on soft supports it fires, and the run's factor is its
+    1 + e / delta (full contact: e below delta, tooth loads F0 (1 + (e / delta) sin)); on the
+    issue's 2e8 N/m it is silent, and the run's factor is far above 1 with teeth free."""
+    fields = dict(AERO, k_p1=k_p, k_p2=k_p)
+    f = closed_forms(ps.load_case(fields))
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        loads = ps.simulate(fields).loads
+    got = kinds([str(w.message) for w in rec if issubclass(w.category, ps.SplineWarning)])
+    if k_p == 5e6:
+        assert "supports" in got and f["seen"] < 0.1
+        assert loads["load_sharing"] == pytest.approx(1 + f["seen"], rel=1e-3)
+        assert loads["teeth_free_mean"] == 0
+    else:
+        assert "supports" not in got and f["seen"] > 1
+        assert loads["load_sharing"] > 4 and loads["teeth_free_mean"] > 15
 
 
 def test_shaft_windup():
@@ -156,10 +192,11 @@ def test_plausible_input_warns_nothing():
 
 
 #: What the constructed demonstration scenes raise, and why (their header comments say so):
-#: rattle_z24 keeps the paper's shafts (k_T 7.855 N m/rad); chaos_z24 also the paper's supports
-#: (k_p 5e6 N/m) and starts from rest with its offset twice the backlash. Their physics is the
+#: rattle_z24 keeps the paper's shafts (k_T 7.855 N m/rad) and supports; chaos_z24 also
+#: (k_p 5e6 N/m) and starts from rest with its offset twice the backlash (under its light 2 N m the
+#: supports leave the mesh far more than a tooth deflection: no support warning). Their physics is the
 #: measured one of the chaos and benchmark scenes (tests/test_chaos.py, bench/), kept as it is.
-DEMONSTRATION = {"rattle_z24": {"windup"}, "chaos_z24": {"supports", "windup", "start"}}
+DEMONSTRATION = {"rattle_z24": {"windup", "supports"}, "chaos_z24": {"windup", "start"}}
 
 
 @pytest.mark.parametrize("path", sorted(CASES.glob("*.nml")), ids=lambda p: p.stem)
@@ -174,7 +211,9 @@ def test_shipped_cases_raise_what_their_fields_call_for(path):
     assert got - {"k_m"} == expected_kinds(case), msgs
     for kind in got:
         one(msgs, kind)
-    if path.stem.startswith("physical_"):
+    if path.stem == "physical_z24":       # the paper's 5e6 N/m supports hold its 50 um offset
+        assert got == {"supports"}, msgs
+    elif path.stem.startswith("physical_"):
         assert msgs == []
     elif path.stem in DEMONSTRATION:
         assert got == DEMONSTRATION[path.stem], msgs
@@ -185,7 +224,7 @@ def test_shipped_cases_raise_what_their_fields_call_for(path):
 def test_executable_prints_the_same_lines(exe, tmp_path):
     fields = dict(EXAMPLE, t_d=150e3, t_l=150e3)
     py = messages(fields)
-    assert kinds(py) == {"supports", "windup", "start", "load"}
+    assert kinds(py) == {"windup", "start", "load"}   # 150 kN m: the offset within a deflection
     path = tmp_path / "real_spline.nml"
     ps.load_case(fields).to_namelist(path)
     run = subprocess.run([exe, str(path), "-o", str(tmp_path / "out.csv")], capture_output=True,

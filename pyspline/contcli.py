@@ -1,0 +1,115 @@
+"""`pyspline continue`: the command line of pyspline.continuation (docs/continuation.md)."""
+from __future__ import annotations
+
+import numpy as np
+
+from .case import load_case
+from .continuation import continuation, parse_field
+from .errors import CaseError
+
+
+CONTINUE_HELP = """\
+Follow the period-n orbit of CASE in one real field from --start to --stop by pseudo-arclength
+continuation, through stable and unstable parts; locate folds (a multiplier through +1),
+period doublings (through -1; the doubled branch is followed too), Neimark-Sacker points (a
+complex pair through the unit circle) and grazing (a tooth's contact sequence changes).
+
+Writes into --out DIR:
+  DIR/continuation.nc          the branch points and special points (xarray.open_dataset(
+                               path, engine='h5netcdf'); docs/continuation.md)
+  DIR/frequency_response.png   --measure (T_m peak-to-peak) against the field: stable solid,
+                               unstable dashed, special points marked; with --sweep N the
+                               runs of a follow-up and follow-down sweep of N points over it
+  DIR/sweep.nc                 with --sweep N: that sweep
+Prints one line per special point. Exit status: README's (CaseError 2, SolverError 3); 1 when
+the branch could not be followed to --stop (the points so far are written, with where and why
+it stopped: attrs['status'] and the last line on stderr) or no orbit was found at --start.
+
+example: pyspline continue cases/physical_ripple.nml --field speed_rpm --start 5000 --stop 7000
+"""
+
+
+def cmd_continue(args, fixed, exit_code) -> int:
+    import sys
+    from pathlib import Path
+    from .dataset import write_netcdf
+    from .errors import SplineError
+    from .frplots import MEASURES, frequency_response
+    out = Path(args.out)
+    try:
+        case = load_case(args.case, **fixed(args.fix))
+        command = " ".join(["pyspline", "continue", args.case, f"--field={args.field}",
+                            f"--start={args.start:g}", f"--stop={args.stop:g}", f"--n={args.n}"])
+        name, index = parse_field(case, args.field)
+        if args.sweep < 0 or args.sweep == 1:
+            raise CaseError(f"--sweep {args.sweep}: the follow sweep's number of points, >= 2 "
+                            "(0: no sweep)")
+        if args.sweep and index is not None:
+            raise CaseError(f"--sweep: a follow sweep runs whole fields; {args.field} is "
+                            "one element of an array field")
+        ds = continuation(case, args.field, args.start, args.stop, n=args.n, ds=args.ds,
+                          max_points=args.max_points, tol=args.tol, progress=not args.quiet,
+                          command=command)
+        sw = None
+        if args.sweep:
+            from .sweep import sweep
+            sw = sweep(case, progress=not args.quiet, follow="both", spectrum=False,
+                       **{name: np.linspace(args.start, args.stop, args.sweep)})
+    except SplineError as exc:
+        print(f"error: {type(exc).__name__}: {' '.join(str(exc).split())}", file=sys.stderr)
+        return exit_code(exc)
+    write_netcdf(ds, out / "continuation.nc")
+    label = ds.attrs["field"]
+    print(f"{ds.attrs['n_points']} points on {ds.attrs['n_branches']} branch(es), "
+          f"{int(ds.stable.sum())} stable, in {ds.attrs['wall_s']:.1f} s")
+    for i in range(ds.sizes["special"]):
+        kind = str(ds.special_type.values[i])
+        mu = complex(ds.special_mu_real[i], ds.special_mu_imag[i])
+        what = (f"closest approach {float(ds.special_closest_approach[i]):.3g} m" if kind ==
+                "grazing" else f"critical multiplier {mu:.4f}")
+        print(f"{kind:16s} {label} = {float(ds[f'special_{label}'][i]):.6g}  period "
+              f"{int(ds.special_n[i])}  {what}  {MEASURES['Tm_pp'][0]} "
+              f"{float(ds.special_Tm_pp[i]):.4g} N m"
+              + ("" if ds.special_smooth[i] else "  (non-smooth: the multiplier jumped across)"))
+    print(f"wrote {out / 'continuation.nc'}")
+    if sw is not None:
+        write_netcdf(sw, out / "sweep.nc")
+        print(f"wrote {out / 'sweep.nc'}")
+    path = out / "frequency_response.png"
+    frequency_response(ds, args.measure, sweep=sw, path=path,
+                       title=f"{case.name}: {MEASURES[args.measure][0]} of the periodic orbits "
+                             f"vs {label}" + (", follow sweeps up and down" if sw else "")
+                             + ("" if ds.attrs["status"] == "complete" else
+                                f" (stopped at {label} = {float(ds[label][-1]):.6g})"))
+    print(f"wrote {path}")
+    if ds.attrs["status"] != "complete":
+        print(f"stopped: {ds.attrs['status']}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def add_continue(sub, fixed, exit_code) -> None:
+    """The `continue` subcommand (pyspline/cli.py)."""
+    import argparse
+    r = sub.add_parser("continue", help="follow a periodic orbit in one field (pseudo-arclength "
+                       "continuation): continuation.nc and frequency_response.png in --out",
+                       description=CONTINUE_HELP,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    r.add_argument("case", metavar="CASE", help="case file (namelist)")
+    r.add_argument("--field", required=True, help="the field: speed_rpm, t_d, l_x, "
+                   "ripple_amp (its first element), ripple_amp(2), unbalance(1), ...")
+    r.add_argument("--start", type=float, required=True, help="the field's first value")
+    r.add_argument("--stop", type=float, required=True, help="the field's last value")
+    r.add_argument("--n", type=int, default=1, help="shaft revolutions of the period (default 1)")
+    r.add_argument("--ds", type=float, default=0.05, help="first arclength step (default 0.05)")
+    r.add_argument("--max-points", type=int, default=200, help="most branch points (200)")
+    r.add_argument("--tol", type=float, help="corrector residual, scaled (default 100 rtol)")
+    r.add_argument("--measure", choices=("Tm_pp", "F_max", "D2_pp"), default="Tm_pp",
+                   help="response measure of the figure (default Tm_pp)")
+    r.add_argument("--sweep", type=int, default=0, metavar="N",
+                   help="also a follow-up and follow-down sweep of N points, overlaid")
+    r.add_argument("--fix", action="append", metavar="FIELD=VALUE",
+                   help="change a field of the case (e.g. rtol=1e-9)")
+    r.add_argument("--out", default=".", metavar="DIR", help="output directory (default .)")
+    r.add_argument("--quiet", action="store_true", help="no progress bar")
+    r.set_defaults(func=lambda a: cmd_continue(a, fixed, exit_code))

@@ -1,0 +1,162 @@
+"""Continuation on a 7-DOF drive with clearance (docs/continuation.md): the paper's Z = 16
+spline in bending-torsion (dof 7) with shafts of k_t = 1000 N m/rad, a mesh damping ratio of
+0.01 per tooth pair and a torque ripple of 25 % at order 1 near the mesh resonance (40 Hz:
+2400 r/min). Over 2200-2500 r/min its response is an S-curve: the full-contact branch opens
+the teeth at a grazing, folds back unstable, then folds again onto an upper branch that loses
+contact every revolution. rtol 1e-8 (the folds move by 1e-5 r/min from rtol 1e-9, the S-curve
+takes half the time). Held against the closed-form full-contact response, follow sweeps
+at 1 r/min steps and the multipliers' meaning."""
+import importlib
+import warnings
+
+import numpy as np
+import pytest
+
+import pyspline
+from conftest import CASES
+from test_continuation import forced_response
+from test_orbits import scale_of
+
+DRIVE = pyspline.load_case(CASES / "paper_ideal.nml", start="equilibrium", rtol=1e-8,
+                           atol=1e-10, t_end=0.05, n_out=201, roots=True, dof=7,
+                           k_t1=1e3, k_t2=1e3, zeta_m=0.01, ripple_order=[1, 0, 0, 0],
+                           ripple_amp=[0.25, 0, 0, 0])
+BAND = (2200.0, 2500.0)
+
+
+def continued(method, **kw):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", pyspline.SplineWarning)   # complete: no warning
+        return pyspline.continuation(DRIVE.replace(method=method), "speed_rpm", *BAND,
+                                     progress=False, **kw)
+
+
+def grazing_closed_form():
+    """The speed at which the closed-form full-contact response's smallest tooth force
+    reaches zero: the swing of D2 reaches the static contact deflection |D2_eq| - c0 (every
+    tooth at once in the aligned drive)."""
+    def margin(p):
+        y_eq, Y, _ = forced_response(DRIVE, p, 1.0, 0.25)
+        return abs(y_eq[5]) - DRIVE["c0"] - abs(Y[5])
+    lo, hi = BAND
+    assert margin(lo) > 0 > margin(hi)
+    for _ in range(40):
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if margin(mid) > 0 else (lo, mid)
+    return lo
+
+
+@pytest.mark.parametrize("method", ["bdf", "adams", "erk"])
+def test_full_contact_branch_is_the_closed_form(method):
+    """Below the grazing every tooth stays in contact: over 1800-2400 r/min each point of the
+    branch is the closed-form forced response y_eq + Re Y(omega), with every integrator."""
+    ds = pyspline.continuation(DRIVE.replace(method=method), "speed_rpm", 1800, 2400,
+                               progress=False)
+    assert ds.attrs["status"] == "complete" and ds.attrs["n_special"] == 0
+    assert ds.speed_rpm[-1] == pytest.approx(2400, rel=1e-12) and ds.attrs["n_points"] >= 5
+    s = scale_of(DRIVE)
+    for p, y0 in zip(ds.speed_rpm.values, ds.y0.values):
+        y_eq, Y, _ = forced_response(DRIVE, p, 1.0, 0.25)
+        err = np.abs((y0 - (y_eq + Y.real)) / s).max()
+        assert err < 1e-4 * np.abs(Y / s).max(), (p, err)
+    assert (ds.switches == 0).all() and ds.stable.all()
+
+
+@pytest.fixture(scope="module", params=["adams", "auto"])
+def s_curve(request):
+    """The whole S-curve over the band from one call: the case's own method (paper_ideal's
+    Adams) and 'auto' (which picks Adams for a given k_m too, by its own rule)."""
+    return continued(request.param)
+
+
+@pytest.fixture(scope="module")
+def follow_sweeps():
+    """Follow sweeps up and down over the hysteresis at 1 r/min steps: (speeds, T_m
+    peak-to-peak (direction, speed)). Up from 2340 (below the lower fold: one orbit), down
+    from 2450 (above the upper fold: one orbit)."""
+    speeds = np.arange(2340.0, 2451.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        sw = pyspline.sweep(DRIVE.replace(t_end=0.3, t_transient=0.2, n_out=401),
+                            speed_rpm=speeds, follow="both", progress=False, spectrum=False)
+    assert (sw.error == "").all()
+    return speeds, (sw.Tm_max - sw.Tm_min).values
+
+
+def folds(ds):
+    return np.sort(ds.special_speed_rpm.values[ds.special_type.values == "fold"])
+
+
+def test_s_curve_folds_where_the_follow_sweeps_jump(s_curve, follow_sweeps):
+    """Two folds, each with a multiplier at +1, within 0.5 % of where the follow sweeps jump
+    (up: off the full-contact branch at the upper fold; down: off the contact-loss branch at
+    the lower fold); the branch is traced from start to stop and turns back only there."""
+    ds = s_curve
+    lo, hi = folds(ds)
+    speeds, pp = follow_sweeps
+    up = speeds[np.argmax(np.diff(pp[0])) + 1]      # the first speed on the upper branch
+    down = speeds[np.argmax(np.diff(pp[1]))]        # the last speed on the lower branch
+    assert hi == pytest.approx(up, rel=5e-3) and lo == pytest.approx(down, rel=5e-3)
+    assert down < lo < hi < up, (down, lo, hi, up)
+    p = ds.speed_rpm.values
+    assert p[0] == BAND[0] and p[-1] == pytest.approx(BAND[1], rel=1e-12)
+    turns = p[np.flatnonzero(np.diff(np.sign(np.diff(p)))) + 1]
+    assert len(turns) == 2 and np.allclose(turns, [hi, lo], atol=0.5)
+    sp = ds.special_type.values == "fold"
+    mu = ds.special_mu_real.values[sp] + 1j * ds.special_mu_imag.values[sp]
+    assert np.abs(mu - 1).max() < 1e-3 and (ds.special_smooth.values[sp] == 1).all()
+
+
+def test_s_curve_grazing_where_the_closed_form_opens_a_tooth(s_curve):
+    """The first grazing is where the closed-form full-contact response's smallest tooth
+    force reaches zero; the full-contact branch below it, contact lost every revolution on
+    the upper branch."""
+    ds = s_curve
+    first = list(ds.special_type.values).index("grazing")
+    assert float(ds.special_speed_rpm[first]) == pytest.approx(grazing_closed_form(), abs=0.1)
+    p, sw = ds.speed_rpm.values, ds.switches.values
+    i_hi = np.flatnonzero(np.diff(p) < 0)[0]      # the upper fold
+    assert (sw[:i_hi][p[:i_hi] < grazing_closed_form() - 0.5] == 0).all()
+    assert (sw[-5:] > 0).all()
+
+
+def test_s_curve_middle_branch_has_a_real_multiplier_beyond_one(s_curve):
+    """Between the folds (along the branch) the orbit is a saddle: a real multiplier > +1;
+    stable before the first fold and after the second."""
+    ds = s_curve
+    p, stable = ds.speed_rpm.values, ds.stable.values.astype(bool)
+    i1, i2 = np.flatnonzero(np.diff(np.sign(np.diff(p)))) + 1
+    mu = ds.mu_real.values + 1j * ds.mu_imag.values
+    for i in range(i1 + 1, i2):
+        real = mu[i][np.abs(mu[i].imag) < 1e-9]
+        assert real.real.max() > 1 + 1e-4, (p[i], mu[i])
+    assert stable[:i1 - 1].all() and not stable[i1 + 1:i2].any() and stable[i2 + 1:].all()
+
+
+def test_a_step_onto_another_branch_is_rejected(monkeypatch):
+    """Inside the hysteresis two orbits coexist. A corrector made to converge on the upper
+    branch's orbit (as a long step across a fold can) lands far from its predictor: the step is rejected (attrs['rejected_jumps']), halved, and the full-contact
+    branch is still traced from start to stop; without the check the branch would go on along
+    the upper one (contact lost every revolution)."""
+    cont = importlib.import_module("pyspline.continuation")   # the module, not the function
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        # above the upper fold one orbit: a 1 s run from the equilibrium settles on it
+        upper = pyspline.continuation(DRIVE.replace(t_end=1.0), "speed_rpm", 2500, 2400,
+                                      progress=False)
+    assert upper.attrs["status"] == "complete" and (upper.switches > 0).all()
+    y_up = upper.y0.values[-1]
+    original, jumped = cont._Branch.correct, []
+
+    def onto_the_upper_branch(self, u_pred, row, target):
+        if not jumped and 2395 < self.prob.p_of(u_pred[-1]) < 2415:
+            jumped.append(u_pred[-1])       # converges on the upper orbit at 2400 r/min
+            q = (2400 - self.prob.p0) / self.prob.pscale
+            u_pred, row, target = np.r_[(y_up / self.prob.d0)[self.prob.free], q], 0 * row, q
+            row[-1] = 1
+        return original(self, u_pred, row, target)
+    monkeypatch.setattr(cont._Branch, "correct", onto_the_upper_branch)
+    ds = pyspline.continuation(DRIVE, "speed_rpm", 2380, 2420, progress=False)
+    assert jumped and ds.attrs["rejected_jumps"] == 1
+    assert ds.attrs["status"] == "complete" and ds.speed_rpm[-1] == pytest.approx(2420, rel=1e-12)
+    assert (ds.switches == 0).all() and np.all(np.diff(ds.speed_rpm) > 0)
