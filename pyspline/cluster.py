@@ -46,7 +46,7 @@ def local_dask_client(n_workers: int = 2, processes: bool = True, **kwargs):
         instead of 1-2 s and need no guard, but Dask's event loop then shares the GIL and the
         cores with them: on sweeps of cheap points (5 ms each, 2 cores) they scaled less than
         worker processes in five of six runs: medians of 1.47-1.66x against 1.57-1.92x
-        (docs/performance.md, sessions 9 and 10).
+        (docs/performance.md, "What Dask costs").
     kwargs : passed to LocalCluster (e.g. dashboard_address=':8787' to watch the sweep: the
         dashboard needs bokeh)."""
     import multiprocessing

@@ -1,54 +1,71 @@
 #!/usr/bin/env bash
-# Install the toolchain (gfortran, SUNDIALS 6.4 with its Fortran 2003 modules) and the Python
-# packages, build an optimised CVODE and ARKODE, then build and install pyspline (the f2py extension and
-# the spline-dyn executable).
+# Set up a Debian 12 machine for pyspline and install it: the toolchain (gfortran, cmake, reference
+# LAPACK), an optimised CVODE and ARKODE built from Debian's SUNDIALS source package, the Python
+# packages, then pyspline itself (the f2py extension and the spline-dyn executable).
+# `--tests` adds what only the tests use: pytest, pytest-xdist, hypothesis, f90nml, the
+# cross-checks and peers (ROSS, numba, numbalsoda, dask-jobqueue) and Debian's CVODE and ARKODE
+# runtime libraries (tests/test_build.py: the optimised build gives Debian's numbers bit for bit).
+# One line per step; each step's output goes to $log, whose tail is printed if a step fails.
 #
-# Why build CVODE and ARKODE: Debian 12's SUNDIALS 6.4.1 libraries are compiled without optimisation
-# (debian/rules sets CMAKE_C_FLAGS=-fcommon, which replaces the -O2 of dpkg-buildflags, and
-# no CMAKE_BUILD_TYPE), and CVODE's own work per step is most of a run. So this script takes
-# Debian's source package of the same version (apt-get source) and builds CVODE, ARKODE (ERKStep,
-# method = 'erk') and their Fortran modules optimised (C: -O3 -fno-semantic-interposition) into $PYSPLINE_SUNDIALS (~1 min,
-# once; default under ~/.cache; a prefix without ARKODE, from an older setup.sh, is rebuilt). Same version, same numbers: on x86-64 without -march the
-# compiler contracts no FMAs and reassociates no sums, so results are bit-identical to the
-# Debian build (tests/test_build.py); a run is up to 2.4x faster at -O2, and -O3 took another
-# 11 % off a paper_lx1e-4 point (docs/building.md). If the source cannot be had, pyspline is built on Debian's libraries, with a warning.
-# PYSPLINE_SUNDIALS=system skips the build.
+# Why build CVODE and ARKODE: Debian 12's SUNDIALS 6.4.1 libraries are compiled without
+# optimisation (debian/rules' CMAKE_C_FLAGS=-fcommon replaces dpkg-buildflags' -O2), and CVODE's
+# own work per step is most of a run. The source of the same version builds optimised (C: -O3
+# -fno-semantic-interposition) into $PYSPLINE_SUNDIALS (default under ~/.cache; once): same
+# version, same numbers, up to 2.4x faster (docs/building.md). Only if the source cannot be had,
+# Debian's libsundials-dev and libsundials-fortran-dev (with their MPI/PETSc chain) are installed
+# and pyspline is built on them, with a warning. PYSPLINE_SUNDIALS=system takes that route.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+tests=0; [ "${1:-}" = "--tests" ] && tests=1
 SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
-need=()
-for pkg in gfortran libsundials-dev libsundials-fortran-dev liblapack-dev libblas-dev cmake; do
-  dpkg -s "$pkg" >/dev/null 2>&1 || need+=("$pkg")
-done
-if [ ${#need[@]} -gt 0 ]; then
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${need[@]}"
+log="$(mktemp -t pyspline-setup.XXXXXX.log)"
+step() {   # step "what" command...: one line, the command's output in $log
+  local what="$1" t0=$SECONDS; shift
+  printf 'setup: %s ... ' "$what"
+  if "$@" >>"$log" 2>&1; then echo "done ($((SECONDS - t0)) s)"
+  else echo "FAILED (the last lines of $log:)"; tail -20 "$log" >&2; return 1; fi
+}
+apt_install() {
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "$@"
+}
+pip_install() { python3 -m pip install -q --disable-pip-version-check "$@"; }
+
+need=(); update=0
+pkgs=(gfortran cmake liblapack-dev libblas-dev)
+[ $tests = 1 ] && pkgs+=(libsundials-cvode6 libsundials-arkode5)
+for pkg in "${pkgs[@]}"; do dpkg -s "$pkg" >/dev/null 2>&1 || need+=("$pkg"); done
+
+prefix="${PYSPLINE_SUNDIALS:-}"
+built() { [ -f "$1/fortran/fcvode_mod.mod" ] && [ -f "$1/fortran/farkode_erkstep_mod.mod" ]; }
+add_deb_src() {   # Debian's source package needs a deb-src entry for the binaries' archive
+  apt-get source --download-only --print-uris sundials >/dev/null 2>&1 && return 0
+  sed -n 's/^Types: deb$/Types: deb-src/p; /^URIs:/p; /^Suites:/p; /^Components:/p; /^Signed-By:/p' \
+    /etc/apt/sources.list.d/debian.sources 2>/dev/null | head -5 \
+    | $SUDO tee /etc/apt/sources.list.d/pyspline-deb-src.sources >/dev/null
+}
+sundials_version() {   # the installed libsundials-dev's, else the archive's
+  dpkg-query -W -f='${Version}' libsundials-dev 2>/dev/null \
+    || apt-cache show --no-all-versions libsundials-dev 2>/dev/null | sed -n 's/^Version: //p'
+}
+cache="${XDG_CACHE_HOME:-$HOME/.cache}/pyspline"
+version="$(sundials_version || true)"
+if [ "$prefix" != system ] && { [ -z "$version" ] || ! built "${prefix:-$cache/sundials-$version-O3-arkode}"; }; then
+  add_deb_src || true
+  update=1   # the package lists, with the deb-src entry
 fi
-python3 -m pip install -q --disable-pip-version-check \
-  "numpy>=2.0" meson meson-python ninja pytest hypothesis matplotlib scipy f90nml tqdm \
-  xarray "h5netcdf[h5py]" distributed
+updated=0
+apt_update() { [ $updated = 1 ] || step "apt-get update" $SUDO apt-get update -qq; updated=1; }
+if [ $update = 1 ] || [ ${#need[@]} -gt 0 ]; then
+  apt_update
+  version="$(sundials_version)"
+fi
+if [ ${#need[@]} -gt 0 ]; then step "apt-get install ${need[*]}" apt_install "${need[@]}"; fi
+[ -z "$prefix" ] && prefix="$cache/sundials-$version-O3-arkode"
 
-# Test-only cross-checks and benchmark peers (never imported by the package): ROSS (an
-# independent potential-energy stiffness; 2.3 needs plotly < 6), numba + numbalsoda (the
-# compiled-LSODA peer of bench/numba_peer.py), dask-jobqueue (tests/test_batch.py renders the
-# SLURMCluster job script of docs/building.md).
-python3 -m pip install -q --disable-pip-version-check ross-rotordynamics "plotly<6" numba numbalsoda \
-  dask-jobqueue
-
-# The source of exactly the installed version: same interface, same numbers.
-version="$(dpkg-query -W -f='${Version}' libsundials-dev)"
-prefix="${PYSPLINE_SUNDIALS:-${XDG_CACHE_HOME:-$HOME/.cache}/pyspline/sundials-$version-O3-arkode}"
 build_sundials() {
   local work src
   work="$(mktemp -d)"
-  # Debian's source package needs a deb-src entry for the same archive as the binaries.
-  if ! apt-get source --download-only --print-uris sundials >/dev/null 2>&1; then
-    sed -n 's/^Types: deb$/Types: deb-src/p; /^URIs:/p; /^Suites:/p; /^Components:/p; /^Signed-By:/p' \
-      /etc/apt/sources.list.d/debian.sources 2>/dev/null | head -5 \
-      | $SUDO tee /etc/apt/sources.list.d/pyspline-deb-src.sources >/dev/null || return 1
-    $SUDO apt-get update -qq || return 1
-  fi
-  (cd "$work" && apt-get source --download-only -qq "sundials=$version") >/dev/null 2>&1 || return 1
+  (cd "$work" && apt-get source --download-only -qq "sundials=$version") || return 1
   tar -xf "$work"/sundials_*.orig.tar.* -C "$work" || return 1
   src="$(ls -d "$work"/sundials-*/ | head -1)"
   cmake -S "$src" -B "$work/build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
@@ -57,18 +74,32 @@ build_sundials() {
     -DBUILD_ARKODE=ON -DBUILD_CVODES=OFF -DBUILD_IDA=OFF -DBUILD_IDAS=OFF -DBUILD_KINSOL=OFF \
     -DBUILD_STATIC_LIBS=OFF -DEXAMPLES_ENABLE_C=OFF -DEXAMPLES_ENABLE_F2003=OFF \
     -DEXAMPLES_INSTALL=OFF -DCMAKE_INSTALL_PREFIX="$prefix" \
-    -DCMAKE_INSTALL_RPATH="$prefix/lib" -DCMAKE_INSTALL_LIBDIR=lib >"$work/cmake.log" 2>&1 \
-    && cmake --build "$work/build" -j 2 >>"$work/cmake.log" 2>&1 \
-    && cmake --install "$work/build" >>"$work/cmake.log" 2>&1 \
-    || { tail -20 "$work/cmake.log" >&2; return 1; }
+    -DCMAKE_INSTALL_RPATH="$prefix/lib" -DCMAKE_INSTALL_LIBDIR=lib \
+    && cmake --build "$work/build" -j 2 && cmake --install "$work/build" || return 1
   rm -rf "$work"
 }
-setup_args=()
-if [ "$prefix" != "system" ]; then
-  if [ ! -f "$prefix/fortran/fcvode_mod.mod" ] || [ ! -f "$prefix/fortran/farkode_erkstep_mod.mod" ]; then
-    echo "setup: building optimised CVODE and ARKODE $version into $prefix (Debian's build is unoptimised)"
-    build_sundials || { echo "setup: WARNING: could not build CVODE and ARKODE; using Debian's unoptimised SUNDIALS (same numbers, ~2.4x slower)" >&2; prefix=system; }
+# ninja for SUNDIALS' cmake build and for meson
+step "pip: build tools and pyspline's packages" pip_install "numpy>=2.0" meson meson-python \
+  ninja matplotlib scipy tqdm xarray "h5netcdf[h5py]" distributed
+if [ "$prefix" != system ] && ! built "$prefix"; then
+  if ! step "building optimised CVODE and ARKODE $version into $prefix" build_sundials; then
+    echo "setup: WARNING: could not build CVODE and ARKODE; using Debian's unoptimised SUNDIALS (same numbers, ~2.4x slower)" >&2
+    prefix=system
   fi
-  [ "$prefix" != "system" ] && setup_args=("-Csetup-args=-Dsundials_prefix=$prefix")
 fi
-python3 -m pip install -q --disable-pip-version-check --no-build-isolation "${setup_args[@]}" .
+setup_args=()
+if [ "$prefix" = system ]; then
+  if ! dpkg -s libsundials-fortran-dev >/dev/null 2>&1; then
+    apt_update
+    step "apt-get install Debian's SUNDIALS" apt_install libsundials-dev libsundials-fortran-dev
+  fi
+else
+  setup_args=("-Csetup-args=-Dsundials_prefix=$prefix")
+fi
+if [ $tests = 1 ]; then
+  # ROSS 2.3 needs plotly < 6
+  step "pip: test packages" pip_install pytest pytest-xdist hypothesis f90nml \
+    ross-rotordynamics "plotly<6" numba numbalsoda dask-jobqueue
+fi
+step "pip install . (pyspline)" pip_install --no-build-isolation "${setup_args[@]}" .
+rm -f "$log"

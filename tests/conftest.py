@@ -43,6 +43,20 @@ def assert_executable_matches_python(case, exe, tmp_path):
 
 PAPER = dict(k_m=2.3e5, m_1=2.0, m_2=2.0)
 
+
+def random_states(c0, n, rng):
+    """n states of the drive (SI) around a backlash c0 for right-hand-side checks: lateral
+    states in and out of contact, a large shaft twist, D2 across the dead zone."""
+    import numpy as np
+    ys = []
+    for _ in range(n):
+        q = np.r_[rng.uniform(-2, 2, 4) * c0,              # lateral: in and out of contact
+                  rng.uniform(-300, 300) * c0,             # D1 (shaft twist is large)
+                  rng.uniform(-6, 6) * c0,                 # D2 across the dead zone
+                  rng.uniform(-300, 300) * c0]
+        ys.append(np.r_[q, rng.uniform(-0.2, 0.2, 7)])
+    return ys
+
 #: Warnings a test module expects from the shipped cases it uses and declares with pytestmark
 #: (never filtered for the whole suite; tests/test_warnings.py checks that they are raised):
 #: the wind-up of the paper's shafts, k_T = 7.855 N m/rad, in the paper cases, the template and

@@ -265,6 +265,10 @@ def test_stats():
 
 # --------------------------------------------------------------------------- plots
 
+def _texts_of(ax):
+    return " ".join(t.get_text() for t in ax.texts)
+
+
 def _png_ok(path, fig):
     from matplotlib.figure import Figure
     assert isinstance(fig, Figure)
@@ -340,8 +344,23 @@ def _spectra(z=12):
 
 @pytest.mark.parametrize("style", ["map", "lines"])
 def test_plot_waterfall(tmp_path, style):
-    fig = pl.waterfall(_spectra(), z=12, style=style, path=tmp_path / f"wf_{style}.png")
+    ds = _spectra()
+    fig = pl.waterfall(ds, z=12, style=style, path=tmp_path / f"wf_{style}.png")
     _png_ok(tmp_path / f"wf_{style}.png", fig)
+    ax = fig.axes[0]
+    assert "tooth pass 12x" in ax.get_title()
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("frequency [Hz]", "shaft speed [rpm]")
+    assert ax.get_xlim() == (0.0, ds["freq_hz"].max())          # up to Nyquist, no further
+    lo, hi = ax.get_ylim()
+    assert lo < ds["speed_rpm"].min() and hi > ds["speed_rpm"].max()
+    assert {"1x", "2x", "12x"} <= {t.get_text().strip() for t in ax.texts}   # the order labels
+    amp = ds["amplitude"][:, 1:]
+    if style == "map":          # the colour scale spans the amplitudes (log)
+        clim = ax.collections[0].get_clim()
+        assert clim[1] == pytest.approx(amp.max(), rel=1e-6) and 0 < clim[0] < 1e-3 * amp.max()
+    else:                       # one line per speed, the note gives the log scale's range
+        assert len(ax.collections) == len(ds["speed_rpm"])
+        assert f"to {amp.max():.3g}" in _texts_of(ax)
 
 
 def test_plot_scene(tmp_path):
@@ -359,5 +378,24 @@ def test_plot_scene(tmp_path):
     fig = pl.scene(t, D2, vD2, Tm, F, Tf=Tf, section=np.c_[D2[k], vD2[k]], spectrum=spec,
                    speed_rpm=rpm, z=z, path=tmp_path / "scene.png", title="synthetic run")
     _png_ok(tmp_path / "scene.png", fig)
+    assert fig._suptitle.get_text() == "synthetic run"
+    ax_d, ax_t, ax_p, ax_f, ax_tf, ax_s = fig.axes[:6]
+    assert [a.get_title() for a in (ax_t, ax_p, ax_f, ax_tf, ax_s)] == [
+        "meshing torque T_m", "phase plane", "tooth load F_j", "flash temperature T_f",
+        "spectrum of T_m"]
+    assert ax_d.get_ylabel() == "D_2 [µm]" and ax_p.get_ylabel() == "dD_2/dt [mm/s]"
+    for ax, x in ((ax_d, D2 * 1e6), (ax_t, Tm)):   # the whole range (no start transient), margins
+        lo, hi = ax.get_ylim()
+        assert lo < x.min() and hi > x.max() and hi - lo < 1.2 * np.ptp(x)
+    assert ax_p.get_xlim() == ax_d.get_ylim()
+    assert ax_f.images[0].get_clim() == (F.min(), F.max())
+    assert ax_tf.images[0].get_clim() == (Tf.min(), Tf.max())
+    peak = max(ax_s.lines, key=lambda ln: np.max(ln.get_ydata()))   # the tooth pass, z f_shaft
+    assert peak.get_xdata()[np.argmax(peak.get_ydata())] == pytest.approx(z * rpm / 60, abs=10)
+    assert z * rpm / 60 < ax_s.get_xlim()[1] <= 10000.0              # within Nyquist
     fig = pl.scene(t, D2, vD2, Tm, F, Tf=Tf.max(axis=1), path=tmp_path / "scene_min.png")
     _png_ok(tmp_path / "scene_min.png", fig)
+    ax_tf = fig.axes[4]       # one temperature a time: the hottest tooth's, as a line
+    assert ax_tf.get_title() == "flash temperature, hottest tooth" and not ax_tf.images
+    lo, hi = ax_tf.get_ylim()
+    assert lo < Tf.max(axis=1).min() and hi > Tf.max(axis=1).max()

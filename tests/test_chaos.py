@@ -77,13 +77,13 @@ def test_benettin_copy_carries_no_solver_noise():
 
 def test_benettin_separation_needs_located_switches_when_tiny():
     """Where teeth switch contact (an unbalanced drive at 15000 r/min: k_v 0.35-1.94), the
-    exponent is -1.8 1/s with the switches located (roots), for d0 = 1e-8 and the default
-    alike. Without roots a switch falls inside a step, and a separation below rtol is then
-    meaningless: d0 = rtol / 10 reads tens of 1/s (49-82 measured at d0 = 1e-9 and 3e-9, on two
-    builds that differ at round-off; d0 = 1e-8 = rtol reads 11-20), the reason the default d0 is
-    1e4 rtol, which gives the right answer either way."""
+    exponent is about -2 1/s with the switches located (roots), for d0 = 1e-8 and the default
+    alike (-2.18 over these 0.3 s, -1.80 over 0.5 s). Without roots a switch falls inside a
+    step, and a separation below rtol is then meaningless: d0 = rtol / 10 reads tens of 1/s (79
+    here; 49-82 over 0.5 s at d0 = 1e-9 and 3e-9, on two builds that differ at round-off), the
+    reason the default d0 is 1e4 rtol, which gives the right answer either way."""
     case = pyspline.load_case(CASES / "physical_z24.nml", speed_rpm=15000.0, t_d=5.0, t_l=5.0,
-                              unbalance=[2e-4, 0.0], t_transient=0.3, t_end=0.8, n_out=2001,
+                              unbalance=[2e-4, 0.0], t_transient=0.3, t_end=0.6, n_out=2001,
                               max_steps=10**7, lyapunov=True, method="adams", roots=False)
     located = [pyspline.simulate(case.replace(roots=True, lyapunov_d0=d0)).lyapunov["exponent"]
                for d0 in (1e-8, 0.0)]
@@ -144,10 +144,11 @@ def test_tangent_exponent_locates_the_switches_itself():
 def test_auto_method_keeps_the_copy_on_cvode():
     """method = 'auto' picks ERK for a stiff drive from rest, but not for Benettin's separated
     copy: ERK decides the copy's switches in the state it lands on for the reference's, and a
-    small separation then reads +334 1/s on the unbalanced drive (steel shafts) whose exponent
-    CVODE, the tangent and a larger separation all read as -1.8 1/s."""
+    small separation then reads hundreds of 1/s (402 over these 0.3 s) on the unbalanced drive
+    (steel shafts) whose exponent CVODE, the tangent and a larger separation all read as about
+    -2 1/s."""
     case = pyspline.load_case(CASES / "physical_z24.nml", speed_rpm=15000.0, t_d=5.0, t_l=5.0,
-                              unbalance=[2e-4, 0.0], t_transient=0.3, t_end=0.8, n_out=2001,
+                              unbalance=[2e-4, 0.0], t_transient=0.3, t_end=0.6, n_out=2001,
                               max_steps=10**7, lyapunov=True, lyapunov_d0=1e-8)
     auto = pyspline.simulate(case)
     with pytest.warns(pyspline.SplineWarning, match="with method = 'erk'"):

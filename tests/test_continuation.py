@@ -181,7 +181,7 @@ def test_cli_end_to_end(tmp_path):
     ("nonsense", "unknown field 'nonsense'"),
     ("speed_rpm(2)", "field speed_rpm is not an array"),
     ("ripple_amp(5)", r"ripple_amp\(5\): index out of 1..4")])
-def test_bad_field(field, match):
+def test_field_that_cannot_be_continued(field, match):
     with pytest.raises(pyspline.CaseError, match=match):
         pyspline.continuation(RESONANCE, field, 0.1, 0.2, progress=False)
 

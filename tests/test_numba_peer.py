@@ -13,6 +13,7 @@ pytest.importorskip("numba")
 pytest.importorskip("numbalsoda")
 
 import oracle  # noqa: E402
+from conftest import random_states  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "bench"))
 import numba_peer  # noqa: E402
@@ -34,19 +35,9 @@ CASES = {
 GENERAL = sorted(set(CASES) - {"spacing"})
 
 
-def random_states(c0, n, rng):
-    """As tests/test_oracle.py: lateral states in and out of contact, D2 across the dead zone."""
-    ys = []
-    for _ in range(n):
-        q = np.r_[rng.uniform(-2, 2, 4) * c0, rng.uniform(-300, 300) * c0,
-                  rng.uniform(-6, 6) * c0, rng.uniform(-300, 300) * c0]
-        ys.append(np.r_[q, rng.uniform(-0.2, 0.2, 7)])
-    return ys
-
-
 @pytest.mark.parametrize("name,kind", [(n, None) for n in sorted(CASES)] +
                          [(n, "general") for n in GENERAL if n != "coupled"])
-def test_rhs_matches_oracle(name, kind):
+def test_peer_rhs_matches_oracle(name, kind):
     """kind None: the fast RHS, or the general one for the coupled level."""
     case = numba_peer.load_case(dict(CASES[name], name=name))
     p = oracle.prepare(case)

@@ -7,22 +7,9 @@ import pytest
 
 import oracle
 import pyspline
-from conftest import PAPER, PAPER_SHAFTS
+from conftest import PAPER, PAPER_SHAFTS, random_states
 
 pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
-
-
-def random_states(case, n, rng):
-    c0 = case["c0"]
-    ys = []
-    for _ in range(n):
-        q = np.r_[rng.uniform(-2, 2, 4) * c0,              # lateral: in and out of contact
-                  rng.uniform(-300, 300) * c0,             # D1 (shaft twist is large)
-                  rng.uniform(-6, 6) * c0,                 # D2 across the dead zone
-                  rng.uniform(-300, 300) * c0]
-        v = rng.uniform(-0.2, 0.2, 7)
-        ys.append(np.r_[q, v])
-    return ys
 
 
 CASES = {
@@ -52,7 +39,7 @@ def test_rhs_matches_oracle(name):
     rng = np.random.default_rng(zlib.crc32(name.encode()))
     n_free = n_contact = 0
     n_clipped = np.zeros(2, int)
-    for y in random_states(case, 40, rng):
+    for y in random_states(case["c0"], 40, rng):
         t = rng.uniform(0, 0.05)
         f, mesh, tm = model.rhs_mesh(t, y)
         np.testing.assert_array_equal(model.rhs(t, y), f)     # the fast path is the same RHS
