@@ -50,6 +50,7 @@ import contextlib
 import os
 import shutil
 import subprocess
+import tempfile
 import time
 from pathlib import Path
 
@@ -116,14 +117,16 @@ def host_command(quick: bool = False) -> list[str]:
     exe = os.environ.get("SPLINE_DYN") or shutil.which("spline-dyn")
     if not exe:
         raise RuntimeError("--host needs the executable: put spline-dyn on PATH or set SPLINE_DYN")
-    cmd = [exe, str(cases_dir() / "chaos_z24.nml"), "-o", os.devnull, "--set", "n_out=2"]
+    cmd = [exe, str(cases_dir() / "chaos_z24.nml"), "--set", "n_out=2"]
     return cmd + (["--set", "t_transient=0", "--set", "t_end=0.02"] if quick else [])
 
 
 def host_runs(cmd: list[str], runs: int, width: int) -> None:
-    """`runs` runs of `cmd`, `width` at a time: separate processes, nothing shared."""
-    with cf.ThreadPoolExecutor(width) as pool:
-        for run in pool.map(lambda _: subprocess.run(cmd, capture_output=True, text=True),
+    """`runs` runs of `cmd`, `width` at a time: separate processes, nothing shared (each its
+    own CSV: spline-dyn refuses -o onto a device such as /dev/null)."""
+    with tempfile.TemporaryDirectory() as tmp, cf.ThreadPoolExecutor(width) as pool:
+        for run in pool.map(lambda i: subprocess.run(cmd + ["-o", f"{tmp}/{i}.csv"],
+                                                     capture_output=True, text=True),
                             range(runs)):
             if run.returncode:
                 raise RuntimeError(f"{' '.join(cmd)} failed: {run.stderr.strip()}")

@@ -20,7 +20,7 @@ import warnings
 import numpy as np
 
 from .case import Case, defaults, load_case
-from .core import STATE_QUANTITIES, load
+from .core import STATE_QUANTITIES, load, sundials_said
 from .errors import CaseError, SolverError, SplineWarning
 from .orbits import (OrbitError, _period_map, _scale, _trajectory, fd_monodromy,
                      forcing_periods, map_and_monodromy, periodic_orbit)
@@ -333,35 +333,36 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
             raise CaseError(f"continuation in {label}: {arg} = {value:g} is not a valid value "
                             f"of {label}: {exc}") from None
     c0 = prob.case_at(start)
-    orbit = periodic_orbit(c0, n=n, guess=guess, tol=tol, monodromy=monodromy)
-    prob.free = _map_only(prob.model(start), t0, prob.t1(start, n), orbit.y0)[2]
-    k = int(prob.free.sum())
-    branches, specials, status = [], [], "complete"
-    bar = tqdm(total=max_points, desc=f"continue {label}", unit="point", disable=not progress,
-               dynamic_ncols=True)
-    try:
-        u0 = np.r_[orbit.y0[prob.free] / prob.d0[prob.free], 0.0]
-        todo = [(n, u0, None, orbit.y0.copy())]
-        while todo and sum(len(b) for b in branches) < max_points:
-            nb, u_start, tau0, y_fixed = todo.pop(0)
-            br = _Branch(prob, nb, y_fixed, tol, max_corrector)
-            pts, why = _follow(br, u_start, tau0, (stop - start) / prob.pscale, ds, ds_min,
-                               ds_max, max_angle, max_points - sum(len(b) for b in branches),
-                               len(branches), bar)
-            _use(prob, monodromy, base["method"])
-            if why != "complete" and status == "complete":
-                status = why
-            branches.append(pts)
-            if detect:
-                for a, b in zip(pts, pts[1:]):
-                    for sp in _locate_all(br, a, b, k):
-                        sp["branch"] = len(branches) - 1
-                        specials.append(sp)
-                        if (sp["type"] == "period_doubling" and switch and len(branches) < 4
-                                and nb <= 4 * n and _smooth(sp)):
-                            todo.append(_doubled_start(sp, nb, y_fixed))
-    finally:
-        bar.close()
+    with sundials_said("the continuation's map runs") as said:
+        orbit = periodic_orbit(c0, n=n, guess=guess, tol=tol, monodromy=monodromy)
+        prob.free = _map_only(prob.model(start), t0, prob.t1(start, n), orbit.y0)[2]
+        k = int(prob.free.sum())
+        branches, specials, status = [], [], "complete"
+        bar = tqdm(total=max_points, desc=f"continue {label}", unit="point", disable=not progress,
+                   dynamic_ncols=True)
+        try:
+            u0 = np.r_[orbit.y0[prob.free] / prob.d0[prob.free], 0.0]
+            todo = [(n, u0, None, orbit.y0.copy())]
+            while todo and sum(len(b) for b in branches) < max_points:
+                nb, u_start, tau0, y_fixed = todo.pop(0)
+                br = _Branch(prob, nb, y_fixed, tol, max_corrector)
+                pts, why = _follow(br, u_start, tau0, (stop - start) / prob.pscale, ds, ds_min,
+                                   ds_max, max_angle, max_points - sum(len(b) for b in branches),
+                                   len(branches), bar)
+                _use(prob, monodromy, base["method"])
+                if why != "complete" and status == "complete":
+                    status = why
+                branches.append(pts)
+                if detect:
+                    for a, b in zip(pts, pts[1:]):
+                        for sp in _locate_all(br, a, b, k):
+                            sp["branch"] = len(branches) - 1
+                            specials.append(sp)
+                            if (sp["type"] == "period_doubling" and switch and len(branches) < 4
+                                    and nb <= 4 * n and _smooth(sp)):
+                                todo.append(_doubled_start(sp, nb, y_fixed))
+        finally:
+            bar.close()
     wall = time.perf_counter() - wall0
     if status != "complete":
         warnings.warn(f"{status}: the branch so far is returned ({sum(map(len, branches))} "
@@ -369,6 +370,7 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     return continuation_dataset(base, prob, label, branches, specials, margin, k, dict(
         start=start, stop=stop, n=n, tol=tol, wall_s=wall, monodromy=monodromy, status=status,
         fallbacks="; ".join(prob.log) or "none", rejected_jumps=prob.jumps,
+        sundials_warnings=said["runs"],
         command=command or f"pyspline.continuation({base.name!r}, {label!r}, {start:g}, "
                            f"{stop:g}, n={n})"))
 

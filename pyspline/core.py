@@ -8,6 +8,7 @@ parallel. A SIGINT during a run stops it within one right-hand-side call (Keyboa
 """
 from __future__ import annotations
 
+import contextlib
 import functools
 import time
 import warnings
@@ -60,6 +61,28 @@ def raise_for(ierr: int, errmsg) -> None:
     """Turn the core's (ierr, message) into the matching exception."""
     if ierr != 0:
         raise _errors().get(int(ierr), SplineError)(decode(errmsg))
+
+
+
+@contextlib.contextmanager
+def sundials_said(what: str):
+    """SUNDIALS' counted warnings of many runs (a continuation's map runs) said once: how many
+    runs warned and the first one's words; said["runs"] holds the number; every other warning
+    passes as it came."""
+    said = {"runs": 0}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        yield said
+    first = None
+    for w in caught:
+        if issubclass(w.category, SplineWarning) and "SUNDIALS warned" in str(w.message):
+            said["runs"] += 1
+            first = first or str(w.message)
+        else:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    if first:
+        warnings.warn(f"SUNDIALS warned in {said['runs']} of {what}; the first: {first}",
+                      SplineWarning, stacklevel=3)
 
 
 def run_outcome(ierr: int, errmsg) -> None:
