@@ -26,8 +26,9 @@ import numpy as np
 from .case import case_from_text, defaults
 from .dataset import MERGED, build_dataset, write_netcdf
 from .errors import BY_NAME, CaseError, SplineError, SplineWarning
-from .sweep import (SWEEP_LOADS, _stat_names, _template, _version, lyapunov_summary,
-                    point_hash, section_summary)
+from .summary import (SWEEP_LOADS, _stat_names, _template, _version, lyapunov_summary,
+                      section_summary)
+from .sweep import point_hash
 
 __all__ = ["merge", "read_summary", "summary_point"]
 

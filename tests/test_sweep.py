@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import pyspline
-from pyspline import analysis
+from pyspline import analysis, summary
 from pyspline.core import _names
 
 xr = pytest.importorskip("xarray")
@@ -329,7 +329,7 @@ def test_binned_spectrum_keeps_tone_heights():
     x = 3.0 + 1.5 * np.sin(2 * np.pi * f1 * t) + 0.25 * np.sin(2 * np.pi * z * f1 * t)
     axis = sw._default_orders([pyspline.load_case({})])
     assert axis[0] == 0 and axis[-1] == pytest.approx(2 * z + 2)
-    a = sw._binned_spectrum(t, x, rpm, axis)
+    a = summary._binned_spectrum(t, x, rpm, axis)
     assert a[np.argmin(abs(axis - 1))] == pytest.approx(1.5, rel=1e-9)
     assert a[np.argmin(abs(axis - z))] == pytest.approx(0.25, rel=1e-9)
     assert np.nanmax(a[(axis > 1.5) & (axis < 15)]) < 1e-3
