@@ -23,7 +23,7 @@ import numpy as np
 
 from .case import load_case
 from .errors import CaseError, SolverError, SplineError, SplineWarning, ThermalInterferenceError
-from .batch import add_merge
+from .mergecli import add_merge
 from .sweep import MERGED, POINTS_DIR, parse_values, sweep
 
 
