@@ -29,7 +29,7 @@ from .dataset import MERGED, build_dataset, write_netcdf
 from .errors import BY_NAME, CaseError, SplineError, SplineWarning
 from .summary import (SWEEP_LOADS, _stat_names, _template, _version, lyapunov_summary,
                       section_summary)
-from .sweep import point_hash
+from .sweeps import point_hash
 
 __all__ = ["merge", "read_summary", "summary_point"]
 

@@ -24,7 +24,7 @@ import numpy as np
 from .case import load_case
 from .errors import CaseError, SolverError, SplineError, SplineWarning, ThermalInterferenceError
 from .mergecli import add_merge
-from .sweep import MERGED, POINTS_DIR, parse_values, sweep
+from .sweeps import MERGED, POINTS_DIR, parse_values, sweep
 
 
 def _pm(value, se, fmt) -> str:

@@ -18,7 +18,7 @@ from pyspline import analysis, summary
 from pyspline.core import _names
 
 xr = pytest.importorskip("xarray")
-sw = sys.modules["pyspline.sweep"]      # pyspline.sweep is the function; this is its module
+sw = sys.modules["pyspline.sweeps"]
 
 from conftest import CASES, PAPER_SHAFTS  # noqa: E402
 
@@ -520,7 +520,7 @@ def test_every_writing_command_checks_its_out_before_running(tmp_path, monkeypat
     monkeypatch.setattr(cli, "sweep", never)
     monkeypatch.setattr(pyspline.core, "simulate", never)
     monkeypatch.setattr(sys.modules["pyspline.batch"], "merge", never)
-    monkeypatch.setattr(sys.modules["pyspline.continuation"], "continuation", never)
+    monkeypatch.setattr(sys.modules["pyspline.arclength"], "continuation", never)
     afile = tmp_path / "afile"
     afile.write_text("mine\n")
     argv = [str(CASES / "paper_lx1e-4.nml") if a == "CASE" else a for a in command]
