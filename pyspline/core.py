@@ -5,6 +5,9 @@ by the core's field table) and comes back as a loaded model: the bytes of its mo
 the caller (``Model``). Every call takes those bytes, so loaded cases never alias, any number can
 be used at once, and simulate and start_state release the GIL: a thread pool runs scenes in
 parallel. A SIGINT during a run stops it within one right-hand-side call (KeyboardInterrupt).
+
+The layers below this public face: ``Model`` is pyspline.case's (``Case.model``), ``Result`` and
+the run itself pyspline.result's; each imports only the ones below it (tests/test_imports.py).
 """
 from __future__ import annotations
 
