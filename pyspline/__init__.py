@@ -8,8 +8,8 @@ from .core import Model, Result, load, mesh_stiffness, rhs, simulate, start_stat
 from .dataset import open_sweep
 from .errors import CaseError, SolverError, SplineError, SplineWarning, ThermalInterferenceError
 from .orbits import Orbit, OrbitError, periodic_orbit
-from .continuation import continuation
-from .sweep import sweep  # pyspline.sweep: the function
+from .arclength import continuation
+from .sweeps import sweep
 
 __all__ = ["Case", "CaseError", "Model", "Result", "SolverError", "SplineError", "SplineWarning",
            "ThermalInterferenceError", "defaults", "load", "load_case", "local_dask_client",

@@ -1,5 +1,6 @@
 """Case input: the fields of a case (namelist group ``&spline_case``), read from files or given
-as a dict, and handed to the core in memory as field values.
+as a dict, and handed to the core in memory as field values; ``Model``, the case loaded into the
+core (``Case.model``).
 
 The defaults live in the Fortran core only (``case_t`` in fortran/case.f90): Python reads them
 from the core once, so a field that Python knows is a field the executable knows, with the same
@@ -28,6 +29,7 @@ except ImportError as exc:  # the source tree shadows the installed package
         "pyspline from outside the repository root (or use the `pyspline` command).") from exc
 
 from .errors import CaseError, decode
+from .result import _names, _warn, raise_for, run
 
 GROUP = "spline_case"
 _CONTROL = re.compile(rb"[\x00-\x1f\x7f]")
@@ -198,7 +200,6 @@ class Case(Mapping):
         """The case loaded into the core (pyspline.Model), built on first use and kept (a
         case file's is built by load_case, in the same core call that read the file)."""
         if not hasattr(self._model, "bytes"):    # None, or the parts load_case built
-            from .core import Model
             self._model = Model(self)
         return self._model
 
@@ -321,3 +322,87 @@ def load_case(source, **overrides) -> Case:
         model.flags.writeable = False
         case._model = (model, sizes, warn)
     return case
+
+
+class Model:
+    """A case loaded into the core once (validated, geometry and stiffness derived): use it for
+    repeated calls (``simulate``, ``rhs``, ``start_state``). It holds the core's model as bytes
+    that the caller owns: it can be copied, pickled to another process and used from many
+    threads at once. ``Case.model`` keeps one per case."""
+
+    __slots__ = ("case", "bytes", "z", "n_out", "n_section", "n_lyapunov", "n_slices",
+                 "__weakref__")
+
+    def __init__(self, case):
+        case = load_case(case)
+        if isinstance(case._model, tuple):       # built by load_case with the file's fields
+            data, sizes, warn = case._model
+        else:                                    # one core call: validate and build
+            packed = _values_of(case._fields)
+            if packed is None:                   # a value only the reader can judge
+                data, sizes, warn, ierr, msg = _api.api_load_text(case.text().encode("utf-8"),
+                                                                  _MODEL_BYTES)
+            else:
+                data, sizes, warn, ierr, msg = _api.api_load_fields(*packed, _MODEL_BYTES)
+            raise_for(ierr, msg)
+            data.flags.writeable = False
+        self.case, self.bytes = case, data
+        self.z, self.n_out, self.n_section, self.n_lyapunov, self.n_slices = sizes.tolist()
+        _warn(warn)                              # the core's model warnings (k_m)
+
+    def __getstate__(self):
+        return {k: getattr(self, k) for k in self.__slots__ if k != "__weakref__"}
+
+    def __setstate__(self, state):
+        for k, v in state.items():
+            object.__setattr__(self, k, v)
+
+    def __repr__(self):
+        return f"Model({self.case.name!r}, z={self.z}, n_out={self.n_out})"
+
+    def simulate(self) -> "Result":
+        return run(self)
+
+    def start_state(self) -> np.ndarray:
+        """The start state (SI): the static equilibrium (default) or rest, plus dq0, dv0."""
+        y, ierr, msg = _api.api_start_state(self.bytes)
+        raise_for(ierr, msg)
+        return y
+
+    def rhs(self, t: float, y) -> np.ndarray:
+        """dy/dt in SI units at (t, y), contact states decided by the state (Eqs. 8-24)."""
+        ydot, ierr = _api.api_rhs(self.bytes, t, y)
+        if ierr:
+            raise_for(ierr, f"case {self.case.name}: the right-hand side failed at t = {t} s "
+                      "(thermal interference)")
+        return ydot
+
+    __call__ = rhs
+
+    def rhs_mesh(self, t: float, y) -> tuple[np.ndarray, dict, float]:
+        """rhs plus the mesh at (t, y): (dy/dt, per-tooth dict as Result.tooth but 1-D, T_m)."""
+        q = _names("tooth")
+        ydot, mesh, tm, ierr, msg = _api.api_rhs_mesh(self.bytes, self.z, len(q), t,
+                                                      np.asarray(y, dtype=float))
+        raise_for(ierr, msg)
+        return ydot, {n: mesh[:, i] for i, (n, *_) in enumerate(q)}, float(tm)
+
+    def output_times(self) -> np.ndarray:
+        t, ierr, msg = _api.api_output_times(self.bytes, self.n_out)
+        raise_for(ierr, msg)
+        return t
+
+    def info(self) -> dict:
+        """Derived quantities (SI): r_b, r_pitch, omega, the Eq. 25 scales l_ref and w_ref,
+        c_bulk, kappa, the k_m used, k_m_computed, thermal_level, the c_m used, the tooth
+        pair's effective mass m_e, the Eq. 18 terms as a dict 'k_terms' (k_h, k_b1, ..., k_m
+        of the geometry), and 'spacing_error', the tooth spacing errors in use e_j [m] of teeth
+        1 .. Z, shape (Z,): the case's list plus the seeded ones (docs/model.md section 11)."""
+        info, terms, spacing, ierr, msg = _api.api_model_info(self.bytes, self.z)
+        raise_for(ierr, msg)
+        out = {n: float(v) for (n, *_), v in zip(_names("info"), info)}
+        out["k_m_computed"] = bool(out["k_m_computed"])
+        out["thermal_level"] = int(out["thermal_level"])
+        out["k_terms"] = {n: float(v) for (n, *_), v in zip(_names("kterms"), terms)}
+        out["spacing_error"] = spacing
+        return out

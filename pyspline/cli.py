@@ -23,8 +23,8 @@ import numpy as np
 
 from .case import load_case
 from .errors import CaseError, SolverError, SplineError, SplineWarning, ThermalInterferenceError
-from .batch import add_merge
-from .sweep import MERGED, POINTS_DIR, parse_values, sweep
+from .mergecli import add_merge
+from .sweeps import MERGED, POINTS_DIR, parse_values, sweep
 
 
 def _pm(value, se, fmt) -> str:

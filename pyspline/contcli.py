@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from .case import load_case
-from .continuation import continuation, parse_field
+from .arclength import continuation, parse_field
 from .errors import CaseError
 
 
@@ -52,7 +52,7 @@ def cmd_continue(args, fixed, exit_code) -> int:
                           command=command)
         sw = None
         if args.sweep:
-            from .sweep import sweep
+            from .sweeps import sweep
             sw = sweep(case, progress=not args.quiet, follow="both", spectrum=False,
                        **{name: np.linspace(args.start, args.stop, args.sweep)})
     except SplineError as exc:

@@ -17,6 +17,7 @@ from math import lcm
 import numpy as np
 
 from .errors import SplineWarning
+from .summary import failed_summary, summarise
 
 DIRECTIONS = ("up", "down", "both")
 
@@ -51,7 +52,6 @@ def run_chain(cases: list, options: dict) -> list:
     """Summaries of the cases run in the given order, each from the previous one's final
     state (a failed point breaks the chain: the next starts from its own start)."""
     from .core import simulate
-    from .sweep import failed_summary, summarise
     out, prev = [], None
     for case in cases:
         if isinstance(case, Exception):

@@ -16,13 +16,13 @@ from conftest import ROOT, PAPER_SHAFTS
 pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 from pyspline.batch import merge, read_summary
 from pyspline.cli import main
-from pyspline.sweep import summarise
+from pyspline.summary import summarise
 
 CASE = ROOT / "cases" / "paper_lx1e-4.nml"
 SHORT = dict(t_end=0.05, n_out=401)          # 5 revolutions: fast, sections and a Benettin record
 TIMINGS = ("core_wall_s", "wall_s")
 #: the sweep's RMS is numpy's (pairwise sums), the summary's the executable's sequential sum;
-#: period_residual is relative to the RMS of D2 and dD2/dt (sweep.section_summary)
+#: period_residual is relative to the RMS of D2 and dD2/dt (summary.section_summary)
 RMS = ("Tm_rms", "kv_rms", "F_rms", "D2_rms", "period_residual")
 
 

@@ -141,7 +141,7 @@ def test_a_step_onto_another_branch_is_rejected(monkeypatch):
     branch's orbit (as a long step across a fold can) lands far from its predictor: the step is rejected (attrs['rejected_jumps']), halved, and the full-contact
     branch is still traced from start to stop; without the check the branch would go on along
     the upper one (contact lost every revolution)."""
-    cont = importlib.import_module("pyspline.continuation")   # the module, not the function
+    cont = importlib.import_module("pyspline.arclength")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pyspline.SplineWarning)
         # above the upper fold one orbit: a 1 s run from the equilibrium settles on it

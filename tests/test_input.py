@@ -398,7 +398,7 @@ def test_file_load_builds_the_model_its_fields_build(name):
     from pyspline import core
     case = pyspline.load_case(CASES / name)
     built, fields = case.model, core.Model(dict(case))
-    model, sizes, warn, ierr, msg = core._api.api_load_text(case.text().encode(), core._MODEL_BYTES)
+    model, sizes, warn, ierr, msg = core._api.api_load_text(case.text().encode(), pyspline.case._MODEL_BYTES)
     assert ierr == 0
     text = core.Model.__new__(core.Model)
     for k, v in dict(case=case, bytes=model, z=sizes[0], n_out=sizes[1], n_section=sizes[2],

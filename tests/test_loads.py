@@ -10,7 +10,7 @@ import pytest
 import oracle
 import pyspline
 from pyspline.core import LOAD_QUANTITIES, TOOTH_LOAD_QUANTITIES
-from pyspline.sweep import SWEEP_LOADS
+from pyspline.summary import SWEEP_LOADS
 from conftest import CASES, PAPER_SHAFTS, PAPER_SUPPORTS
 
 #: the offset scenes below are built to impact (offset beyond the backlash, from rest): their

@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 
 import pyspline
-from pyspline import analysis
+from pyspline import analysis, summary
 from pyspline.core import _names
 
 xr = pytest.importorskip("xarray")
-sw = sys.modules["pyspline.sweep"]      # pyspline.sweep is the function; this is its module
+sw = sys.modules["pyspline.sweeps"]
 
 from conftest import CASES, PAPER_SHAFTS  # noqa: E402
 
@@ -329,7 +329,7 @@ def test_binned_spectrum_keeps_tone_heights():
     x = 3.0 + 1.5 * np.sin(2 * np.pi * f1 * t) + 0.25 * np.sin(2 * np.pi * z * f1 * t)
     axis = sw._default_orders([pyspline.load_case({})])
     assert axis[0] == 0 and axis[-1] == pytest.approx(2 * z + 2)
-    a = sw._binned_spectrum(t, x, rpm, axis)
+    a = summary._binned_spectrum(t, x, rpm, axis)
     assert a[np.argmin(abs(axis - 1))] == pytest.approx(1.5, rel=1e-9)
     assert a[np.argmin(abs(axis - z))] == pytest.approx(0.25, rel=1e-9)
     assert np.nanmax(a[(axis > 1.5) & (axis < 15)]) < 1e-3
@@ -520,7 +520,7 @@ def test_every_writing_command_checks_its_out_before_running(tmp_path, monkeypat
     monkeypatch.setattr(cli, "sweep", never)
     monkeypatch.setattr(pyspline.core, "simulate", never)
     monkeypatch.setattr(sys.modules["pyspline.batch"], "merge", never)
-    monkeypatch.setattr(sys.modules["pyspline.continuation"], "continuation", never)
+    monkeypatch.setattr(sys.modules["pyspline.arclength"], "continuation", never)
     afile = tmp_path / "afile"
     afile.write_text("mine\n")
     argv = [str(CASES / "paper_lx1e-4.nml") if a == "CASE" else a for a in command]

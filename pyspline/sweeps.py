@@ -10,29 +10,28 @@ once as ``DIR/points/<index>.<hash>.npz`` and all of them are merged into ``DIR/
 directory computes only the points whose file is missing (a point is known by its grid index
 and a hash of its case text, so a changed case is never served from a stale file).
 
-The Dataset and its NetCDF file are built in pyspline.dataset, a local Dask cluster in
+A point's summary is pyspline.summary's; the Dataset and its NetCDF file are built in
+pyspline.dataset, a local Dask cluster in
 pyspline.cluster, the figures in pyspline.plots, the command line in pyspline.cli.
 """
 from __future__ import annotations
 
 import concurrent.futures as cf
 import datetime
-import functools
 import hashlib
 import itertools
 import os
 import sys
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
 
-from . import analysis
 from .case import Case, defaults, load_case
 from .cluster import local_dask_client
-from .core import STATE_NAMES
 from .dataset import MERGED, build_dataset, open_sweep, write_netcdf
 from .errors import CaseError
+from .summary import _stat_names, _template, _version, failed_summary, summarise
 
 __all__ = ["local_dask_client", "open_sweep", "parse_values", "point_cases", "read_table",
            "run_point", "summarise", "sweep", "table_cases", "task_points", "write_netcdf"]
@@ -44,8 +43,6 @@ SUMMARY_VERSION = 3
 ORDER_STEP = 0.05
 SECTIONS = ("shaft", "tooth", "none")
 POINTS_DIR = "points"
-
-_I_D2 = STATE_NAMES.index("D2")     # column of D2 in Result.y / section_y; dD2/dt is 7 later
 
 
 # --------------------------------------------------------------------------- values
@@ -215,123 +212,6 @@ def point_filename(index: tuple, digest: str) -> str:
 
 # --------------------------------------------------------------------------- one point
 
-def _template(options: dict, stat_names: Sequence[str]) -> dict:
-    """The summary of a point that produced nothing (all NaN), with every key a summary has."""
-    nan = np.nan
-    s = {}
-    if options["section"] != "none":
-        empty = np.zeros(0)
-        s.update(section_t=empty, section_D2=empty, section_vD2=empty, period=nan,
-                 period_residual=nan)
-    if options["lyapunov"]:
-        s.update(lyapunov=nan, lyapunov_spread=nan, lyapunov_rel_spread=nan,
-                 lyapunov_slope=nan, predictability_horizon=nan, chaotic=nan)
-    for q in ("Tm", "kv", "F"):
-        s.update({f"{q}_max": nan, f"{q}_min": nan, f"{q}_rms": nan})
-    s.update(Tf_max=nan, D2_max=nan, D2_min=nan, D2_rms=nan)
-    s.update({k: nan for k in SWEEP_LOADS})
-    s.update({k: nan for k in stat_names})
-    if options.get("orders") is not None:
-        s["Tm_spectrum"] = np.full(len(options["orders"]), nan)
-    s.update(error="", error_class="")
-    return s
-
-
-#: The loads of a run a sweep keeps per point (Result.loads: the core's, docs/model.md
-#: section 15; Tf_max too), units from the core's table.
-SWEEP_LOADS = ("load_sharing", "free_frac_max", "back_frac_max", "teeth_free_mean", "teeth_back",
-               "impacts_per_rev", "closing_speed_max", "Tm_rms_se", "load_sharing_rev",
-               "load_sharing_rev_se", "sigma_root", "sigma_flank", "tau_pitch", "kv_rms_se",
-               "F_rms_se", "D2_rms_se", "teeth_free_mean_se", "free_frac_max_se",
-               "back_frac_max_se", "impacts_per_rev_se", "Tf_max_rev", "Tf_max_rev_se")
-
-
-@functools.cache
-def _stat_names() -> tuple:
-    from .core import _names
-    return tuple(n for n, *_ in _names("stats")) + ("wall_s",)
-
-
-def _binned_spectrum(t, x, speed_rpm, orders_axis) -> np.ndarray:
-    """Amplitude spectrum of x (Hann window, mean removed) on the order axis: in each bin
-    (centre +- step/2) the largest amplitude of the FFT lines in it (peak heights survive a
-    coarser axis); a bin with no line (finer axis than the FFT) interpolated; NaN beyond the
-    Nyquist frequency and at zero speed."""
-    o_axis = np.asarray(orders_axis, dtype=float)
-    out = np.full(o_axis.shape, np.nan)
-    if speed_rpm == 0 or len(t) < 4:
-        return out
-    f, a = analysis.amplitude_spectrum(t, x)
-    o = analysis.orders(f, speed_rpm)
-    step = np.diff(o_axis).min() if len(o_axis) > 1 else 1.0
-    k = np.floor((o - o_axis[0]) / step + 0.5).astype(np.int64)
-    ok = (k >= 0) & (k < len(o_axis))
-    np.fmax.at(out, k[ok], a[ok])
-    empty = np.isnan(out) & (o_axis <= o[-1])
-    out[empty] = np.interp(o_axis[empty], o, a)
-    return out
-
-
-def section_summary(s: dict, case, section_t, D2s, vD2s, rms: tuple) -> None:
-    """Put the Poincare section (times, D2, dD2/dt) and its period into summary `s`; rms: the
-    RMS of D2 and of dD2/dt over the run's outputs."""
-    s.update(section_t=np.asarray(section_t, dtype=float), section_D2=D2s, section_vD2=vD2s)
-    if len(D2s) >= 4:     # classify_period needs 2 points in the tail (the last half)
-        # what the solver's tolerance is relative to: the trajectory's RMS, but at least
-        # the scales of Eq. 25 (its atol acts on states scaled by them), so that a fixed
-        # point whose dD2/dt is zero up to solver noise counts as period 1
-        info = case.model.info()
-        scale = [max(rms[0], info["l_ref"]), max(rms[1], info["l_ref"] * info["w_ref"])]
-        period, info = analysis.classify_period(np.c_[D2s, vD2s], case["rtol"], scale=scale)
-        s["period"] = float(period)
-        r = info["residual"]
-        s["period_residual"] = r[period] if period else (min(r.values()) if r else np.nan)
-
-
-def lyapunov_summary(s: dict, lyap_t, log_growth, exponent: float, t0: float) -> None:
-    """Put the Lyapunov exponent and the fit of its Benettin record (times lyap_t, cumulative
-    log growth; t0 the first output time) into summary `s`."""
-    s.update(lyapunov=exponent, predictability_horizon=analysis.predictability_horizon(exponent))
-    if len(lyap_t) >= 3 and np.isfinite(log_growth).all():
-        fit = analysis.largest_lyapunov_fit(lyap_t, log_growth, t0=t0)
-        s.update(lyapunov_spread=fit.spread, lyapunov_rel_spread=fit.rel_spread,
-                 lyapunov_slope=fit.slope, chaotic=float(analysis.is_chaotic(exponent, fit.spread)))
-
-
-def failed_summary(exc: Exception, options: dict) -> dict:
-    """The summary of a point that failed: all NaN, the message in 'error' (never empty: a
-    message-less exception gives its repr) and the class name in 'error_class'."""
-    s = _template(options, _stat_names())
-    s.update(error=str(exc) or repr(exc), error_class=type(exc).__name__)
-    return s
-
-
-def summarise(res, options: dict) -> dict:
-    """The summary of one Result (see `sweep` for the keys), all numbers in SI units."""
-    s = _template(options, _stat_names())
-    case = res.case
-    if options["section"] != "none" and res.section_y is not None:
-        sy = np.asarray(res.section_y, dtype=float).reshape(-1, 14)
-        section_summary(s, case, res.section_t, sy[:, _I_D2], sy[:, 7 + _I_D2],
-                        (np.sqrt(np.mean(res.D2**2)), np.sqrt(np.mean(res.vD2**2))))
-    if options["lyapunov"] and res.lyapunov is not None:
-        ly = res.lyapunov
-        lyapunov_summary(s, ly["t"], ly["log_growth"], float(ly["exponent"]), float(res.t[0]))
-    for q, arr in (("Tm", res.Tm), ("kv", res.kv), ("F", res.tooth["F"])):
-        st = analysis.stats(arr, quantiles=False)
-        s.update({f"{q}_max": st["max"], f"{q}_min": st["min"], f"{q}_rms": st["rms"]})
-    s["Tf_max"] = float(np.max(res.tooth["Tf"]))
-    s.update({k: float(res.loads[k]) for k in SWEEP_LOADS})
-    s.update(D2_max=float(res.D2.max()), D2_min=float(res.D2.min()),
-             D2_rms=float(np.sqrt(np.mean(res.D2 ** 2))))
-    for k in _stat_names():
-        if k in res.stats:
-            s[k] = float(res.stats[k])
-    if options.get("orders") is not None:
-        s["Tm_spectrum"] = _binned_spectrum(res.t, res.Tm, case["speed_rpm"], options["orders"])
-    return s
-
-
 def run_point(case: Case, options: dict) -> dict:
     """The task of one sweep point (module level, picklable arguments and result): simulate
     the point's case and return its summary. A failure of the case (any Exception: CaseError,
@@ -404,10 +284,6 @@ def _default_orders(cases) -> np.ndarray:
     n = int(round((2 * z + 2) / ORDER_STEP))
     return np.round(np.arange(n + 1) * ORDER_STEP, 10)
 
-
-def _version() -> str:
-    from . import __version__
-    return __version__
 
 
 def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapunov=False, *,

@@ -1,0 +1,317 @@
+"""The core's runs and their Result, below the case layer: the core's name tables (the output
+quantities, states, loads, statistics), its errors and warnings as Python's, and ``run``: a
+loaded Model (pyspline.case) through api_simulate into a Result. pyspline.core is the public
+face (``simulate`` takes a Case, a dict or a path); this module imports no other of pyspline's
+but errors, so that case and core both build on it.
+"""
+from __future__ import annotations
+
+import contextlib
+import functools
+import time
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import _core
+from .errors import BY_NAME, SplineError, SplineWarning, decode
+
+_api = _core.spline_api
+THERMAL_LEVELS = ("none", "bulk", "oneway", "coupled")   #: stats["thermal_level"] 0..3
+
+
+@functools.cache
+def _names(kind: str) -> tuple:
+    """The core's list `kind` (api_names in fortran/api.f90): (name, unit, description) per
+    entry; units SI, '-' a ratio, '' none. The output quantities and statistics are the table
+    of fortran/quantities.f90, the case fields that of fortran/case_type.f90."""
+    out = []
+    for i in range(1, 1000):
+        name, unit, descr = (decode(s) for s in _api.api_names(kind, i))
+        if not name:
+            break
+        out.append((name, unit, descr))
+    return tuple(out)
+
+
+def cf_units(unit: str) -> str:
+    """A unit of the core's tables as a netCDF/CF 'units' attribute: '1' for a ratio ('-')."""
+    return "1" if unit == "-" else unit
+
+
+@functools.cache
+def _errors() -> dict:
+    """Error code of the core -> exception class (codes and names from fortran/errors.f90)."""
+    return {i: BY_NAME.get(name, SplineError) for i, (name, *_) in enumerate(_names("errors"))}
+
+
+
+@contextlib.contextmanager
+def sundials_said(what: str):
+    """SUNDIALS' counted warnings of many runs (a continuation's map runs) said once: how many
+    runs warned and the first one's words; said["runs"] holds the number; every other warning
+    passes as it came."""
+    said = {"runs": 0}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        yield said
+    first = None
+    for w in caught:
+        if issubclass(w.category, SplineWarning) and "SUNDIALS warned" in str(w.message):
+            said["runs"] += 1
+            first = first or str(w.message)
+        else:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    if first:
+        warnings.warn(f"SUNDIALS warned in {said['runs']} of {what}; the first: {first}",
+                      SplineWarning, stacklevel=3)
+
+
+def _warn(text, stacklevel: int = 3) -> None:
+    """The core's warnings (one per line, the words spline-dyn prints) as SplineWarning,
+    attributed to the frame `stacklevel` up (3: the caller of _warn's caller)."""
+    text = decode(text)
+    for line in text.splitlines() if text else ():
+        if line.strip():
+            warnings.warn(line.strip(), SplineWarning, stacklevel=stacklevel)
+
+
+def raise_for(ierr: int, errmsg) -> None:
+    """Turn the core's (ierr, message) into the matching exception."""
+    if ierr != 0:
+        raise _errors().get(int(ierr), SplineError)(decode(errmsg))
+
+
+def run_outcome(ierr: int, errmsg) -> None:
+    """A run's (ierr, message): the exception, or on success the message's lines (the
+    integrator's warnings, counted over the run: spline_integrator::integrator_warnings) as
+    SplineWarning."""
+    raise_for(ierr, errmsg)
+    _warn(errmsg)
+
+
+def level_name(dof: int, thermal: str) -> str:
+    """A model level of the fidelity ladder, e.g. '7-DOF coupled'."""
+    return f"{dof}-DOF {thermal}"
+
+
+
+#: Result quantities from the core's table (fortran/quantities.f90): name -> (description,
+#: unit), every output (time t, states, Tm, kv, per-tooth), the states (position and velocity,
+#: order of a state vector) and the per-tooth quantities (time, tooth).
+QUANTITIES = {n: (d, u) for n, u, d in _names("outputs")}
+STATE_QUANTITIES = {n: (d, u) for n, u, d in _names("states")}
+TOOTH_QUANTITIES = {n: (d, u) for n, u, d in _names("tooth")}
+FIELDS = {n: (d, u) for n, u, d in _names("fields")}   #: the case fields: (description, unit)
+STATE_NAMES = tuple(STATE_QUANTITIES)[:len(STATE_QUANTITIES) // 2]   #: x1 .. D3 (positions)
+#: The loads of a run (spline_loads::run_loads, docs/model.md section 15): name -> (description,
+#: unit), the scalars and the per-tooth ones (arrays over the teeth).
+LOAD_QUANTITIES = {n: (d, u) for n, u, d in _names("loads")}
+TOOTH_LOAD_QUANTITIES = {n: (d, u) for n, u, d in _names("tooth_loads")}
+
+
+def _attrs(name: str) -> dict:
+    """xarray attrs of an output quantity of the core's table: long_name, units (if any)."""
+    long, unit = QUANTITIES.get(name) or LOAD_QUANTITIES.get(name) or TOOTH_LOAD_QUANTITIES[name]
+    return {"long_name": long, "units": cf_units(unit)} if unit else {"long_name": long}
+
+
+def _tooth_quantity(name: str) -> property:
+    def get(self):
+        try:
+            return self.tooth[name]
+        except KeyError:
+            raise AttributeError(f"this Result has no per-tooth quantity {name!r}") from None
+    get.__name__ = name
+    long, unit = TOOTH_QUANTITIES[name]
+    return property(get, doc=f"{long} [{unit}], shape (nt, Z)")
+
+
+def _state(name: str) -> property:
+    i = tuple(STATE_QUANTITIES).index(name)
+
+    def get(self):
+        return self.y[:, i]
+    get.__name__ = name
+    long, unit = STATE_QUANTITIES[name]
+    return property(get, doc=f"{long} [{unit}], shape (nt,)")
+
+
+@dataclass
+class Result:
+    """A simulation in SI units. Per-tooth arrays have shape (nt, Z).
+
+    Every quantity is an attribute: the states ``x1 y1 x2 y2 D1 D2 D3`` [m] and their
+    velocities ``vx1 ... vD3`` [m/s] (nt,), the per-tooth ``F Fx Fy dn c Tf rc1 rc2`` (nt, Z;
+    without flash temperature or slices c, Tf, rc1, rc2 are constants, read-only broadcasts),
+    ``Tm`` and ``kv`` (nt,); ``loads``: the load sharing, free and back-flank teeth, impacts
+    and T_f max of the run (the core's). ``to_xarray()`` gives all of it as an xarray.Dataset."""
+    case: Case
+    t: np.ndarray            #: output times [s]
+    y: np.ndarray            #: states (nt, 14): x1, y1, x2, y2, D1, D2, D3 [m], then their velocities [m/s]
+    tooth: dict              #: per-tooth quantities by name: F, Fx, Fy [N], dn, c [m], Tf [degC], rc1, rc2 [m]
+    Tm: np.ndarray           #: meshing torque T_m (Eq. 22) [N m]
+    stats: dict = field(default_factory=dict)   #: CVODE statistics and run time
+    section_t: np.ndarray = None   #: Poincare section times [s] (case field section)
+    section_y: np.ndarray = None   #: states at the section times (n, 14), SI, like y
+    lyapunov: dict = None    #: Benettin record (case field lyapunov): t [s], log_growth, exponent [1/s]
+    face: np.ndarray = None  #: sliced face (n_slices > 1): load of slice s of tooth j, (nt, Z, n_slices) [N]
+    tilt: np.ndarray = None  #: sliced face: tilting moment (M_x, M_y) on spline 1, (nt, 2) [N m]
+    #: the loads of the run (the core's, from its outputs: docs/model.md section 15), by name:
+    #: scalars (load_sharing, impacts_per_rev, Tf_max, ...) and per-tooth arrays (Z,)
+    #: (F_peak, load_factor, free_frac, back_frac, onsets); units: LOAD_QUANTITIES,
+    #: TOOTH_LOAD_QUANTITIES
+    loads: dict = None
+    #: the tooth spacing errors in use e_j (Z,) [m], the case's list plus the seeded ones
+    #: (Model.info()['spacing_error'])
+    spacing_error: np.ndarray = None
+
+    F = _tooth_quantity("F")
+    Fx = _tooth_quantity("Fx")
+    Fy = _tooth_quantity("Fy")
+    dn = _tooth_quantity("dn")
+    c = _tooth_quantity("c")
+    Tf = _tooth_quantity("Tf")
+    rc1 = _tooth_quantity("rc1")
+    rc2 = _tooth_quantity("rc2")
+    x1, y1, x2, y2 = _state("x1"), _state("y1"), _state("x2"), _state("y2")
+    D1, D2, D3 = _state("D1"), _state("D2"), _state("D3")
+    vx1, vy1, vx2, vy2 = _state("vx1"), _state("vy1"), _state("vx2"), _state("vy2")
+    vD1, vD2, vD3 = _state("vD1"), _state("vD2"), _state("vD3")
+
+    @property
+    def level(self) -> str:
+        """The model level that ran (differs from the case's under fidelity = 'auto')."""
+        return level_name(self.stats["dof"], THERMAL_LEVELS[self.stats["thermal_level"]])
+
+    @property
+    def kv(self) -> np.ndarray:
+        """Dynamic load coefficient k_v = |T_m| / T_d, shape (nt,)."""
+        return np.abs(self.Tm) / self.case["t_d"]
+
+    def __getattr__(self, name):
+        # per-tooth quantities that the core has and this class does not name yet
+        tooth = self.__dict__.get("tooth", {})
+        if name in tooth:
+            return tooth[name]
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+    def __dir__(self):
+        return sorted(set(super().__dir__()) | set(self.__dict__.get("tooth", {})))
+
+    def to_xarray(self):
+        """The run as an xarray.Dataset (SI units in each variable's attrs['units']).
+
+        dims: time (the output times t [s]), tooth (1..Z), section_point (the Poincare section,
+        if the case asked for one), renormalisation (the Benettin record, if lyapunov).
+        Variables: the states x1 .. D3 and velocities vx1 .. vD3 (time); Tm, kv (time); the
+        per-tooth F, Fx, Fy, dn, c, Tf, rc1, rc2 (time, tooth); the loads (``loads``: per
+        tooth on the tooth dim, the scalars without a dim); section_t and the states on the
+        section section_x1 .. section_vD3 (section_point); lyapunov_log_growth
+        (renormalisation, with coordinate lyapunov_t [s]); a sliced face (n_slices > 1): face
+        (time, tooth, slice) [N] and tilt (time, moment: M_x, M_y) [N m]. attrs: case (namelist text), name, level, pyspline_version, the
+        exponent as lyapunov_exponent [1/s], and the run statistics as stat_<name>."""
+        import xarray as xr
+        from . import __version__
+        z = next(iter(self.tooth.values())).shape[1] if self.tooth else 0
+        tooth_no = np.arange(1, z + 1)
+        coords = {"time": ("time", np.asarray(self.t), _attrs("t")),
+                  "tooth": ("tooth", tooth_no, {"long_name": "tooth number j"})}
+        data = {n: ("time", self.y[:, i], _attrs(n)) for i, n in enumerate(STATE_QUANTITIES)}
+        data["Tm"] = ("time", self.Tm, _attrs("Tm"))
+        data["kv"] = ("time", self.kv, _attrs("kv"))
+        for n, arr in self.tooth.items():
+            data[n] = (("time", "tooth"), arr, _attrs(n))
+        for n, v in (self.loads or {}).items():     # per tooth on the tooth dim, scalars 0-d
+            data[n] = (("tooth",) if n in TOOTH_LOAD_QUANTITIES else (), v, _attrs(n))
+        if self.spacing_error is not None:
+            long, unit = FIELDS["spacing_error"]
+            data["spacing_error"] = ("tooth", self.spacing_error,
+                                     {"long_name": long + ", in use (the list plus the seeded)",
+                                      "units": unit})
+        if self.section_t is not None and len(self.section_t):
+            sec = np.asarray(self.section_y).reshape(-1, 14)
+            data["section_t"] = ("section_point", self.section_t,
+                                 {"long_name": "time of the Poincare section point "
+                                  f"({self.case['section']})", "units": "s"})
+            for i, n in enumerate(STATE_QUANTITIES):
+                a = _attrs(n)
+                a["long_name"] += " on the Poincare section"
+                data["section_" + n] = ("section_point", sec[:, i], a)
+        if self.face is not None:               # a sliced face (n_slices > 1)
+            data["face"] = (("time", "tooth", "slice"), self.face,
+                            {"long_name": "load of each slice of each tooth's face",
+                             "units": "N"})
+            data["tilt"] = (("time", "moment"), self.tilt,
+                            {"long_name": "tilting moment on spline 1 (M_x, M_y)",
+                             "units": "N m"})
+            coords["slice"] = ("slice", np.arange(1, self.face.shape[2] + 1),
+                               {"long_name": "face slice number"})
+            coords["moment"] = ("moment", np.array(["M_x", "M_y"]))
+        attrs = {"case": self.case.text(), "name": self.case.name,
+                 "pyspline_version": __version__}
+        if self.stats:
+            attrs["level"] = self.level
+        if self.lyapunov is not None:
+            coords["lyapunov_t"] = ("renormalisation", self.lyapunov["t"],
+                                    {"long_name": "time of the Benettin renormalisation",
+                                     "units": "s"})
+            data["lyapunov_log_growth"] = ("renormalisation", self.lyapunov["log_growth"],
+                                           {"long_name": "cumulative log stretch of the "
+                                            "separation (Benettin)", "units": "1"})
+            attrs["lyapunov_exponent"] = float(self.lyapunov["exponent"])
+        for k, v in self.stats.items():
+            attrs[f"stat_{k}"] = v
+        return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+
+def run(model) -> Result:
+    """Run a loaded Model (pyspline.simulate: any case) and return a Result. Raises CaseError, SolverError or ThermalInterferenceError with a message naming the
+    case; KeyboardInterrupt if SIGINT arrives during the run. Releases the GIL while it runs."""
+    q, s = _names("tooth"), _names("stats")
+    t0 = time.perf_counter()
+    nft = model.n_out if model.n_slices else 0
+    # the per-tooth array (the largest) is allocated here, not zeroed (f2py zeroes its own)
+    tooth = np.empty((model.n_out, model.z, len(q)), order="F")
+    t, ycol, tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, nqw, consts, ierr, msg = \
+        _api.api_simulate(model.bytes, model.z, model.n_out, len(q), len(s), model.n_section,
+                          model.n_lyapunov, nft, model.n_slices, tooth)
+    wall = time.perf_counter() - t0
+    run_outcome(ierr, msg)
+    y = ycol.T                # (nt, 14), a view of the core's columns (no transposed copy)
+    st = {n: (float(v) if unit else int(v)) for (n, unit, _), v in zip(s, stats)}  # counts: int
+    st["wall_s"] = wall
+    _warn(_api.api_warnings(model.bytes, stats, 1), 4)   # the run's (one-way backlash, Eq. 2),
+    #                                  attributed to the caller of pyspline.simulate
+    lyap = None
+    if model.n_lyapunov:
+        span = lyap_t - (t[0] if len(t) else 0.0)
+        lyap = dict(t=lyap_t, log_growth=lyap_g, exponent=float(lyap_g[-1] / span[-1]))
+    # a level without flash temperature or slices writes F, Fx, Fy, dn only (nqw = 4): its
+    # c, Tf, rc1, rc2 are constants, given once (consts) and broadcast (read-only views)
+    tooth = tooth[:, :, :nqw]
+    per = {n: (tooth[:, :, i] if i < nqw else np.broadcast_to(consts[i - 4], tooth.shape[:2]))
+           for i, (n, *_) in enumerate(q)}
+    return Result(case=model.case, t=t, y=y, tooth=per, Tm=tm, stats=st,
+                  section_t=sec_t, section_y=sec_y, lyapunov=lyap,
+                  face=face if model.n_slices else None, tilt=tilt if model.n_slices else None,
+                  loads=run_loads(model, t, y, tooth, tm),
+                  spacing_error=model.info()["spacing_error"])
+
+
+def run_loads(model, t, y, tooth, tm) -> dict:
+    """The loads of a run from its outputs (the core's spline_loads::run_loads; the numbers
+    spline-dyn writes): {name: value} for the scalars of LOAD_QUANTITIES (float) and the
+    per-tooth arrays (Z,) of TOOTH_LOAD_QUANTITIES. tooth: (nt, Z, nq) as api_simulate gives it
+    (all of Result.tooth's quantities in their order, or F, Fx, Fy, dn alone for a level without
+    T_f), tm: T_m (nt,)."""
+    loads, tload, ierr, msg = _api.api_loads(model.bytes, len(LOAD_QUANTITIES),
+                                             len(TOOTH_LOAD_QUANTITIES), t, np.asarray(y).T,
+                                             tooth, tm)
+    raise_for(ierr, msg)
+    _warn(_api.api_warnings(model.bytes, loads, 2))      # nominal stresses beyond their limits
+    out = {n: float(v) for n, v in zip(LOAD_QUANTITIES, loads)}
+    out.update({n: tload[:, i] for i, n in enumerate(TOOTH_LOAD_QUANTITIES)})
+    return out

@@ -1,0 +1,77 @@
+"""The package's modules import alone, and none imports another that imports it back (issue 33:
+no import circles). The graph counts every import of a module, at its top or inside a function,
+since a deferred import only hides a circle; a module's imports of the packages it is in
+(``from . import __version__``) are left out: a package is loaded before any of its modules."""
+import ast
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import pyspline
+
+ROOT = Path(pyspline.__file__).parent
+MODULES = sorted(".".join(("pyspline",) + p.relative_to(ROOT).with_suffix("").parts)
+                 .removesuffix(".__init__") for p in ROOT.rglob("*.py"))
+
+
+def _imports(module: str) -> set:
+    """The package's modules that `module` imports, anywhere in its source."""
+    path = ROOT.joinpath(*module.split(".")[1:])
+    is_pkg = path.is_dir()
+    tree = ast.parse((path / "__init__.py" if is_pkg else path.with_suffix(".py")).read_text())
+    here = module.split(".") if is_pkg else module.split(".")[:-1]
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            out |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom):
+            base = (here[:len(here) - node.level + 1] if node.level else [])
+            name = ".".join(base + ([node.module] if node.module else []))
+            out.add(name)
+            out |= {f"{name}.{a.name}" for a in node.names}      # from . import analysis
+    return {m for m in out if m in MODULES and m != module and not module.startswith(m + ".")}
+
+
+def _cycle(graph: dict) -> list:
+    """A cycle of the graph as a list of its nodes, or [] if there is none."""
+    state, path = {}, []
+
+    def visit(n):
+        state[n] = 1
+        path.append(n)
+        for m in sorted(graph[n]):
+            if state.get(m) == 1:
+                return path[path.index(m):] + [m]
+            if m not in state and (found := visit(m)):
+                return found
+        state[n] = 2
+        path.pop()
+        return []
+
+    for n in sorted(graph):
+        if n not in state and (found := visit(n)):
+            return found
+    return []
+
+
+def test_cycle_finder():
+    assert _cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
+    assert _cycle({"a": {"b", "c"}, "b": {"c"}, "c": set()}) == []
+
+
+def test_graph_sees_deferred_imports():
+    assert "pyspline.core" in _imports("pyspline.summary")
+    assert "pyspline.analysis" in _imports("pyspline.summary")     # from . import analysis
+    assert "pyspline.paper" in _imports("pyspline.cli")            # inside a function
+
+
+def test_no_import_cycle():
+    graph = {m: _imports(m) for m in MODULES}
+    assert _cycle(graph) == []
+
+
+@pytest.mark.parametrize("module", [m for m in MODULES if m != "pyspline.__main__"])  # a command
+def test_imports_alone(module):
+    subprocess.run([sys.executable, "-P", "-c", f"import {module}"], check=True, timeout=120)
