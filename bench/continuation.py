@@ -34,8 +34,8 @@ from pyspline.orbits import _scale
 from pyspline.paper import cases_dir
 from speed import _write_csv
 
-cont = importlib.import_module("pyspline.continuation")   # the module (pyspline.continuation
-MONODROMY = ("exact", "fd")                               # is also the function's name)
+cont = importlib.import_module("pyspline.arclength")   # the module of pyspline.continuation
+MONODROMY = ("exact", "fd")
 
 
 def scenes(quick: bool) -> list[tuple[str, pyspline.Case, float, float]]:
