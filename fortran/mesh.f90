@@ -10,6 +10,7 @@ module spline_mesh
   implicit none
   private
   public :: mesh_eval, mesh_forces, mesh_outputs, mesh_switch_functions, coupling_stats_t, tooth_approach
+  public :: eq16_mode, eq16_root_mode
 
   integer, parameter :: max_coupling_iter = 60
   real(wp), parameter :: coupling_tol = 1.0e-14_wp   !< relative step tolerance on T_f
@@ -439,5 +440,27 @@ contains
       s = s1
     end do
   end subroutine mesh_switch_functions
+
+  !> The contact state of Eq. 16 from a contact's switch functions (mesh_switch_functions):
+  !> +1 drive flank (g_drive = dn - c > 0), -1 back flank (g_back = dn + c < 0), else 0 free.
+  elemental integer function eq16_mode(g_drive, g_back) result(mode)
+    real(wp), intent(in) :: g_drive, g_back
+    mode = 0
+    if (g_drive > 0.0_wp) mode = 1
+    if (g_back < 0.0_wp) mode = -1
+  end function eq16_mode
+
+  !> The contact state of Eq. 16 after a located root of a contact's switch functions (root
+  !> directions as SUNDIALS reports them, 0: no root): g_drive rising, the drive flank engages
+  !> (+1), falling, it opens (0); g_back falling, the back flank engages (-1), rising, it opens
+  !> (0); mode: the state before.
+  elemental integer function eq16_root_mode(mode, root_drive, root_back) result(new)
+    integer, intent(in) :: mode, root_drive, root_back
+    new = mode
+    if (root_drive == 1) new = 1
+    if (root_drive == -1) new = 0
+    if (root_back == -1) new = -1
+    if (root_back == 1) new = 0
+  end function eq16_root_mode
 
 end module spline_mesh

@@ -24,7 +24,7 @@ module spline_variational
   use spline_model, only: model_t, nstate, ndof, thermal_coupled
   use spline_geometry, only: tooth_angles
   use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, integrated_states
-  use spline_mesh, only: mesh_switch_functions
+  use spline_mesh, only: mesh_switch_functions, eq16_mode, eq16_root_mode
   use spline_integrator, only: integrator_t, lib_log_t, integrator_open, cvode_create, &
        integrator_advance, integrator_root_info, integrator_restart, integrator_fail_text, &
        integrator_warnings, integrator_free
@@ -230,11 +230,7 @@ contains
       integer :: j, new
       ctx%ys_full(ctx%idx(1:n)) = yr(1:n)
       do j = 1, ctx%nc
-        new = ctx%modes(j)
-        if (rootsfound(2*j - 1) == 1) new = 1
-        if (rootsfound(2*j - 1) == -1) new = 0
-        if (rootsfound(2*j) == -1) new = -1
-        if (rootsfound(2*j) == 1) new = 0
+        new = eq16_root_mode(ctx%modes(j), rootsfound(2*j - 1), rootsfound(2*j))
         if (new == ctx%modes(j)) cycle
         nsw = nsw + 1
         if (salt) call apply_saltation(ctx, tau, j, new, yr)
@@ -265,16 +261,11 @@ contains
     type(tan_ctx_t), intent(inout) :: ctx
     real(c_double), intent(in) :: tau, v(:)
     real(wp) :: y(nstate), g(2*ctx%nc), ys(nstate)
-    integer :: j
     ys = ctx%ys_full
     ys(ctx%idx(1:ctx%n)) = v(1:ctx%n)
     call from_scaled(ctx%m, ys, y)
     call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), g)
-    do j = 1, ctx%nc
-      ctx%modes(j) = 0
-      if (g(2*j - 1) > 0.0_wp) ctx%modes(j) = 1
-      if (g(2*j) < 0.0_wp) ctx%modes(j) = -1
-    end do
+    ctx%modes = eq16_mode(g(1::2), g(2::2))
   end subroutine sync_modes
 
   !> Phi <- S Phi at the switch of contact k (tooth j, slice s) to state new, at tau:
