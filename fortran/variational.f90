@@ -24,7 +24,7 @@ module spline_variational
   use spline_model, only: model_t, nstate, ndof, thermal_coupled
   use spline_geometry, only: tooth_angles
   use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, integrated_states
-  use spline_mesh, only: mesh_switch_functions, eq16_mode, eq16_root_mode
+  use spline_mesh, only: mesh_switch_functions, eq16_mode, eq16_root_mode, slice_offset
   use spline_integrator, only: integrator_t, lib_log_t, integrator_open, cvode_create, &
        integrator_advance, integrator_root_info, integrator_restart, integrator_fail_text, &
        integrator_warnings, integrator_free
@@ -289,8 +289,7 @@ contains
       ys(ctx%idx(1:n)) = v(1:n)
       call from_scaled(m, ys, y)
       call tooth_angles(m%z, m%omega, tau/m%w_ref, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
-      zs = 0.0_wp
-      if (ns > 1) zs = m%b*((is - 0.5_wp)/ns - 0.5_wp)
+      zs = slice_offset(m, is)
       ex = y(1) + m%l_x - y(3)
       ey = y(2) + m%l_y - y(4)
       hy = 0.0_wp
