@@ -79,7 +79,7 @@ contains
         ! slices of the face (angular misalignment; thermal none or bulk: c_j = c_bulk)
         fj = 0.0_wp
         do is = 1, ns
-          zs = slice_offset(m, is)
+          zs = slice_z(m, is)
           dns = dnj + zs*(m%gamma_y*sp(j) + m%gamma_x*cp(j))
           ddns = ddnj + m%omega*zs*(m%gamma_y*cp(j) - m%gamma_x*sp(j))
           if (present(mode)) then
@@ -427,7 +427,7 @@ contains
         g(2*j) = dnj + m%c_bulk
       else
         do is = 1, ns
-          dns = dnj + slice_offset(m, is)*(m%gamma_y*sp(j) + m%gamma_x*cp(j))
+          dns = dnj + slice_z(m, is)*(m%gamma_y*sp(j) + m%gamma_x*cp(j))
           k = (j - 1)*ns + is
           g(2*k - 1) = dns - m%c_bulk
           g(2*k) = dns + m%c_bulk
@@ -437,12 +437,19 @@ contains
   end subroutine mesh_switch_functions
 
   !> The axial position of slice is of the n_s of the face, from its mid-plane (docs/model.md
-  !> section 11): z_s = b ((s - 1/2) / n_s - 1/2).
+  !> section 11): z_s = b ((s - 1/2) / n_s - 1/2). For other modules; this one calls slice_z,
+  !> inlined (tooth_approach says why).
   elemental real(wp) function slice_offset(m, is) result(zs)
     type(model_t), intent(in) :: m
     integer, intent(in) :: is
-    zs = m%b*((is - 0.5_wp)/m%n_slices - 0.5_wp)
+    zs = slice_z(m, is)
   end function slice_offset
+
+  elemental real(wp) function slice_z(m, is) result(zs)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: is
+    zs = m%b*((is - 0.5_wp)/m%n_slices - 0.5_wp)
+  end function slice_z
 
   !> The contact state of Eq. 16 from a contact's switch functions (mesh_switch_functions):
   !> +1 drive flank (g_drive = dn - c > 0), -1 back flank (g_back = dn + c < 0), else 0 free.
