@@ -11,7 +11,7 @@ module spline_mesh
   implicit none
   private
   public :: mesh_eval, mesh_forces, mesh_outputs, mesh_switch_functions, coupling_stats_t, tooth_approach
-  public :: eq16_mode, eq16_root_mode, slice_offset
+  public :: eq11_gradient, eq16_mode, eq16_root_mode, slice_offset
 
   integer, parameter :: max_coupling_iter = 60
   real(wp), parameter :: coupling_tol = 1.0e-14_wp   !< relative step tolerance on T_f
@@ -176,6 +176,17 @@ contains
     dn = ex*sp - ey*cp + q6 + e
     ddn = evx*sp - evy*cp + v6 + omega*(ex*cp + ey*sp)
   end subroutine eq11
+
+  !> The gradient of Eq. 11 in the displacements q (layout of Eq. 24) for tooth angle phi_j
+  !> (sp, cp: its sine and cosine): u = d(dn_j)/dq = d(d(dn_j)/dt)/dv = (sin, -cos, -sin, cos,
+  !> 0, 1, 0); w (optional) = (cos, sin, -cos, -sin, 0, 0, 0), d(d(dn_j)/dt)/dq = omega w.
+  pure subroutine eq11_gradient(sp, cp, u, w)
+    real(wp), intent(in) :: sp, cp
+    real(wp), intent(out) :: u(7)
+    real(wp), intent(out), optional :: w(7)
+    u = [sp, -cp, -sp, cp, 0.0_wp, 1.0_wp, 0.0_wp]
+    if (present(w)) w = [cp, sp, -cp, -sp, 0.0_wp, 0.0_wp, 0.0_wp]
+  end subroutine eq11_gradient
 
   !> The right-hand side's mesh kernel: mesh_eval's F_x1, F_y1 and T_m to round-off (a few ulp of
   !> dn_j; tests/fortran/test_mesh.f90), for a model without face slices or coupled flash

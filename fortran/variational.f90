@@ -24,7 +24,8 @@ module spline_variational
   use spline_model, only: model_t, nstate, ndof, thermal_coupled
   use spline_geometry, only: tooth_angles
   use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, integrated_states
-  use spline_mesh, only: mesh_switch_functions, eq16_mode, eq16_root_mode, slice_offset
+  use spline_mesh, only: mesh_switch_functions, eq11_gradient, eq16_mode, eq16_root_mode, &
+       slice_offset
   use spline_integrator, only: integrator_t, lib_log_t, integrator_open, cvode_create, &
        integrator_advance, integrator_root_info, integrator_restart, integrator_fail_text, &
        integrator_warnings, integrator_free
@@ -87,8 +88,7 @@ contains
     do j = 1, m%z
       wt = real(count(modes((j - 1)*ns + 1:j*ns) /= 0), wp)/ns   ! share of the face in contact
       if (wt == 0.0_wp) cycle
-      u = [sp(j), -cp(j), -sp(j), cp(j), 0.0_wp, 1.0_wp, 0.0_wp]
-      w = [cp(j), sp(j), -cp(j), -sp(j), 0.0_wp, 0.0_wp, 0.0_wp]
+      call eq11_gradient(sp(j), cp(j), u, w)
       gf(1:ndof) = wt*(m%k_m*u + m%c_m*m%omega*w)
       gf(ndof+1:) = wt*m%c_m*u
       gx = gx - gf*sp(j)
@@ -278,7 +278,7 @@ contains
     integer, intent(in) :: k, new
     real(c_double), intent(inout) :: v(:)
     real(wp) :: ys(nstate), y(nstate), fm(nstate), fp(nstate), hy(nstate), ht, den, sp(max_teeth)
-    real(wp) :: cp(max_teeth), ex, ey, zs, dfi(nstate), hphi
+    real(wp) :: cp(max_teeth), ex, ey, zs, dfi(nstate), hphi, u(ndof)
     integer :: mode_new(size(ctx%modes)), j, is, ns, n, c, ie
     associate(m => ctx%m)
       n = ctx%n
@@ -293,7 +293,8 @@ contains
       ex = y(1) + m%l_x - y(3)
       ey = y(2) + m%l_y - y(4)
       hy = 0.0_wp
-      hy(1:ndof) = m%l_ref*[sp(j), -cp(j), -sp(j), cp(j), 0.0_wp, 1.0_wp, 0.0_wp]
+      call eq11_gradient(sp(j), cp(j), u)
+      hy(1:ndof) = m%l_ref*u
       ht = m%omega*(ex*cp(j) + ey*sp(j) + zs*(m%gamma_y*cp(j) - m%gamma_x*sp(j)))/m%w_ref
       mode_new = ctx%modes
       mode_new(k) = new
