@@ -4,7 +4,7 @@ module spline_dynamics
   use spline_kinds, only: wp
   use spline_errors, only: err_ok, err_solver
   use spline_model, only: model_t, ndof, nstate, thermal_coupled
-  use spline_mesh, only: mesh_eval, mesh_forces, mesh_switch_functions, coupling_stats_t
+  use spline_mesh, only: mesh_eval, mesh_forces, mesh_switch_functions, coupling_stats_t, eq16_mode
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -172,7 +172,7 @@ contains
     character(len=*), intent(inout) :: errmsg
     real(wp) :: r(ndof), rn(ndof), jac(ndof, ndof), dq(ndof), qn(ndof), h, lam
     real(wp) :: g(2*m%z*m%n_slices), dqbar(ndof), q_prev(ndof), dq_prev(ndof), lam_prev
-    integer :: it, k, ls, j, modes(m%z*m%n_slices)
+    integer :: it, k, ls, modes(m%z*m%n_slices)
     q = 0.0_wp
     q(2) = -m%m_1*m%grav/max(m%k_p1, tiny(1.0_wp))
     q(4) = -m%m_2*m%grav/max(m%k_p2, tiny(1.0_wp))
@@ -188,11 +188,7 @@ contains
     do it = 1, max_newton
       ! contact states at q (Eq. 16, as the right-hand side decides them)
       call mesh_switch_functions(m, t, q, g)
-      do j = 1, m%z*m%n_slices
-        modes(j) = 0
-        if (g(2*j - 1) > 0.0_wp) modes(j) = 1
-        if (g(2*j) < 0.0_wp) modes(j) = -1
-      end do
+      modes = eq16_mode(g(1::2), g(2::2))
       do k = 1, ndof
         h = 1.0e-7_wp*max(abs(q(k)), m%l_ref)
         qn = q

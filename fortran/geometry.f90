@@ -4,7 +4,7 @@ module spline_geometry
   use spline_kinds, only: wp, pi
   implicit none
   private
-  public :: tooth_angles, pitch_rotation, contact_radius, profile_shift, iso4156_radii, active_profile, &
+  public :: tooth_angles, tooth1_angle, pitch_step, pitch_rotation, contact_radius, profile_shift, iso4156_radii, active_profile, &
        root_section
 
 contains
@@ -49,14 +49,43 @@ contains
     real(wp), intent(out) :: sphi(z), cphi(z)
     integer :: j
     real(wp) :: phi
-    phi = 2.0_wp*pi/z + omega*t + theta0 - alpha
+    phi = angle1(z, omega, t, theta0, alpha)
     sphi(1) = sin(phi)
     cphi(1) = cos(phi)
     do j = 2, z
-      sphi(j) = sphi(j-1)*cd + cphi(j-1)*sd
-      cphi(j) = cphi(j-1)*cd - sphi(j-1)*sd
+      call step(sd, cd, sphi(j-1), cphi(j-1), sphi(j), cphi(j))
     end do
   end subroutine tooth_angles
+
+  !> Eqs. 8-9 for tooth 1: phi_1 = 2 pi / Z + omega t + theta_0 - alpha. For other modules; this
+  !> one calls angle1, which the compiler inlines (spline_mesh::tooth_approach says why).
+  elemental real(wp) function tooth1_angle(z, omega, t, theta0, alpha) result(phi)
+    integer, intent(in) :: z
+    real(wp), intent(in) :: omega, t, theta0, alpha
+    phi = angle1(z, omega, t, theta0, alpha)
+  end function tooth1_angle
+
+  elemental real(wp) function angle1(z, omega, t, theta0, alpha) result(phi)
+    integer, intent(in) :: z
+    real(wp), intent(in) :: omega, t, theta0, alpha
+    phi = 2.0_wp*pi/z + omega*t + theta0 - alpha
+  end function angle1
+
+  !> Eqs. 8-9 from one tooth to the next: (sn, cn) = sin and cos of phi_j + 2 pi / Z from
+  !> (s, c) of phi_j, with sd, cd of the pitch angle (pitch_rotation). For other modules; this
+  !> one calls step, inlined.
+  elemental subroutine pitch_step(sd, cd, s, c, sn, cn)
+    real(wp), intent(in) :: sd, cd, s, c
+    real(wp), intent(out) :: sn, cn
+    call step(sd, cd, s, c, sn, cn)
+  end subroutine pitch_step
+
+  elemental subroutine step(sd, cd, s, c, sn, cn)
+    real(wp), intent(in) :: sd, cd, s, c
+    real(wp), intent(out) :: sn, cn
+    sn = s*cd + c*sd
+    cn = c*cd - s*sd
+  end subroutine step
 
   !> The rotation between neighbouring teeth of Eqs. 8-9: sd = sin(2 pi / Z), cd = cos(2 pi / Z).
   pure subroutine pitch_rotation(z, sd, cd)

@@ -2,14 +2,16 @@
 !> dead-zone contact with time-varying backlash (Eqs. 2, 15-17), flash-temperature coupling
 !> (Eqs. 1, 3-7, 12-13) and the energy-consistent mesh forces on the bodies (Eqs. 19-22, corrected).
 module spline_mesh
-  use spline_kinds, only: wp, pi, max_teeth
+  use spline_kinds, only: wp, max_teeth
   use spline_errors, only: err_ok, err_solver, err_thermal
   use spline_model, only: model_t, thermal_oneway, thermal_coupled
-  use spline_geometry, only: tooth_angles, profile_shift, contact_radius, active_profile
+  use spline_geometry, only: tooth_angles, tooth1_angle, pitch_step, profile_shift, contact_radius, &
+       active_profile
   use spline_thermal, only: thermal_backlash, flash_temperature
   implicit none
   private
   public :: mesh_eval, mesh_forces, mesh_outputs, mesh_switch_functions, coupling_stats_t, tooth_approach
+  public :: eq11_gradient, eq16_mode, eq16_root_mode, slice_offset
 
   integer, parameter :: max_coupling_iter = 60
   real(wp), parameter :: coupling_tol = 1.0e-14_wp   !< relative step tolerance on T_f
@@ -77,7 +79,7 @@ contains
         ! slices of the face (angular misalignment; thermal none or bulk: c_j = c_bulk)
         fj = 0.0_wp
         do is = 1, ns
-          zs = m%b*((is - 0.5_wp)/ns - 0.5_wp)
+          zs = slice_z(m, is)
           dns = dnj + zs*(m%gamma_y*sp(j) + m%gamma_x*cp(j))
           ddns = ddnj + m%omega*zs*(m%gamma_y*cp(j) - m%gamma_x*sp(j))
           if (present(mode)) then
@@ -175,6 +177,17 @@ contains
     ddn = evx*sp - evy*cp + v6 + omega*(ex*cp + ey*sp)
   end subroutine eq11
 
+  !> The gradient of Eq. 11 in the displacements q (layout of Eq. 24) for tooth angle phi_j
+  !> (sp, cp: its sine and cosine): u = d(dn_j)/dq = d(d(dn_j)/dt)/dv = (sin, -cos, -sin, cos,
+  !> 0, 1, 0); w (optional) = (cos, sin, -cos, -sin, 0, 0, 0), d(d(dn_j)/dt)/dq = omega w.
+  pure subroutine eq11_gradient(sp, cp, u, w)
+    real(wp), intent(in) :: sp, cp
+    real(wp), intent(out) :: u(7)
+    real(wp), intent(out), optional :: w(7)
+    u = [sp, -cp, -sp, cp, 0.0_wp, 1.0_wp, 0.0_wp]
+    if (present(w)) w = [cp, sp, -cp, -sp, 0.0_wp, 0.0_wp, 0.0_wp]
+  end subroutine eq11_gradient
+
   !> The right-hand side's mesh kernel: mesh_eval's F_x1, F_y1 and T_m to round-off (a few ulp of
   !> dn_j; tests/fortran/test_mesh.f90), for a model without face slices or coupled flash
   !> temperature (the teeth's backlash is c_bulk; at the one-way level T_f does not act back).
@@ -189,7 +202,7 @@ contains
     real(wp) :: s, c, phi, ex, ey, evx, evy, cb, km, cm, a, b, va, vb, sfc, sfs, sumf, q6, v6
     real(wp) :: dnj, ddnj, fs(max_teeth)    ! fixed size: no allocation per call
     integer :: j, z
-    phi = 2.0_wp*pi/m%z + m%omega*t + m%theta0 - m%alpha     ! tooth_angles, tooth 1
+    phi = tooth1_angle(m%z, m%omega, t, m%theta0, m%alpha)
     s = sin(phi)
     c = cos(phi)
     cb = m%c_bulk; km = m%k_m; cm = m%c_m
@@ -237,8 +250,8 @@ contains
   !> modes(:, k), 2: decided by the state) and T_m, for a model without flash temperature or face
   !> slices: Eqs. 8-9, 11, 15-17 and 19-22 as tooth_angles and mesh_eval evaluate them,
   !> operation for operation (run.f90's tooth_outputs checks the first and last output against
-  !> mesh_eval), in blocks of nblk outputs, one pass per tooth (f(k, j) is contiguous in k; the
-  !> pitch rotation of tooth_angles runs over the block's outputs at once). finite: whether every
+  !> mesh_eval), in blocks of nblk outputs, one pass per tooth (f(k, j) is contiguous in k;
+  !> tooth_angles' pitch_step runs over the block's outputs at once). finite: whether every
   !> value written to f, fx, fy and dn is finite (x*0 is 0 for a finite x, NaN otherwise),
   !> formed while they are in registers, so the run's checks need not read them again.
   pure subroutine mesh_outputs(m, nt, t, y, modes, f, fx, fy, dn, tm, finite)
@@ -260,7 +273,7 @@ contains
       nk = min(nblk, nt - k0)
       do i = 1, nk
         k = k0 + i
-        phi = 2.0_wp*pi/m%z + m%omega*t(k) + m%theta0 - m%alpha     ! tooth_angles, tooth 1
+        phi = tooth1_angle(m%z, m%omega, t(k), m%theta0, m%alpha)
         sp(i, 1) = sin(phi)
         cp(i, 1) = cos(phi)
         ex(i) = y(1, k) + m%l_x - y(3, k)
@@ -269,8 +282,8 @@ contains
         evy(i) = y(9, k) - y(11, k)
       end do
       do j = 2, m%z             ! tooth_angles' rotation by the pitch, for nk outputs at once
-        sp(1:nk, j) = sp(1:nk, j-1)*m%cos_pitch + cp(1:nk, j-1)*m%sin_pitch
-        cp(1:nk, j) = cp(1:nk, j-1)*m%cos_pitch - sp(1:nk, j-1)*m%sin_pitch
+        call pitch_step(m%sin_pitch, m%cos_pitch, sp(1:nk, j-1), cp(1:nk, j-1), sp(1:nk, j), &
+             cp(1:nk, j))
       end do
       sumf = 0.0_wp
       do j = 1, m%z    ! scalar: a branch-free form the compiler vectorises measured slower
@@ -411,33 +424,64 @@ contains
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(7)
     real(wp), intent(out) :: g(2*m%z*m%n_slices)
-    real(wp) :: s, c, s1, phi, ex, ey, dnj, ddnj, dns, zs
+    real(wp) :: sp(max_teeth), cp(max_teeth), ex, ey, dnj, ddnj, dns
     integer :: j, is, k, ns
-    phi = 2.0_wp*pi/m%z + m%omega*t + m%theta0 - m%alpha     ! tooth_angles, in the loop below
-    s = sin(phi)
-    c = cos(phi)
+    call tooth_angles(m%z, m%omega, t, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
     ex = q(1) + m%l_x - q(3)
     ey = q(2) + m%l_y - q(4)
     ns = m%n_slices
     do j = 1, m%z
-      call eq11(ex, ey, 0.0_wp, 0.0_wp, q(6), 0.0_wp, 0.0_wp, m%spacing_error(j), s, c, dnj, &
-           ddnj)                                  ! Eq. 11 (its rate unused)
+      call eq11(ex, ey, 0.0_wp, 0.0_wp, q(6), 0.0_wp, 0.0_wp, m%spacing_error(j), sp(j), cp(j), &
+           dnj, ddnj)                             ! Eq. 11 (its rate unused)
       if (ns == 1) then
         g(2*j - 1) = dnj - m%c_bulk
         g(2*j) = dnj + m%c_bulk
       else
         do is = 1, ns
-          zs = m%b*((is - 0.5_wp)/ns - 0.5_wp)
-          dns = dnj + zs*(m%gamma_y*s + m%gamma_x*c)
+          dns = dnj + slice_z(m, is)*(m%gamma_y*sp(j) + m%gamma_x*cp(j))
           k = (j - 1)*ns + is
           g(2*k - 1) = dns - m%c_bulk
           g(2*k) = dns + m%c_bulk
         end do
       end if
-      s1 = s*m%cos_pitch + c*m%sin_pitch
-      c = c*m%cos_pitch - s*m%sin_pitch
-      s = s1
     end do
   end subroutine mesh_switch_functions
+
+  !> The axial position of slice is of the n_s of the face, from its mid-plane (docs/model.md
+  !> section 11): z_s = b ((s - 1/2) / n_s - 1/2). For other modules; this one calls slice_z,
+  !> inlined (tooth_approach says why).
+  elemental real(wp) function slice_offset(m, is) result(zs)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: is
+    zs = slice_z(m, is)
+  end function slice_offset
+
+  elemental real(wp) function slice_z(m, is) result(zs)
+    type(model_t), intent(in) :: m
+    integer, intent(in) :: is
+    zs = m%b*((is - 0.5_wp)/m%n_slices - 0.5_wp)
+  end function slice_z
+
+  !> The contact state of Eq. 16 from a contact's switch functions (mesh_switch_functions):
+  !> +1 drive flank (g_drive = dn - c > 0), -1 back flank (g_back = dn + c < 0), else 0 free.
+  elemental integer function eq16_mode(g_drive, g_back) result(mode)
+    real(wp), intent(in) :: g_drive, g_back
+    mode = 0
+    if (g_drive > 0.0_wp) mode = 1
+    if (g_back < 0.0_wp) mode = -1
+  end function eq16_mode
+
+  !> The contact state of Eq. 16 after a located root of a contact's switch functions (root
+  !> directions as SUNDIALS reports them, 0: no root): g_drive rising, the drive flank engages
+  !> (+1), falling, it opens (0); g_back falling, the back flank engages (-1), rising, it opens
+  !> (0); mode: the state before.
+  elemental integer function eq16_root_mode(mode, root_drive, root_back) result(new)
+    integer, intent(in) :: mode, root_drive, root_back
+    new = mode
+    if (root_drive == 1) new = 1
+    if (root_drive == -1) new = 0
+    if (root_back == -1) new = -1
+    if (root_back == 1) new = 0
+  end function eq16_root_mode
 
 end module spline_mesh

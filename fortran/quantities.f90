@@ -65,8 +65,8 @@ module spline_quantities
        ist_eps_thermal = nsolver_stats + 5, ist_closed = nsolver_stats + 6, &
        ist_closed_t = nsolver_stats + 7, ist_f_error = nsolver_stats + 8, &
        ist_f_error_t = nsolver_stats + 9, ist_f_parted_t = nsolver_stats + 10, &
-       ist_rtol_used = nsolver_stats + 11
-  integer, parameter :: nstats = nsolver_stats + 11
+       ist_rtol_used = nsolver_stats + 11, ist_outputs_fallback = nsolver_stats + 12
+  integer, parameter :: nstats = nsolver_stats + 12
   type(quantity_t), parameter :: stat_q(nstats) = [ &
        quantity_t('steps', '', 'CVODE steps (all restarts)'), &
        quantity_t('rhs_evals', '', 'right-hand-side evaluations of CVODE'), &
@@ -104,7 +104,9 @@ module spline_quantities
        quantity_t('F_parted_t_s', 's', 'first output where a tighter run''s F_j differ by over &
             &0.1 max |F_j|: the trajectories part (chaos; -1: never, or not estimated)'), &
        quantity_t('rtol_used', '-', 'relative tolerance of the run (the case''s, or what accuracy &
-            &or goal picked)')]
+            &or goal picked)'), &
+       quantity_t('outputs_fallback', '', '1: the per-tooth outputs fell back to mesh_eval at every &
+            &output, as mesh_outputs differed from it at the first or last (a drift; 0 expected)')]
 
   !> The loads of a run (spline_loads::run_loads, docs/model.md section 15), per tooth: their
   !> positions in a run's tooth-load array (ilt_*) and the table.

@@ -13,7 +13,7 @@ module spline_run
   use spline_quantities, only: nsolver_stats, nstats, ntooth_q, iq_tf, tooth_q, state_q, &
        ist_core_wall, ist_dof, ist_thermal_level, ist_eps_lateral, ist_eps_thermal, ist_closed, &
        ist_closed_t, ist_roots_found, ist_f_error, ist_f_error_t, ist_f_parted_t, ist_rtol_used, &
-       ist_linear_tail_t
+       ist_outputs_fallback, ist_linear_tail_t
   use spline_accuracy, only: force_error, check_factor, max_tighten
   use spline_case_text, only: num
   use spline_fidelity, only: auto_level, auto_tol, backlash_estimate
@@ -364,6 +364,7 @@ contains
     real(wp) :: y0(nstate)
     real(wp), allocatable :: ts(:), ysec(:, :)
     integer, allocatable :: modes(:, :)
+    logical :: fallback
     errmsg = ''
     stats = 0.0_wp
     nw = ntooth_q; consts = 0.0_wp; fin = .false.
@@ -377,7 +378,9 @@ contains
       tooth = 0.0_wp; tm = 0.0_wp
       return
     end if
-    call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt, lazy, nw, consts, fin)
+    call tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt, lazy, nw, consts, fin, &
+         fallback)
+    stats(ist_outputs_fallback) = merge(1.0_wp, 0.0_wp, fallback)
     if (ierr /= err_ok) then
       tooth = 0.0_wp; tm = 0.0_wp; nw = ntooth_q; consts = 0.0_wp; fin = .false.
     end if
@@ -410,8 +413,10 @@ contains
   !> lazy (optional): there, c_j, T_f, r_c1, r_c2 are not written but returned once in consts
   !> (nw = 4 quantities written; else nw = ntooth_q, consts = 0). finite (optional): there, whether
   !> every value written to tooth is finite (mesh_outputs' finite); else .false. (not known).
+  !> fallback (optional): whether mesh_outputs' outputs were replaced by mesh_eval's (a drift;
+  !> the run's outputs_fallback).
   subroutine tooth_outputs(m, t, y, modes, tooth, tm, ierr, errmsg, face, tilt, lazy, nw, consts, &
-       finite)
+       finite, fallback)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t(:), y(:, :)
     integer, intent(in) :: modes(:, :)
@@ -422,12 +427,13 @@ contains
     logical, intent(in), optional :: lazy
     integer, intent(out), optional :: nw
     real(wp), intent(out), optional :: consts(ntooth_q - 4)
-    logical, intent(out), optional :: finite
+    logical, intent(out), optional :: finite, fallback
     real(wp) :: row(m%z, ntooth_q), fs(m%n_slices, m%z), mt(2), cq(ntooth_q - 4)
     integer :: k, nq
     logical :: lz, fin
     ierr = err_ok
     if (present(finite)) finite = .false.
+    if (present(fallback)) fallback = .false.
     lz = .false.
     if (present(lazy)) lz = lazy
     nq = ntooth_q
@@ -443,6 +449,7 @@ contains
         if (present(finite)) finite = fin .and. all(ieee_is_finite(cq))
         return
       end if
+      if (present(fallback)) fallback = .true.
     end if
     nq = ntooth_q
     if (present(nw)) then

@@ -15,7 +15,7 @@ module spline_solver
   use spline_errors, only: err_ok, err_solver, err_interrupted, msglen
   use spline_model, only: model_t, nstate, ndof
   use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, integrated_states
-  use spline_mesh, only: mesh_switch_functions, coupling_stats_t
+  use spline_mesh, only: mesh_switch_functions, coupling_stats_t, eq16_mode, eq16_root_mode
   use spline_linear, only: tail_t, tail_possible, tail_try, tail_state, tail_states
   use spline_integrator, only: integrator_t, lib_log_t, integrator_open, cvode_create, &
        erk_create, integrator_advance, integrator_root_info, integrator_land_on_root, &
@@ -386,9 +386,7 @@ contains
     call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), g)
     eps = 1.0e-9_wp*ctx%m%c_bulk
     do j = 1, ctx%m%z*ctx%m%n_slices         ! every contact: a tooth, or a slice of a tooth
-      want = 0
-      if (g(2*j - 1) > 0.0_wp) want = 1
-      if (g(2*j) < 0.0_wp) want = -1
+      want = eq16_mode(g(2*j - 1), g(2*j))
       if (want /= ctx%modes(j, c)) then
         if (abs(g(2*j - 1)) > eps .and. abs(g(2*j)) > eps) nchanged = nchanged + 1
         ctx%modes(j, c) = want
@@ -408,10 +406,8 @@ contains
     do c = 1, ctx%ncopy
       o = (c - 1)*ctx%nrc
       do j = 1, nc
-        if (rootsfound(o + 2*j - 1) == 1) ctx%modes(j, c) = 1
-        if (rootsfound(o + 2*j - 1) == -1) ctx%modes(j, c) = 0
-        if (rootsfound(o + 2*j) == -1) ctx%modes(j, c) = -1
-        if (rootsfound(o + 2*j) == 1) ctx%modes(j, c) = 0
+        ctx%modes(j, c) = eq16_root_mode(ctx%modes(j, c), rootsfound(o + 2*j - 1), &
+             rootsfound(o + 2*j))
       end do
     end do
     nroots = nroots + count(rootsfound /= 0)

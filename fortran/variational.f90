@@ -24,7 +24,8 @@ module spline_variational
   use spline_model, only: model_t, nstate, ndof, thermal_coupled
   use spline_geometry, only: tooth_angles
   use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, integrated_states
-  use spline_mesh, only: mesh_switch_functions
+  use spline_mesh, only: mesh_switch_functions, eq11_gradient, eq16_mode, eq16_root_mode, &
+       slice_offset
   use spline_integrator, only: integrator_t, lib_log_t, integrator_open, cvode_create, &
        integrator_advance, integrator_root_info, integrator_restart, integrator_fail_text, &
        integrator_warnings, integrator_free
@@ -87,8 +88,7 @@ contains
     do j = 1, m%z
       wt = real(count(modes((j - 1)*ns + 1:j*ns) /= 0), wp)/ns   ! share of the face in contact
       if (wt == 0.0_wp) cycle
-      u = [sp(j), -cp(j), -sp(j), cp(j), 0.0_wp, 1.0_wp, 0.0_wp]
-      w = [cp(j), sp(j), -cp(j), -sp(j), 0.0_wp, 0.0_wp, 0.0_wp]
+      call eq11_gradient(sp(j), cp(j), u, w)
       gf(1:ndof) = wt*(m%k_m*u + m%c_m*m%omega*w)
       gf(ndof+1:) = wt*m%c_m*u
       gx = gx - gf*sp(j)
@@ -230,11 +230,7 @@ contains
       integer :: j, new
       ctx%ys_full(ctx%idx(1:n)) = yr(1:n)
       do j = 1, ctx%nc
-        new = ctx%modes(j)
-        if (rootsfound(2*j - 1) == 1) new = 1
-        if (rootsfound(2*j - 1) == -1) new = 0
-        if (rootsfound(2*j) == -1) new = -1
-        if (rootsfound(2*j) == 1) new = 0
+        new = eq16_root_mode(ctx%modes(j), rootsfound(2*j - 1), rootsfound(2*j))
         if (new == ctx%modes(j)) cycle
         nsw = nsw + 1
         if (salt) call apply_saltation(ctx, tau, j, new, yr)
@@ -265,16 +261,11 @@ contains
     type(tan_ctx_t), intent(inout) :: ctx
     real(c_double), intent(in) :: tau, v(:)
     real(wp) :: y(nstate), g(2*ctx%nc), ys(nstate)
-    integer :: j
     ys = ctx%ys_full
     ys(ctx%idx(1:ctx%n)) = v(1:ctx%n)
     call from_scaled(ctx%m, ys, y)
     call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), g)
-    do j = 1, ctx%nc
-      ctx%modes(j) = 0
-      if (g(2*j - 1) > 0.0_wp) ctx%modes(j) = 1
-      if (g(2*j) < 0.0_wp) ctx%modes(j) = -1
-    end do
+    ctx%modes = eq16_mode(g(1::2), g(2::2))
   end subroutine sync_modes
 
   !> Phi <- S Phi at the switch of contact k (tooth j, slice s) to state new, at tau:
@@ -287,7 +278,7 @@ contains
     integer, intent(in) :: k, new
     real(c_double), intent(inout) :: v(:)
     real(wp) :: ys(nstate), y(nstate), fm(nstate), fp(nstate), hy(nstate), ht, den, sp(max_teeth)
-    real(wp) :: cp(max_teeth), ex, ey, zs, dfi(nstate), hphi
+    real(wp) :: cp(max_teeth), ex, ey, zs, dfi(nstate), hphi, u(ndof)
     integer :: mode_new(size(ctx%modes)), j, is, ns, n, c, ie
     associate(m => ctx%m)
       n = ctx%n
@@ -298,12 +289,12 @@ contains
       ys(ctx%idx(1:n)) = v(1:n)
       call from_scaled(m, ys, y)
       call tooth_angles(m%z, m%omega, tau/m%w_ref, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
-      zs = 0.0_wp
-      if (ns > 1) zs = m%b*((is - 0.5_wp)/ns - 0.5_wp)
+      zs = slice_offset(m, is)
       ex = y(1) + m%l_x - y(3)
       ey = y(2) + m%l_y - y(4)
       hy = 0.0_wp
-      hy(1:ndof) = m%l_ref*[sp(j), -cp(j), -sp(j), cp(j), 0.0_wp, 1.0_wp, 0.0_wp]
+      call eq11_gradient(sp(j), cp(j), u)
+      hy(1:ndof) = m%l_ref*u
       ht = m%omega*(ex*cp(j) + ey*sp(j) + zs*(m%gamma_y*cp(j) - m%gamma_x*sp(j)))/m%w_ref
       mode_new = ctx%modes
       mode_new(k) = new

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import pyspline
-from conftest import CASES, PAPER_SHAFTS, PAPER_SUPPORTS
+from conftest import CASES, DEMONSTRATION_SCENES, PAPER_SHAFTS, PAPER_SUPPORTS
 
 pytestmark = [PAPER_SHAFTS, PAPER_SUPPORTS]   # expected warnings (conftest)
 
@@ -31,3 +31,15 @@ def test_tooth_outputs_are_the_mesh_at_the_stored_states(name, kw):
         free += np.count_nonzero(mesh["F"] == 0.0)
     if not kw.get("linear_tail", True):
         assert free > 0      # the transient has teeth in the dead zone: both branches compared
+
+
+@DEMONSTRATION_SCENES
+@pytest.mark.parametrize("path", sorted(CASES.glob("*.nml")), ids=lambda p: p.stem)
+def test_no_output_falls_back_to_mesh_eval(path):
+    """Every shipped case, its first 5 ms: the per-tooth outputs come from mesh_outputs, not its
+    fallback to mesh_eval (a drift between the two, which would show only as a slowdown; the
+    comparison at every output: tests/fortran/test_outputs.f90)."""
+    case = pyspline.load_case(path, t0=0.0, t_end=5e-3, n_out=101, t_transient=0.0,
+                              revolutions=0.0, transient_revolutions=0.0,
+                              outputs_per_revolution=0.0)
+    assert pyspline.simulate(case).stats["outputs_fallback"] == 0
