@@ -22,6 +22,10 @@ def _stretches(period):
     return [(int(a), int(b) - 1, int(per[a])) for a, b in zip(edges[:-1], edges[1:])]
 
 
+def _spans(stretches):
+    return "; ".join(f"{d} {a:g}..{b:g}" for d, a, b in stretches)
+
+
 def _split_at_jumps(pp, a, b):
     """Split the run [a, b] of a chain where its response pp jumps (a step more than five
     times the run's median step: the chain fell onto another attractor)."""
@@ -175,7 +179,7 @@ def branches(case, field: str, start: float, stop: float, points: int = 31, *,
                 orb = None if finals[d][k] is None else _seed(case.replace(**{name: p}),
                                                               finals[d][k], n, max_n)
                 if orb is None:
-                    no_period.append(f"{d} {values[idx[i]]:g}..{values[idx[j]]:g}")
+                    no_period.append((d, values[idx[i]], values[idx[j]]))
                     continue
                 if any(_on_branch(x, field, p, orb.y0, scale) for x in pieces):
                     continue
@@ -195,15 +199,17 @@ def branches(case, field: str, start: float, stop: float, points: int = 31, *,
     if not pieces:
         raise SplineError(f"branches: no periodic attractor found by the follow sweeps over "
                           f"{field} = {start:g}..{stop:g} (stretches without a period: "
-                          f"{'; '.join(no_period) or 'none'})")
+                          f"{_spans(no_period) or 'none'})")
     keep = []           # largest first; a piece every point of which is on a kept one goes
     for i in sorted(range(len(pieces)), key=lambda i: -pieces[i].sizes["point"]):
         if not any(all(_on_branch(pieces[j], field, p, y, scale) for p, y in
                        zip(pieces[i][field].values, pieces[i].y0.values)) for j in keep):
             keep.append(i)
     ds = _concat([pieces[i] for i in keep])
+    if no_period:       # frplots.frequency_response shades them
+        ds["no_period_range"] = (("stretch", "end"), np.sort([[a, b] for _, a, b in no_period]))
     ds.attrs.update(start=start, stop=stop, seeds="; ".join(seeds[i] for i in keep),
-                    no_period="; ".join(no_period), status="; ".join(status) or "complete",
+                    no_period=_spans(no_period), status="; ".join(status) or "complete",
                     n_points=ds.sizes["point"], n_branches=int(ds.branch.max()) + 1,
                     command=command or f"pyspline.branches({case.name!r}, {field!r}, "
                                        f"{start:g}, {stop:g}, points={points})")

@@ -1,0 +1,105 @@
+"""pyspline.branches and pyspline.fold_curve (docs/continuation.md) on the 7-DOF Z16 drive of
+tests/test_cont_drives.py: every branch of its band from one call, held against the follow
+sweeps' jumps and values; the folds followed in the ripple amplitude, held against the
+verdicts of follow sweeps."""
+import warnings
+
+import numpy as np
+import pytest
+
+import pyspline
+from pyspline.branches import coexistence
+from test_cont_drives import BAND, DRIVE, folds, follow_sweeps  # noqa: F401 (a fixture)
+
+SETTLED = DRIVE.replace(t_end=2.0, t_transient=1.0, n_out=401)   # the seeding sweep's runs
+
+
+@pytest.fixture(scope="module")
+def every_branch():
+    return pyspline.branches(DRIVE, "speed_rpm", *BAND, points=31, progress=False,
+                             sweep_case=SETTLED)
+
+
+def test_branches_finds_both_orbits_of_the_band_and_no_third(every_branch, follow_sweeps):
+    """Both stable orbits the follow sweeps find inside the hysteresis (the full-contact one
+    up, the contact-loss one down) lie on the branches, joined through the unstable middle
+    into one S-curve; at every speed of the hysteresis the branches cross it three times
+    (two stable, one saddle), outside it once: no spurious third orbit, no branch twice."""
+    ds, sw = every_branch
+    assert ds.attrs["status"] == "complete" and ds.attrs["no_period"] == ""
+    p, pp, stable = ds.speed_rpm.values, ds.Tm_pp.values, ds.stable.values.astype(bool)
+    lo, hi = folds(ds)
+    assert len(folds(ds)) == 2
+    speeds, swept = follow_sweeps
+    for x in (2370.0, 2400.0, 2425.0, 2300.0, 2470.0):
+        cross = [k for b in np.unique(ds.branch) for k in np.flatnonzero(ds.branch == b)[:-1]
+                 if ds.branch[k + 1] == b and (p[k] - x) * (p[k + 1] - x) <= 0]
+        assert len(cross) == (3 if lo < x < hi else 1), (x, cross)
+        got = np.sort([np.interp(x, sorted(p[[k, k + 1]]), pp[[k, k + 1]][np.argsort(
+            p[[k, k + 1]])]) for k in cross if stable[k] and stable[k + 1]])
+        want = np.unique(np.round(swept[:, speeds == x].ravel(), 6))
+        assert len(got) == len(want) == (2 if lo < x < hi else 1), (x, got, want)
+        assert got == pytest.approx(np.sort(want), rel=1e-3), x
+
+
+def test_branches_folds_where_the_follow_sweeps_jump(every_branch, follow_sweeps):
+    """The folds of the branches within 0.5 % of the 1 r/min follow sweeps' jumps, and the
+    seeding sweep's own jumps (10 r/min steps) bracket them."""
+    ds, sw = every_branch
+    lo, hi = folds(ds)
+    speeds, pp = follow_sweeps
+    up = speeds[np.argmax(np.diff(pp[0])) + 1]
+    down = speeds[np.argmax(np.diff(pp[1]))]
+    assert hi == pytest.approx(up, rel=5e-3) and lo == pytest.approx(down, rel=5e-3)
+    assert not coexistence(sw)[sw.speed_rpm.values < lo - 10].any()
+    assert coexistence(sw)[(sw.speed_rpm.values > lo + 1) & (sw.speed_rpm.values < hi - 1)].all()
+
+
+def test_fold_curve_against_follow_sweeps():
+    """The folds followed in the ripple amplitude (a = 0.25, 0.18 by repeated continuation
+    over 2300-2500 r/min): the follow sweeps at a = 0.18 and 0.25 say two orbits exactly
+    between the folds (10 r/min steps: within a step of them) and one outside; the band
+    narrows as a falls (the folds approach a cusp)."""
+    fc = pyspline.fold_curve(DRIVE, "speed_rpm", 2300, 2500, "ripple_amp(1)", [0.25, 0.18],
+                             progress=False, check=[0.25, 0.18], check_points=21,
+                             check_case=SETTLED)
+    assert (fc.status == "complete").all()
+    f = fc.fold.values
+    assert np.isfinite(f[:, :2]).all() and np.isnan(f[:, 2:]).all()
+    assert f[1, 1] - f[1, 0] < f[0, 1] - f[0, 0]
+    x = fc.check_field.values
+    for i in range(2):
+        two = fc.coexist.values[i].astype(bool)
+        inside = (x > f[i, 0] + 10) & (x < f[i, 1] - 10)
+        outside = (x < f[i, 0] - 10) | (x > f[i, 1] + 10)
+        assert two[inside].all() and not two[outside].any(), (fc.check_value[i], x[two], f[i])
+
+
+def test_bad_input_is_a_case_error():
+    for kw in (dict(points=2), dict(points=1.5), dict(max_n=0)):
+        with pytest.raises(pyspline.CaseError, match=list(kw)[0]):
+            pyspline.branches(DRIVE, "speed_rpm", *BAND, progress=False, **kw)
+    with pytest.raises(pyspline.CaseError, match="values2"):
+        pyspline.fold_curve(DRIVE, "speed_rpm", *BAND, "ripple_amp(1)", [np.nan])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(pyspline.CaseError, match="scalar field"):
+            pyspline.branches(DRIVE, "ripple_amp(1)", 0.1, 0.2, progress=False)
+
+
+def test_cli_all_and_fold_input(tmp_path, every_branch):
+    """`pyspline continue --all` writes the branches (the Python call's folds), the seeding
+    sweep and the figure, exit 0; a --fold without numbers is a CaseError naming it, exit 2."""
+    import xarray as xr
+    from test_continuation import cli
+    path = tmp_path / "drive.nml"
+    path.write_text(SETTLED.text())
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
+              "--stop", "2500", "--all", "--out", "out", "--quiet")
+    assert run.returncode == 0, run.stderr
+    ds = xr.open_dataset(tmp_path / "out" / "branches.nc", engine="h5netcdf")
+    assert folds(ds) == pytest.approx(folds(every_branch[0]), abs=1e-3)
+    assert (tmp_path / "out" / "branches.png").stat().st_size > 10_000
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
+              "--stop", "2500", "--fold", "ripple_amp(1)=0.2,x")
+    assert run.returncode == 2 and "--fold ripple_amp(1)=" in run.stderr, run.stderr
