@@ -11,7 +11,7 @@ import pyspline
 from pyspline.branches import coexistence
 from test_cont_drives import BAND, DRIVE, folds, follow_sweeps  # noqa: F401 (a fixture)
 
-SETTLED = DRIVE.replace(t_end=2.0, t_transient=1.0, n_out=401)   # the seeding sweep's runs
+SETTLED = DRIVE.replace(t_end=2.0, t_transient=1.0, n_out=8001)  # the seeding sweep's runs
 
 
 @pytest.fixture(scope="module")
@@ -20,9 +20,11 @@ def every_branch():
                              sweep_case=SETTLED)
 
 
-def test_branches_finds_both_orbits_of_the_band_and_no_third(every_branch, follow_sweeps):
-    """Both stable orbits the follow sweeps find inside the hysteresis (the full-contact one
-    up, the contact-loss one down) lie on the branches, joined through the unstable middle
+def test_branches_finds_both_orbits_of_the_band_and_no_third(every_branch):
+    """Both stable orbits the seeding follow sweeps (runs of 2 s, the last 1 s at 200 samples a revolution; 10 r/min steps) find inside
+    the hysteresis (the full-contact one up, the contact-loss one down) lie on the branches
+    (T_m peak-to-peak to 0.5 %: the largest of 200 samples a revolution of an impacting
+    orbit's torque, on either side; the two orbits are a factor 2 apart), joined through the unstable middle
     into one S-curve; at every speed of the hysteresis the branches cross it three times
     (two stable, one saddle), outside it once: no spurious third orbit, no branch twice."""
     ds, sw = every_branch
@@ -30,16 +32,17 @@ def test_branches_finds_both_orbits_of_the_band_and_no_third(every_branch, follo
     p, pp, stable = ds.speed_rpm.values, ds.Tm_pp.values, ds.stable.values.astype(bool)
     lo, hi = folds(ds)
     assert len(folds(ds)) == 2
-    speeds, swept = follow_sweeps
-    for x in (2370.0, 2400.0, 2425.0, 2300.0, 2470.0):
+    speeds, swept = sw.speed_rpm.values, (sw.Tm_max - sw.Tm_min).values
+    for x in (2370.0, 2400.0, 2420.0, 2300.0, 2470.0):
         cross = [k for b in np.unique(ds.branch) for k in np.flatnonzero(ds.branch == b)[:-1]
                  if ds.branch[k + 1] == b and (p[k] - x) * (p[k + 1] - x) <= 0]
         assert len(cross) == (3 if lo < x < hi else 1), (x, cross)
         got = np.sort([np.interp(x, sorted(p[[k, k + 1]]), pp[[k, k + 1]][np.argsort(
             p[[k, k + 1]])]) for k in cross if stable[k] and stable[k + 1]])
-        want = np.unique(np.round(swept[:, speeds == x].ravel(), 6))
+        up, down = swept[:, speeds == x].ravel()
+        want = [up, down] if coexistence(sw)[speeds == x][0] else [up]
         assert len(got) == len(want) == (2 if lo < x < hi else 1), (x, got, want)
-        assert got == pytest.approx(np.sort(want), rel=1e-3), x
+        assert got == pytest.approx(np.sort(want), rel=5e-3), x
 
 
 def test_branches_folds_where_the_follow_sweeps_jump(every_branch, follow_sweeps):
@@ -56,23 +59,23 @@ def test_branches_folds_where_the_follow_sweeps_jump(every_branch, follow_sweeps
 
 
 def test_fold_curve_against_follow_sweeps():
-    """The folds followed in the ripple amplitude (a = 0.25, 0.18 by repeated continuation
-    over 2300-2500 r/min): the follow sweeps at a = 0.18 and 0.25 say two orbits exactly
-    between the folds (10 r/min steps: within a step of them) and one outside; the band
-    narrows as a falls (the folds approach a cusp)."""
-    fc = pyspline.fold_curve(DRIVE, "speed_rpm", 2300, 2500, "ripple_amp(1)", [0.25, 0.18],
-                             progress=False, check=[0.25, 0.18], check_points=21,
-                             check_case=SETTLED)
+    """The folds followed in the ripple amplitude a (repeated continuation over 2300-2500
+    r/min at a = 0.25, 0.2, 0.1): follow sweeps up and down at 10 r/min steps say two orbits
+    between the folds and one outside them (a step of margin: runs next to a fold do not
+    settle); at a = 0.1 no fold in the band and one orbit at every speed."""
+    values = [0.25, 0.2, 0.1]
+    fc = pyspline.fold_curve(DRIVE, "speed_rpm", 2300, 2500, "ripple_amp(1)", values,
+                             progress=False, check=values, check_points=21, check_case=SETTLED)
     assert (fc.status == "complete").all()
     f = fc.fold.values
-    assert np.isfinite(f[:, :2]).all() and np.isnan(f[:, 2:]).all()
-    assert f[1, 1] - f[1, 0] < f[0, 1] - f[0, 0]
+    assert np.isfinite(f[:2, :2]).all() and np.isnan(f[:2, 2:]).all() and np.isnan(f[2]).all()
     x = fc.check_field.values
-    for i in range(2):
+    for i in range(3):
         two = fc.coexist.values[i].astype(bool)
         inside = (x > f[i, 0] + 10) & (x < f[i, 1] - 10)
-        outside = (x < f[i, 0] - 10) | (x > f[i, 1] + 10)
-        assert two[inside].all() and not two[outside].any(), (fc.check_value[i], x[two], f[i])
+        outside = ~((x > f[i, 0] - 10) & (x < f[i, 1] + 10))
+        assert two[inside].all() and not two[outside].any(), (values[i], x[two], f[i])
+        assert inside.any() == (i < 2)
 
 
 def test_bad_input_is_a_case_error():
