@@ -21,12 +21,13 @@ def every_branch():
 
 
 def test_branches_finds_both_orbits_of_the_band_and_no_third(every_branch):
-    """Both stable orbits the seeding follow sweeps (runs of 2 s, the last 1 s at 200 samples a revolution; 10 r/min steps) find inside
-    the hysteresis (the full-contact one up, the contact-loss one down) lie on the branches
-    (T_m peak-to-peak to 0.5 %: the largest of 200 samples a revolution of an impacting
-    orbit's torque, on either side; the two orbits are a factor 2 apart), joined through the unstable middle
-    into one S-curve; at every speed of the hysteresis the branches cross it three times
-    (two stable, one saddle), outside it once: no spurious third orbit, no branch twice."""
+    """Both stable orbits the seeding follow sweeps find inside the hysteresis (runs of 2 s,
+    the last 1 s at 200 samples a revolution; 10 r/min steps: the full-contact orbit up, the
+    contact-loss one down) lie on the branches (T_m peak-to-peak to 0.5 %: the largest of 200
+    samples a revolution of an impacting orbit's torque, on either side; the two orbits are a
+    factor 2 apart), joined through the unstable middle into one S-curve; at every speed of
+    the hysteresis the branches cross it three times (two stable, one saddle), outside it
+    once: no spurious third orbit, no branch twice."""
     ds, sw = every_branch
     assert ds.attrs["status"] == "complete" and ds.attrs["no_period"] == ""
     p, pp, stable = ds.speed_rpm.values, ds.Tm_pp.values, ds.stable.values.astype(bool)
