@@ -139,8 +139,8 @@ def branches(case, field: str, start: float, stop: float, points: int = 31, *,
     n <= max_n on which Newton converges to a stable orbit) and a continuation from there to
     start and to stop (`cont`: continuation's keywords). A seed whose orbit lies on a branch
     already traced (same orbit at the same value) is not continued again; a branch whose every
-    point lies on another is dropped. Stretches without a stable periodic orbit of n <= max_n (chaotic or
-    quasi-periodic, or not settled) seed nothing; they are listed in attrs['no_period'].
+    point lies on another is dropped. Stretches without a stable periodic orbit of n <= max_n
+    (chaotic or quasi-periodic, or not settled) seed nothing; listed in attrs['no_period'].
 
     Returns (Dataset, sweep): the Dataset of `continuation` for all the branches (dim 'point',
     'branch' numbered through, 'seed' the seed's index; dims 'special' likewise; attrs
