@@ -84,6 +84,17 @@ def _on_branch(ds, label, p, y, scale):
     return False
 
 
+def merged(pieces, label, scale):
+    """The indices of the pieces to keep, largest first: a piece every point of which lies on
+    a kept one (_on_branch) is the same branch and goes."""
+    keep = []
+    for i in sorted(range(len(pieces)), key=lambda i: -pieces[i].sizes["point"]):
+        if not any(all(_on_branch(pieces[j], label, p, y, scale) for p, y in
+                       zip(pieces[i][label].values, pieces[i].y0.values)) for j in keep):
+            keep.append(i)
+    return keep
+
+
 def _join(down, up, label):
     """One branch from a seed's two halves: `down` (seed to start) reversed, then `up` (seed to
     stop) without its first point (the seed again). Doubled branches keep their own numbers."""
@@ -200,11 +211,7 @@ def branches(case, field: str, start: float, stop: float, points: int = 31, *,
         raise SplineError(f"branches: no periodic attractor found by the follow sweeps over "
                           f"{field} = {start:g}..{stop:g} (stretches without a period: "
                           f"{_spans(no_period) or 'none'})")
-    keep = []           # largest first; a piece every point of which is on a kept one goes
-    for i in sorted(range(len(pieces)), key=lambda i: -pieces[i].sizes["point"]):
-        if not any(all(_on_branch(pieces[j], field, p, y, scale) for p, y in
-                       zip(pieces[i][field].values, pieces[i].y0.values)) for j in keep):
-            keep.append(i)
+    keep = merged(pieces, field, scale)
     ds = _concat([pieces[i] for i in keep])
     if no_period:       # frplots.frequency_response shades them
         ds["no_period_range"] = (("stretch", "end"), np.sort([[a, b] for _, a, b in no_period]))

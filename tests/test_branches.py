@@ -46,6 +46,24 @@ def test_branches_finds_both_orbits_of_the_band_and_no_third(every_branch):
         assert got == pytest.approx(np.sort(want), rel=5e-3), x
 
 
+def test_pieces_of_the_same_branch_are_merged(every_branch):
+    """A piece of a branch (points 30-70 of the S-curve) is the same branch and goes; two
+    pieces that share no orbit (the points before 30 and after 70) are both kept; a piece
+    moved off the branch by 5 % of each state's swing along it is another branch."""
+    from pyspline.branches import merged
+    from test_orbits import scale_of
+    ds, _ = every_branch
+    s = scale_of(DRIVE)
+    mid = ds.isel(point=slice(30, 70))
+    a, b = ds.isel(point=slice(0, 30)), ds.isel(point=slice(70, None))
+    assert merged([mid, ds], "speed_rpm", s) == [1]
+    assert sorted(merged([a, b], "speed_rpm", s)) == [0, 1]
+    off = mid.copy(deep=True)
+    swing = np.ptp(ds.y0.values, axis=0)
+    off["y0"] = off.y0 + 0.05 * swing
+    assert sorted(merged([off, ds], "speed_rpm", s)) == [0, 1]
+
+
 def test_branches_folds_where_the_follow_sweeps_jump(every_branch, follow_sweeps):
     """The folds of the branches within 0.5 % of the 1 r/min follow sweeps' jumps, and the
     seeding sweep's own jumps (10 r/min steps) bracket them."""
