@@ -128,6 +128,13 @@ def bifurcation_follow(ds, param: str, coord: str = "section_D2", path=None,
     return ps.finish(fig, path)
 
 
+def _field_label(field: str) -> str:
+    """'long name (field) [unit]' of a case field, an array element as NAME(i)."""
+    from .dataset import _field_attrs
+    a = _field_attrs(field.split("(")[0].strip())
+    return f"{a['long_name']} ({field})" + (f" [{a['units']}]" if a.get("units") else "")
+
+
 def fold_plane(fc, path=None, title: str | None = None) -> Figure:
     """The folds (and the first grazing) of pyspline.fold_curve in the (field, field2) plane:
     the band between the two folds shaded (two orbits coexist there), the brute-force
@@ -156,8 +163,8 @@ def fold_plane(fc, path=None, title: str | None = None) -> Figure:
                 label="follow sweeps up and down differ: two orbits")
         ax.plot(xs[~two], ys[~two], "s", mfc="none", mec="0.5", ms=5,
                 label="follow sweeps agree: one orbit")
-    ax.set_xlabel(field)
-    ax.set_ylabel(field2)
+    ax.set_xlabel(_field_label(field))
+    ax.set_ylabel(_field_label(field2))
     ax.grid(alpha=0.3, lw=0.5)
     ax.legend(fontsize=8, loc="best", framealpha=0.9)
     ax.set_title(title or f"folds of the periodic orbits in ({field}, {field2}): the region "
