@@ -9,7 +9,7 @@ import warnings
 
 import numpy as np
 
-from .continuation import continuation, parse_field
+from .continuation import continuation, field_label, parse_field
 from .errors import CaseError, SplineError, SplineWarning
 from .follow import repeat_revolutions
 
@@ -245,8 +245,10 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
     brute-force verdict per value: one orbit or two coexisting (`coexistence`).
 
     Returns a Dataset: dim `value2` (field2's values): `fold` (value2, fold; sorted, NaN
-    padded), `grazing` (value2, grazing), `status` (each continuation's); with check, dims
-    `check` and `check_point`: `check_value`, `check_field`, `coexist`."""
+    padded), `grazing` (value2, grazing; in order along the branch from start: the first is
+    where the orbit of start changes its contact sequence), `status` (each continuation's); with check, dims
+    `check` and `check_point`: `check_value`, `check_field`, `coexist`. A value at which no
+    orbit is found at start (OrbitError, SolverError) has no folds and says so in `status`."""
     import xarray as xr
     from .continuation import set_field
     from .sweep import sweep
@@ -257,15 +259,23 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
     folds, grazes, status, guess = [], [], [], None
     for v in values2:
         at = set_field(case, name2, index2, v)
-        with warnings.catch_warnings(record=True):
-            warnings.simplefilter("always", SplineWarning)
-            ds = continuation(at, field, start, stop, n=n, guess=guess, progress=progress,
-                              **cont)
+        try:
+            with warnings.catch_warnings(record=True):
+                warnings.simplefilter("always", SplineWarning)
+                ds = continuation(at, field, start, stop, n=n, guess=guess,
+                                  progress=progress, **cont)
+        except CaseError:
+            raise
+        except SplineError as exc:      # no orbit at start there: the other values go on
+            folds.append([])
+            grazes.append([])
+            status.append(f"{field2} = {v:g}: {type(exc).__name__}: {exc}")
+            continue
         guess = ds.y0.values[0]
         kinds = ds.special_type.values.astype(str)
         sp = ds[f"special_{ds.attrs['field']}"].values
         folds.append(np.sort(sp[kinds == "fold"]))
-        grazes.append(np.sort(sp[kinds == "grazing"]))
+        grazes.append(sp[kinds == "grazing"])       # in order along the branch from start
         status.append(ds.attrs["status"])
 
     def padded(rows):
@@ -273,7 +283,7 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
         for i, r in enumerate(rows):
             out[i, :len(r)] = r
         return out
-    label = ds.attrs["field"]
+    label = field_label(*parse_field(case, field))
     out = xr.Dataset({"fold": (("value2", "fold"), padded(folds)),
                       "grazing": (("value2", "grazing"), padded(grazes)),
                       "status": (("value2",), np.array(status, dtype=object))},

@@ -155,7 +155,9 @@ def fold_plane(fc, path=None, title: str | None = None) -> Figure:
                 ms=5, lw=1.4, label=f"{name} (mu = +1)" if j < 2 else None)
     g = fc.grazing.values[:, 0]
     ok = np.isfinite(g)
-    ax.plot(g[ok], v[ok], "x--", color="0.3", lw=1, label="first grazing (a tooth opens)")
+    if ok.any():
+        ax.plot(g[ok], v[ok], "x--", color="0.3", lw=1,
+                label="first grazing along the branch (its contact sequence changes)")
     if "coexist" in fc:
         xs, ys = np.meshgrid(fc.check_field.values, fc.check_value.values)
         two = fc.coexist.values.astype(bool)
