@@ -111,7 +111,9 @@ def test_bad_input_is_a_case_error():
 
 def test_cli_all_and_fold_input(tmp_path, every_branch):
     """`pyspline continue --all` writes the branches (the Python call's folds), the seeding
-    sweep and the figure, exit 0; a --fold without numbers is a CaseError naming it, exit 2."""
+    sweep and the figure, exit 0; `--fold` the folds at one amplitude (the same) with the
+    follow sweeps' verdict (20 r/min steps: two orbits exactly between them); a --fold
+    without numbers is a CaseError naming it, exit 2."""
     import xarray as xr
     from test_continuation import cli
     path = tmp_path / "drive.nml"
@@ -122,6 +124,16 @@ def test_cli_all_and_fold_input(tmp_path, every_branch):
     ds = xr.open_dataset(tmp_path / "out" / "branches.nc", engine="h5netcdf")
     assert folds(ds) == pytest.approx(folds(every_branch[0]), abs=1e-3)
     assert (tmp_path / "out" / "branches.png").stat().st_size > 10_000
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2300",
+              "--stop", "2500", "--fold", "ripple_amp(1)=0.25", "--check", "0.25", "--sweep",
+              "11", "--out", "fold", "--quiet")
+    assert run.returncode == 0, run.stderr
+    fc = xr.open_dataset(tmp_path / "fold" / "fold_curve.nc", engine="h5netcdf")
+    assert fc.fold.values[0] == pytest.approx(folds(every_branch[0]), abs=1e-2)
+    lo, hi = fc.fold.values[0]
+    x, two = fc.check_field.values, fc.coexist.values[0].astype(bool)
+    assert (two == ((x > lo) & (x < hi))).all(), (x[two], lo, hi)
+    assert (tmp_path / "fold" / "fold_curve.png").stat().st_size > 10_000
     run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
               "--stop", "2500", "--fold", "ripple_amp(1)=0.2,x")
     assert run.returncode == 2 and "--fold ripple_amp(1)=" in run.stderr, run.stderr
