@@ -9,11 +9,12 @@ from .dataset import open_sweep
 from .errors import CaseError, SolverError, SplineError, SplineWarning, ThermalInterferenceError
 from .orbits import Orbit, OrbitError, periodic_orbit
 from .arclength import continuation
+from .branches import branches, fold_curve
 from .sweeps import sweep
 
 __all__ = ["Case", "CaseError", "Model", "Result", "SolverError", "SplineError", "SplineWarning",
            "ThermalInterferenceError", "defaults", "load", "load_case", "local_dask_client",
-           "merge", "mesh_stiffness", "open_sweep", "Orbit", "OrbitError", "periodic_orbit", "continuation", "rhs", "simulate", "start_state", "sweep", "tooth_stiffness"]
+           "merge", "mesh_stiffness", "open_sweep", "Orbit", "OrbitError", "periodic_orbit", "continuation", "branches", "fold_curve", "rhs", "simulate", "start_state", "sweep", "tooth_stiffness"]
 from importlib.metadata import PackageNotFoundError, version as _version
 
 try:

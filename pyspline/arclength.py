@@ -96,6 +96,15 @@ def check_arguments(case, label, start, stop, n, tol, **positive):
     return out["start"], out["stop"], out["tol"]
 
 
+def set_field(case: Case, name: str, index, p: float) -> Case:
+    """The case with field `name` (its element `index` of an array field) set to p."""
+    if index is None:
+        return case.replace(**{name: float(p)})
+    v = list(case[name])
+    v[index] = float(p)
+    return case.replace(**{name: v})
+
+
 def field_label(name: str, index) -> str:
     return name if index is None else f"{name}({index + 1})"
 
@@ -124,11 +133,7 @@ class _Problem:
         self.case, self.models = self.case.replace(method=method), {}
 
     def case_at(self, p: float) -> Case:
-        if self.index is None:
-            return self.case.replace(**{self.name: float(p)})
-        v = list(self.case[self.name])
-        v[self.index] = float(p)
-        return self.case.replace(**{self.name: v})
+        return set_field(self.case, self.name, self.index, p)
 
     def model(self, p: float):
         """The loaded case at p; CaseError when p is outside the field's valid range or the

@@ -25,6 +25,14 @@ Prints one line per special point. Exit status: README's (CaseError 2, SolverErr
 the branch could not be followed to --stop (the points so far are written, with where and why
 it stopped: attrs['status'] and the last line on stderr) or no orbit was found at --start.
 
+With --all: every periodic branch of the band (pyspline.branches): a follow sweep of --sweep N
+points (default 31; runs of the case's t_end: let it settle them, e.g. --fix t_end=1
+--fix t_transient=0.5) seeds a continuation from each distinct attractor; branches.nc (the
+branches), sweep.nc and branches.png. With --fold FIELD2=V1,V2,...: the folds and grazings of
+the branch from --start followed in FIELD2 (pyspline.fold_curve), the brute-force verdicts of
+follow sweeps of --sweep N points (default 31) at the values of --check V,V,... overlaid;
+fold_curve.nc and fold_curve.png.
+
 example: pyspline continue cases/physical_ripple.nml --field speed_rpm --start 5000 --stop 7000
 """
 
@@ -47,6 +55,8 @@ def cmd_continue(args, fixed, exit_code) -> int:
         if args.sweep and index is not None:
             raise CaseError(f"--sweep: a follow sweep runs whole fields; {args.field} is "
                             "one element of an array field")
+        if args.all or args.fold:
+            return _other(args, case, name, index, command, out)
         ds = continuation(case, args.field, args.start, args.stop, n=args.n, ds=args.ds,
                           max_points=args.max_points, tol=args.tol, progress=not args.quiet,
                           command=command)
@@ -88,6 +98,63 @@ def cmd_continue(args, fixed, exit_code) -> int:
     return 0
 
 
+def _values(text: str, what: str):
+    try:
+        v = np.array([float(x) for x in text.split(",")])
+    except ValueError:
+        raise CaseError(f"{what} {text!r}: numbers separated by commas") from None
+    if not len(v) or not np.isfinite(v).all():
+        raise CaseError(f"{what} {text!r}: finite numbers separated by commas")
+    return v
+
+
+def _other(args, case, name, index, command, out) -> int:
+    """`continue --all` (pyspline.branches) and `continue --fold` (pyspline.fold_curve)."""
+    from .branches import branches, fold_curve
+    from .dataset import write_netcdf
+    from .frplots import fold_plane, frequency_response
+    if args.all and args.fold:
+        raise CaseError("--all and --fold: one at a time")
+    points = args.sweep or 31
+    if points < 3:
+        raise CaseError(f"--sweep {args.sweep}: the follow sweeps' number of points, >= 3")
+    if args.all:
+        ds, sw = branches(case, args.field, args.start, args.stop, points=points,
+                          progress=not args.quiet, command=command + " --all", ds=args.ds,
+                          max_points=args.max_points, tol=args.tol)
+        write_netcdf(ds, out / "branches.nc")
+        write_netcdf(sw, out / "sweep.nc")
+        print(f"{ds.attrs['n_points']} points on {ds.attrs['n_branches']} branch(es) from the "
+              f"seeds {ds.attrs['seeds']}; no periodic attractor: {ds.attrs['no_period'] or '-'}")
+        for kind, p in zip(ds.special_type.values, ds[f"special_{ds.attrs['field']}"].values):
+            print(f"{kind:16s} {ds.attrs['field']} = {p:.6g}")
+        frequency_response(ds, args.measure, sweep=sw, path=out / "branches.png",
+                           title=f"{case.name}: every periodic branch found, follow sweeps up "
+                                 "and down")
+        print(f"wrote {out / 'branches.nc'}, {out / 'sweep.nc'}, {out / 'branches.png'}")
+        status = ds.attrs["status"]
+    else:
+        field2, _, text = args.fold.partition("=")
+        fc = fold_curve(case, args.field, args.start, args.stop, field2.strip(),
+                        _values(text, f"--fold {field2}="), n=args.n, progress=not args.quiet,
+                        check=_values(args.check, "--check") if args.check else (),
+                        check_points=points, command=command + f" --fold {args.fold}",
+                        ds=args.ds, max_points=args.max_points, tol=args.tol)
+        write_netcdf(fc, out / "fold_curve.nc")
+        for v, f, g in zip(fc.value2.values, fc.fold.values, fc.grazing.values):
+            print(f"{field2.strip()} = {v:.6g}: folds {np.round(f[np.isfinite(f)], 2)}, "
+                  f"grazings {np.round(g[np.isfinite(g)], 2)}")
+        fold_plane(fc, path=out / "fold_curve.png")
+        print(f"wrote {out / 'fold_curve.nc'}, {out / 'fold_curve.png'}")
+        status = "complete" if (fc.status == "complete").all() else \
+            "; ".join(str(x) for x in fc.status.values if x != "complete")
+    if status != "complete":
+        import sys
+        print(f"stopped: {status}", file=sys.stderr)
+        return 1
+    return 0
+
+
 def add_continue(sub, fixed, exit_code) -> None:
     """The `continue` subcommand (pyspline/cli.py)."""
     import argparse
@@ -108,6 +175,12 @@ def add_continue(sub, fixed, exit_code) -> None:
                    help="response measure of the figure (default Tm_pp)")
     r.add_argument("--sweep", type=int, default=0, metavar="N",
                    help="also a follow-up and follow-down sweep of N points, overlaid")
+    r.add_argument("--all", action="store_true", help="every periodic branch of the band, "
+                   "seeded by follow sweeps of --sweep N points (default 31): branches.nc, .png")
+    r.add_argument("--fold", metavar="FIELD2=V1,V2,...", help="the folds and grazings followed "
+                   "in a second field: fold_curve.nc and fold_curve.png")
+    r.add_argument("--check", metavar="V1,V2,...", help="with --fold: values of FIELD2 with a "
+                   "follow sweep's verdict (one orbit or two) overlaid")
     r.add_argument("--fix", action="append", metavar="FIELD=VALUE",
                    help="change a field of the case (e.g. rtol=1e-9)")
     r.add_argument("--out", default=".", metavar="DIR", help="output directory (default .)")

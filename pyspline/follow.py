@@ -65,6 +65,8 @@ def run_chain(cases: list, options: dict) -> list:
                                         category=SplineWarning)
                 res = simulate(run)
             out.append(summarise(res, options))
+            if options.get("final_state"):     # sweep(finals=...): pyspline.branches' seeds
+                out[-1]["final"] = (res.y[-1].copy(), float(res.t[-1]))
             prev = (res.y[-1].copy(), float(res.t[-1]), run.model.info()["omega"])
         except Exception as exc:        # noqa: BLE001 -- a failed point is a result
             out.append(failed_summary(exc, options))

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
 
 from . import plotstyle as ps
 
@@ -82,6 +83,12 @@ def frequency_response(branch, measure: str = "Tm_pp", sweep=None, path=None,
                     ls="", marker=mk, ms=6, mfc="none", mec=colour, mew=1.2, zorder=4)
             handles.append(Line2D([], [], ls="", marker=mk, ms=6, mfc="none", mec=colour,
                                   mew=1.2, label=label))
+    for k, (a, b) in enumerate(branch["no_period_range"].values if "no_period_range" in
+                               branch else []):      # pyspline.branches: no seed there
+        ax.axvspan(a / fx, b / fx, color="0.85", zorder=0)
+        if not k:
+            handles.append(Patch(color="0.85", label="no periodic attractor (n <= max_n): "
+                                 "chaotic, quasi-periodic or not settled"))
     ax.set_xlabel(ps.label(branch, field, factor_unit=ux))
     ax.set_ylabel(f"{name} [{uy}]" if uy else name)
     ax.grid(alpha=0.3, lw=0.5)
@@ -118,4 +125,50 @@ def bifurcation_follow(ds, param: str, coord: str = "section_D2", path=None,
               title_fontsize=8)
     ax.set_title(title or f"bifurcation diagram: {ps.long_name(ds, coord)} vs {param}, "
                           "both directions")
+    return ps.finish(fig, path)
+
+
+def _field_label(field: str) -> str:
+    """'long name (field) [unit]' of a case field, an array element as NAME(i)."""
+    from .dataset import _field_attrs
+    a = _field_attrs(field.split("(")[0].strip())
+    return f"{a['long_name']} ({field})" + (f" [{a['units']}]" if a.get("units") else "")
+
+
+def fold_plane(fc, path=None, title: str | None = None) -> Figure:
+    """The folds (and the first grazing) of pyspline.fold_curve in the (field, field2) plane:
+    the band between the two folds shaded (two orbits coexist there), the brute-force
+    verdicts of follow sweeps (one orbit / two coexisting) overlaid."""
+    field, field2 = fc.attrs["field"], fc.attrs["field2"]
+    v = fc.value2.values
+    folds = fc.fold.values
+    fig = Figure(figsize=(9, 5.5), layout="constrained")
+    ax = fig.add_subplot()
+    pair = np.isfinite(folds[:, :2]).all(axis=1)
+    if pair.any():
+        ax.fill_betweenx(v[pair], folds[pair, 0], folds[pair, 1], color="#D55E00", alpha=0.12,
+                         lw=0, label="between the folds: two stable orbits coexist")
+    for j, name in enumerate(["lower fold", "upper fold"] + [f"fold {j + 1}" for j in
+                                                            range(2, folds.shape[1])]):
+        ok = np.isfinite(folds[:, j])
+        ax.plot(folds[ok, j], v[ok], "o-", color="#D55E00", mfc="white" if j else "#D55E00",
+                ms=5, lw=1.4, label=f"{name} (mu = +1)" if j < 2 else None)
+    g = fc.grazing.values[:, 0]
+    ok = np.isfinite(g)
+    if ok.any():
+        ax.plot(g[ok], v[ok], "x--", color="0.3", lw=1,
+                label="first grazing along the branch (its contact sequence changes)")
+    if "coexist" in fc:
+        xs, ys = np.meshgrid(fc.check_field.values, fc.check_value.values)
+        two = fc.coexist.values.astype(bool)
+        ax.plot(xs[two], ys[two], "s", color="#0072B2", ms=5,
+                label="follow sweeps up and down differ: two orbits")
+        ax.plot(xs[~two], ys[~two], "s", mfc="none", mec="0.5", ms=5,
+                label="follow sweeps agree: one orbit")
+    ax.set_xlabel(_field_label(field))
+    ax.set_ylabel(_field_label(field2))
+    ax.grid(alpha=0.3, lw=0.5)
+    ax.legend(fontsize=8, loc="best", framealpha=0.9)
+    ax.set_title(title or f"folds of the periodic orbits in ({field}, {field2}): the region "
+                          "of coexistence")
     return ps.finish(fig, path)

@@ -288,7 +288,7 @@ def _default_orders(cases) -> np.ndarray:
 
 def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapunov=False, *,
           spectrum=None, orders=None, command=None, chunk=None, workers=None, table=None,
-          follow=None, **fields):
+          follow=None, finals=None, **fields):
     """Run `case` (a Case, dict of fields or namelist path) over one or two swept fields, or
     over the rows of a design table, and return an xarray.Dataset of the per-point summaries.
 
@@ -324,6 +324,8 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
         so hysteresis and coexisting attractors show; 'both' adds a dim 'direction' (up,
         down). Chains are serial: an executor runs one chain per direction; `out` gets
         sweep.nc only (no point files: a point depends on the one before).
+    finals : with follow, a dict filled with {direction: [(final state (14,), SI, its time) or
+        None (a failed point), by index of the swept values]} (pyspline.branches' seeds).
 
     Dataset: coordinates = the swept values (units from the core's field table); per point
     section_t/section_D2/section_vD2 (dim 'section_point', NaN-padded), period and
@@ -386,7 +388,7 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
 
     if follow is not None:
         return _follow(base, grid, cases, keys, options, follow, point_fields, executor, progress,
-                       out, command, section, lyapunov)
+                       out, command, section, lyapunov, finals)
     hashes, summaries, todo, n_reused = {}, {}, [], 0
     points_dir = None
     if out is not None:
@@ -511,7 +513,7 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
 
 
 def _follow(base, grid, cases, keys, options, follow, point_fields, executor, progress, out,
-            command, section, lyapunov):
+            command, section, lyapunov, finals=None):
     """sweep(..., follow=...): chains of points (pyspline.follow), one Dataset per direction
     ('both': concatenated along 'direction')."""
     from tqdm import tqdm
@@ -534,7 +536,11 @@ def _follow(base, grid, cases, keys, options, follow, point_fields, executor, pr
     total = len(values) * (2 if follow == "both" else 1)
     with tqdm(total=total, desc=f"sweep {name} (follow {follow})", unit="run",
               disable=not progress, dynamic_ncols=True) as bar:
-        runs = follow_sweep(cases, values, follow, options, executor, bar)
+        runs = follow_sweep(cases, values, follow, options if finals is None else
+                            dict(options, final_state=True), executor, bar)
+    if finals is not None:      # {direction: [(state, time) or None by index]}
+        finals.update({d: [r[(i,)].get("final") for i in range(len(values))]
+                       for d, r in runs.items()})
     if follow == "both":     # one grid (direction, field): the dataset builder pads sections
         dgrid = {"direction": np.array(["up", "down"]), **grid}
         summaries = {(k,) + i: s for k, d in enumerate(("up", "down")) for i, s in runs[d].items()}

@@ -1,0 +1,308 @@
+"""Every branch in one call (`pyspline.branches`, `pyspline continue --all`): follow sweeps up
+and down find the periodic attractors of a band, each distinct one seeds a continuation over
+the band (stable and unstable parts), branches through the same orbit are merged; and the folds
+of a band followed in a second field (`fold_curve`, `pyspline continue --fold`).
+docs/continuation.md."""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+from .arclength import continuation, field_label, parse_field
+from .errors import CaseError, SplineError, SplineWarning
+from .follow import repeat_revolutions
+
+
+def _stretches(period):
+    """(first, last, n) index runs of one direction's sweep points with the same period n
+    (n = 0: no period found: not settled, chaotic or quasi-periodic)."""
+    per = np.nan_to_num(np.asarray(period, float)).astype(int)
+    edges = np.r_[0, np.flatnonzero(np.diff(per)) + 1, len(per)]
+    return [(int(a), int(b) - 1, int(per[a])) for a, b in zip(edges[:-1], edges[1:])]
+
+
+def _spans(stretches):
+    return "; ".join(f"{d} {a:g}..{b:g}" for d, a, b in stretches)
+
+
+def _split_at_jumps(pp, a, b):
+    """Split the run [a, b] of a chain where its response pp jumps (a step more than five
+    times the run's median step: the chain fell onto another attractor)."""
+    steps = np.abs(np.diff(pp[a:b + 1]))
+    if len(steps) < 2:
+        return [(a, b)]
+    big = np.flatnonzero(steps > 5 * np.median(steps) + 1e-3 * np.abs(pp[a:b + 1]).max())
+    cuts = np.r_[a, a + big + 1, b + 1]
+    return [(int(i), int(j) - 1) for i, j in zip(cuts[:-1], cuts[1:])]
+
+
+def _at_phase(case, y, t):
+    """The state the run from y at time t reaches at the next time with the forcing phase of
+    the case's t0 (the continuation's section)."""
+    from .core import load
+    from .orbits import _period_map
+    model = load(case)
+    span = 2 * np.pi * repeat_revolutions(case) / model.info()["omega"]
+    dt = (case["t0"] - t) % span
+    if dt < 1e-9 * span:
+        return np.asarray(y, float)
+    y1, _ = _period_map(model, t, t + dt, np.asarray(y, float)[:, None])
+    return y1[:, 0]
+
+
+def _seed(case, final, n, max_n):
+    """The stable period-n orbit the sweep's run at `case` ended near (final: its state and
+    time): n from the exact sections when the sweep found one, else the first n <= max_n whose
+    Newton converges from that state onto a stable orbit; None when there is none (not
+    settled, chaotic or quasi-periodic)."""
+    from .orbits import periodic_orbit
+    guess = _at_phase(case, *final)
+    for m in ([n] if 0 < n <= max_n else range(1, max_n + 1)):
+        try:
+            orb = periodic_orbit(case, m, guess=guess)
+        except SplineError:
+            continue
+        if orb.stable:
+            return orb
+    return None
+
+
+def _on_branch(ds, label, p, y, scale):
+    """Whether (p, y) lies on a branch of `ds`: within a tenth of the chord (scaled) of the
+    branch interpolated linearly between two consecutive points that bracket p (the chord's
+    sagitta at the continuation's max_angle is about 2 % of it)."""
+    for b in np.unique(ds.branch.values):
+        rows = np.flatnonzero(ds.branch.values == b)
+        ps, ys = ds[label].values[rows], ds.y0.values[rows]
+        for k in np.flatnonzero((ps[:-1] - p) * (ps[1:] - p) <= 0):
+            w = 0.0 if ps[k + 1] == ps[k] else (p - ps[k]) / (ps[k + 1] - ps[k])
+            yi = ys[k] + w * (ys[k + 1] - ys[k])
+            chord = np.abs((ys[k + 1] - ys[k]) / scale).max()
+            if np.abs((yi - y) / scale).max() <= 0.1 * chord + 1e-6 * np.abs(y / scale).max():
+                return True
+    return False
+
+
+def merged(pieces, label, scale):
+    """The indices of the pieces to keep, largest first: a piece every point of which lies on
+    a kept one (_on_branch) is the same branch and goes."""
+    keep = []
+    for i in sorted(range(len(pieces)), key=lambda i: -pieces[i].sizes["point"]):
+        if not any(all(_on_branch(pieces[j], label, p, y, scale) for p, y in
+                       zip(pieces[i][label].values, pieces[i].y0.values)) for j in keep):
+            keep.append(i)
+    return keep
+
+
+def _join(down, up, label):
+    """One branch from a seed's two halves: `down` (seed to start) reversed, then `up` (seed to
+    stop) without its first point (the seed again). Doubled branches keep their own numbers."""
+    import xarray as xr
+    pv = [v for v in down.data_vars if "point" in down[v].dims]
+    sv = [v for v in down.data_vars if "special" in down[v].dims]
+    main_d = np.flatnonzero(down.branch.values == 0)[::-1]
+    rest_d = np.flatnonzero(down.branch.values != 0)
+    main_u = np.flatnonzero(up.branch.values == 0)[1:]
+    rest_u = np.flatnonzero(up.branch.values != 0)
+    dn = down[pv].isel(point=np.r_[main_d, rest_d])
+    un = up[pv].isel(point=np.r_[main_u, rest_u])
+    nb = int(down.branch.max()) + 1
+    un["branch"] = xr.where(un.branch > 0, un.branch + nb - 1, 0)
+    sp_u = up[sv].copy()
+    sp_u["special_branch"] = xr.where(sp_u.special_branch > 0, sp_u.special_branch + nb - 1, 0)
+    out = xr.merge([xr.concat([dn, un], dim="point"),
+                    xr.concat([down[sv], sp_u], dim="special")], combine_attrs="override")
+    out.attrs = dict(up.attrs)
+    return out
+
+
+def _concat(pieces):
+    """The branches of several seeds as one Dataset: `branch` numbered through, `seed` the
+    seed each point and special point came from."""
+    import xarray as xr
+    pts, sps, nb = [], [], 0
+    for s, d in enumerate(pieces):
+        pv = [v for v in d.data_vars if "point" in d[v].dims]
+        sv = [v for v in d.data_vars if "special" in d[v].dims]
+        a, b = d[pv].copy(), d[sv].copy()
+        a["branch"] = a.branch + nb
+        b["special_branch"] = b.special_branch + nb
+        a["seed"] = ("point", np.full(a.sizes["point"], s))
+        b["special_seed"] = ("special", np.full(b.sizes["special"], s, int))
+        nb += int(d.branch.max()) + 1
+        pts.append(a)
+        sps.append(b)
+    return xr.merge([xr.concat(pts, dim="point"), xr.concat(sps, dim="special")],
+                    combine_attrs="override")
+
+
+def branches(case, field: str, start: float, stop: float, points: int = 31, *,
+             max_n: int = 8, progress: bool = True, command: str | None = None,
+             sweep_case=None, **cont):
+    """Every periodic branch of `case` over `field` in [start, stop] from one call.
+
+    A follow sweep up and down (`points` values from start to stop, runs of `sweep_case`,
+    default `case`: give it a t_end that settles) finds the attractors: each stretch of a
+    direction with one period n from the exact Poincare sections (0: none found) and no jump in
+    T_m peak-to-peak is an attractor; its middle point's final state, brought to the case's
+    section phase, seeds `periodic_orbit` (period n, or when the sections gave none, the first
+    n <= max_n on which Newton converges to a stable orbit) and a continuation from there to
+    start and to stop (`cont`: continuation's keywords). A seed whose orbit lies on a branch
+    already traced (same orbit at the same value) is not continued again; a branch whose every
+    point lies on another is dropped. Stretches without a stable periodic orbit of n <= max_n
+    (chaotic or quasi-periodic, or not settled) seed nothing; listed in attrs['no_period'].
+
+    Returns (Dataset, sweep): the Dataset of `continuation` for all the branches (dim 'point',
+    'branch' numbered through, 'seed' the seed's index; dims 'special' likewise; attrs
+    'seeds': field value, direction and period of each seed continued, 'status' each seed's),
+    and the follow sweep's Dataset (frplots.frequency_response(ds, sweep=sw) draws both)."""
+    from .core import load
+    from .orbits import _scale
+    from .sweeps import sweep
+    name, index = parse_field(case, field)
+    if index is not None:
+        raise CaseError(f"field {field!r}: branches sweeps whole fields (the follow sweep); "
+                        "give a scalar field")
+    if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 3:
+        raise CaseError(f"points = {points!r}: the follow sweep's number of values, a whole "
+                        "number >= 3")
+    if isinstance(max_n, bool) or not isinstance(max_n, (int, np.integer)) or max_n < 1:
+        raise CaseError(f"max_n = {max_n!r}: the longest period to seed, a whole number >= 1")
+    if not (np.isfinite(start) and np.isfinite(stop)) or start == stop:
+        raise CaseError(f"start = {start!r}, stop = {stop!r}: two different finite values")
+    values = np.linspace(min(start, stop), max(start, stop), points)
+    finals = {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SplineWarning)   # unsettled runs near the folds
+        sw = sweep(sweep_case if sweep_case is not None else case, progress=progress,
+                   follow="both", spectrum=False, finals=finals, **{name: values})
+    scale = _scale(load(case))
+    pieces, seeds, no_period, status = [], [], [], []
+    for d in ("up", "down"):
+        idx = np.arange(points) if d == "up" else np.arange(points)[::-1]
+        sub = sw.sel(direction=d)
+        pp = (sub.Tm_max - sub.Tm_min).values[idx]
+        for a, b, n in _stretches(sub.period.values[idx]):
+            for i, j in _split_at_jumps(pp, a, b):
+                k = idx[(i + j) // 2]
+                p = float(values[k])
+                orb = None if finals[d][k] is None else _seed(case.replace(**{name: p}),
+                                                              finals[d][k], n, max_n)
+                if orb is None:
+                    no_period.append((d, values[idx[i]], values[idx[j]]))
+                    continue
+                if any(_on_branch(x, field, p, orb.y0, scale) for x in pieces):
+                    continue
+                halves = []
+                for end in (start, stop):
+                    if p == end:
+                        continue
+                    with warnings.catch_warnings(record=True):
+                        warnings.simplefilter("always", SplineWarning)
+                        halves.append(continuation(case, field, p, end, n=orb.n, guess=orb.y0,
+                                                   progress=progress, **cont))
+                    if halves[-1].attrs["status"] != "complete":
+                        status.append(f"seed {d} {field} = {p:g} to {end:g}: "
+                                      f"{halves[-1].attrs['status']}")
+                pieces.append(_join(*halves, field) if len(halves) == 2 else halves[0])
+                seeds.append(f"{p:g} {d} n={orb.n}")
+    if not pieces:
+        raise SplineError(f"branches: no periodic attractor found by the follow sweeps over "
+                          f"{field} = {start:g}..{stop:g} (stretches without a period: "
+                          f"{_spans(no_period) or 'none'})")
+    keep = merged(pieces, field, scale)
+    ds = _concat([pieces[i] for i in keep])
+    if no_period:       # frplots.frequency_response shades them
+        ds["no_period_range"] = (("stretch", "end"), np.sort([[a, b] for _, a, b in no_period]))
+    ds.attrs.update(start=start, stop=stop, seeds="; ".join(seeds[i] for i in keep),
+                    no_period=_spans(no_period), status="; ".join(status) or "complete",
+                    n_points=ds.sizes["point"], n_branches=int(ds.branch.max()) + 1,
+                    command=command or f"pyspline.branches({case.name!r}, {field!r}, "
+                                       f"{start:g}, {stop:g}, points={points})")
+    return ds, sw
+
+
+def coexistence(sw, rel: float = 0.05):
+    """The verdict of a follow='both' sweep per value: True where the up and the down chains
+    end on different attractors (T_m peak-to-peak apart by more than `rel` of the larger:
+    two orbits coexist), False where they agree (one orbit)."""
+    up, down = ((sw.Tm_max - sw.Tm_min).sel(direction=d).values for d in ("up", "down"))
+    return np.abs(up - down) > rel * np.maximum(np.abs(up), np.abs(down))
+
+
+def fold_curve(case, field: str, start: float, stop: float, field2: str, values2, n: int = 1,
+               *, check=(), check_points: int = 31, check_case=None, progress: bool = True,
+               command: str | None = None, **cont):
+    """The folds and grazings of the period-n branch over `field` in [start, stop], followed in
+    a second field: at each of `values2` (in the order given) the branch is continued over the
+    band from the orbit at `start` of the previous value (a fold curve by repeated
+    one-parameter continuation; `cont`: continuation's keywords). Two folds bound the band
+    where two orbits coexist; where the fold curves meet (a cusp) the hysteresis ends.
+
+    check : values of field2 at which a follow sweep up and down (`check_points` values over
+    the band, runs of `check_case`, default `case`: give it a t_end that settles) gives the
+    brute-force verdict per value: one orbit or two coexisting (`coexistence`).
+
+    Returns a Dataset: dim `value2` (field2's values): `fold` (value2, fold; sorted, NaN
+    padded), `grazing` (value2, grazing; in order along the branch from start: the first is
+    where the orbit of start changes its contact sequence), `status` (each continuation's); with check, dims
+    `check` and `check_point`: `check_value`, `check_field`, `coexist`. A value at which no
+    orbit is found at start (OrbitError, SolverError) has no folds and says so in `status`."""
+    import xarray as xr
+    from .arclength import set_field
+    from .sweeps import sweep
+    name2, index2 = parse_field(case, field2)
+    values2 = np.atleast_1d(np.asarray(values2, float))
+    if values2.ndim != 1 or not len(values2) or not np.isfinite(values2).all():
+        raise CaseError(f"values2 = {values2!r}: finite values of {field2}, at least one")
+    folds, grazes, status, guess = [], [], [], None
+    for v in values2:
+        at = set_field(case, name2, index2, v)
+        try:
+            with warnings.catch_warnings(record=True):
+                warnings.simplefilter("always", SplineWarning)
+                ds = continuation(at, field, start, stop, n=n, guess=guess,
+                                  progress=progress, **cont)
+        except CaseError:
+            raise
+        except SplineError as exc:      # no orbit at start there: the other values go on
+            folds.append([])
+            grazes.append([])
+            status.append(f"{field2} = {v:g}: {type(exc).__name__}: {exc}")
+            continue
+        guess = ds.y0.values[0]
+        kinds = ds.special_type.values.astype(str)
+        sp = ds[f"special_{ds.attrs['field']}"].values
+        folds.append(np.sort(sp[kinds == "fold"]))
+        grazes.append(sp[kinds == "grazing"])       # in order along the branch from start
+        status.append(ds.attrs["status"])
+
+    def padded(rows):
+        out = np.full((len(rows), max([len(r) for r in rows] + [1])), np.nan)
+        for i, r in enumerate(rows):
+            out[i, :len(r)] = r
+        return out
+    label = field_label(*parse_field(case, field))
+    out = xr.Dataset({"fold": (("value2", "fold"), padded(folds)),
+                      "grazing": (("value2", "grazing"), padded(grazes)),
+                      "status": (("value2",), np.array(status, dtype=object))},
+                     coords={"value2": values2})
+    if len(check):
+        check = np.atleast_1d(np.asarray(check, float))
+        pts = np.linspace(min(start, stop), max(start, stop), check_points)
+        verdict = []
+        for v in check:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", SplineWarning)
+                sw = sweep(set_field(check_case if check_case is not None else case, name2,
+                                     index2, v), progress=progress, follow="both",
+                           spectrum=False, **{parse_field(case, field)[0]: pts})
+            verdict.append(coexistence(sw))
+        out["check_value"] = ("check", check)
+        out["check_field"] = ("check_point", pts)
+        out["coexist"] = (("check", "check_point"), np.array(verdict, int))
+    out.attrs.update(case=case.text(), field=label, field2=field2, start=start, stop=stop, n=n,
+                     command=command or f"pyspline.fold_curve({case.name!r}, {field!r}, "
+                                        f"{start:g}, {stop:g}, {field2!r}, [...])")
+    return out

@@ -1,0 +1,139 @@
+"""pyspline.branches and pyspline.fold_curve (docs/continuation.md) on the 7-DOF Z16 drive of
+tests/test_cont_drives.py: every branch of its band from one call, held against the follow
+sweeps' jumps and values; the folds followed in the ripple amplitude, held against the
+verdicts of follow sweeps."""
+import warnings
+
+import numpy as np
+import pytest
+
+import pyspline
+from pyspline.branches import coexistence
+from test_cont_drives import BAND, DRIVE, folds, follow_sweeps  # noqa: F401 (a fixture)
+
+SETTLED = DRIVE.replace(t_end=2.0, t_transient=1.0, n_out=8001)  # the seeding sweep's runs
+
+
+@pytest.fixture(scope="module")
+def every_branch():
+    return pyspline.branches(DRIVE, "speed_rpm", *BAND, points=31, progress=False,
+                             sweep_case=SETTLED)
+
+
+def test_branches_finds_both_orbits_of_the_band_and_no_third(every_branch):
+    """Both stable orbits the seeding follow sweeps find inside the hysteresis (runs of 2 s,
+    the last 1 s at 200 samples a revolution; 10 r/min steps: the full-contact orbit up, the
+    contact-loss one down) lie on the branches (T_m peak-to-peak to 0.5 %: the largest of 200
+    samples a revolution of an impacting orbit's torque, on either side; the two orbits are a
+    factor 2 apart), joined through the unstable middle into one S-curve; at every speed of
+    the hysteresis the branches cross it three times (two stable, one saddle), outside it
+    once: no spurious third orbit, no branch twice."""
+    ds, sw = every_branch
+    assert ds.attrs["status"] == "complete" and ds.attrs["no_period"] == ""
+    p, pp, stable = ds.speed_rpm.values, ds.Tm_pp.values, ds.stable.values.astype(bool)
+    lo, hi = folds(ds)
+    assert len(folds(ds)) == 2
+    speeds, swept = sw.speed_rpm.values, (sw.Tm_max - sw.Tm_min).values
+    for x in (2370.0, 2400.0, 2420.0, 2300.0, 2470.0):
+        cross = [k for b in np.unique(ds.branch) for k in np.flatnonzero(ds.branch == b)[:-1]
+                 if ds.branch[k + 1] == b and (p[k] - x) * (p[k + 1] - x) <= 0]
+        assert len(cross) == (3 if lo < x < hi else 1), (x, cross)
+        got = np.sort([np.interp(x, sorted(p[[k, k + 1]]), pp[[k, k + 1]][np.argsort(
+            p[[k, k + 1]])]) for k in cross if stable[k] and stable[k + 1]])
+        up, down = swept[:, speeds == x].ravel()
+        want = [up, down] if coexistence(sw)[speeds == x][0] else [up]
+        assert len(got) == len(want) == (2 if lo < x < hi else 1), (x, got, want)
+        assert got == pytest.approx(np.sort(want), rel=5e-3), x
+
+
+def test_pieces_of_the_same_branch_are_merged(every_branch):
+    """A piece of a branch (points 30-70 of the S-curve) is the same branch and goes; two
+    pieces that share no orbit (the points before 30 and after 70) are both kept; a piece
+    moved off the branch by 5 % of each state's swing along it is another branch."""
+    from pyspline.branches import merged
+    from test_orbits import scale_of
+    ds, _ = every_branch
+    s = scale_of(DRIVE)
+    mid = ds.isel(point=slice(30, 70))
+    a, b = ds.isel(point=slice(0, 30)), ds.isel(point=slice(70, None))
+    assert merged([mid, ds], "speed_rpm", s) == [1]
+    assert sorted(merged([a, b], "speed_rpm", s)) == [0, 1]
+    off = mid.copy(deep=True)
+    swing = np.ptp(ds.y0.values, axis=0)
+    off["y0"] = off.y0 + 0.05 * swing
+    assert sorted(merged([off, ds], "speed_rpm", s)) == [0, 1]
+
+
+def test_branches_folds_where_the_follow_sweeps_jump(every_branch, follow_sweeps):
+    """The folds of the branches within 0.5 % of the 1 r/min follow sweeps' jumps, and the
+    seeding sweep's own jumps (10 r/min steps) bracket them."""
+    ds, sw = every_branch
+    lo, hi = folds(ds)
+    speeds, pp = follow_sweeps
+    up = speeds[np.argmax(np.diff(pp[0])) + 1]
+    down = speeds[np.argmax(np.diff(pp[1]))]
+    assert hi == pytest.approx(up, rel=5e-3) and lo == pytest.approx(down, rel=5e-3)
+    assert not coexistence(sw)[sw.speed_rpm.values < lo - 10].any()
+    assert coexistence(sw)[(sw.speed_rpm.values > lo + 1) & (sw.speed_rpm.values < hi - 1)].all()
+
+
+def test_fold_curve_against_follow_sweeps():
+    """The folds followed in the ripple amplitude a (repeated continuation over 2300-2500
+    r/min at a = 0.25, 0.2, 0.1): follow sweeps up and down at 10 r/min steps say two orbits
+    between the folds and one outside them (a step of margin: runs next to a fold do not
+    settle); at a = 0.1 no fold in the band and one orbit at every speed."""
+    values = [0.25, 0.2, 0.1]
+    fc = pyspline.fold_curve(DRIVE, "speed_rpm", 2300, 2500, "ripple_amp(1)", values,
+                             progress=False, check=values, check_points=21, check_case=SETTLED)
+    assert (fc.status == "complete").all()
+    f = fc.fold.values
+    assert np.isfinite(f[:2, :2]).all() and np.isnan(f[:2, 2:]).all() and np.isnan(f[2]).all()
+    x = fc.check_field.values
+    for i in range(3):
+        two = fc.coexist.values[i].astype(bool)
+        inside = (x > f[i, 0] + 10) & (x < f[i, 1] - 10)
+        outside = ~((x > f[i, 0] - 10) & (x < f[i, 1] + 10))
+        assert two[inside].all() and not two[outside].any(), (values[i], x[two], f[i])
+        assert inside.any() == (i < 2)
+
+
+def test_bad_input_is_a_case_error():
+    for kw in (dict(points=2), dict(points=1.5), dict(max_n=0)):
+        with pytest.raises(pyspline.CaseError, match=list(kw)[0]):
+            pyspline.branches(DRIVE, "speed_rpm", *BAND, progress=False, **kw)
+    with pytest.raises(pyspline.CaseError, match="values2"):
+        pyspline.fold_curve(DRIVE, "speed_rpm", *BAND, "ripple_amp(1)", [np.nan])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(pyspline.CaseError, match="scalar field"):
+            pyspline.branches(DRIVE, "ripple_amp(1)", 0.1, 0.2, progress=False)
+
+
+def test_cli_all_and_fold_input(tmp_path, every_branch):
+    """`pyspline continue --all` writes the branches (the Python call's folds), the seeding
+    sweep and the figure, exit 0; `--fold` the folds at one amplitude (the same) with the
+    follow sweeps' verdict (20 r/min steps: two orbits exactly between them); a --fold
+    without numbers is a CaseError naming it, exit 2."""
+    import xarray as xr
+    from test_continuation import cli
+    path = tmp_path / "drive.nml"
+    path.write_text(SETTLED.text())
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
+              "--stop", "2500", "--all", "--out", "out", "--quiet")
+    assert run.returncode == 0, run.stderr
+    ds = xr.open_dataset(tmp_path / "out" / "branches.nc", engine="h5netcdf")
+    assert folds(ds) == pytest.approx(folds(every_branch[0]), abs=1e-3)
+    assert (tmp_path / "out" / "branches.png").stat().st_size > 10_000
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2300",
+              "--stop", "2500", "--fold", "ripple_amp(1)=0.25", "--check", "0.25", "--sweep",
+              "11", "--out", "fold", "--quiet")
+    assert run.returncode == 0, run.stderr
+    fc = xr.open_dataset(tmp_path / "fold" / "fold_curve.nc", engine="h5netcdf")
+    assert fc.fold.values[0] == pytest.approx(folds(every_branch[0]), abs=1e-2)
+    lo, hi = fc.fold.values[0]
+    x, two = fc.check_field.values, fc.coexist.values[0].astype(bool)
+    assert (two == ((x > lo) & (x < hi))).all(), (x[two], lo, hi)
+    assert (tmp_path / "fold" / "fold_curve.png").stat().st_size > 10_000
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
+              "--stop", "2500", "--fold", "ripple_amp(1)=0.2,x")
+    assert run.returncode == 2 and "--fold ripple_amp(1)=" in run.stderr, run.stderr
