@@ -58,9 +58,9 @@ module spline_case_type
     integer  :: dof = 7
     character(len=optlen) :: thermal = 'none'
     real(wp) :: t_bulk = 0.0_wp, f_m = 0.1_wp, u_flash = 0.83_wp, eta_hertz = 1.127_wp
-    !> The solver defaults are what won where it was measured (docs/performance.md, "Impacting
-    !> scenes, and how the defaults were chosen"): Adams with fixed-point iteration, on every
-    !> scene of the stability sweep and on the impacting Z = 24 scene.
+    !> The solver defaults: method 'auto' picks per scene (docs/model.md section 8) what won where
+    !> it was measured (docs/performance.md, "Impacting scenes, and how the defaults were
+    !> chosen"), with located contact switches.
     character(len=optlen) :: method = 'auto', jacobian = 'dq', nonlinear = 'auto'
     logical  :: roots = .true., stald = .false., linear_tail = .true.
     real(wp) :: rtol = 1.0e-8_wp, atol = 1.0e-10_wp
