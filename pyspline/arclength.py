@@ -24,6 +24,7 @@ from .core import STATE_QUANTITIES, load, sundials_said
 from .errors import CaseError, SolverError, SplineWarning
 from .orbits import (OrbitError, _period_map, _scale, _trajectory, fd_monodromy,
                      forcing_periods, map_and_monodromy, periodic_orbit)
+from .summary import _version
 
 __all__ = ["continuation", "SPECIAL_TYPES"]
 
@@ -687,7 +688,3 @@ def _smooth(sp) -> bool:
         return abs(abs(mu) - 1) < 1e-2
     return True
 
-
-def _version():
-    from . import __version__
-    return __version__
