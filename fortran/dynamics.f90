@@ -3,7 +3,7 @@
 module spline_dynamics
   use spline_kinds, only: wp, max_teeth
   use spline_errors, only: err_ok, err_solver
-  use spline_model, only: model_t, ndof, nstate, thermal_coupled
+  use spline_model, only: model_t, ndof, nstate, thermal_coupled, static_tooth_load
   use spline_geometry, only: tooth_angles
   use spline_mesh, only: mesh_eval, mesh_forces, mesh_switch_functions, coupling_stats_t, eq16_mode, &
        eq11_gradient
@@ -250,7 +250,7 @@ contains
     if (m%k_p2 == 0.0_wp) q(4) = 0.0_wp
     q(5) = -m%r_b*m%t_d/max(m%k_t1, tiny(1.0_wp))
     q(7) = m%r_b*m%t_l/max(m%k_t2, tiny(1.0_wp))
-    q(6) = -sign(m%c_bulk, m%t_d) - m%t_d/(m%z*m%k_m*m%r_b)
+    q(6) = -sign(m%c_bulk, m%t_d) - sign(static_tooth_load(m)/m%k_m, m%t_d)
     if (m%spacing) q(6) = q(6) - sum(m%spacing_error(1:m%z))/m%z   ! full contact: dn_j + e_j
     lam_prev = 0.0_wp; q_prev = 0.0_wp; dq_prev = 0.0_wp
     call residual(q, r)

@@ -8,7 +8,7 @@
 module spline_loads
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use spline_kinds, only: wp, pi, max_teeth
-  use spline_model, only: model_t, nstate
+  use spline_model, only: model_t, nstate, static_tooth_load
   use spline_geometry, only: tooth_angles, root_section, active_profile
   use spline_mesh, only: tooth_approach
   use spline_errors, only: itoa, ftoa
@@ -123,7 +123,7 @@ contains
     loads = 0.0_wp; tload = 0.0_wp
     if (nt == 0) return
     back = -drive_flank(m)
-    fs = abs(m%t_d)/(m%z*m%r_b)
+    fs = static_tooth_load(m)
     speed = 0.0_wp
     loads(il_revolutions) = m%omega*(t(nt) - t(1))/(2.0_wp*pi)
     nb = int(loads(il_revolutions))
