@@ -297,7 +297,7 @@ contains
   !> geometry (Eq. 18), supports that take most of the offset, a shaft wound up beyond
   !> windup_limit, a start at rest with teeth overlapping, a tooth deflected beyond
   !> deflection_limit of the module. The executable prints them to stderr, Python raises
-  !> pyspline.SplineWarning (api_warnings).
+  !> pyspline.SplineWarning (api_load_file's and api_load_fields' warn).
   function model_warnings(m) result(text)
     type(model_t), intent(in) :: m
     character(len=:), allocatable :: text

@@ -17,7 +17,7 @@ from .case import Model, load_case
 from .result import (FIELDS, LOAD_QUANTITIES, QUANTITIES, STATE_NAMES,  # noqa: F401 -- the
                      STATE_QUANTITIES, THERMAL_LEVELS, TOOTH_LOAD_QUANTITIES,  # public names
                      TOOTH_QUANTITIES, Result, _api, _names, cf_units, level_name, raise_for,
-                     run, run_loads, run_outcome, sundials_said)
+                     run, run_outcome, sundials_said)
 
 
 def load(case) -> Model:
