@@ -45,8 +45,8 @@ def check(tmp_path_factory):
         pytest.skip("gfortran not found")
     tmp = tmp_path_factory.mktemp("stiffness_check")
     exe = tmp / "stiffness_check"
-    src = [ROOT / "fortran" / "kinds.f90", ROOT / "fortran" / "stiffness.f90",
-           ROOT / "tests" / "stiffness_check.f90"]
+    src = [ROOT / "fortran" / "common" / "kinds.f90",
+           ROOT / "fortran" / "physics" / "stiffness.f90", ROOT / "tests" / "stiffness_check.f90"]
     subprocess.run([fc, "-O2", "-J", str(tmp), *map(str, src), "-o", str(exe)], check=True,
                    cwd=tmp, capture_output=True, text=True)
     run = subprocess.run([str(exe)], capture_output=True, text=True, cwd=tmp)
