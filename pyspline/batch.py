@@ -3,7 +3,7 @@ per run, e.g. one per Slurm array task; no time series) read back exactly and me
 xarray.Dataset `pyspline.sweep` builds for the same points (`merge`; its command,
 `pyspline merge`, is pyspline.mergecli).
 
-A summary (app/spline_dyn.f90 write_summary) has lines ``NAME [UNIT] = VALUES`` (numbers
+A summary (fortran/interface/spline_dyn.f90 write_summary) has lines ``NAME [UNIT] = VALUES`` (numbers
 comma-separated, 17 significant digits: every double reads back exactly), ``NAME = 'TEXT'``
 lines, and the case as a namelist (every field). What a sweep point keeps comes from it as
 follows: the statistics, the loads, the extremes and RMS of T_m, k_v, F, T_f, D2 (the core's

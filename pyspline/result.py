@@ -23,9 +23,9 @@ THERMAL_LEVELS = ("none", "bulk", "oneway", "coupled")   #: stats["thermal_level
 
 @functools.cache
 def _names(kind: str) -> tuple:
-    """The core's list `kind` (api_names in fortran/api.f90): (name, unit, description) per
+    """The core's list `kind` (api_names in fortran/interface/api.f90): (name, unit, description) per
     entry; units SI, '-' a ratio, '' none. The output quantities and statistics are the table
-    of fortran/quantities.f90, the case fields that of fortran/case_type.f90."""
+    of fortran/common/quantities.f90, the case fields that of fortran/input/case_type.f90."""
     out = []
     for i in range(1, 1000):
         name, unit, descr = (decode(s) for s in _api.api_names(kind, i))
@@ -42,7 +42,7 @@ def cf_units(unit: str) -> str:
 
 @functools.cache
 def _errors() -> dict:
-    """Error code of the core -> exception class (codes and names from fortran/errors.f90)."""
+    """Error code of the core -> exception class (codes and names from fortran/common/errors.f90)."""
     return {i: BY_NAME.get(name, SplineError) for i, (name, *_) in enumerate(_names("errors"))}
 
 
@@ -97,7 +97,7 @@ def level_name(dof: int, thermal: str) -> str:
 
 
 
-#: Result quantities from the core's table (fortran/quantities.f90): name -> (description,
+#: Result quantities from the core's table (fortran/common/quantities.f90): name -> (description,
 #: unit), every output (time t, states, Tm, kv, per-tooth), the states (position and velocity,
 #: order of a state vector) and the per-tooth quantities (time, tooth).
 QUANTITIES = {n: (d, u) for n, u, d in _names("outputs")}

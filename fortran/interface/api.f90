@@ -1,4 +1,4 @@
-!> The thin interface that f2py wraps (signatures and GIL release: fortran/_core.pyf).
+!> The thin interface that f2py wraps (signatures and GIL release: fortran/interface/_core.pyf).
 !>
 !> A case crosses in one call (api_load_file for a file, api_load_fields for fields Python
 !> holds): checked, parsed, validated and built, it comes back as its fields (two flat arrays

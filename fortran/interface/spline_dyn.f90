@@ -38,7 +38,7 @@ program spline_dyn
     character(len=:), allocatable :: s
   end type string_t
 
-  interface   ! fortran/fileinfo.c
+  interface   ! fortran/interface/fileinfo.c
     integer(c_int) function c_same_file(a, b) bind(C, name='spline_same_file')
       import :: c_char, c_int
       character(kind=c_char), intent(in) :: a(*), b(*)
@@ -68,7 +68,7 @@ program spline_dyn
       import :: c_int
     end function c_sigint_count
     integer(c_int) function c_csv_record(x, n, buf, cap) bind(C, name='spline_csv_record')
-      import :: c_char, c_double, c_int                       ! app/csvrow.c
+      import :: c_char, c_double, c_int                       ! fortran/interface/csvrow.c
       real(c_double), intent(in) :: x(*)
       integer(c_int), value :: n, cap
       character(kind=c_char), intent(out) :: buf(*)
@@ -192,7 +192,7 @@ program spline_dyn
     open(newunit=u, file=tmp, status='replace', action='write', iostat=ios, iomsg=iomsg)
     if (ios /= 0) call die('cannot write the output '//out//': '//trim(iomsg), err_case)
   end if
-  ! From here a SIGINT is counted, not fatal (fortran/interrupt.c): the run stops at its next
+  ! From here a SIGINT is counted, not fatal (fortran/integration/interrupt.c): the run stops at its next
   ! right-hand side, the temporary file is removed, and the exit status is 130.
   sigint0 = c_sigint_watch()
 
@@ -265,7 +265,7 @@ program spline_dyn
     end do
   end do
   write(u, '(a)', iostat=ios) ''
-  ! the records, formatted by app/csvrow.c: 17 significant digits (exact), a quarter of the
+  ! the records, formatted by fortran/interface/csvrow.c: 17 significant digits (exact), a quarter of the
   ! time of an ES edit descriptor
   allocate(row(1 + nstate + 2 + m%z*ntooth_q))
   allocate(character(len=26*size(row)) :: record)
@@ -451,7 +451,7 @@ contains
     call rename_into(stmp, summary)
   end subroutine write_summary
 
-  !> One summary line: NAME [UNIT] = x(1),x(2),... (app/csvrow.c: 17 significant digits).
+  !> One summary line: NAME [UNIT] = x(1),x(2),... (fortran/interface/csvrow.c: 17 significant digits).
   subroutine put(name, unit, x)
     character(len=*), intent(in) :: name, unit
     real(wp), intent(in) :: x(:)
