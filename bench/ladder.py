@@ -6,7 +6,7 @@ times the thermal levels none, bulk, oneway, coupled. A level is *eligible* for 
 reports the quantities the case's own level reports (T_f needs oneway or coupled). The error is
 the max relative error of T_m(t) and of the per-tooth F_j at the output times against the
 case's own level (speed._errors); the cost is the core's median run time. The auto rule lives in
-the Fortran core (fortran/fidelity.f90, run.f90); this module measures it.
+the Fortran core (fortran/physics/fidelity.f90, run.f90); this module measures it.
 """
 from __future__ import annotations
 

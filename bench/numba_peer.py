@@ -65,7 +65,7 @@ __all__ = ["Setup", "make_rhs", "solve", "rhs_eval", "load_case", "DEFAULTS", "l
 lsoda_sig = types.void(types.double, types.CPointer(types.double),
                        types.CPointer(types.double), types.CPointer(types.double))
 
-# Defaults of every model field (the component defaults of `case_t`, fortran/case_type.f90, values only; docs/model.md s.8).
+# Defaults of every model field (the component defaults of `case_t`, fortran/input/case_type.f90, values only; docs/model.md s.8).
 DEFAULTS = dict(
     z=16, module_m=2.0e-3, alpha_deg=30.0, b=0.03, s=3.14e-3, c0=2.0e-4, e_mod=2.1e11, nu=0.3,
     lambda_th=1.2e-5, k_cond=46.47, rho=7800.0, c_heat=481.48,

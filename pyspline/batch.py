@@ -3,12 +3,12 @@ per run, e.g. one per Slurm array task; no time series) read back exactly and me
 xarray.Dataset `pyspline.sweep` builds for the same points (`merge`; its command,
 `pyspline merge`, is pyspline.mergecli).
 
-A summary (app/spline_dyn.f90 write_summary) has lines ``NAME [UNIT] = VALUES`` (numbers
+A summary (fortran/interface/spline_dyn.f90 write_summary) has lines ``NAME [UNIT] = VALUES`` (numbers
 comma-separated, 17 significant digits: every double reads back exactly), ``NAME = 'TEXT'``
 lines, and the case as a namelist (every field). What a sweep point keeps comes from it as
-follows: the statistics, the loads, the max/min of T_m, k_v, F, T_f, D2 and the Poincare
-section are the core's numbers, bit for bit; the RMS values are the executable's
-sqrt(sum(x**2)/n) (numpy sums pairwise: equal to about 1e-15 relative); the period of the
+follows: the statistics, the loads, the extremes and RMS of T_m, k_v, F, T_f, D2 (the core's
+run_results, which Python's Result.extremes come from too) and the Poincare section are the
+core's numbers, bit for bit; the period of the
 section and the Lyapunov exponent and its fit are computed here from the section points and
 the Benettin record, as `summarise` does; wall_s is the executable's time of the run. Not
 available from a summary: the spectrum of T_m (it needs the time series): a merged dataset
@@ -27,7 +27,7 @@ import numpy as np
 from .case import case_from_text, defaults
 from .dataset import MERGED, build_dataset, write_netcdf
 from .errors import BY_NAME, CaseError, SplineError, SplineWarning
-from .summary import (SWEEP_LOADS, _stat_names, _template, _version, lyapunov_summary,
+from .summary import (SWEEP_EXTREMES, SWEEP_LOADS, _stat_names, _template, _version, lyapunov_summary,
                       section_summary)
 from .sweeps import point_hash
 
@@ -144,10 +144,7 @@ def summary_point(summary: dict, options: dict) -> dict:
         lt, lg = v["lyapunov.t"], v["lyapunov.log_growth"]
         t0 = one("run.t_first")
         lyapunov_summary(s, lt, lg, float(lg[-1] / (lt - t0)[-1]), t0)
-    for q in ("Tm", "kv", "F"):
-        s.update({f"{q}_{w}": one(f"run.{q}_{w}") for w in ("max", "min", "rms")})
-    s.update(Tf_max=one("run.Tf_max"), D2_max=one("run.D2_max"), D2_min=one("run.D2_min"),
-             D2_rms=one("run.D2_rms"))
+    s.update({k: one("run." + k) for k in SWEEP_EXTREMES})
     s.update({k: one("loads." + k) for k in SWEEP_LOADS})
     for k in _stat_names():
         if "stats." + k in v:

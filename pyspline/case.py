@@ -2,12 +2,12 @@
 as a dict, and handed to the core in memory as field values; ``Model``, the case loaded into the
 core (``Case.model``).
 
-The defaults live in the Fortran core only (``case_t`` in fortran/case.f90): Python reads them
+The defaults live in the Fortran core only (``case_t`` in fortran/input/case.f90): Python reads them
 from the core once, so a field that Python knows is a field the executable knows, with the same
 default. A case file is loaded by the core in one call (api_load_file: the path checked, read
 and parsed by the reader spline-dyn uses, then validated and built), so a bad file gets the same
 message from both; the fields come back as two flat arrays laid out by the core's field table
-(fortran/case_values.f90), and go back to the core the same way. What Python checks itself: the
+(fortran/input/case_values.f90), and go back to the core the same way. What Python checks itself: the
 Python types of a dict's values.
 """
 from __future__ import annotations
@@ -33,7 +33,7 @@ from .result import _names, _warn, raise_for, run
 
 GROUP = "spline_case"
 _CONTROL = re.compile(rb"[\x00-\x1f\x7f]")
-NAME_BYTES = 128   #: longest case name (UTF-8 bytes; fortran/case.f90 namelen)
+NAME_BYTES = 128   #: longest case name (UTF-8 bytes; fortran/input/case.f90 namelen)
 #: list fields with one number per tooth (as many as the most teeth): a shorter list gives the
 #: first teeth, as in a namelist file
 PER_TOOTH = frozenset({"spacing_error"})
@@ -60,7 +60,7 @@ def _layout() -> tuple:
 
 
 def _fields_of(values: np.ndarray, chars: np.ndarray) -> tuple[dict, bool]:
-    """A case's fields (Python types) from the core's value arrays (fortran/case_values.f90),
+    """A case's fields (Python types) from the core's value arrays (fortran/input/case_values.f90),
     and whether its strings are the bytes the core holds (not when Python strips a leading
     blank or replaces bytes that are no UTF-8)."""
     rows = _layout()[0]
@@ -120,7 +120,7 @@ def defaults() -> dict:
 
 
 def _shown(path: str) -> str:
-    """A path as messages show it (fortran/case.f90 shown): the last 237 characters of a long one."""
+    """A path as messages show it (fortran/input/case.f90 shown): the last 237 characters of a long one."""
     return path if len(path) <= 240 else "..." + path[-237:]
 
 

@@ -17,7 +17,7 @@ from .case import Model, load_case
 from .result import (FIELDS, LOAD_QUANTITIES, QUANTITIES, STATE_NAMES,  # noqa: F401 -- the
                      STATE_QUANTITIES, THERMAL_LEVELS, TOOTH_LOAD_QUANTITIES,  # public names
                      TOOTH_QUANTITIES, Result, _api, _names, cf_units, level_name, raise_for,
-                     run, run_loads, run_outcome, sundials_said)
+                     run, run_outcome, sundials_said)
 
 
 def load(case) -> Model:
@@ -56,7 +56,7 @@ def mesh_stiffness(case) -> dict:
 def tooth_stiffness(z, module, alpha_deg, b, r_root, r_contact, e_mod=2.1e11, nu=0.3,
                     internal=False, r_tip=0.0, nquad=32) -> dict:
     """Bending, shear and axial-compression stiffness [N/m] of one involute tooth of any gear
-    (potential energy method; fortran/stiffness.f90), loaded at radius r_contact."""
+    (potential energy method; fortran/physics/stiffness.f90), loaded at radius r_contact."""
     kb, ks, ka, ierr, msg = _api.api_tooth_stiffness(
         int(internal), float(z), module, np.radians(alpha_deg), b, r_root, r_tip, e_mod, nu,
         r_contact, nquad)

@@ -24,7 +24,7 @@ MERGED = "sweep.nc"     #: the merged sweep in a sweep's output directory
 
 @functools.cache
 def field_meta() -> dict:
-    """{field: (long_name, units)} from the core's field table (fortran/case_type.f90, through
+    """{field: (long_name, units)} from the core's field table (fortran/input/case_type.f90, through
     api_names('fields')): e.g. 'l_x' -> ('parallel misalignment of spline 1 in x', 'm'); a
     ratio's unit is '1'; an option whose description lists its choices is named by its name."""
     return {n: (n if "|" in d else d or n, cf_units(u)) for n, u, d in _names("fields")}

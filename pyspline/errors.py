@@ -1,4 +1,4 @@
-"""Exceptions of pyspline, one per error code of the Fortran core (fortran/errors.f90)."""
+"""Exceptions of pyspline, one per error code of the Fortran core (fortran/common/errors.f90)."""
 from __future__ import annotations
 
 

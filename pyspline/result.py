@@ -23,9 +23,9 @@ THERMAL_LEVELS = ("none", "bulk", "oneway", "coupled")   #: stats["thermal_level
 
 @functools.cache
 def _names(kind: str) -> tuple:
-    """The core's list `kind` (api_names in fortran/api.f90): (name, unit, description) per
+    """The core's list `kind` (api_names in fortran/interface/api.f90): (name, unit, description) per
     entry; units SI, '-' a ratio, '' none. The output quantities and statistics are the table
-    of fortran/quantities.f90, the case fields that of fortran/case_type.f90."""
+    of fortran/common/quantities.f90, the case fields that of fortran/input/case_type.f90."""
     out = []
     for i in range(1, 1000):
         name, unit, descr = (decode(s) for s in _api.api_names(kind, i))
@@ -42,7 +42,7 @@ def cf_units(unit: str) -> str:
 
 @functools.cache
 def _errors() -> dict:
-    """Error code of the core -> exception class (codes and names from fortran/errors.f90)."""
+    """Error code of the core -> exception class (codes and names from fortran/common/errors.f90)."""
     return {i: BY_NAME.get(name, SplineError) for i, (name, *_) in enumerate(_names("errors"))}
 
 
@@ -97,7 +97,7 @@ def level_name(dof: int, thermal: str) -> str:
 
 
 
-#: Result quantities from the core's table (fortran/quantities.f90): name -> (description,
+#: Result quantities from the core's table (fortran/common/quantities.f90): name -> (description,
 #: unit), every output (time t, states, Tm, kv, per-tooth), the states (position and velocity,
 #: order of a state vector) and the per-tooth quantities (time, tooth).
 QUANTITIES = {n: (d, u) for n, u, d in _names("outputs")}
@@ -109,6 +109,9 @@ STATE_NAMES = tuple(STATE_QUANTITIES)[:len(STATE_QUANTITIES) // 2]   #: x1 .. D3
 #: unit), the scalars and the per-tooth ones (arrays over the teeth).
 LOAD_QUANTITIES = {n: (d, u) for n, u, d in _names("loads")}
 TOOTH_LOAD_QUANTITIES = {n: (d, u) for n, u, d in _names("tooth_loads")}
+#: The extremes and RMS of a run's outputs (spline_loads::run_extremes; Result.extremes, what a
+#: sweep point and spline-dyn's summary keep): name -> (description, unit).
+EXTREMES = {n: (d, u) for n, u, d in _names("extremes")}
 
 
 def _attrs(name: str) -> dict:
@@ -163,6 +166,9 @@ class Result:
     #: (F_peak, load_factor, free_frac, back_frac, onsets); units: LOAD_QUANTITIES,
     #: TOOTH_LOAD_QUANTITIES
     loads: dict = None
+    #: the extremes and RMS of the outputs (the core's, EXTREMES), by name: Tm_max, Tm_min,
+    #: Tm_rms, kv_*, F_* and Tf_* (over all teeth), D2_*, vD2_* (floats)
+    extremes: dict = None
     #: the tooth spacing errors in use e_j (Z,) [m], the case's list plus the seeded ones
     #: (Model.info()['spacing_error'])
     spacing_error: np.ndarray = None
@@ -269,22 +275,25 @@ class Result:
 
 def run(model) -> Result:
     """Run a loaded Model (pyspline.simulate: any case) and return a Result. Raises CaseError, SolverError or ThermalInterferenceError with a message naming the
-    case; KeyboardInterrupt if SIGINT arrives during the run. Releases the GIL while it runs."""
+    case; KeyboardInterrupt if SIGINT arrives during the run. Releases the GIL while it runs.
+    One call of the core (api_simulate) gives the outputs, the loads, the extremes and the
+    run's warnings."""
     q, s = _names("tooth"), _names("stats")
     t0 = time.perf_counter()
     nft = model.n_out if model.n_slices else 0
     # the per-tooth array (the largest) is allocated here, not zeroed (f2py zeroes its own)
     tooth = np.empty((model.n_out, model.z, len(q)), order="F")
-    t, ycol, tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, nqw, consts, ierr, msg = \
-        _api.api_simulate(model.bytes, model.z, model.n_out, len(q), len(s), model.n_section,
-                          model.n_lyapunov, nft, model.n_slices, tooth)
+    (t, ycol, tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, nqw, consts, loads,
+     tload, ext, warned, ierr, msg) = _api.api_simulate(
+        model.bytes, model.z, model.n_out, len(q), len(s), model.n_section, model.n_lyapunov,
+        nft, model.n_slices, len(LOAD_QUANTITIES), len(TOOTH_LOAD_QUANTITIES), len(EXTREMES),
+        tooth)
     wall = time.perf_counter() - t0
     run_outcome(ierr, msg)
     y = ycol.T                # (nt, 14), a view of the core's columns (no transposed copy)
     st = {n: (float(v) if unit else int(v)) for (n, unit, _), v in zip(s, stats)}  # counts: int
     st["wall_s"] = wall
-    _warn(_api.api_warnings(model.bytes, stats, 1), 4)   # the run's (one-way backlash, Eq. 2),
-    #                                  attributed to the caller of pyspline.simulate
+    _warn(warned, 4)          # the run's and its loads', attributed to pyspline.simulate's caller
     lyap = None
     if model.n_lyapunov:
         span = lyap_t - (t[0] if len(t) else 0.0)
@@ -294,24 +303,10 @@ def run(model) -> Result:
     tooth = tooth[:, :, :nqw]
     per = {n: (tooth[:, :, i] if i < nqw else np.broadcast_to(consts[i - 4], tooth.shape[:2]))
            for i, (n, *_) in enumerate(q)}
+    out = {n: float(v) for n, v in zip(LOAD_QUANTITIES, loads)}
+    out.update({n: tload[:, i] for i, n in enumerate(TOOTH_LOAD_QUANTITIES)})
     return Result(case=model.case, t=t, y=y, tooth=per, Tm=tm, stats=st,
                   section_t=sec_t, section_y=sec_y, lyapunov=lyap,
                   face=face if model.n_slices else None, tilt=tilt if model.n_slices else None,
-                  loads=run_loads(model, t, y, tooth, tm),
+                  loads=out, extremes={n: float(v) for n, v in zip(EXTREMES, ext)},
                   spacing_error=model.info()["spacing_error"])
-
-
-def run_loads(model, t, y, tooth, tm) -> dict:
-    """The loads of a run from its outputs (the core's spline_loads::run_loads; the numbers
-    spline-dyn writes): {name: value} for the scalars of LOAD_QUANTITIES (float) and the
-    per-tooth arrays (Z,) of TOOTH_LOAD_QUANTITIES. tooth: (nt, Z, nq) as api_simulate gives it
-    (all of Result.tooth's quantities in their order, or F, Fx, Fy, dn alone for a level without
-    T_f), tm: T_m (nt,)."""
-    loads, tload, ierr, msg = _api.api_loads(model.bytes, len(LOAD_QUANTITIES),
-                                             len(TOOTH_LOAD_QUANTITIES), t, np.asarray(y).T,
-                                             tooth, tm)
-    raise_for(ierr, msg)
-    _warn(_api.api_warnings(model.bytes, loads, 2))      # nominal stresses beyond their limits
-    out = {n: float(v) for n, v in zip(LOAD_QUANTITIES, loads)}
-    out.update({n: tload[:, i] for i, n in enumerate(TOOTH_LOAD_QUANTITIES)})
-    return out

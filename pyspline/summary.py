@@ -27,9 +27,7 @@ def _template(options: dict, stat_names: Sequence[str]) -> dict:
     if options["lyapunov"]:
         s.update(lyapunov=nan, lyapunov_spread=nan, lyapunov_rel_spread=nan,
                  lyapunov_slope=nan, predictability_horizon=nan, chaotic=nan)
-    for q in ("Tm", "kv", "F"):
-        s.update({f"{q}_max": nan, f"{q}_min": nan, f"{q}_rms": nan})
-    s.update(Tf_max=nan, D2_max=nan, D2_min=nan, D2_rms=nan)
+    s.update({k: nan for k in SWEEP_EXTREMES})
     s.update({k: nan for k in SWEEP_LOADS})
     s.update({k: nan for k in stat_names})
     if options.get("orders") is not None:
@@ -37,6 +35,12 @@ def _template(options: dict, stat_names: Sequence[str]) -> dict:
     s.update(error="", error_class="")
     return s
 
+
+#: The extremes and RMS of a run a sweep keeps per point: the core's (Result.extremes, spline-dyn's
+#: summary lines run.*; spline_loads::run_extremes), so a sweep and merged summaries agree bit
+#: for bit.
+SWEEP_EXTREMES = ("Tm_max", "Tm_min", "Tm_rms", "kv_max", "kv_min", "kv_rms", "F_max", "F_min",
+                  "F_rms", "Tf_max", "D2_max", "D2_min", "D2_rms")
 
 #: The loads of a run a sweep keeps per point (Result.loads: the core's, docs/model.md
 #: section 15; Tf_max too), units from the core's table.
@@ -114,17 +118,12 @@ def summarise(res, options: dict) -> dict:
     if options["section"] != "none" and res.section_y is not None:
         sy = np.asarray(res.section_y, dtype=float).reshape(-1, 14)
         section_summary(s, case, res.section_t, sy[:, _I_D2], sy[:, 7 + _I_D2],
-                        (np.sqrt(np.mean(res.D2**2)), np.sqrt(np.mean(res.vD2**2))))
+                        (res.extremes["D2_rms"], res.extremes["vD2_rms"]))
     if options["lyapunov"] and res.lyapunov is not None:
         ly = res.lyapunov
         lyapunov_summary(s, ly["t"], ly["log_growth"], float(ly["exponent"]), float(res.t[0]))
-    for q, arr in (("Tm", res.Tm), ("kv", res.kv), ("F", res.tooth["F"])):
-        st = analysis.stats(arr, quantiles=False)
-        s.update({f"{q}_max": st["max"], f"{q}_min": st["min"], f"{q}_rms": st["rms"]})
-    s["Tf_max"] = float(np.max(res.tooth["Tf"]))
+    s.update({k: res.extremes[k] for k in SWEEP_EXTREMES})
     s.update({k: float(res.loads[k]) for k in SWEEP_LOADS})
-    s.update(D2_max=float(res.D2.max()), D2_min=float(res.D2.min()),
-             D2_rms=float(np.sqrt(np.mean(res.D2 ** 2))))
     for k in _stat_names():
         if k in res.stats:
             s[k] = float(res.stats[k])

@@ -65,7 +65,7 @@ def test_scenes_in_threads_equal_serial_runs():
 def test_cases_load_in_parallel_threads():
     """Two threads parsing and loading cases at once (api_load_text, like api_load_file, runs
     with the GIL released) get exactly the models a lone load gives, and no error. libgfortran's
-    reads from internal files are not thread-safe; without the core's lock (fortran/iolock.c)
+    reads from internal files are not thread-safe; without the core's lock (fortran/interface/iolock.c)
     6400 such loads gave 12 refusals and 4 silently different models. A model is compared by
     what it says (its sizes, derived quantities and right-hand side): the padding between the
     components of its bytes is not defined."""

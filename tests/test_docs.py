@@ -33,7 +33,7 @@ def test_every_named_path_exists(doc):
 
 def test_docs_name_the_routines_that_exist():
     """Every `module::routine` named in docs/model.md and README.md is defined in fortran/."""
-    source = "\n".join(p.read_text().lower() for p in (ROOT / "fortran").glob("*.f90"))
+    source = "\n".join(p.read_text().lower() for p in (ROOT / "fortran").rglob("*.f90"))
     for doc in (ROOT / "README.md", ROOT / "docs" / "model.md"):
         for mod, routine in re.findall(r"`(spline_\w+)::(\w+)`", doc.read_text()):
             assert f"module {mod}" in source, (doc.name, mod)

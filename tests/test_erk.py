@@ -1,4 +1,4 @@
-"""method = 'erk': ARKODE's ERKStep (Dormand-Prince 5(4), fortran/integrator.f90) against the independent oracle,
+"""method = 'erk': ARKODE's ERKStep (Dormand-Prince 5(4), fortran/integration/integrator.f90) against the independent oracle,
 against CVODE at tight tolerance on every shipped case, converging as rtol tightens, with the
 contact switches located, and the executable equal to Python."""
 

@@ -91,7 +91,7 @@ def test_template_lists_every_field_with_the_core_defaults():
 
 
 def _table_units():
-    """Field name -> unit, from the core's one field table (fortran/case_type.f90 `fields`,
+    """Field name -> unit, from the core's one field table (fortran/input/case_type.f90 `fields`,
     through api_names('fields'))."""
     from pyspline.core import _names
     return {name: unit for name, unit, _ in _names("fields")}
@@ -133,7 +133,7 @@ def _exe_error(exe, args, tmp_path):
 @pytest.mark.parametrize("name", BAD_FILES)
 def test_python_and_executable_say_the_same(name, exe, tmp_path):
     """A bad case file gets the same message, word for word, from pyspline and spline-dyn:
-    the file is parsed by one reader (fortran/case_parse.f90 case_parse) and validated by one check."""
+    the file is parsed by one reader (fortran/input/case_parse.f90 case_parse) and validated by one check."""
     path = str(CORPUS / name)
     with pytest.raises(pyspline.CaseError) as exc:
         pyspline.simulate(pyspline.load_case(path))
@@ -175,7 +175,7 @@ def _not_a_file(kind, tmp_path):
                                   "nul_inside", "not_a_dir"])
 def test_not_a_case_file_same_words(kind, exe, tmp_path):
     """Paths that are no case file: refused before any open (a FIFO would block), in the same
-    words by Python (os.stat) and the executable (stat(2) in fortran/fileinfo.c)."""
+    words by Python (os.stat) and the executable (stat(2) in fortran/interface/fileinfo.c)."""
     path = str(_not_a_file(kind, tmp_path))
     with pytest.raises(pyspline.CaseError) as exc:
         pyspline.load_case(path)
@@ -274,7 +274,7 @@ def test_memory_is_checked_before_allocating():
 
 def test_static_equilibrium_of_large_misaligned_splines():
     """Z = 200 .. 1000 with the computed k_m and a misalignment: the frozen-contact Newton
-    (fortran/dynamics.f90 static_equilibrium) converges where a plain difference Jacobian stalled."""
+    (fortran/physics/dynamics.f90 static_equilibrium) converges where a plain difference Jacobian stalled."""
     import numpy as np
     for z in (200, 400, 1000):
         y = pyspline.start_state(dict(z=z, l_x=1e-4, l_y=-3e-5, k_m=0.0, t_end=1e-3, n_out=3))
@@ -444,7 +444,7 @@ def test_values_a_value_array_cannot_carry_get_the_reader_s_message():
 
 
 def test_reader_puts_every_element_in_its_field(tmp_path):
-    """The reader puts each checked value at its own element's place (fortran/case_parse.f90,
+    """The reader puts each checked value at its own element's place (fortran/input/case_parse.f90,
     by case_value_offset and case_put_value of case_values.f90, computed from the field table):
     a file giving every element of every field a different value reads back, through the
     core's value arrays (walk, the list of case_t's components), as written. Not validated (stage 1: read only), so the values need not make a model."""

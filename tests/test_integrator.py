@@ -1,4 +1,4 @@
-"""The integrator layer (fortran/integrator.f90): SUNDIALS' own messages never reach stdout or
+"""The integrator layer (fortran/integration/integrator.f90): SUNDIALS' own messages never reach stdout or
 stderr (captured at the file-descriptor level, where C's fprintf writes), in any entry point;
 its warnings come back counted, once per run (a SplineWarning; spline-dyn: a 'warning:' line);
 map runs are bounded in steps and in wall time, and a run that meets a bound names it.

@@ -1,4 +1,4 @@
-"""The loads of a run (fortran/loads.f90, docs/model.md section 15): load sharing against the
+"""The loads of a run (fortran/physics/loads.f90, docs/model.md section 15): load sharing against the
 closed form of static full contact (aligned and with parallel misalignment), free and
 back-flank fractions and contact onsets against a count from Result.F and Result.dn, the closing
 speed against the oracle's d(dn)/dt, and the executable's numbers against Python's."""

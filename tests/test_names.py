@@ -1,5 +1,5 @@
-"""Names, units and descriptions live once, in the core's tables (fortran/quantities.f90: the
-output quantities and run statistics; fortran/case_type.f90: the case fields), read through
+"""Names, units and descriptions live once, in the core's tables (fortran/common/quantities.f90: the
+output quantities and run statistics; fortran/input/case_type.f90: the case fields), read through
 api_names. Every place that shows them says what the tables say: the README's result table,
 Result.to_xarray, the sweep dataset, spline-dyn's CSV header (cases/template.nml's units:
 tests/test_input.py)."""

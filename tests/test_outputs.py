@@ -1,4 +1,4 @@
-"""The per-tooth outputs of a run (fortran/run.f90 tooth_outputs): formed after the integration
+"""The per-tooth outputs of a run (fortran/interface/run.f90 tooth_outputs): formed after the integration
 from the stored states, they are the mesh (mesh_eval, Model.rhs_mesh) at those states to the bit,
 whichever way the core forms them (one pass per tooth at thermal none and bulk)."""
 import numpy as np

@@ -1,4 +1,4 @@
-"""Mesh stiffness by the potential energy method (Eq. 18; fortran/stiffness.f90)."""
+"""Mesh stiffness by the potential energy method (Eq. 18; fortran/physics/stiffness.f90)."""
 import numpy as np
 import pytest
 from scipy.integrate import quad

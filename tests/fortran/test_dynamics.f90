@@ -1,4 +1,4 @@
-!> Module spline_dynamics (fortran/dynamics.f90) against docs/model.md sections 1 and 5
+!> Module spline_dynamics (fortran/physics/dynamics.f90) against docs/model.md sections 1 and 5
 !> (Eqs. 23-25): the static equilibrium in closed form (full contact, gravity, parallel
 !> misalignment, unequal supports) and zero accelerations there, linearity of the right-hand
 !> side in full contact, free bodies inside the backlash, and the scaled system of Eq. 25

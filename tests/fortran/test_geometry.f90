@@ -1,4 +1,4 @@
-!> Module spline_geometry (fortran/geometry.f90) and the geometry model_from_case derives from it,
+!> Module spline_geometry (fortran/physics/geometry.f90) and the geometry model_from_case derives from it,
 !> against docs/model.md sections 2, 6 and 12: ISO 4156 radii, base radius, tooth angles
 !> (Eqs. 8-9), profile shift (Eq. 12) and contact radius (Eq. 13 on the active profile).
 program test_geometry

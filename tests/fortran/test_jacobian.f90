@@ -1,7 +1,8 @@
-!> The frozen-contact Jacobian of Eq. 25 in closed form (spline_variational::rhs_jacobian) against
+!> The frozen-contact Jacobian of Eq. 25 in closed form (spline_dynamics::rhs_jacobian, on
+!> accel_jacobian: the variational run's, the linear tail's and the static equilibrium's) against
 !> unit steps of the right-hand side (spline_dynamics::rhs_scaled) with the same contact states
-!> frozen, as spline_linear's tail and spline_dynamics' static equilibrium form it (the right-hand
-!> side is affine in the state there, so a unit step is exact to round-off): face slices with an
+!> frozen (the right-hand side is affine in the state there, so a unit step is exact to
+!> round-off): face slices with an
 !> angular misalignment, spacing errors, mesh damping, and partial contact (teeth on the drive
 !> flank, on the back flank and free, teeth with only part of their face in contact), at a time
 !> off the teeth's symmetry.
@@ -10,8 +11,7 @@ program test_jacobian
   use spline_case, only: case_t
   use spline_model, only: model_t, nstate, ndof
   use spline_mesh, only: mesh_switch_functions, eq16_mode
-  use spline_dynamics, only: rhs_scaled, to_scaled
-  use spline_variational, only: rhs_jacobian
+  use spline_dynamics, only: rhs_scaled, to_scaled, rhs_jacobian
   use check, only: check_true, check_done, default_case_model
   implicit none
   type(case_t) :: cs

@@ -1,4 +1,4 @@
-!> Module spline_linear (fortran/linear.f90): the closed-form tail at many output times at once
+!> Module spline_linear (fortran/integration/linear.f90): the closed-form tail at many output times at once
 !> (tail_states) against the tail at each time (tail_state): the same bits at every anchor and
 !> wherever the times are not uniformly spaced; between anchors (the step matrix advancing the
 !> motion about the equilibrium) within 1e-12 of the motion's largest excursion per state kind,

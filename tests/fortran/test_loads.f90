@@ -1,4 +1,4 @@
-!> Module spline_loads (fortran/loads.f90) against docs/model.md section 15 on outputs made by
+!> Module spline_loads (fortran/physics/loads.f90) against docs/model.md section 15 on outputs made by
 !> hand, whose loads are known: a tooth always on its drive flank, one never loaded, one that
 !> cycles free -> back flank -> drive flank (two onsets every three outputs), a flash
 !> temperature at one tooth and time, a closing speed set by dD2/dt, and a T_m whose RMS per

@@ -1,4 +1,4 @@
-!> Module spline_loads (fortran/loads.f90) against a straightforward count on random outputs
+!> Module spline_loads (fortran/physics/loads.f90) against a straightforward count on random outputs
 !> (docs/model.md section 15): one output and one tooth at a time, a branch for each rule (free
 !> where F_j = 0, else on the flank of the sign of dn_j; an onset where in contact on another
 !> flank than at the output before; output k in revolution floor(omega (t_k - t_1) / 2 pi) + 1).

@@ -1,4 +1,4 @@
-!> Module spline_mesh (fortran/mesh.f90) against docs/model.md sections 2-4 (Eqs. 11, 15-17, 19-22):
+!> Module spline_mesh (fortran/physics/mesh.f90) against docs/model.md sections 2-4 (Eqs. 11, 15-17, 19-22):
 !> closed forms in full contact (uniform clearance: T_m = r_b Z k_m delta; lateral offset: the
 !> isotropic restoring force Z k_m e / 2), zero forces inside the backlash, a tooth-by-tooth
 !> recomputation in partial contact, the forces as the gradient of the mesh potential, and the

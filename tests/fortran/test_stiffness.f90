@@ -1,4 +1,4 @@
-!> Module spline_stiffness (fortran/stiffness.f90) against docs/model.md sections 7 and 11 (Eq. 18):
+!> Module spline_stiffness (fortran/physics/stiffness.f90) against docs/model.md sections 7 and 11 (Eq. 18):
 !> the Hertz closed form, a uniform cantilever in closed form (Timoshenko: bending, shear, axial),
 !> the scaling of every term with face width b, Young's modulus E and Poisson's ratio nu,
 !> convergence in the Gauss points, the series combination of Eq. 18 (with and without the

@@ -14,14 +14,14 @@
 !> With all Re(lambda_k) < 0 each modal term only shrinks, so for all tau >= tau_0
 !>   |D2(tau) - D2*| <= sum_k |v_6k| |c_k|,  |e(tau) - e*| <= sum_k |(v_1k - v_3k, v_2k - v_4k)| |c_k|,
 !> and the condition holds for ever if s D2* - c - |e*| exceeds these bounds (with a margin for
-!> the round-off of the eigenvectors). A is built from the right-hand side itself (rhs_scaled
-!> with the contact states frozen on flank s), one column per unit step: exact for an affine map;
-!> the map is checked to be affine and time-invariant at a second state and time before use.
+!> the round-off of the eigenvectors). A is the core's frozen-contact Jacobian (spline_dynamics::
+!> rhs_jacobian, every contact frozen on flank s); the right-hand side (rhs_scaled) is checked to
+!> be that affine, time-invariant map at a second state and time before use.
 module spline_linear
   use spline_kinds, only: wp
   use spline_errors, only: err_ok
   use spline_model, only: model_t, nstate, ndof, thermal_coupled
-  use spline_dynamics, only: rhs_scaled, from_scaled
+  use spline_dynamics, only: rhs_scaled, rhs_jacobian, from_scaled
   use spline_mesh, only: mesh_switch_functions
   implicit none
   private
@@ -110,14 +110,15 @@ contains
     end if
   end function tail_try
 
-  !> The system of flank s: A by unit steps of rhs_scaled with every contact frozen on s, checked
-  !> affine and time-invariant; y*; the eigenpairs of A and V^-1.
+  !> The system of flank s: A = rhs_jacobian with every contact frozen on s, checked against
+  !> rhs_scaled (affine and time-invariant); y*; the eigenpairs of A and V^-1.
   subroutine build(tl, m, idx, n, tau, ys, s)
     type(tail_t), intent(inout) :: tl
     type(model_t), intent(in) :: m
     integer, intent(in) :: idx(nstate), n, s
     real(wp), intent(in) :: tau, ys(nstate)
-    real(wp) :: a(n, n), f0(nstate), f1(nstate), y1(nstate), d(n), scale, rwork(2*n), cs
+    real(wp) :: a(n, n), jac(nstate, nstate), f0(nstate), f1(nstate), y1(nstate), d(n), scale, &
+         rwork(2*n), cs
     complex(wp) :: ac(n, n), vl(1, 1), work(4*n), vr(n, n), winv(n, n), lam(n), am(n, n), &
          vf(nstate, n)
     integer :: mode(m%z), k, ierr, info, ipiv(n)
@@ -130,13 +131,8 @@ contains
     msg = ''
     call rhs_scaled(m, tau, ys, f0, ierr, msg, mode=mode)
     if (ierr /= err_ok) return
-    do k = 1, n
-      y1 = ys
-      y1(idx(k)) = y1(idx(k)) + 1.0_wp
-      call rhs_scaled(m, tau, y1, f1, ierr, msg, mode=mode)
-      if (ierr /= err_ok) return
-      a(:, k) = f1(idx(1:n)) - f0(idx(1:n))
-    end do
+    call rhs_jacobian(m, tau, mode, jac)
+    a = jac(idx(1:n), idx(1:n))
     ! affine and time-invariant: a second state at a second time
     y1 = ys
     do k = 1, n

@@ -9,7 +9,7 @@ module spline_quantities
   implicit none
   private
   public :: quantity_t, nout_q, output_q, state_q, tooth_q, ntooth_q, iq_tf
-  public :: nsolver_stats, nstats, stat_q, nload_tooth, load_tooth_q, nload, load_q
+  public :: nsolver_stats, nstats, stat_q, nload_tooth, load_tooth_q, nload, load_q, nextreme, extreme_q
 
   type :: quantity_t
     character(len=24) :: name
@@ -186,5 +186,23 @@ module spline_quantities
             &means (NaN: < 2 batches)'), &
        quantity_t('stress_ratio', '-', 'largest of sigma_root, sigma_flank, tau_pitch over its &
             &limit (1: at the typical allowable warned beyond)')]
+
+  !> The extremes and RMS of a run's outputs (spline_loads::run_extremes): max, min and RMS
+  !> (sqrt(mean(x**2))) of T_m, k_v, the tooth loads F_j and flash temperatures T_f over all
+  !> teeth, D_2 and dD_2/dt; what a sweep point keeps and spline-dyn's summary writes (run.*).
+  integer, parameter :: nextreme = 18
+  type(quantity_t), parameter :: extreme_q(nextreme) = [ &
+       quantity_t('Tm_max', 'N m', 'largest T_m'), quantity_t('Tm_min', 'N m', 'smallest T_m'), &
+       quantity_t('Tm_rms', 'N m', 'RMS of T_m'), quantity_t('kv_max', '-', 'largest k_v'), &
+       quantity_t('kv_min', '-', 'smallest k_v'), quantity_t('kv_rms', '-', 'RMS of k_v'), &
+       quantity_t('F_max', 'N', 'largest tooth load F_j over all teeth'), &
+       quantity_t('F_min', 'N', 'smallest tooth load F_j over all teeth'), &
+       quantity_t('F_rms', 'N', 'RMS of the tooth loads F_j over all teeth'), &
+       quantity_t('Tf_max', 'degC', 'largest flash temperature T_f over all teeth'), &
+       quantity_t('Tf_min', 'degC', 'smallest flash temperature T_f over all teeth'), &
+       quantity_t('Tf_rms', 'degC', 'RMS of the flash temperatures T_f over all teeth'), &
+       quantity_t('D2_max', 'm', 'largest D_2'), quantity_t('D2_min', 'm', 'smallest D_2'), &
+       quantity_t('D2_rms', 'm', 'RMS of D_2'), quantity_t('vD2_max', 'm/s', 'largest dD_2/dt'), &
+       quantity_t('vD2_min', 'm/s', 'smallest dD_2/dt'), quantity_t('vD2_rms', 'm/s', 'RMS of dD_2/dt')]
 
 end module spline_quantities

@@ -1,4 +1,4 @@
-/* One process-wide lock around the core's I/O on internal files (fortran/case_parse.f90: taken by
+/* One process-wide lock around the core's I/O on internal files (fortran/input/case_parse.f90: taken by
  * case_parse, for its list-directed internal reads of reals, subscripts and repeat counts, and by
  * case_write_text, for its namelist write; no routine that holds it takes it again).
  *

@@ -13,17 +13,18 @@ module spline_run
   use spline_quantities, only: nsolver_stats, nstats, ntooth_q, iq_tf, tooth_q, state_q, &
        ist_core_wall, ist_dof, ist_thermal_level, ist_eps_lateral, ist_eps_thermal, ist_closed, &
        ist_closed_t, ist_roots_found, ist_f_error, ist_f_error_t, ist_f_parted_t, ist_rtol_used, &
-       ist_outputs_fallback, ist_linear_tail_t
+       ist_outputs_fallback, ist_linear_tail_t, nload, nload_tooth, nextreme
   use spline_accuracy, only: force_error, check_factor, max_tighten
   use spline_case_text, only: num
   use spline_fidelity, only: auto_level, auto_tol, backlash_estimate
   use spline_sections, only: section_count, section_times
   use spline_lyapunov, only: lyapunov_benettin, lyapunov_tangent
   use spline_integrator, only: lib_log_t, integrator_warnings
+  use spline_loads, only: run_loads, run_extremes, stress_warnings
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
-  public :: run_case, output_times, tooth_outputs, tooth_quantities, run_warnings
+  public :: run_case, run_results, output_times, tooth_outputs, tooth_quantities, run_warnings
 
   !> rtol above which CVODE's located contact switches are warned (run_warnings)
   real(wp), parameter :: restart_rtol = 1.0e-3_wp
@@ -135,6 +136,28 @@ contains
     end if
     end subroutine run_once
   end subroutine run_case
+
+  !> What follows from a finished run's outputs (t, y, tooth, tm, stats as run_case gives them;
+  !> tooth(:, :, 1:nq): every quantity of tooth_q, or F, F_x, F_y, dn alone with the constants
+  !> consts = (c_j, T_f, r_c1, r_c2), run_case's nq and consts): the loads (spline_loads::
+  !> run_loads: loads, tload(z, nload_tooth)), the extremes and RMS (run_extremes: ext) and the
+  !> run's warnings, one per line ('' if none: run_warnings, then stress_warnings). The
+  !> executable and Python (api_simulate, in the same call as the run) alike.
+  subroutine run_results(m, t, y, tooth, tm, stats, consts, loads, tload, ext, warnings)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t(:), y(:, :), tm(:), stats(nstats), consts(ntooth_q - 4)
+    real(wp), intent(in), contiguous :: tooth(:, :, :)
+    real(wp), intent(out) :: loads(nload), tload(m%z, nload_tooth), ext(nextreme)
+    character(len=:), allocatable, intent(out) :: warnings
+    call run_loads(m, t, y, tooth, tm, loads, tload)
+    if (size(tooth, 3) >= iq_tf) then
+      call run_extremes(m, y, tm, tooth(:, :, 1), tooth(:, :, iq_tf), ext)
+    else                               ! T_f a constant of the level: as its every output
+      call run_extremes(m, y, tm, tooth(:, :, 1), &
+           spread(spread(consts(iq_tf - 4), 1, size(t)), 2, m%z), ext)
+    end if
+    warnings = run_warnings(m, stats)//stress_warnings(m, loads)
+  end subroutine run_results
 
   !> The error estimate of a run of m with tooth forces f at the outputs t (docs/accuracy.md):
   !> m at rtol and atol / check_factor over the outputs up to the first after the run's linear
@@ -280,7 +303,7 @@ contains
   !> Warnings about a finished run, one per line ('' if none), from its statistics: the
   !> one-way flash temperature that would have closed the backlash (result_checks); contact
   !> switches located for CVODE at an rtol above restart_rtol (restart_warning). The
-  !> executable prints them to stderr, Python raises pyspline.SplineWarning (api_warnings).
+  !> executable prints them to stderr, Python raises pyspline.SplineWarning (run_results).
   function run_warnings(m, stats) result(text)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: stats(nstats)

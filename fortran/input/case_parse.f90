@@ -21,7 +21,7 @@ module spline_case_parse
   private
   public :: case_parse, case_write_text
 
-  interface   ! fortran/iolock.c: one lock around the parser's reads from internal files
+  interface   ! fortran/interface/iolock.c: one lock around the parser's reads from internal files
     subroutine io_lock() bind(C, name='spline_io_lock')
     end subroutine io_lock
     subroutine io_unlock() bind(C, name='spline_io_unlock')

@@ -1,4 +1,4 @@
-!> The interface of fortran/interrupt.c: a SIGINT during a run (the GIL is released while the
+!> The interface of fortran/integration/interrupt.c: a SIGINT during a run (the GIL is released while the
 !> core runs) is counted, and a run compares the count with the one it started with.
 module spline_sigint
   use, intrinsic :: iso_c_binding, only: c_int

@@ -8,11 +8,11 @@
 module spline_loads
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use spline_kinds, only: wp, pi, max_teeth
-  use spline_model, only: model_t, nstate
+  use spline_model, only: model_t, nstate, static_tooth_load
   use spline_geometry, only: tooth_angles, root_section, active_profile
   use spline_mesh, only: tooth_approach
   use spline_errors, only: itoa, ftoa
-  use spline_quantities, only: iq_tf, nload, nload_tooth, il_f_static, &
+  use spline_quantities, only: iq_tf, nload, nload_tooth, nextreme, il_f_static, &
        il_load_sharing, il_load_sharing_tooth, il_free_max, il_back_max, il_free_mean, &
        il_unloaded, il_back_teeth, il_impacts_rev, il_closing_speed, il_tf_max, il_tf_max_tooth, &
        il_tf_max_t, il_revolutions, il_batches, il_tm_rms_se, il_sharing_rev, &
@@ -22,7 +22,7 @@ module spline_loads
        ilt_back, ilt_onsets, ilt_free_se, ilt_back_se
   implicit none
   private
-  public :: run_loads, drive_flank, approach_speed, tooth_stresses, stress_warnings
+  public :: run_loads, run_extremes, drive_flank, approach_speed, tooth_stresses, stress_warnings
 
   !> Limits of stress_warnings [Pa] (docs/model.md section 15, "Tooth stresses"): typical
   !> allowables of case-hardened steel splines (58-63 HRC) at full load, 10^4 torque cycles,
@@ -123,7 +123,7 @@ contains
     loads = 0.0_wp; tload = 0.0_wp
     if (nt == 0) return
     back = -drive_flank(m)
-    fs = abs(m%t_d)/(m%z*m%r_b)
+    fs = static_tooth_load(m)
     speed = 0.0_wp
     loads(il_revolutions) = m%omega*(t(nt) - t(1))/(2.0_wp*pi)
     nb = int(loads(il_revolutions))
@@ -241,6 +241,30 @@ contains
       loads(il_tf_max_t) = t(k)
     end if
   end subroutine run_loads
+
+
+  !> The extremes and RMS of a run's outputs x(nextreme), spline_quantities' extreme_q: max, min
+  !> and RMS (sqrt(sum(x**2)/n), a sequential sum) of T_m (tm), k_v = |T_m|/T_d, the tooth loads
+  !> f(nt, Z) and flash temperatures tf(nt, Z) over all teeth, D_2 and dD_2/dt (y: SI states,
+  !> a column per output). The one computation of them: spline-dyn's summary and Python's
+  !> (Result.extremes, the sweep point's summary).
+  pure subroutine run_extremes(m, y, tm, f, tf, x)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: y(:, :), tm(:), f(:, :), tf(:, :)
+    real(wp), intent(out) :: x(nextreme)
+    x(1:3) = three(tm)
+    x(4:6) = three(abs(tm)/m%t_d)
+    x(7:9) = three(reshape(f, [size(f)]))
+    x(10:12) = three(reshape(tf, [size(tf)]))
+    x(13:15) = three(y(6, :))
+    x(16:18) = three(y(13, :))
+  contains
+    pure function three(v) result(r)
+      real(wp), intent(in) :: v(:)
+      real(wp) :: r(3)
+      r = [maxval(v), minval(v), sqrt(sum(v**2)/size(v))]
+    end function three
+  end subroutine run_extremes
 
   !> Nominal stresses of a tooth carrying the load f along its line of action (docs/model.md
   !> section 15, "Tooth stresses"), from its tangential part at the pitch circle

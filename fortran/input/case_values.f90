@@ -1,8 +1,8 @@
 !> A case's fields as two flat arrays, laid out by the field table (case_field, the order of
 !> case_t): every number and logical (an integer as its value, a logical as 1 or 0) in one
 !> real array, every character field (blank-padded to its size) in one string. This is how a
-!> case crosses to Python and back (fortran/api.f90), with no text to tokenise or re-read, and
-!> how the reader (fortran/case_parse.f90) assigns each checked value (case_put_value).
+!> case crosses to Python and back (fortran/interface/api.f90), with no text to tokenise or re-read, and
+!> how the reader (fortran/input/case_parse.f90) assigns each checked value (case_put_value).
 module spline_case_values
   use spline_kinds, only: wp
   use spline_errors, only: err_ok, err_case
@@ -136,7 +136,7 @@ contains
     end subroutine field
     subroutine mismatch()
       ierr = err_case
-      errmsg = 'case values: fortran/case_values.f90 is out of step with the field table'
+      errmsg = 'case values: fortran/input/case_values.f90 is out of step with the field table'
     end subroutine mismatch
     subroutine r(x)
       real(wp), intent(inout) :: x

@@ -1,4 +1,4 @@
-!> The thin interface that f2py wraps (signatures and GIL release: fortran/_core.pyf).
+!> The thin interface that f2py wraps (signatures and GIL release: fortran/interface/_core.pyf).
 !>
 !> A case crosses in one call (api_load_file for a file, api_load_fields for fields Python
 !> holds): checked, parsed, validated and built, it comes back as its fields (two flat arrays
@@ -22,10 +22,9 @@ module spline_api
        kterm_names, model_warnings
   use spline_stiffness, only: external_tooth_stiffness, internal_tooth_stiffness
   use spline_dynamics, only: accelerations, start_state
-  use spline_run, only: run_case, tooth_quantities, output_times, run_warnings
+  use spline_run, only: run_case, run_results, tooth_quantities, output_times
   use spline_quantities, only: quantity_t, nstats, stat_q, ntooth_q, tooth_q, state_q, nout_q, &
-       output_q, nload, load_q, nload_tooth, load_tooth_q
-  use spline_loads, only: run_loads, stress_warnings
+       output_q, nload, load_q, nload_tooth, load_tooth_q, nextreme, extreme_q
   use spline_sections, only: section_count
   use spline_lyapunov, only: lyapunov_count, lyapunov_benettin, lyapunov_tangent
   use spline_orbits, only: period_map, map_and_monodromy
@@ -33,9 +32,9 @@ module spline_api
   private
   public :: api_load_file, api_load_fields, api_load_text, api_read_text, api_model_size
   public :: api_simulate
-  public :: api_rhs, api_rhs_mesh, api_start_state, api_loads
+  public :: api_rhs, api_rhs_mesh, api_start_state
   public :: api_output_times, api_model_info, api_defaults, api_names, api_tooth_stiffness
-  public :: api_field_hint, api_warnings, api_period_map, api_map_monodromy, api_lyapunov
+  public :: api_field_hint, api_period_map, api_map_monodromy, api_lyapunov
 
   integer, parameter :: ninfo = 12   !< entries of api_model_info
   integer, parameter :: nsizes = 5   !< entries of a load's sizes (load_model)
@@ -180,29 +179,6 @@ contains
     hint = case_suggest(word)
   end subroutine api_field_hint
 
-  !> Warnings about a loaded model (stage 0: model_warnings) or about a run of it (stage 1:
-  !> run_warnings, from the run's statistics in stats; stage 2: stress_warnings, from the run's
-  !> loads in stats, as api_loads returns them), one per line; blank if none.
-  subroutine api_warnings(model, nb, stats, ns, stage, text)
-    integer(c_int), intent(in) :: nb, ns, stage
-    integer(c_int), intent(in) :: model(nb)
-    real(c_double), intent(in) :: stats(ns)
-    character(len=4096), intent(out) :: text
-    type(model_t) :: m
-    character(len=msglen) :: errmsg
-    integer :: ie
-    text = ''
-    call unpack(model, m, ie, errmsg)
-    if (ie /= err_ok) return
-    if (stage == 0) then
-      text = model_warnings(m)
-    else if (stage == 1 .and. ns == nstats) then
-      text = run_warnings(m, stats)
-    else if (stage == 2 .and. ns == nload) then
-      text = stress_warnings(m, stats)
-    end if
-  end subroutine api_warnings
-
   !> 4-byte words in a loaded model (the size of the array the api_load_* calls fill).
   integer(c_int) function api_model_size() result(nb)
     type(model_t) :: m
@@ -232,26 +208,34 @@ contains
   !> nft = nt, else both 0) the load of every slice face(nt, z, nslice) and the tilting moment
   !> tilt(nt, 2) (M_x, M_y) on spline 1 [N m]. nqw: the quantities written into tooth, 4 for a
   !> level without flash temperature or slices (F, F_x, F_y, dn; its c_j, T_f, r_c1, r_c2 are
-  !> the constants consts, run_case's nq), else nq (consts 0).
+  !> the constants consts, run_case's nq), else nq (consts 0). In the same call, what follows from
+  !> the outputs (spline_run::run_results): the loads (order of api_names('loads')), tload(z, :)
+  !> (api_names('tooth_loads')), the extremes and RMS ext (api_names('extremes')) and the run's
+  !> warnings, one per line (blank if none; the integrator's are errmsg's on success).
   !> A SIGINT during the run stops it (ierr 4). Called without the GIL.
-  subroutine api_simulate(model, nb, z, nt, nq, ns, nsec, nlyap, nft, nslice, t, y, tooth, tm, &
-       stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, nqw, consts, ierr, errmsg)
-    integer(c_int), intent(in) :: nb, z, nt, nq, ns, nsec, nlyap, nft, nslice
+  subroutine api_simulate(model, nb, z, nt, nq, ns, nsec, nlyap, nft, nslice, nl, ntl, nx, t, y, &
+       tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, nqw, consts, loads, tload, ext, &
+       warnings, ierr, errmsg)
+    integer(c_int), intent(in) :: nb, z, nt, nq, ns, nsec, nlyap, nft, nslice, nl, ntl, nx
     integer(c_int), intent(in) :: model(nb)
     real(c_double), intent(out) :: t(nt), y(14, nt), tooth(nt, z, nq), tm(nt), stats(ns)
     real(c_double), intent(out) :: sec_t(nsec), sec_y(nsec, 14), lyap_t(nlyap), lyap_g(nlyap)
     real(c_double), intent(out) :: face(nft, z, nslice), tilt(nft, 2), consts(4)
+    real(c_double), intent(out) :: loads(nl), tload(z, ntl), ext(nx)
+    character(len=8192), intent(out) :: warnings
     integer(c_int), intent(out) :: nqw, ierr
     character(len=msglen), intent(out) :: errmsg
     type(model_t) :: m
     real(wp), allocatable :: scol(:, :)
+    character(len=:), allocatable :: text
     integer :: ie, nw
     stats = 0; sec_t = 0; sec_y = 0; lyap_t = 0; lyap_g = 0   ! t, y, tooth, tm: below
-    face = 0; tilt = 0; nqw = nq; consts = 0
+    face = 0; tilt = 0; nqw = nq; consts = 0; loads = 0; tload = 0; ext = 0; warnings = ''
     call unpack(model, m, ie, errmsg)
     if (ie == err_ok .and. (m%z /= z .or. m%n_out /= nt .or. nq /= ntooth_q .or. ns /= nstats &
          .or. nsec /= section_count(m) .or. nlyap /= lyapunov_count(m) .or. &
-         nslice /= merge(m%n_slices, 0, m%n_slices > 1) .or. nft /= merge(nt, 0, nslice > 0))) then
+         nslice /= merge(m%n_slices, 0, m%n_slices > 1) .or. nft /= merge(nt, 0, nslice > 0) &
+         .or. nl /= nload .or. ntl /= nload_tooth .or. nx /= nextreme)) then
       ie = err_case
       errmsg = 'api_simulate: array sizes do not match the loaded case'
     end if
@@ -267,34 +251,15 @@ contains
       end if
       nqw = nw
       sec_y = transpose(scol)
+      if (ie == err_ok) then
+        call run_results(m, t, y, tooth(:, :, 1:nw), tm, stats, consts, loads, tload, ext, text)
+        warnings = text
+      end if
     else
       t = 0; y = 0; tooth = 0; tm = 0       ! run_case defines them whenever it runs
     end if
     ierr = ie
   end subroutine api_simulate
-
-  !> The loads of a run of a loaded model from its outputs (t, y, tooth, tm as api_simulate
-  !> returns them): loads in the order of api_names('loads'), tload(z, :) in the order of
-  !> api_names('tooth_loads') (spline_loads::run_loads, the numbers spline-dyn writes).
-  subroutine api_loads(model, nb, z, nt, nq, nl, ntl, t, y, tooth, tm, loads, tload, ierr, &
-       errmsg)
-    integer(c_int), intent(in) :: nb, z, nt, nq, nl, ntl
-    integer(c_int), intent(in) :: model(nb)
-    real(c_double), intent(in) :: t(nt), y(14, nt), tooth(nt, z, nq), tm(nt)
-    real(c_double), intent(out) :: loads(nl), tload(z, ntl)
-    integer(c_int), intent(out) :: ierr
-    character(len=msglen), intent(out) :: errmsg
-    type(model_t) :: m
-    integer :: ie
-    loads = 0; tload = 0
-    call unpack(model, m, ie, errmsg)
-    if (ie == err_ok .and. (m%z /= z .or. (nq /= ntooth_q .and. nq /= 4) .or. nl /= nload .or. &
-         ntl /= nload_tooth)) then
-      ie = err_case; errmsg = 'api_loads: array sizes do not match the loaded case'
-    end if
-    if (ie == err_ok) call run_loads(m, t, y, tooth, tm, loads, tload)
-    ierr = ie
-  end subroutine api_loads
 
   !> SI right-hand side dy/dt at (t, y) of a loaded model, contact states from the state:
   !> the project's Fortran RHS for solvers driven from Python (the benchmarks' peers).
@@ -496,7 +461,8 @@ contains
   !> of the executable's CSV columns: t, the states, Tm, kv, the per-tooth quantities),
   !> 'states' (a state vector's), 'tooth' (the per-tooth quantities, order of api_simulate's
   !> tooth), 'stats' (a run's statistics), 'loads' and 'tooth_loads' (the loads of a run, its
-  !> scalars and per tooth: api_loads): the table of spline_quantities; 'fields' (the case
+  !> scalars and per tooth), 'extremes' (a run's extremes and RMS; all of them api_simulate's
+  !> outputs): the table of spline_quantities; 'fields' (the case
   !> fields, case_type.f90's table); 'layout' (the case fields, unit: type i, r, l or c and
   !> the size, e.g. 'r7', 'c16': how api_load_fields lays them out); 'info'
   !> (api_model_info), 'kterms' (Eq. 18 terms), 'errors' (error codes 0..nerr, i = code + 1).
@@ -526,6 +492,8 @@ contains
       if (i >= 1 .and. i <= nload) call row(load_q(i))
     case ('tooth_loads')
       if (i >= 1 .and. i <= nload_tooth) call row(load_tooth_q(i))
+    case ('extremes')
+      if (i >= 1 .and. i <= nextreme) call row(extreme_q(i))
     case ('fields')
       call case_field_meta(i, name, ftype, n, unit, descr)
     case ('layout')

@@ -4,7 +4,7 @@
 !> applied to Phi at every located contact switch h = dn_k -+ c = 0 (the mesh damping acts only
 !> in contact, so the vector field jumps there). Between switches the contact state of every
 !> tooth (slice) is frozen and the right-hand side is affine in the state, so J depends on time
-!> and the contact states only: it is written here in closed form (rhs_jacobian) from Eqs.
+!> and the contact states only: spline_dynamics' closed form (rhs_jacobian) from Eqs.
 !> 11, 15-17 and 19-24. Everything is in the scaled states and time of Eq. 25. The thermal level
 !> coupled (the tooth force depends on itself through the flash temperature) is not covered.
 !> The run is CVODE's (the case's method and solver) made and driven through the integrator
@@ -23,7 +23,7 @@ module spline_variational
   use spline_errors, only: err_ok, err_case, err_solver, err_interrupted, msglen
   use spline_model, only: model_t, nstate, ndof, thermal_coupled
   use spline_geometry, only: tooth_angles
-  use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, integrated_states
+  use spline_dynamics, only: rhs_scaled, rhs_jacobian, to_scaled, from_scaled, integrated_states
   use spline_mesh, only: mesh_switch_functions, eq11_gradient, eq16_mode, eq16_root_mode, &
        slice_offset
   use spline_integrator, only: integrator_t, lib_log_t, integrator_open, cvode_create, &
@@ -31,7 +31,7 @@ module spline_variational
        integrator_warnings, integrator_free
   implicit none
   private
-  public :: rhs_jacobian, tangent_flow, variational_check
+  public :: tangent_flow, variational_check
 
   !> One tangent run: owned by tangent_flow, given to CVODE as user data.
   type :: tan_ctx_t
@@ -65,58 +65,6 @@ contains
            'separated copy (lyapunov_method = ''copy'')'
     end if
   end subroutine variational_check
-
-  !> J = d(ys')/d(ys), the Jacobian of Eq. 25 (rhs_scaled) at scaled time tau with the contact
-  !> states frozen at modes (exact: the right-hand side is affine in the state there). A tooth
-  !> (slice) in contact carries F = k_m (dn -+ c) + c_m d(dn)/dt (Eqs. 15-17; / n_s per slice)
-  !> with dn = e_x sin(phi) - e_y cos(phi) + D2 + e_j (Eq. 11), so
-  !>   dF/dq = k_m u + c_m omega w,  dF/dv = c_m u,
-  !>   u = (sin, -cos, -sin, cos, 0, 1, 0), w = (cos, sin, -cos, -sin, 0, 0, 0);
-  !> F_x1 = -sum F sin, F_y1 = sum F cos, T_m = r_b sum F (Eqs. 19-22), and the accelerations
-  !> of Eqs. 23-24 (spline_dynamics::accelerations) are linear in them and in q, v.
-  pure subroutine rhs_jacobian(m, tau, modes, jac)
-    type(model_t), intent(in) :: m
-    real(wp), intent(in) :: tau
-    integer, intent(in) :: modes(:)
-    real(wp), intent(out) :: jac(nstate, nstate)
-    real(wp) :: sp(max_teeth), cp(max_teeth), u(ndof), w(ndof), gf(nstate), gx(nstate), gy(nstate)
-    real(wp) :: gt(nstate), a(ndof, nstate), ds1(nstate), ds3(nstate), dth1(nstate), wt, d(nstate)
-    integer :: j, i, ns
-    call tooth_angles(m%z, m%omega, tau/m%w_ref, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
-    ns = m%n_slices
-    gx = 0.0_wp; gy = 0.0_wp; gt = 0.0_wp
-    do j = 1, m%z
-      wt = real(count(modes((j - 1)*ns + 1:j*ns) /= 0), wp)/ns   ! share of the face in contact
-      if (wt == 0.0_wp) cycle
-      call eq11_gradient(sp(j), cp(j), u, w)
-      gf(1:ndof) = wt*(m%k_m*u + m%c_m*m%omega*w)
-      gf(ndof+1:) = wt*m%c_m*u
-      gx = gx - gf*sp(j)
-      gy = gy + gf*cp(j)
-      gt = gt + m%r_b*gf
-    end do
-    a = 0.0_wp
-    a(1, :) = gx/m%m_1; a(1, 1) = a(1, 1) - m%k_p1/m%m_1; a(1, 8) = a(1, 8) - m%c_p1/m%m_1
-    a(2, :) = gy/m%m_1; a(2, 2) = a(2, 2) - m%k_p1/m%m_1; a(2, 9) = a(2, 9) - m%c_p1/m%m_1
-    a(3, :) = -gx/m%m_2; a(3, 3) = a(3, 3) - m%k_p2/m%m_2; a(3, 10) = a(3, 10) - m%c_p2/m%m_2
-    a(4, :) = -gy/m%m_2; a(4, 4) = a(4, 4) - m%k_p2/m%m_2; a(4, 11) = a(4, 11) - m%c_p2/m%m_2
-    ds1 = 0.0_wp; ds1(5) = m%k_t1/m%r_b; ds1(12) = m%c_t1/m%r_b
-    ds3 = 0.0_wp; ds3(7) = m%k_t2/m%r_b; ds3(14) = m%c_t2/m%r_b
-    dth1 = (gt - ds1)/m%j_1
-    a(5, :) = m%r_b*(dth1 - ds1/m%j_m)
-    a(6, :) = m%r_b*((-gt - ds3)/m%j_2 - dth1)
-    a(7, :) = m%r_b*((-gt - ds3)/m%j_2 - ds3/m%j_l)
-    ! SI -> scaled (Eq. 25): J_s(i, k) = J(i, k) d_k / (w_ref d_i), d = (l, l w_ref)
-    d(1:ndof) = m%l_ref
-    d(ndof+1:) = m%l_ref*m%w_ref
-    jac = 0.0_wp
-    do i = 1, ndof
-      jac(i, ndof + i) = 1.0_wp            ! dq/dt = v: d_k / (w d_i) = 1
-    end do
-    do i = 1, ndof
-      jac(ndof + i, :) = a(i, :)*d/(m%w_ref*d(ndof + i))
-    end do
-  end subroutine rhs_jacobian
 
   !> Integrate the state from y0 (SI, at m%t0) to t1 and the ntan tangent vectors phi(:, k)
   !> (scaled integrated states, ctx order: integrated_states) beside it: the variational

@@ -17,7 +17,7 @@ module spline_model
   private
   public :: model_t, model_from_case, set_thermal_level, model_magic, model_warnings
   public :: nstate, ndof, thermal_none, thermal_bulk, thermal_oneway, thermal_coupled
-  public :: nkterms, kterm_names, ik_m, lyapunov_separation
+  public :: nkterms, kterm_names, ik_m, lyapunov_separation, static_tooth_load
 
   integer, parameter :: ndof = 7            !< x1, y1, x2, y2, D1, D2, D3 (Eq. 24)
   integer, parameter :: nstate = 2*ndof     !< displacements then velocities
@@ -297,7 +297,7 @@ contains
   !> geometry (Eq. 18), supports that take most of the offset, a shaft wound up beyond
   !> windup_limit, a start at rest with teeth overlapping, a tooth deflected beyond
   !> deflection_limit of the module. The executable prints them to stderr, Python raises
-  !> pyspline.SplineWarning (api_warnings).
+  !> pyspline.SplineWarning (api_load_file's and api_load_fields' warn).
   function model_warnings(m) result(text)
     type(model_t), intent(in) :: m
     character(len=:), allocatable :: text
@@ -358,7 +358,7 @@ contains
     k_mesh = m%z*m%k_m/2.0_wp
     k_s = 1.0_wp/(1.0_wp/m%k_p1 + 1.0_wp/m%k_p2)
     e = l*k_s/(k_mesh + k_s)
-    delta = abs(m%t_d)/(m%z*m%r_b*m%k_m)
+    delta = static_tooth_load(m)/m%k_m
     if (l <= delta .or. e > support_limit*delta) return
     text = 'case '//trim(m%name)//': fields k_p1 = '//num(m%k_p1)//', k_p2 = '//num(m%k_p2)// &
          ' N/m: the supports (in series '//num(k_s)//' N/m, the mesh Z k_m / 2 = '//num(k_mesh)// &
@@ -426,7 +426,7 @@ contains
     if (abs(m%t_l) > abs(t)) then
       t = m%t_l; tname = 't_l'
     end if
-    f = abs(t)/(m%z*m%r_b)
+    f = static_tooth_load(m, t)
     d = f/k
     if (d <= deflection_limit*m%m_n) return
     text = 'case '//trim(m%name)//': field '//tname//' = '//num(t)//' N m loads each tooth '// &
@@ -434,6 +434,16 @@ contains
          ' N/m), '//num(100.0_wp*d/m%m_n)//' % of the module (limit '// &
          itoa(nint(100.0_wp*deflection_limit))//' %): a torque in N mm? Run as given'//new_line('a')
   end function load_warning
+
+  !> |T| / (Z r_b): the load of each tooth when the Z teeth share the torque T equally (the
+  !> static, aligned mesh of Eq. 22) [N]; T: the driving torque T_d unless given.
+  pure real(wp) function static_tooth_load(m, t) result(f0)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in), optional :: t
+    f0 = abs(m%t_d)
+    if (present(t)) f0 = abs(t)
+    f0 = f0/(m%z*m%r_b)
+  end function static_tooth_load
 
   !> x without blanks: 4 decimals to 10, then 3, 2, 1 to 1e4 (19.096, 0.2546), else 5.000E+06.
   function num(x) result(s)

@@ -16,12 +16,12 @@
 module spline_fidelity
   use spline_kinds, only: wp
   use spline_model, only: model_t, ndof, thermal_none, thermal_bulk, thermal_oneway, &
-       thermal_coupled, set_thermal_level
+       thermal_coupled, set_thermal_level, static_tooth_load
   use spline_dynamics, only: static_equilibrium
   use spline_errors, only: err_ok, msglen
   implicit none
   private
-  public :: static_tooth_load, lateral_estimate, backlash_estimate, auto_level, auto_tol
+  public :: lateral_estimate, backlash_estimate, auto_level, auto_tol
 
   real(wp), parameter :: fidelity_margin = 0.5_wp   !< auto reduces when estimate <= margin * tol
 
@@ -60,12 +60,6 @@ contains
     type(model_t), intent(in) :: m
     tol = fidelity_margin*m%fidelity_tol
   end function auto_tol
-
-  !> F0 = |T_d| / (Z r_b): the tooth load of the static, aligned mesh (Eq. 22) [N].
-  pure real(wp) function static_tooth_load(m) result(f0)
-    type(model_t), intent(in) :: m
-    f0 = abs(m%t_d)/(m%z*m%r_b)
-  end function static_tooth_load
 
   !> Estimated relative tooth-force error of the torsional level: k_m e / F0, with e the lateral
   !> excitation |(l_x, l_y)| + g |m_1/k_p1 - m_2/k_p2| + |lateral dq0| + the unbalance's and

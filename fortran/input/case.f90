@@ -28,7 +28,7 @@ module spline_case
        fidelity_values, section_values, option_index, nfields, max_case_bytes, max_output_bytes, &
        lyapunov_method_values, goal_values
 
-  interface   ! fortran/fileinfo.c
+  interface   ! fortran/interface/fileinfo.c
     integer(c_int) function c_file_kind(path, size, errbuf, errlen) bind(C, name='spline_file_kind')
       import :: c_char, c_int, c_long_long
       character(kind=c_char), intent(in) :: path(*)

@@ -1,15 +1,17 @@
 !> Equations of motion: the 8-DOF system of Eq. 23 reduced exactly to 7 DOF in the relative
 !> coordinates of Eq. 24, its scaled first-order form (Eq. 25), and the static equilibrium.
 module spline_dynamics
-  use spline_kinds, only: wp
+  use spline_kinds, only: wp, max_teeth
   use spline_errors, only: err_ok, err_solver
-  use spline_model, only: model_t, ndof, nstate, thermal_coupled
-  use spline_mesh, only: mesh_eval, mesh_forces, mesh_switch_functions, coupling_stats_t, eq16_mode
+  use spline_model, only: model_t, ndof, nstate, thermal_coupled, static_tooth_load
+  use spline_geometry, only: tooth_angles
+  use spline_mesh, only: mesh_eval, mesh_forces, mesh_switch_functions, coupling_stats_t, eq16_mode, &
+       eq11_gradient
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
-  public :: accelerations, driving_torque, unbalance_forces, rhs_scaled, to_scaled, from_scaled, static_equilibrium, start_state, &
-       integrated_states
+  public :: accelerations, accel_jacobian, rhs_jacobian, driving_torque, unbalance_forces, rhs_scaled, &
+       to_scaled, from_scaled, static_equilibrium, start_state, integrated_states
 
   integer, parameter :: max_newton = 100    !< Newton steps of the static equilibrium
 
@@ -61,6 +63,73 @@ contains
     a(6) = m%r_b*((-tm - s3)*m%inv_j2 - th1dd)
     a(7) = m%r_b*((-tm - s3)*m%inv_j2 - (s3 - m%t_l)*m%inv_jl)
   end subroutine accelerations
+
+  !> The frozen-contact Jacobian of the accelerations (Eqs. 23-24) at time t, in SI units:
+  !> a(i, :) = d(a_i)/d(q, v) with the contact states frozen at modes (as accelerations' mode;
+  !> exact: the right-hand side is affine in the state there). A tooth (slice) in contact
+  !> carries F = k_m (dn -+ c) + c_m d(dn)/dt (Eqs. 15-17; / n_s per slice) with
+  !> dn = e_x sin(phi) - e_y cos(phi) + D2 + e_j (Eq. 11), so
+  !>   dF/dq = k_m u + c_m omega w,  dF/dv = c_m u,
+  !>   u = (sin, -cos, -sin, cos, 0, 1, 0), w = (cos, sin, -cos, -sin, 0, 0, 0);
+  !> F_x1 = -sum F sin, F_y1 = sum F cos, T_m = r_b sum F (Eqs. 19-22), and the accelerations
+  !> are linear in them and in q, v. The one Jacobian of the core: the variational run's and the
+  !> linear tail's (rhs_jacobian), the static equilibrium's; the coupled flash temperature
+  !> (Eqs. 1-7 fed back) is not in it (tests/fortran/test_jacobian.f90: against unit steps).
+  pure subroutine accel_jacobian(m, t, modes, a)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: t
+    integer, intent(in) :: modes(:)
+    real(wp), intent(out) :: a(ndof, nstate)
+    real(wp) :: sp(max_teeth), cp(max_teeth), u(ndof), w(ndof), gf(nstate), gx(nstate), gy(nstate)
+    real(wp) :: gt(nstate), ds1(nstate), ds3(nstate), dth1(nstate), wt
+    integer :: j, ns
+    call tooth_angles(m%z, m%omega, t, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
+    ns = m%n_slices
+    gx = 0.0_wp; gy = 0.0_wp; gt = 0.0_wp
+    do j = 1, m%z
+      wt = real(count(modes((j - 1)*ns + 1:j*ns) /= 0), wp)/ns   ! share of the face in contact
+      if (wt == 0.0_wp) cycle
+      call eq11_gradient(sp(j), cp(j), u, w)
+      gf(1:ndof) = wt*(m%k_m*u + m%c_m*m%omega*w)
+      gf(ndof+1:) = wt*m%c_m*u
+      gx = gx - gf*sp(j)
+      gy = gy + gf*cp(j)
+      gt = gt + m%r_b*gf
+    end do
+    a = 0.0_wp
+    a(1, :) = gx/m%m_1; a(1, 1) = a(1, 1) - m%k_p1/m%m_1; a(1, 8) = a(1, 8) - m%c_p1/m%m_1
+    a(2, :) = gy/m%m_1; a(2, 2) = a(2, 2) - m%k_p1/m%m_1; a(2, 9) = a(2, 9) - m%c_p1/m%m_1
+    a(3, :) = -gx/m%m_2; a(3, 3) = a(3, 3) - m%k_p2/m%m_2; a(3, 10) = a(3, 10) - m%c_p2/m%m_2
+    a(4, :) = -gy/m%m_2; a(4, 4) = a(4, 4) - m%k_p2/m%m_2; a(4, 11) = a(4, 11) - m%c_p2/m%m_2
+    ds1 = 0.0_wp; ds1(5) = m%k_t1/m%r_b; ds1(12) = m%c_t1/m%r_b
+    ds3 = 0.0_wp; ds3(7) = m%k_t2/m%r_b; ds3(14) = m%c_t2/m%r_b
+    dth1 = (gt - ds1)/m%j_1
+    a(5, :) = m%r_b*(dth1 - ds1/m%j_m)
+    a(6, :) = m%r_b*((-gt - ds3)/m%j_2 - dth1)
+    a(7, :) = m%r_b*((-gt - ds3)/m%j_2 - ds3/m%j_l)
+  end subroutine accel_jacobian
+
+  !> J = d(ys')/d(ys), the Jacobian of Eq. 25 (rhs_scaled) at scaled time tau with the contact
+  !> states frozen at modes: accel_jacobian in the scaled states.
+  pure subroutine rhs_jacobian(m, tau, modes, jac)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: tau
+    integer, intent(in) :: modes(:)
+    real(wp), intent(out) :: jac(nstate, nstate)
+    real(wp) :: a(ndof, nstate), d(nstate)
+    integer :: i
+    call accel_jacobian(m, tau/m%w_ref, modes, a)
+    ! SI -> scaled (Eq. 25): J_s(i, k) = J(i, k) d_k / (w_ref d_i), d = (l, l w_ref)
+    d(1:ndof) = m%l_ref
+    d(ndof+1:) = m%l_ref*m%w_ref
+    jac = 0.0_wp
+    do i = 1, ndof
+      jac(i, ndof + i) = 1.0_wp            ! dq/dt = v: d_k / (w d_i) = 1
+    end do
+    do i = 1, ndof
+      jac(ndof + i, :) = a(i, :)*d/(m%w_ref*d(ndof + i))
+    end do
+  end subroutine rhs_jacobian
 
   !> Driving torque with ripple (docs/model.md section 11): T_d(t) = T_d [1 + sum_k a_k sin(n_k omega t
   !> + psi_k)], the engine orders n_k; exactly T_d without ripple.
@@ -157,12 +226,13 @@ contains
 
   !> Static equilibrium at time t: the displacements q with zero velocities for which all
   !> accelerations of Eq. 23 vanish (under T_d, T_L, gravity and misalignment). Semi-smooth
-  !> Newton on the piecewise-linear residual: the Jacobian (forward differences) is taken with
+  !> Newton on the piecewise-linear residual: the Jacobian (accel_jacobian) is taken with
   !> the contact states of Eq. 16 frozen at the current iterate, so it is the exact Jacobian of
   !> the piece the iterate lies on, never a difference across a tooth's contact switch (with a
   !> misalignment and many teeth, Z >= ~150, the teeth near their switch made the plain
   !> difference Jacobian point uphill and the line search stall); backtracking line search on
-  !> the residual. The closed-form guess: shafts twisted by the torques, every tooth loaded
+  !> the residual (with the coupled flash temperature, which the Jacobian leaves out, a
+  !> quasi-Newton iteration). The closed-form guess: shafts twisted by the torques, every tooth loaded
   !> equally, supports sagging under gravity. Converged when the scaled step is below 1e-12.
   subroutine static_equilibrium(m, t, q, ierr, errmsg)
     type(model_t), intent(in) :: m
@@ -170,9 +240,9 @@ contains
     real(wp), intent(out) :: q(ndof)
     integer, intent(out) :: ierr
     character(len=*), intent(inout) :: errmsg
-    real(wp) :: r(ndof), rn(ndof), jac(ndof, ndof), dq(ndof), qn(ndof), h, lam
+    real(wp) :: r(ndof), rn(ndof), jac(ndof, ndof), ja(ndof, nstate), dq(ndof), qn(ndof), lam
     real(wp) :: g(2*m%z*m%n_slices), dqbar(ndof), q_prev(ndof), dq_prev(ndof), lam_prev
-    integer :: it, k, ls, modes(m%z*m%n_slices)
+    integer :: it, ls, modes(m%z*m%n_slices)
     q = 0.0_wp
     q(2) = -m%m_1*m%grav/max(m%k_p1, tiny(1.0_wp))
     q(4) = -m%m_2*m%grav/max(m%k_p2, tiny(1.0_wp))
@@ -180,7 +250,7 @@ contains
     if (m%k_p2 == 0.0_wp) q(4) = 0.0_wp
     q(5) = -m%r_b*m%t_d/max(m%k_t1, tiny(1.0_wp))
     q(7) = m%r_b*m%t_l/max(m%k_t2, tiny(1.0_wp))
-    q(6) = -sign(m%c_bulk, m%t_d) - m%t_d/(m%z*m%k_m*m%r_b)
+    q(6) = -sign(m%c_bulk, m%t_d) - sign(static_tooth_load(m)/m%k_m, m%t_d)
     if (m%spacing) q(6) = q(6) - sum(m%spacing_error(1:m%z))/m%z   ! full contact: dn_j + e_j
     lam_prev = 0.0_wp; q_prev = 0.0_wp; dq_prev = 0.0_wp
     call residual(q, r)
@@ -189,14 +259,8 @@ contains
       ! contact states at q (Eq. 16, as the right-hand side decides them)
       call mesh_switch_functions(m, t, q, g)
       modes = eq16_mode(g(1::2), g(2::2))
-      do k = 1, ndof
-        h = 1.0e-7_wp*max(abs(q(k)), m%l_ref)
-        qn = q
-        qn(k) = q(k) + h
-        call residual(qn, rn, modes)
-        if (ierr /= err_ok) return
-        jac(:, k) = (rn - r)/h
-      end do
+      call accel_jacobian(m, t, modes, ja)
+      jac = ja(:, 1:ndof)/(m%l_ref*m%w_ref**2)     ! d(residual)/dq at zero velocities
       call solve_dense(jac, -r, dq, ierr)
       if (ierr /= err_ok .and. lam_prev > 1.0e-6_wp) then
         ! singular here (e.g. the step left every tooth out of contact): back to half the step
@@ -246,12 +310,11 @@ contains
     write(errmsg, '(a,i0,a)') 'case '//trim(m%name)//': static equilibrium did not converge in ', &
          max_newton, ' Newton steps: use start = ''rest'''
   contains
-    subroutine residual(qq, rr, mode)
+    subroutine residual(qq, rr)
       real(wp), intent(in) :: qq(ndof)
       real(wp), intent(out) :: rr(ndof)
-      integer, intent(in), optional :: mode(m%z*m%n_slices)
       real(wp), parameter :: zero(ndof) = 0.0_wp
-      call accelerations(m, t, qq, zero, rr, ierr, errmsg, mode)
+      call accelerations(m, t, qq, zero, rr, ierr, errmsg)
       rr = rr/(m%l_ref*m%w_ref**2)
     end subroutine residual
   end subroutine static_equilibrium

@@ -23,13 +23,13 @@ program spline_dyn
   use spline_case, only: case_t, case_read_file, case_parse, case_name_of, case_write_text, &
        c_file_kind
   use spline_model, only: model_t, model_from_case, model_warnings, nstate, nkterms, kterm_names
-  use spline_run, only: run_case, run_warnings
-  use spline_quantities, only: nstats, stat_q, state_q, iq_tf, ntooth_q, tooth_q, nout_q, output_q, nload, &
+  use spline_run, only: run_case, run_results
+  use spline_quantities, only: nstats, stat_q, state_q, ntooth_q, tooth_q, nout_q, output_q, nload, &
        load_q, nload_tooth, load_tooth_q, il_load_sharing, il_free_mean, il_back_teeth, &
        il_impacts_rev, il_closing_speed, il_tf_max, il_tf_max_tooth, il_tf_max_t, il_sigma_root, &
        il_sigma_flank, il_tau_pitch, il_batches, il_tm_rms_se, il_sharing_rev, il_sharing_rev_se, &
-       il_free_mean_se, il_impacts_rev_se, il_tf_rev, il_tf_rev_se, il_stress_ratio
-  use spline_loads, only: run_loads, stress_warnings
+       il_free_mean_se, il_impacts_rev_se, il_tf_rev, il_tf_rev_se, il_stress_ratio, nextreme, &
+       extreme_q
   use spline_sections, only: section_count
   use spline_lyapunov, only: lyapunov_count
   implicit none
@@ -38,7 +38,7 @@ program spline_dyn
     character(len=:), allocatable :: s
   end type string_t
 
-  interface   ! fortran/fileinfo.c
+  interface   ! fortran/interface/fileinfo.c
     integer(c_int) function c_same_file(a, b) bind(C, name='spline_same_file')
       import :: c_char, c_int
       character(kind=c_char), intent(in) :: a(*), b(*)
@@ -68,14 +68,14 @@ program spline_dyn
       import :: c_int
     end function c_sigint_count
     integer(c_int) function c_csv_record(x, n, buf, cap) bind(C, name='spline_csv_record')
-      import :: c_char, c_double, c_int                       ! app/csvrow.c
+      import :: c_char, c_double, c_int                       ! fortran/interface/csvrow.c
       real(c_double), intent(in) :: x(*)
       integer(c_int), value :: n, cap
       character(kind=c_char), intent(out) :: buf(*)
     end function c_csv_record
   end interface
 
-  character(len=:), allocatable :: path, out, arg, tmp, record, summary, stmp
+  character(len=:), allocatable :: path, out, arg, tmp, record, summary, stmp, text
   type(string_t), allocatable :: sets(:)
   character(len=msglen) :: errmsg
   character(len=256) :: iomsg
@@ -83,7 +83,7 @@ program spline_dyn
   type(model_t) :: m
   real(wp), allocatable :: t(:), y(:, :), tooth(:, :, :), tm(:)
   real(c_double), allocatable :: row(:)
-  real(wp) :: stats(nstats), loads(nload)
+  real(wp) :: stats(nstats), loads(nload), ext(nextreme)
   real(wp), allocatable :: tload(:, :), sec_t(:), sec_y(:, :), lyap_t(:), lyap_g(:)
   real(wp) :: wall
   integer :: ierr, i, j, k, n, q, u, su, nargs, nsets, ios
@@ -192,7 +192,7 @@ program spline_dyn
     open(newunit=u, file=tmp, status='replace', action='write', iostat=ios, iomsg=iomsg)
     if (ios /= 0) call die('cannot write the output '//out//': '//trim(iomsg), err_case)
   end if
-  ! From here a SIGINT is counted, not fatal (fortran/interrupt.c): the run stops at its next
+  ! From here a SIGINT is counted, not fatal (fortran/integration/interrupt.c): the run stops at its next
   ! right-hand side, the temporary file is removed, and the exit status is 130.
   sigint0 = c_sigint_watch()
 
@@ -215,10 +215,10 @@ program spline_dyn
   end if
   call check_interrupt()
   call print_warnings(trim(errmsg))            ! the integrator's (SUNDIALS') warnings, counted
-  call print_warnings(run_warnings(m, stats))
   allocate(tload(m%z, nload_tooth))
-  call run_loads(m, t, y, tooth, tm, loads, tload)
-  call print_warnings(stress_warnings(m, loads))
+  call run_results(m, t, y, tooth, tm, stats, [(0.0_wp, i = 1, ntooth_q - 4)], loads, tload, ext, &
+       text)
+  call print_warnings(text)                    ! the run's, then its loads' (stresses, T_f)
   if (have_summary) call write_summary(.true., '', err_ok)
   if (.not. write_csv) then
     write(*, '(a)') 'case '//trim(m%name)//': '//summary
@@ -265,7 +265,7 @@ program spline_dyn
     end do
   end do
   write(u, '(a)', iostat=ios) ''
-  ! the records, formatted by app/csvrow.c: 17 significant digits (exact), a quarter of the
+  ! the records, formatted by fortran/interface/csvrow.c: 17 significant digits (exact), a quarter of the
   ! time of an ES edit descriptor
   allocate(row(1 + nstate + 2 + m%z*ntooth_q))
   allocate(character(len=26*size(row)) :: record)
@@ -400,7 +400,7 @@ contains
     character(len=*), intent(in) :: msg
     integer, intent(in) :: code
     character(len=:), allocatable :: text
-    integer, parameter :: itm = 2 + nstate, ikv = 3 + nstate, id2 = 6, ivd2 = 13
+    integer, parameter :: id2 = 6, ivd2 = 13
     integer :: i2, nt
     summary_open = .false.
     ios = 0
@@ -429,12 +429,9 @@ contains
       call put('model.spacing_error', 'm', m%spacing_error(1:m%z))   ! in use: list + seeded
       nt = m%n_out
       call put('run.t_first', 's', t(1:min(1, nt)))
-      call extremes('Tm', output_q(itm)%unit, tm)
-      call extremes('kv', output_q(ikv)%unit, abs(tm)/m%t_d)
-      call extremes('F', tooth_q(1)%unit, reshape(tooth(:, :, 1), [nt*m%z]))
-      call extremes('Tf', tooth_q(iq_tf)%unit, reshape(tooth(:, :, iq_tf), [nt*m%z]))
-      call extremes('D2', state_q(id2)%unit, y(id2, :))
-      call extremes('vD2', state_q(ivd2)%unit, y(ivd2, :))
+      do i2 = 1, nextreme                  ! spline_run::run_results' (Python's too)
+        call put('run.'//extreme_q(i2)%name, extreme_q(i2)%unit, [ext(i2)])
+      end do
       call put('section.t', 's', sec_t)
       call put('section.D2', state_q(id2)%unit, sec_y(id2, :))
       call put('section.vD2', state_q(ivd2)%unit, sec_y(ivd2, :))
@@ -454,17 +451,7 @@ contains
     call rename_into(stmp, summary)
   end subroutine write_summary
 
-  !> Summary lines run.Q_max, run.Q_min, run.Q_rms (sqrt(mean(x**2))) of the values x.
-  subroutine extremes(q, unit, x)
-    character(len=*), intent(in) :: q, unit
-    real(wp), intent(in) :: x(:)
-    if (size(x) == 0) return
-    call put('run.'//q//'_max', unit, [maxval(x)])
-    call put('run.'//q//'_min', unit, [minval(x)])
-    call put('run.'//q//'_rms', unit, [sqrt(sum(x**2)/size(x))])
-  end subroutine extremes
-
-  !> One summary line: NAME [UNIT] = x(1),x(2),... (app/csvrow.c: 17 significant digits).
+  !> One summary line: NAME [UNIT] = x(1),x(2),... (fortran/interface/csvrow.c: 17 significant digits).
   subroutine put(name, unit, x)
     character(len=*), intent(in) :: name, unit
     real(wp), intent(in) :: x(:)
