@@ -400,7 +400,7 @@ def test_period_doubling_switches_to_the_doubled_branch(doubling_branch):
 def test_frequency_response_figure(doubling_branch):
     """The figure: each branch stable solid and unstable dashed (period 1 and period 2), the
     special points marked at their located values, the follow sweeps' points over them."""
-    from pyspline.frplots import frequency_response
+    from pyspline.plots import frequency_response
     ds = doubling_branch
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pyspline.SplineWarning)

@@ -9,8 +9,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .. import plotstyle as ps  # noqa: E402
-from ..plotstyle import eng  # noqa: E402
+from ..plots import style as ps  # noqa: E402
+from ..plots import eng  # noqa: E402
 from . import SETTLE, poincare, poincare_count  # noqa: E402
 
 

@@ -24,13 +24,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import MaxNLocator
 
-from . import plotstyle as ps
-from .plotstyle import eng
-from .sweepplots import (bifurcation, bifurcation_grid, lyapunov_vs_param, param_map,
-                         sweep_figures, waterfall)
-
-__all__ = ["bifurcation", "bifurcation_grid", "eng", "lyapunov_vs_param", "param_map", "scene",
-           "sweep_figures", "waterfall"]
+from . import style as ps
 
 
 # --------------------------------------------------------------------------- scene
