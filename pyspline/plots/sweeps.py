@@ -291,7 +291,7 @@ def waterfall(ds, speed: str = "speed_rpm", freq: str = "freq_hz", amp: str = "a
     and warned about (SplineWarning); given `duration`, the sampled time [s] of each run
     (t_end - t0 - t_transient), with the n_out that resolves it. Given `scale`, the signal's
     size (e.g. the largest RMS of T_m), a map whose largest amplitude is round-off by the rule
-    of the run plots (`plotstyle.roundoff_amplitude`, with the runs' `rtol`) says so on it."""
+    of the run plots (`style.roundoff_amplitude`, with the runs' `rtol`) says so on it."""
     rpm = ps.array(ds, speed)
     a = ps.array(ds, amp, dims=(speed, freq) if hasattr(ds, "dims") else None)
     f = ps.array(ds, freq)
