@@ -441,7 +441,7 @@ def cmd_plot(args) -> int:
     """One scene per case; a case that fails prints one line and the next one is drawn. The
     exit status is that of the first failure (`exit_code`), 0 if every case was drawn."""
     from . import analysis, plots
-    from .plotstyle import eng
+    from .plots import eng
     from .core import STATE_NAMES, simulate
     i_D2 = STATE_NAMES.index("D2")          # its column in section_y; dD2/dt is 7 later
     out = Path(args.out)

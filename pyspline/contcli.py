@@ -42,7 +42,7 @@ def cmd_continue(args, fixed, exit_code) -> int:
     from pathlib import Path
     from .dataset import write_netcdf
     from .errors import SplineError
-    from .frplots import MEASURES, frequency_response
+    from .plots.continuation import MEASURES, frequency_response
     out = Path(args.out)
     try:
         case = load_case(args.case, **fixed(args.fix))
@@ -112,7 +112,7 @@ def _other(args, case, name, index, command, out) -> int:
     """`continue --all` (pyspline.branches) and `continue --fold` (pyspline.fold_curve)."""
     from .branches import branches, fold_curve
     from .dataset import write_netcdf
-    from .frplots import fold_plane, frequency_response
+    from .plots import fold_plane, frequency_response
     if args.all and args.fold:
         raise CaseError("--all and --fold: one at a time")
     points = args.sweep or 31

@@ -165,6 +165,7 @@ def test_race_candidate_is_the_loosest_rung_that_passes_twice():
     assert np.allclose(np.diff(rungs), -0.25)          # quarter decades, both sides alike
 
 
+@pytest.mark.xdist_group("numbalsoda")       # the worker of tests/test_numba_peer.py's solves
 def test_race_quick_times_the_peer_with_its_forces(tmp_path):
     """A quick race of the paper scene: both sides reach each accuracy with a candidate timed
     in every round, the peer's error from its own forces, and the ratio is of their medians."""

@@ -2,15 +2,18 @@
 the closed-form forced response of the linear full-contact drive, the closed-form speed at
 which that response first opens a tooth (grazing), folds of the backlash resonance with a
 multiplier at +1 and the hysteresis of follow-up / follow-down sweeps between them, the CLI."""
+import contextlib
+import io
 import re
-import subprocess
 import sys
+import types
 import warnings
 
 import numpy as np
 import pytest
 
 import pyspline
+import pyspline.cli
 from conftest import CASES, jacobian
 from test_orbits import A_RIPPLE, linear_scene, scale_of
 
@@ -45,12 +48,19 @@ def resonance_branch():
         return pyspline.continuation(RESONANCE, "speed_rpm", 2300, 2530, progress=False)
 
 
-def test_linear_branch_is_the_closed_form():
+@pytest.fixture(scope="module")
+def linear_branch():
+    """The linear scene's branch over 2600-3800 r/min (steps of 0.1): the closed form's and the
+    command line's."""
+    case, *_ = linear_scene(2.0)
+    return case, pyspline.continuation(case, "speed_rpm", 2600, 3800, progress=False, ds=0.1)
+
+
+def test_linear_branch_is_the_closed_form(linear_branch):
     """Full contact: every point of the branch over speed through the mesh resonance is the
     closed-form forced response y_eq + Re Y(omega), its multipliers exp(lambda_i T); all
     stable, no special point."""
-    case, *_ = linear_scene(2.0)
-    ds = pyspline.continuation(case, "speed_rpm", 2600, 3800, progress=False, ds=0.1)
+    case, ds = linear_branch
     s = scale_of(case)
     assert ds.attrs["n_points"] >= 5 and ds.attrs["n_special"] == 0
     assert ds.speed_rpm[0] == 2600 and ds.speed_rpm[-1] == pytest.approx(3800, rel=1e-12)
@@ -141,17 +151,22 @@ def test_follow_sweeps_jump_at_the_folds(resonance_branch):
 
 
 def cli(tmp_path, *args):
-    # cwd: not the checkout, whose source tree would shadow the installed package
-    return subprocess.run([sys.executable, "-m", "pyspline", *args], capture_output=True,
-                          text=True, timeout=300, cwd=tmp_path)
+    """`pyspline ARGS` in this process, from tmp_path: the command line's parsing, output and
+    exit status without a second interpreter's imports (`python -m pyspline` itself runs in
+    tests/test_plots.py). Returns (returncode, stdout, stderr) by name."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.chdir(tmp_path), contextlib.redirect_stdout(out), \
+            contextlib.redirect_stderr(err):
+        code = pyspline.cli.main([str(a) for a in args])
+    return types.SimpleNamespace(returncode=code, stdout=out.getvalue(), stderr=err.getvalue())
 
 
-def test_cli_end_to_end(tmp_path):
+def test_cli_end_to_end(tmp_path, linear_branch):
     """`pyspline continue` on the linear scene: continuation.nc holds the branch (the same
     numbers as the Python call), frequency_response.png is drawn, exit 0; a field that
     cannot be continued is a CaseError naming it, exit 2."""
     import xarray as xr
-    case, *_ = linear_scene(2.0)
+    case, want = linear_branch
     path = tmp_path / "scene.nml"
     path.write_text(case.text())
     run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2600",
@@ -159,7 +174,6 @@ def test_cli_end_to_end(tmp_path):
     assert run.returncode == 0, run.stderr
     assert "wrote out/continuation.nc" in run.stdout and "points on 1 branch(es)" in run.stdout
     ds = xr.open_dataset(tmp_path / "out" / "continuation.nc", engine="h5netcdf")
-    want = pyspline.continuation(case, "speed_rpm", 2600, 3800, ds=0.1, progress=False)
     assert np.array_equal(ds.speed_rpm, want.speed_rpm) and np.array_equal(ds.y0, want.y0)
     assert ds.attrs["command"].startswith("pyspline continue")
     assert (tmp_path / "out" / "frequency_response.png").stat().st_size > 10_000
@@ -400,7 +414,7 @@ def test_period_doubling_switches_to_the_doubled_branch(doubling_branch):
 def test_frequency_response_figure(doubling_branch):
     """The figure: each branch stable solid and unstable dashed (period 1 and period 2), the
     special points marked at their located values, the follow sweeps' points over them."""
-    from pyspline.frplots import frequency_response
+    from pyspline.plots import frequency_response
     ds = doubling_branch
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pyspline.SplineWarning)

@@ -9,7 +9,7 @@ import pytest
 from test_analysis import _load_src
 
 pl = _load_src("plots")
-ps = _load_src("plotstyle")
+ps = _load_src("plots.style")
 SplineWarning = _load_src("errors").SplineWarning
 CORPUS = Path(__file__).resolve().parent / "corpus"
 

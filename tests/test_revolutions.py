@@ -10,7 +10,7 @@ import pyspline
 from conftest import CASES, PAPER, PAPER_SHAFTS
 
 pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
-from pyspline import sweepplots
+from pyspline.plots import sweeps as sweepplots
 
 SPEEDS = [2000.0, 3700.0, 6000.0, 12500.0, 20000.0]
 

@@ -28,18 +28,22 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-try:
-    ge = pytest.importorskip("ross.gear_element")
-    from ross.materials import Material
-except Exception as exc:  # not an ImportError: e.g. ross 2.3.0 with plotly >= 6 (ValueError)
-    pytest.skip(f"ross is installed but does not import: {exc!r}", allow_module_level=True)
-
 ROOT = Path(__file__).resolve().parent.parent
+# ROSS takes 11 s of CPU to import: imported by the first test that runs, not at collection
+# (every pytest-xdist worker collects every module), and these tests kept on one worker
+pytestmark = pytest.mark.xdist_group("ross")
+ge = Material = None
 
 
 @pytest.fixture(scope="module")
 def check(tmp_path_factory):
-    """Build and run tests/stiffness_check.f90; return its '@' records."""
+    """Import ROSS, build and run tests/stiffness_check.f90; return its '@' records."""
+    global ge, Material
+    try:
+        ge = pytest.importorskip("ross.gear_element")
+        from ross.materials import Material
+    except Exception as exc:  # not an ImportError: e.g. ross 2.3.0 with plotly >= 6 (ValueError)
+        pytest.skip(f"ross is installed but does not import: {exc!r}")
     fc = shutil.which("gfortran")
     if not fc:
         pytest.skip("gfortran not found")

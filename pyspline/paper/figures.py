@@ -9,13 +9,13 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .. import plotstyle as ps  # noqa: E402
-from ..plotstyle import eng  # noqa: E402
+from ..plots import style as ps  # noqa: E402
+from ..plots import eng  # noqa: E402
 from . import SETTLE, poincare, poincare_count  # noqa: E402
 
 
 def _time_panel(ax, res, y, label, unit):
-    """y(t); a y that is round-off (plotstyle.roundoff_span) on +-1 % around its value, noted."""
+    """y(t); a y that is round-off (plots.style.roundoff_span) on +-1 % around its value, noted."""
     ax.plot(res.t, y, lw=0.7)
     ax.ticklabel_format(axis="y", useOffset=False)
     ax.set_xlabel("time t [s]")

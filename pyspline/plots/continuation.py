@@ -9,7 +9,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from . import plotstyle as ps
+from . import style as ps
 
 #: measures of a branch point and of a sweep point: name -> (label, unit, sweep expression)
 MEASURES = {"Tm_pp": ("T_m peak-to-peak", "N m", lambda d: d["Tm_max"] - d["Tm_min"]),
@@ -130,7 +130,7 @@ def bifurcation_follow(ds, param: str, coord: str = "section_D2", path=None,
 
 def _field_label(field: str) -> str:
     """'long name (field) [unit]' of a case field, an array element as NAME(i)."""
-    from .dataset import _field_attrs
+    from ..dataset import _field_attrs
     a = _field_attrs(field.split("(")[0].strip())
     return f"{a['long_name']} ({field})" + (f" [{a['units']}]" if a.get("units") else "")
 

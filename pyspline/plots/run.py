@@ -1,21 +1,17 @@
-"""Figures of single runs and sweeps: `scene`, one page on one run (what `pyspline plot`
-draws), and, from pyspline.sweepplots, bifurcation diagrams, Lyapunov exponents, waterfalls of
-spectra and `sweep_figures` (what `pyspline sweep` draws).
+"""The figure of one run: `scene`, one page (what `pyspline plot` draws).
 
-Each function takes numpy arrays (the sweep figures also an xarray.Dataset), returns a
-matplotlib Figure and, when given `path`, writes it there as PNG. Figures are built on
-`matplotlib.figure.Figure` and rendered by Agg, independent of pyplot and of the interactive
-backend, so sweeps do not accumulate open figures.
+It takes numpy arrays, returns a matplotlib Figure and, when given `path`, writes it there as
+PNG. Figures are built on `matplotlib.figure.Figure` and rendered by Agg, independent of pyplot
+and of the interactive backend, so sweeps do not accumulate open figures.
 
 No figure magnifies round-off: a signal whose span is below the solver's resolution
-(plotstyle.roundoff_span: 3e-7 of its size, or 10 rtol) is drawn on a range around its value
+(style.roundoff_span: 3e-7 of its size, or 10 rtol) is drawn on a range around its value
 and labelled "no dynamic content"; colour scales come from the second half of a run and line
 panels from the run after its first tenth (a start transient is clipped, and the colour bar or a
 note says so, with where the transient reaches); spectra end at the Nyquist frequency of the
 data and say when the tooth pass lies beyond it (with a SplineWarning).
 
-Imports only numpy, matplotlib and pyspline.errors (xarray when a sweep's waterfalls are
-drawn), no compiled core.
+Imports only numpy, matplotlib and pyspline.errors, no compiled core.
 """
 from __future__ import annotations
 
@@ -24,13 +20,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import MaxNLocator
 
-from . import plotstyle as ps
-from .plotstyle import eng
-from .sweepplots import (bifurcation, bifurcation_grid, lyapunov_vs_param, param_map,
-                         sweep_figures, waterfall)
-
-__all__ = ["bifurcation", "bifurcation_grid", "eng", "lyapunov_vs_param", "param_map", "scene",
-           "sweep_figures", "waterfall"]
+from . import style as ps
 
 
 # --------------------------------------------------------------------------- scene

@@ -20,7 +20,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from . import plotstyle as ps
+from . import style as ps
 
 __all__ = ["bifurcation", "bifurcation_grid", "lyapunov_vs_param", "param_map",
            "sweep_figures", "waterfall"]
@@ -291,7 +291,7 @@ def waterfall(ds, speed: str = "speed_rpm", freq: str = "freq_hz", amp: str = "a
     and warned about (SplineWarning); given `duration`, the sampled time [s] of each run
     (t_end - t0 - t_transient), with the n_out that resolves it. Given `scale`, the signal's
     size (e.g. the largest RMS of T_m), a map whose largest amplitude is round-off by the rule
-    of the run plots (`plotstyle.roundoff_amplitude`, with the runs' `rtol`) says so on it."""
+    of the run plots (`style.roundoff_amplitude`, with the runs' `rtol`) says so on it."""
     rpm = ps.array(ds, speed)
     a = ps.array(ds, amp, dims=(speed, freq) if hasattr(ds, "dims") else None)
     f = ps.array(ds, freq)
@@ -419,7 +419,7 @@ def sweep_figures(ds, out) -> list[Path]:
     x = numeric[0]
     other = [n for n in names if n != x]
     if "direction" in other and "section_D2" in ds:     # follow='both': overlay the two
-        from .frplots import bifurcation_follow
+        from .continuation import bifurcation_follow
         path = out / "bifurcation.png"
         bifurcation_follow(ds, x, path=path, title=f"{title_case}: D_2 on the {section} "
                            f"section vs {x}, followed up and down")
@@ -473,7 +473,7 @@ def _waterfall_ds(sub):
 def _case_value(ds, key) -> float:
     """A number field of the sweep's case (attrs['case'], as Case.text writes it: the fields
     that differ from the defaults), else its default."""
-    from .case import defaults
+    from ..case import defaults
     m = re.search(rf"^\s*{key}\s*=\s*([-+.\w]+)", ds.attrs.get("case", ""), re.M)
     return float(m.group(1)) if m else float(defaults()[key])
 
