@@ -70,18 +70,21 @@ def _seed(case, final, n, max_n):
 
 
 def _on_branch(ds, label, p, y, scale):
-    """Whether (p, y) lies on a branch of `ds`: within a tenth of the chord (scaled) of the
-    branch interpolated linearly between two consecutive points that bracket p (the chord's
-    sagitta at the continuation's max_angle is about 2 % of it)."""
+    """Whether (p, y) lies on a branch of `ds`: within a tenth of a chord (the sagitta at the
+    continuation's max_angle is about 2 % of it) of the segment between two consecutive
+    points of the branch, in the continuation's scaled unknowns (the states by Eq. 25, the
+    field by a tenth of its magnitude): the nearest point of the segment, so that a point at
+    a fold, beyond the field values sampled on either side of it, is found too."""
+    pscale = 0.1 * max(abs(p), np.abs(ds[label].values).max())
+    x = np.r_[p / pscale, np.asarray(y) / scale]
     for b in np.unique(ds.branch.values):
         rows = np.flatnonzero(ds.branch.values == b)
-        ps, ys = ds[label].values[rows], ds.y0.values[rows]
-        for k in np.flatnonzero((ps[:-1] - p) * (ps[1:] - p) <= 0):
-            w = 0.0 if ps[k + 1] == ps[k] else (p - ps[k]) / (ps[k + 1] - ps[k])
-            yi = ys[k] + w * (ys[k + 1] - ys[k])
-            chord = np.abs((ys[k + 1] - ys[k]) / scale).max()
-            if np.abs((yi - y) / scale).max() <= 0.1 * chord + 1e-6 * np.abs(y / scale).max():
-                return True
+        X = np.c_[ds[label].values[rows] / pscale, ds.y0.values[rows] / scale]
+        d, r = np.diff(X, axis=0), x - X[:-1]
+        w = np.clip((r * d).sum(1) / np.maximum((d * d).sum(1), 1e-300), 0, 1)
+        dist = np.abs(r - w[:, None] * d).max(1)
+        if (dist <= 0.1 * np.abs(d).max(1) + 1e-6 * np.abs(x).max()).any():
+            return True
     return False
 
 

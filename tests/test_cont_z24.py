@@ -12,6 +12,7 @@ import warnings
 
 import numpy as np
 import pytest
+from scipy.optimize import brentq
 
 import pyspline
 from test_cont_drives import DRIVE
@@ -110,13 +111,26 @@ def test_grazing_where_the_closed_form_opens_a_tooth(branch):
     def margin(p):
         y_eq, Y, _ = forced_response(Z24, p, 1.0, 0.25)
         return abs(y_eq[5]) - Z24["c0"] - abs(Y[5])
-    lo, hi = BAND
-    assert margin(lo) > 0 > margin(hi)
-    for _ in range(40):
-        lo, hi = ((lo + hi) / 2, hi) if margin((lo + hi) / 2) > 0 else (lo, (lo + hi) / 2)
+    assert margin(BAND[0]) > 0 > margin(BAND[1])
+    lo = brentq(margin, *BAND, xtol=1e-6)
     ds = branch
     first = list(ds.special_type.values).index("grazing")
     assert float(ds.special_speed_rpm[first]) == pytest.approx(lo, abs=0.1)
     p, sw = ds.speed_rpm.values, ds.switches.values
     before = np.arange(len(p)) < np.argmax(np.diff(p) < 0)
     assert (sw[before & (p < lo - 0.5)] == 0).all() and (sw[-5:] == 96).all()
+
+
+def test_special_points_lie_on_their_branch(branch):
+    """branches' merge criterion (a point within a tenth of a chord of the branch's nearest
+    segment) finds every located fold and grazing on the branch: a fold lies beyond the field
+    values sampled on either side of it, where interpolating at the same field value found
+    no bracket and a seed's branch that ended there was kept as a second branch. Moved off by
+    5 % of each state's swing along the branch, none is on it."""
+    from pyspline.branches import _on_branch
+    from test_orbits import scale_of
+    ds, s = branch, scale_of(Z24)
+    swing = np.ptp(ds.y0.values, axis=0)
+    for p, y in zip(ds.special_speed_rpm.values, ds.special_y0.values):
+        assert _on_branch(ds, "speed_rpm", p, y, s), p
+        assert not _on_branch(ds, "speed_rpm", p, y + 0.05 * swing, s), p
