@@ -142,7 +142,7 @@ def fold_plane(fc, path=None, title: str | None = None) -> Figure:
     field, field2 = fc.attrs["field"], fc.attrs["field2"]
     v = fc.value2.values
     folds = fc.fold.values
-    fig = Figure(figsize=(9, 5.5), layout="constrained")
+    fig = Figure(figsize=(12, 5.5), layout="constrained")
     ax = fig.add_subplot()
     pair = np.isfinite(folds[:, :2]).all(axis=1)
     if pair.any():
@@ -173,7 +173,7 @@ def fold_plane(fc, path=None, title: str | None = None) -> Figure:
     ax.set_xlabel(_field_label(field))
     ax.set_ylabel(_field_label(field2))
     ax.grid(alpha=0.3, lw=0.5)
-    ax.legend(fontsize=8, loc="best", framealpha=0.9)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1), framealpha=0.9)
     ax.set_title(title or f"folds of the periodic orbits in ({field}, {field2}): the region "
                           "of coexistence")
     return ps.finish(fig, path)

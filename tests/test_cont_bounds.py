@@ -15,8 +15,10 @@ import pyspline
 from conftest import CASES
 from test_cont_drives import BAND, DRIVE
 
-#: slack of a bound [s]: the last map run, the clock read every 20000 steps, the dataset
-SLACK = 1.5
+#: slack of a bound [s], wall time on a machine shared by several processes a core: the
+#: corrector under way (its map runs are cut only every 20000 steps), the point's period,
+#: the dataset; the calls these bounds stop take 20-300 s without them
+SLACK = 5.0
 
 
 @pytest.fixture(scope="module", autouse=True)
