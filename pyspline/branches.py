@@ -344,9 +344,9 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
                    index2, np.atleast_1d(np.asarray(check, float)), check_points, progress)
     bad = [str(x) for x in out.status.values if x != "complete"]
     if "coexist" in out and (out.coexist < 0).any():
+        late = out.check_value.values[(out.coexist < 0).any("check_point")]
         bad.append(f"the wall-time bound of fold_curve, max_seconds = {max_seconds:g} s, was "
-                   "reached before the check sweeps at " + ", ".join(
-                       f"{v:g}" for v in out.check_value.values[(out.coexist < 0).any("check_point")]))
+                   f"reached before the check sweeps at {', '.join(f'{v:g}' for v in late)}")
     out.attrs.update(case=case.text(), field2=field2, start=start, stop=stop, n=n,
                      status="; ".join(bad) or "complete",
                      command=command or f"pyspline.fold_curve({case.name!r}, {field!r}, "
