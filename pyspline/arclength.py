@@ -22,8 +22,8 @@ import numpy as np
 from .case import Case, defaults, load_case
 from .core import STATE_QUANTITIES, load, sundials_said
 from .errors import CaseError, SolverError, SplineWarning
-from .orbits import (OrbitError, _period_map, _scale, _trajectory, fd_monodromy,
-                     forcing_periods, map_and_monodromy, periodic_orbit)
+from .orbits import (CALL_SECONDS, OrbitError, _period_map, _scale, _trajectory, fd_monodromy,
+                     forcing_periods, map_and_monodromy, out_of_time, periodic_orbit, time_bound)
 from .summary import _version
 
 __all__ = ["continuation", "SPECIAL_TYPES"]
@@ -278,7 +278,8 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
                  ds: float = 0.05, ds_min: float = 1e-4, ds_max: float = 0.25, max_angle: float = 0.15,
                  max_points: int = 200, tol: float | None = None, max_corrector: int = 6,
                  margin: float = 1e-4, switch: bool = True, detect: bool = True,
-                 monodromy: str = "exact", progress: bool = True, command: str | None = None):
+                 monodromy: str = "exact", progress: bool = True, command: str | None = None,
+                 max_seconds: float = CALL_SECONDS):
     """Pseudo-arclength continuation of the period-n orbit of `case` in `field` from `start`
     to `stop`, through stable and unstable parts; returns an xarray.Dataset.
 
@@ -303,6 +304,9 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     detect : locate folds, period doublings, Neimark-Sacker points and grazing.
     monodromy : 'exact' (variational equations, one run per corrector iteration) or 'fd'
         (central differences of the map, 2k + 1 runs: for checking, bench/continuation.py).
+    max_seconds : the wall time of the call (orbits.CALL_SECONDS; math.inf: none): past it the
+        branch so far is returned with its status saying so (special points not yet located
+        stay so).
 
     Dataset: dim 'point' (the branch points in order; variable 'branch' numbers the branches,
     'n' their periods): the field's value, y0 (point, state), Tm_pp, F_max, D2_pp, the
@@ -339,7 +343,8 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
             raise CaseError(f"continuation in {label}: {arg} = {value:g} is not a valid value "
                             f"of {label}: {exc}") from None
     c0 = prob.case_at(start)
-    with sundials_said("the continuation's map runs") as said:
+    with sundials_said("the continuation's map runs") as said, \
+            time_bound(max_seconds, f"continuation (case {base.name})"):
         orbit = periodic_orbit(c0, n=n, guess=guess, tol=tol, monodromy=monodromy)
         prob.free = _map_only(prob.model(start), t0, prob.t1(start, n), orbit.y0)[2]
         k = int(prob.free.sum())
@@ -359,7 +364,7 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
                 if why != "complete" and status == "complete":
                     status = why
                 branches.append(pts)
-                if detect:
+                if detect and not out_of_time():   # past it every map run fails
                     for a, b in zip(pts, pts[1:]):
                         for sp in _locate_all(br, a, b, k):
                             sp["branch"] = len(branches) - 1
@@ -423,6 +428,8 @@ def _follow(br, u0, tau0, q_end, ds, ds_min, ds_max, max_angle, max_points, ibra
     fallbacks = _fallbacks(prob)
     primary, on_fallback = (prob.how, prob.case["method"]), 0
     while len(pts) < max_points:
+        if late := out_of_time():
+            return pts, f"{late} was reached at {prob.name} = {pts[-1]['p']:.6g}"
         a = pts[-1]
         pred = a["u"] + ds * a["tau"]
         end = None

@@ -12,6 +12,7 @@ import numpy as np
 from .arclength import continuation, field_label, parse_field
 from .errors import CaseError, SplineError, SplineWarning
 from .follow import repeat_revolutions
+from .orbits import CALL_SECONDS, OrbitError, out_of_time, time_bound
 
 
 def _stretches(period):
@@ -69,18 +70,21 @@ def _seed(case, final, n, max_n):
 
 
 def _on_branch(ds, label, p, y, scale):
-    """Whether (p, y) lies on a branch of `ds`: within a tenth of the chord (scaled) of the
-    branch interpolated linearly between two consecutive points that bracket p (the chord's
-    sagitta at the continuation's max_angle is about 2 % of it)."""
+    """Whether (p, y) lies on a branch of `ds`: within a tenth of a chord (the sagitta at the
+    continuation's max_angle is about 2 % of it) of the segment between two consecutive
+    points of the branch, in the continuation's scaled unknowns (the states by Eq. 25, the
+    field by a tenth of its magnitude): the nearest point of the segment, so that a point at
+    a fold, beyond the field values sampled on either side of it, is found too."""
+    pscale = 0.1 * max(abs(p), np.abs(ds[label].values).max())
+    x = np.r_[p / pscale, np.asarray(y) / scale]
     for b in np.unique(ds.branch.values):
         rows = np.flatnonzero(ds.branch.values == b)
-        ps, ys = ds[label].values[rows], ds.y0.values[rows]
-        for k in np.flatnonzero((ps[:-1] - p) * (ps[1:] - p) <= 0):
-            w = 0.0 if ps[k + 1] == ps[k] else (p - ps[k]) / (ps[k + 1] - ps[k])
-            yi = ys[k] + w * (ys[k + 1] - ys[k])
-            chord = np.abs((ys[k + 1] - ys[k]) / scale).max()
-            if np.abs((yi - y) / scale).max() <= 0.1 * chord + 1e-6 * np.abs(y / scale).max():
-                return True
+        X = np.c_[ds[label].values[rows] / pscale, ds.y0.values[rows] / scale]
+        d, r = np.diff(X, axis=0), x - X[:-1]
+        w = np.clip((r * d).sum(1) / np.maximum((d * d).sum(1), 1e-300), 0, 1)
+        dist = np.abs(r - w[:, None] * d).max(1)
+        if (dist <= 0.1 * np.abs(d).max(1) + 1e-6 * np.abs(x).max()).any():
+            return True
     return False
 
 
@@ -139,7 +143,7 @@ def _concat(pieces):
 
 def branches(case, field: str, start: float, stop: float, points: int = 31, *,
              max_n: int = 8, progress: bool = True, command: str | None = None,
-             sweep_case=None, **cont):
+             sweep_case=None, max_seconds: float = CALL_SECONDS, **cont):
     """Every periodic branch of `case` over `field` in [start, stop] from one call.
 
     A follow sweep up and down (`points` values from start to stop, runs of `sweep_case`,
@@ -153,10 +157,22 @@ def branches(case, field: str, start: float, stop: float, points: int = 31, *,
     point lies on another is dropped. Stretches without a stable periodic orbit of n <= max_n
     (chaotic or quasi-periodic, or not settled) seed nothing; listed in attrs['no_period'].
 
+    max_seconds : the wall time of the whole call (orbits.CALL_SECONDS; math.inf: none), shared
+        by the seeds' orbits and continuations in turn (each gets what is left; the follow
+        sweep's runs are bounded in steps only): past it the branches so far are returned,
+        'status' saying so, with a SplineWarning; OrbitError naming it when none was traced.
+
     Returns (Dataset, sweep): the Dataset of `continuation` for all the branches (dim 'point',
     'branch' numbered through, 'seed' the seed's index; dims 'special' likewise; attrs
     'seeds': field value, direction and period of each seed continued, 'status' each seed's),
     and the follow sweep's Dataset (frplots.frequency_response(ds, sweep=sw) draws both)."""
+    with time_bound(max_seconds, "branches"):
+        return _branches(case, field, start, stop, points, max_n, progress, command,
+                         sweep_case, cont)
+
+
+def _branches(case, field, start, stop, points, max_n, progress, command, sweep_case, cont):
+    """branches within its time bound."""
     from .core import load
     from .orbits import _scale
     from .sweeps import sweep
@@ -178,7 +194,7 @@ def branches(case, field: str, start: float, stop: float, points: int = 31, *,
         sw = sweep(sweep_case if sweep_case is not None else case, progress=progress,
                    follow="both", spectrum=False, finals=finals, **{name: values})
     scale = _scale(load(case))
-    pieces, seeds, no_period, status = [], [], [], []
+    pieces, seeds, no_period, status, skipped = [], [], [], [], []
     for d in ("up", "down"):
         idx = np.arange(points) if d == "up" else np.arange(points)[::-1]
         sub = sw.sel(direction=d)
@@ -187,8 +203,11 @@ def branches(case, field: str, start: float, stop: float, points: int = 31, *,
             for i, j in _split_at_jumps(pp, a, b):
                 k = idx[(i + j) // 2]
                 p = float(values[k])
-                orb = None if finals[d][k] is None else _seed(case.replace(**{name: p}),
-                                                              finals[d][k], n, max_n)
+                orb = None if finals[d][k] is None or out_of_time() else _seed(
+                    case.replace(**{name: p}), finals[d][k], n, max_n)
+                if orb is None and out_of_time():
+                    skipped.append(f"{d} {field} = {p:g}")
+                    continue
                 if orb is None:
                     no_period.append((d, values[idx[i]], values[idx[j]]))
                     continue
@@ -198,15 +217,27 @@ def branches(case, field: str, start: float, stop: float, points: int = 31, *,
                 for end in (start, stop):
                     if p == end:
                         continue
-                    with warnings.catch_warnings(record=True):
-                        warnings.simplefilter("always", SplineWarning)
-                        halves.append(continuation(case, field, p, end, n=orb.n, guess=orb.y0,
-                                                   progress=progress, **cont))
+                    try:
+                        with warnings.catch_warnings(record=True):
+                            warnings.simplefilter("always", SplineWarning)
+                            halves.append(continuation(case, field, p, end, n=orb.n,
+                                                       guess=orb.y0, progress=progress, **cont))
+                    except OrbitError as exc:   # no time left for its orbit at the seed
+                        if not out_of_time():
+                            raise
+                        status.append(f"seed {d} {field} = {p:g} to {end:g}: {exc}")
+                        break
                     if halves[-1].attrs["status"] != "complete":
                         status.append(f"seed {d} {field} = {p:g} to {end:g}: "
                                       f"{halves[-1].attrs['status']}")
-                pieces.append(_join(*halves, field) if len(halves) == 2 else halves[0])
-                seeds.append(f"{p:g} {d} n={orb.n}")
+                if halves:
+                    pieces.append(_join(*halves, field) if len(halves) == 2 else halves[0])
+                    seeds.append(f"{p:g} {d} n={orb.n}")
+    if skipped:
+        status.append(f"{out_of_time()} was reached: seeds not continued: {', '.join(skipped)}")
+    if not pieces and out_of_time():
+        raise OrbitError(f"branches over {field} = {start:g}..{stop:g}: {out_of_time()} was "
+                         "reached before any branch was traced")
     if not pieces:
         raise SplineError(f"branches: no periodic attractor found by the follow sweeps over "
                           f"{field} = {start:g}..{stop:g} (stretches without a period: "
@@ -220,6 +251,9 @@ def branches(case, field: str, start: float, stop: float, points: int = 31, *,
                     n_points=ds.sizes["point"], n_branches=int(ds.branch.max()) + 1,
                     command=command or f"pyspline.branches({case.name!r}, {field!r}, "
                                        f"{start:g}, {stop:g}, points={points})")
+    if status:
+        warnings.warn(f"branches: {ds.attrs['status']}: the branches so far are returned "
+                      "(attrs['status'])", SplineWarning, stacklevel=3)
     return ds, sw
 
 
@@ -231,78 +265,169 @@ def coexistence(sw, rel: float = 0.05):
     return np.abs(up - down) > rel * np.maximum(np.abs(up), np.abs(down))
 
 
+def _predicted_band(prev):
+    """The band in which to look for a value's fold pair, from the fold pairs of the values
+    before it (prev: (value2, lo, hi), latest last): the last pair, shifted by the last
+    shift (linear in the second field) when there are two, widened each side by the larger
+    of the pair's width, twice the shift and 2 % of the whole band; None when the last value
+    had no fold pair (then the whole band)."""
+    if not prev or len(prev[-1]) < 3:
+        return None
+    v, lo, hi = prev[-1]
+    shift = np.zeros(2)
+    if len(prev) > 1 and len(prev[-2]) == 3 and prev[-2][0] != v:
+        shift = (np.array([lo, hi]) - prev[-2][1:]) / (v - prev[-2][0])
+    return shift, v, lo, hi
+
+
+def _band(start, stop, pred, v):
+    """(b0, b1): the predicted fold pair at v with its margins, within [start, stop] and in
+    its direction."""
+    shift, v_prev, lo, hi = pred
+    lo, hi = np.sort(np.array([lo, hi]) + shift * (v - v_prev))
+    w = max(hi - lo, 2 * np.abs(shift * (v - v_prev)).max(), 0.02 * abs(stop - start))
+    a, b = min(start, stop), max(start, stop)
+    b0, b1 = max(a, lo - w), min(b, hi + w)
+    return (b0, b1) if stop > start else (b1, b0)
+
+
+def _guess_at(ds, p):
+    """The previous value's orbit at p: its branch from start up to the first fold,
+    interpolated linearly per state (its end state beyond it)."""
+    ps = ds[ds.attrs["field"]].values
+    turn = np.flatnonzero(np.diff(np.sign(np.diff(ps))) != 0)
+    last = turn[0] + 2 if len(turn) else len(ps)
+    ps, ys = ps[:last], ds.y0.values[:last]
+    order = np.argsort(ps)
+    return np.array([np.interp(p, ps[order], ys[order, j]) for j in range(ys.shape[1])])
+
+
 def fold_curve(case, field: str, start: float, stop: float, field2: str, values2, n: int = 1,
                *, check=(), check_points: int = 31, check_case=None, progress: bool = True,
-               command: str | None = None, **cont):
+               command: str | None = None, narrow: bool = True,
+               max_seconds: float = CALL_SECONDS, **cont):
     """The folds and grazings of the period-n branch over `field` in [start, stop], followed in
     a second field: at each of `values2` (in the order given) the branch is continued over the
-    band from the orbit at `start` of the previous value (a fold curve by repeated
-    one-parameter continuation; `cont`: continuation's keywords). Two folds bound the band
+    band (a fold curve by repeated one-parameter continuation; `cont`: continuation's
+    keywords), from the previous value's orbit at the band's start. Two folds bound the band
     where two orbits coexist; where the fold curves meet (a cusp) the hysteresis ends.
 
+    narrow : once a value has a fold pair, the next value's band is narrowed around where its
+        folds are predicted (the last pair moved by the last shift, linear in field2; margins
+        of the larger of the pair's width, twice the shift and 2 % of the band): the branch
+        outside the folds is not traced again. A narrowed band that does not give a fold pair
+        is traced again over [start, stop].
+    max_seconds : the wall time of the whole call (orbits.CALL_SECONDS; math.inf: none),
+        shared: each value gets what is left over the values left, so a slow value cannot take
+        the others' time; its status says when its share ran out. The check sweeps run after
+        the values, while time is left (their runs are bounded in steps only).
     check : values of field2 at which a follow sweep up and down (`check_points` values over
     the band, runs of `check_case`, default `case`: give it a t_end that settles) gives the
     brute-force verdict per value: one orbit or two coexisting (`coexistence`).
 
     Returns a Dataset: dim `value2` (field2's values): `fold` (value2, fold; sorted, NaN
-    padded), `grazing` (value2, grazing; in order along the branch from start: the first is
-    where the orbit of start changes its contact sequence), `status` (each continuation's); with check, dims
-    `check` and `check_point`: `check_value`, `check_field`, `coexist`. A value at which no
-    orbit is found at start (OrbitError, SolverError) has no folds and says so in `status`."""
-    import xarray as xr
-    from .arclength import set_field
-    from .sweeps import sweep
+    padded), `grazing` (value2, grazing; in order along the branch from the band's start: the
+    first is where the orbit there changes its contact sequence), `band` (value2, end: the
+    band continued), `status` (each continuation's); with check, dims `check` and
+    `check_point`: `check_value`, `check_field`, `coexist` (-1: not run, the time bound had
+    passed). A value at which no orbit is found at its band's start (OrbitError, SolverError)
+    has no folds and says so in `status`. attrs['status']: 'complete' or what was not."""
     name2, index2 = parse_field(case, field2)
     values2 = np.atleast_1d(np.asarray(values2, float))
     if values2.ndim != 1 or not len(values2) or not np.isfinite(values2).all():
         raise CaseError(f"values2 = {values2!r}: finite values of {field2}, at least one")
-    folds, grazes, status, guess = [], [], [], None
-    for v in values2:
+    with time_bound(max_seconds, "fold_curve"):
+        out = _fold_values(case, field, start, stop, name2, index2, values2, n, narrow,
+                           progress, cont)
+        if len(check):
+            _check(out, case if check_case is None else check_case, field, start, stop, name2,
+                   index2, np.atleast_1d(np.asarray(check, float)), check_points, progress)
+    bad = [str(x) for x in out.status.values if x != "complete"]
+    if "coexist" in out and (out.coexist < 0).any():
+        late = out.check_value.values[(out.coexist < 0).any("check_point")]
+        bad.append(f"the wall-time bound of fold_curve, max_seconds = {max_seconds:g} s, was "
+                   f"reached before the check sweeps at {', '.join(f'{v:g}' for v in late)}")
+    out.attrs.update(case=case.text(), field2=field2, start=start, stop=stop, n=n,
+                     status="; ".join(bad) or "complete",
+                     command=command or f"pyspline.fold_curve({case.name!r}, {field!r}, "
+                                        f"{start:g}, {stop:g}, {field2!r}, [...])")
+    if bad:
+        warnings.warn(f"fold_curve: {out.attrs['status']} (attrs['status'])", SplineWarning,
+                      stacklevel=2)
+    return out
+
+
+def _fold_values(case, field, start, stop, name2, index2, values2, n, narrow, progress, cont):
+    """fold_curve's continuations, one per value of the second field, each within its share
+    of the time left."""
+    import xarray as xr
+    from .arclength import set_field
+    from .orbits import time_left
+    folds, grazes, bands, status, prev, pairs = [], [], [], [], None, []
+    for i, v in enumerate(values2):
         at = set_field(case, name2, index2, v)
-        try:
-            with warnings.catch_warnings(record=True):
-                warnings.simplefilter("always", SplineWarning)
-                ds = continuation(at, field, start, stop, n=n, guess=guess,
-                                  progress=progress, **cont)
-        except CaseError:
-            raise
-        except SplineError as exc:      # no orbit at start there: the other values go on
+        what = f"fold_curve at {field_label(name2, index2)} = {v:g}"
+        pred = _predicted_band(pairs) if narrow else None
+        tries = ([_band(start, stop, pred, v)] if pred else []) + [(start, stop)]
+        with time_bound(max(time_left() / (len(values2) - i), 1e-6), what):
+            for b0, b1 in tries:
+                try:
+                    with warnings.catch_warnings(record=True):
+                        warnings.simplefilter("always", SplineWarning)
+                        ds = continuation(at, field, b0, b1, n=n, progress=progress,
+                                          guess=None if prev is None else _guess_at(prev, b0),
+                                          **cont)
+                except CaseError:
+                    raise
+                except SplineError as exc:      # no orbit at start: the other values go on
+                    ds, why = None, f"{what}: {type(exc).__name__}: {exc}"
+                    continue
+                kinds = ds.special_type.values.astype(str)
+                sp = ds[f"special_{ds.attrs['field']}"].values
+                why = ds.attrs["status"]
+                if (kinds == "fold").sum() >= 2 or (b0, b1) == (start, stop) or out_of_time():
+                    break
+        bands.append((b0, b1))
+        status.append(why)
+        if ds is None:
             folds.append([])
             grazes.append([])
-            status.append(f"{field2} = {v:g}: {type(exc).__name__}: {exc}")
+            pairs.append((v,))
             continue
-        guess = ds.y0.values[0]
-        kinds = ds.special_type.values.astype(str)
-        sp = ds[f"special_{ds.attrs['field']}"].values
+        prev = ds
         folds.append(np.sort(sp[kinds == "fold"]))
-        grazes.append(sp[kinds == "grazing"])       # in order along the branch from start
-        status.append(ds.attrs["status"])
+        grazes.append(sp[kinds == "grazing"])       # in order along the branch from b0
+        pairs.append((v, *folds[-1][:2]) if len(folds[-1]) >= 2 else (v,))
 
     def padded(rows):
         out = np.full((len(rows), max([len(r) for r in rows] + [1])), np.nan)
         for i, r in enumerate(rows):
             out[i, :len(r)] = r
         return out
-    label = field_label(*parse_field(case, field))
-    out = xr.Dataset({"fold": (("value2", "fold"), padded(folds)),
-                      "grazing": (("value2", "grazing"), padded(grazes)),
-                      "status": (("value2",), np.array(status, dtype=object))},
-                     coords={"value2": values2})
-    if len(check):
-        check = np.atleast_1d(np.asarray(check, float))
-        pts = np.linspace(min(start, stop), max(start, stop), check_points)
-        verdict = []
-        for v in check:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", SplineWarning)
-                sw = sweep(set_field(check_case if check_case is not None else case, name2,
-                                     index2, v), progress=progress, follow="both",
-                           spectrum=False, **{parse_field(case, field)[0]: pts})
-            verdict.append(coexistence(sw))
-        out["check_value"] = ("check", check)
-        out["check_field"] = ("check_point", pts)
-        out["coexist"] = (("check", "check_point"), np.array(verdict, int))
-    out.attrs.update(case=case.text(), field=label, field2=field2, start=start, stop=stop, n=n,
-                     command=command or f"pyspline.fold_curve({case.name!r}, {field!r}, "
-                                        f"{start:g}, {stop:g}, {field2!r}, [...])")
-    return out
+    return xr.Dataset({"fold": (("value2", "fold"), padded(folds)),
+                       "grazing": (("value2", "grazing"), padded(grazes)),
+                       "band": (("value2", "end"), np.array(bands, float)),
+                       "status": (("value2",), np.array(status, dtype=object))},
+                      coords={"value2": values2},
+                      attrs=dict(field=field_label(*parse_field(case, field))))
+
+
+def _check(out, case, field, start, stop, name2, index2, check, points, progress):
+    """The follow sweeps' verdicts at the values `check` of the second field into `out`
+    (-1 where the time bound had passed before the sweep)."""
+    from .arclength import set_field
+    from .sweeps import sweep
+    pts = np.linspace(min(start, stop), max(start, stop), points)
+    verdict = []
+    for v in check:
+        if out_of_time():
+            verdict.append(np.full(points, -1))
+            continue
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SplineWarning)
+            sw = sweep(set_field(case, name2, index2, v), progress=progress, follow="both",
+                       spectrum=False, **{parse_field(case, field)[0]: pts})
+        verdict.append(coexistence(sw))
+    out["check_value"] = ("check", check)
+    out["check_field"] = ("check_point", pts)
+    out["coexist"] = (("check", "check_point"), np.array(verdict, int))

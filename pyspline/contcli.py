@@ -6,6 +6,7 @@ import numpy as np
 from .case import load_case
 from .arclength import continuation, parse_field
 from .errors import CaseError
+from .orbits import CALL_SECONDS
 
 
 CONTINUE_HELP = """\
@@ -59,7 +60,7 @@ def cmd_continue(args, fixed, exit_code) -> int:
             return _other(args, case, name, index, command, out)
         ds = continuation(case, args.field, args.start, args.stop, n=args.n, ds=args.ds,
                           max_points=args.max_points, tol=args.tol, progress=not args.quiet,
-                          command=command)
+                          command=command, max_seconds=args.max_seconds)
         sw = None
         if args.sweep:
             from .sweeps import sweep
@@ -121,7 +122,8 @@ def _other(args, case, name, index, command, out) -> int:
     if args.all:
         ds, sw = branches(case, args.field, args.start, args.stop, points=points,
                           progress=not args.quiet, command=command + " --all", ds=args.ds,
-                          max_points=args.max_points, tol=args.tol)
+                          max_points=args.max_points, tol=args.tol,
+                          max_seconds=args.max_seconds)
         write_netcdf(ds, out / "branches.nc")
         write_netcdf(sw, out / "sweep.nc")
         print(f"{ds.attrs['n_points']} points on {ds.attrs['n_branches']} branch(es) from the "
@@ -139,15 +141,15 @@ def _other(args, case, name, index, command, out) -> int:
                         _values(text, f"--fold {field2}="), n=args.n, progress=not args.quiet,
                         check=_values(args.check, "--check") if args.check else (),
                         check_points=points, command=command + f" --fold {args.fold}",
-                        ds=args.ds, max_points=args.max_points, tol=args.tol)
+                        ds=args.ds, max_points=args.max_points, tol=args.tol,
+                        max_seconds=args.max_seconds)
         write_netcdf(fc, out / "fold_curve.nc")
         for v, f, g in zip(fc.value2.values, fc.fold.values, fc.grazing.values):
             print(f"{field2.strip()} = {v:.6g}: folds {np.round(f[np.isfinite(f)], 2)}, "
                   f"grazings {np.round(g[np.isfinite(g)], 2)}")
         fold_plane(fc, path=out / "fold_curve.png")
         print(f"wrote {out / 'fold_curve.nc'}, {out / 'fold_curve.png'}")
-        status = "complete" if (fc.status == "complete").all() else \
-            "; ".join(str(x) for x in fc.status.values if x != "complete")
+        status = fc.attrs["status"]
     if status != "complete":
         import sys
         print(f"stopped: {status}", file=sys.stderr)
@@ -181,6 +183,9 @@ def add_continue(sub, fixed, exit_code) -> None:
                    "in a second field: fold_curve.nc and fold_curve.png")
     r.add_argument("--check", metavar="V1,V2,...", help="with --fold: values of FIELD2 with a "
                    "follow sweep's verdict (one orbit or two) overlaid")
+    r.add_argument("--max-seconds", type=float, default=CALL_SECONDS, metavar="S",
+                   help=f"wall-time bound of the whole call (default {CALL_SECONDS:g}; inf: "
+                   "none): past it what was computed is written, exit 1")
     r.add_argument("--fix", action="append", metavar="FIELD=VALUE",
                    help="change a field of the case (e.g. rtol=1e-9)")
     r.add_argument("--out", default=".", metavar="DIR", help="output directory (default .)")

@@ -10,7 +10,10 @@ eigenvalues are linear algebra on its values.
 """
 from __future__ import annotations
 
+import contextvars
+import time
 import warnings
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from fractions import Fraction
 
@@ -24,6 +27,12 @@ NSTATE = 14
 #: wall-time bound [s] of one call of the core's map (a map_and_monodromy run, or all the runs of
 #: one _period_map call); its step bounds are the case's max_steps and max_total_steps
 MAP_SECONDS = 60.0
+#: wall-time bound [s] of a whole call of continuation, branches or fold_curve (max_seconds):
+#: five times the longest complete call measured (a Z24 band, 60 s on one core)
+CALL_SECONDS = 300.0
+
+#: (deadline on time.perf_counter, the bound's words) of the innermost time_bound
+_DEADLINE = contextvars.ContextVar("pyspline_deadline", default=(np.inf, ""))
 
 
 class OrbitError(SplineError):
@@ -55,13 +64,44 @@ class Orbit:
     method: str = "exact"    #: how M was computed: 'exact' or 'fd'
 
 
-def _wall(model, max_seconds) -> float:
-    """The core's wall-time bound for max_seconds (> 0; inf: none, 0 to the core)."""
+def _seconds(max_seconds, what: str) -> float:
+    """max_seconds as a float; CaseError naming it and `what` unless a number > 0 (inf: none)."""
     if isinstance(max_seconds, bool) or not isinstance(max_seconds, (int, float, np.number)) \
             or not max_seconds > 0:
-        raise CaseError(f"case {model.case.name}: max_seconds = {max_seconds!r}: the wall-time "
-                        "bound of a map run must be a number of seconds > 0 (math.inf: none)")
-    return 0.0 if np.isinf(max_seconds) else float(max_seconds)
+        raise CaseError(f"{what}: max_seconds = {max_seconds!r}: the wall-time bound must be a "
+                        "number of seconds > 0 (math.inf: none)")
+    return float(max_seconds)
+
+
+@contextmanager
+def time_bound(max_seconds, what: str):
+    """Within it every map run ends by max_seconds from now, or by an enclosing bound if that
+    one ends first; out_of_time() says when it has passed. CaseError for a bad max_seconds."""
+    end = time.perf_counter() + _seconds(max_seconds, what)
+    token = _DEADLINE.set(min(_DEADLINE.get(), (end, f"the wall-time bound of {what}, "
+                                                     f"max_seconds = {max_seconds:.3g} s,")))
+    try:
+        yield
+    finally:
+        _DEADLINE.reset(token)
+
+
+def time_left() -> float:
+    """The seconds left of the innermost time_bound (inf outside any)."""
+    return _DEADLINE.get()[0] - time.perf_counter()
+
+
+def out_of_time() -> str:
+    """'' within the time of the innermost time_bound, else the bound's words."""
+    return _DEADLINE.get()[1] if time_left() <= 0 else ""
+
+
+def _wall(model, max_seconds) -> float:
+    """The core's wall-time bound for max_seconds (> 0; inf: none, 0 to the core), cut to what
+    the innermost time_bound leaves (a microsecond once it has passed: the run stops at once)."""
+    left = min(_seconds(max_seconds, f"case {model.case.name}: a map run"),
+               max(time_left(), 1e-6))
+    return 0.0 if np.isinf(left) else left
 
 
 def _period_map(model, t0: float, t1: float, ys: np.ndarray, max_seconds: float = MAP_SECONDS
@@ -157,7 +197,8 @@ def forcing_periods(case: Case, n: int) -> None:
 
 
 def periodic_orbit(case, n: int = 1, guess=None, t0: float | None = None, tol: float | None = None,
-                   max_iter: int = 12, margin: float = 1e-4, monodromy: str = "exact") -> Orbit:
+                   max_iter: int = 12, margin: float = 1e-4, monodromy: str = "exact",
+                   max_seconds: float = MAP_SECONDS) -> Orbit:
     """The period-n orbit of a forced case near a guess, and its Floquet multipliers.
 
     Newton on F(y) = P^n(y) - y = 0, with P^n the core's map over n shaft periods from the
@@ -177,10 +218,13 @@ def periodic_orbit(case, n: int = 1, guess=None, t0: float | None = None, tol: f
     margin: stable means every |mu| < 1 - margin (the multipliers carry the error of M: the
     differences' h^2 + rtol / h, 1e-7 to 4e-7 at rtol 1e-11; exact M a few 1e-9 there; keep
     margin well above it).
+    max_seconds: the wall time the whole call may take, the settling run of the default guess
+    and every map run included (default MAP_SECONDS; math.inf: none).
 
     Returns an Orbit. Raises CaseError for bad input (n, guess, a case without a forcing
-    period), OrbitError when Newton does not converge (what was tried, the residual reached),
-    SolverError when a run of the map fails."""
+    period, max_seconds), OrbitError when Newton does not converge (what was tried, the
+    residual reached) or max_seconds has passed (it names the bound), SolverError when a run of
+    the map fails."""
     model = load(case)
     case = model.case
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
@@ -192,24 +236,36 @@ def periodic_orbit(case, n: int = 1, guess=None, t0: float | None = None, tol: f
     omega, period = info["omega"], 2 * np.pi * n / info["omega"]
     t0 = float(case["t0"] if t0 is None else t0)
     t1 = t0 + period
-    rtol = case["rtol"]
-    tol = 100 * rtol if tol is None else float(tol)
+    tol = 100 * case["rtol"] if tol is None else float(tol)
     if not (np.isfinite(tol) and tol > 0):
         raise CaseError(f"case {case.name}: tol = {tol!r}: the scaled residual to reach must be "
                         "a finite number > 0")
-    scale = _scale(model)
     if monodromy not in ("exact", "fd"):
         raise CaseError(f"case {case.name}: monodromy = {monodromy!r}: 'exact' (variational "
                         "equations) or 'fd' (central differences of the map)")
-    if guess is None:
-        y = _settled_state(model, t0, period)
-    else:
-        y = np.asarray(guess, dtype=float)
-        if y.shape != (NSTATE,):
-            raise CaseError(f"case {case.name}: guess has shape {y.shape}: a state has {NSTATE} "
-                            f"entries ({', '.join(STATE_QUANTITIES)}), SI")
-        if not np.isfinite(y).all():
+    if guess is not None:
+        guess = np.asarray(guess, dtype=float)
+        if guess.shape != (NSTATE,):
+            raise CaseError(f"case {case.name}: guess has shape {guess.shape}: a state has "
+                            f"{NSTATE} entries ({', '.join(STATE_QUANTITIES)}), SI")
+        if not np.isfinite(guess).all():
             raise CaseError(f"case {case.name}: guess is not finite")
+    with time_bound(max_seconds, f"periodic_orbit (case {case.name})"):
+        try:
+            y = _settled_state(model, t0, period) if guess is None else guess
+            return _newton(model, n, t0, t1, y, tol, max_iter, margin, monodromy)
+        except SolverError as exc:
+            late = out_of_time()
+            if not late:
+                raise
+            raise OrbitError(f"case {case.name}: no period-{n} orbit found (period {period:.6g} "
+                             f"s from t0 = {t0:.6g} s): {late} was reached ({exc})") from None
+
+
+def _newton(model, n, t0, t1, y, tol, max_iter, margin, monodromy) -> Orbit:
+    """periodic_orbit's Newton iteration from y (its arguments checked)."""
+    case, period, rtol = model.case, t1 - t0, model.case["rtol"]
+    scale = _scale(model)
     h = rtol ** (1 / 3)
 
     def step(y, with_m):
@@ -228,6 +284,8 @@ def periodic_orbit(case, n: int = 1, guess=None, t0: float | None = None, tol: f
     hist = [float(np.abs(r[free]).max())]
     it = 0
     while hist[-1] > tol:
+        if late := out_of_time():
+            _fail(case, n, period, t0, it, hist, tol, f"{late} was reached")
         if it == max_iter:
             _fail(case, n, period, t0, it, hist, tol, "the iteration limit max_iter was reached")
         if M is None:
@@ -289,15 +347,21 @@ def _settled_state(model, t0: float, period: float) -> np.ndarray:
     t_end = float(model.output_times()[-1])      # the case's t_end, however it was given
     k = max(int(np.ceil((t_end - t0) / period - 1e-9)),
             int(np.floor((case["t0"] - t0) / period)) + 1)
-    res = simulate(_run(case, t_end=t0 + k * period, t_transient=0.0, n_out=2))
-    return res.y[-1].copy()
+    y1, _ = _period_map(model, case["t0"], t0 + k * period, model.start_state()[:, None])
+    return y1[:, 0]
 
 
 def _trajectory(case: Case, t0: float, t1: float, y0: np.ndarray) -> Result:
-    """simulate from (t0, y0) to t1: start at rest plus the state as dq0, dv0 (exact: 0 + y)."""
+    """simulate from (t0, y0) to t1: start at rest plus the state as dq0, dv0 (exact: 0 + y).
+    A run that fails is tried once more at half the case's rtol: the core's state run can fail
+    with CV_ILL_INPUT ("tout too far back") where the map run from the same state does not
+    (measured on the Z16 drive of tests/test_cont_drives.py, a = 0.13, near 2488.47 r/min)."""
     run = _run(case, start="rest", dq0=list(y0[:7]), dv0=list(y0[7:]), t0=t0, t_end=t1,
                t_transient=0.0)
     with warnings.catch_warnings():
         # the orbit may start in contact: the start-at-rest overlap warning says nothing here
         warnings.filterwarnings("ignore", message=r".*start = 'rest' with", category=SplineWarning)
-        return simulate(run)
+        try:
+            return simulate(run)
+        except SolverError:
+            return simulate(run.replace(rtol=run["rtol"] / 2))

@@ -136,13 +136,13 @@ def _field_label(field: str) -> str:
 
 
 def fold_plane(fc, path=None, title: str | None = None) -> Figure:
-    """The folds (and the first grazing) of pyspline.fold_curve in the (field, field2) plane:
+    """The folds and grazings of pyspline.fold_curve in the (field, field2) plane:
     the band between the two folds shaded (two orbits coexist there), the brute-force
     verdicts of follow sweeps (one orbit / two coexisting) overlaid."""
     field, field2 = fc.attrs["field"], fc.attrs["field2"]
     v = fc.value2.values
     folds = fc.fold.values
-    fig = Figure(figsize=(9, 5.5), layout="constrained")
+    fig = Figure(figsize=(12, 5.5), layout="constrained")
     ax = fig.add_subplot()
     pair = np.isfinite(folds[:, :2]).all(axis=1)
     if pair.any():
@@ -158,17 +158,22 @@ def fold_plane(fc, path=None, title: str | None = None) -> Figure:
     if ok.any():
         ax.plot(g[ok], v[ok], "x--", color="0.3", lw=1,
                 label="first grazing along the branch (its contact sequence changes)")
+    rest = fc.grazing.values[:, 1:]
+    ok = np.isfinite(rest)
+    if ok.any():
+        ax.plot(rest[ok], np.broadcast_to(v[:, None], rest.shape)[ok], "x", color="0.55", ms=4,
+                label="the other grazings along the branch")
     if "coexist" in fc:
         xs, ys = np.meshgrid(fc.check_field.values, fc.check_value.values)
-        two = fc.coexist.values.astype(bool)
+        two, one = fc.coexist.values == 1, fc.coexist.values == 0   # -1: not run (time)
         ax.plot(xs[two], ys[two], "s", color="#0072B2", ms=5,
                 label="follow sweeps up and down differ: two orbits")
-        ax.plot(xs[~two], ys[~two], "s", mfc="none", mec="0.5", ms=5,
+        ax.plot(xs[one], ys[one], "s", mfc="none", mec="0.5", ms=5,
                 label="follow sweeps agree: one orbit")
     ax.set_xlabel(_field_label(field))
     ax.set_ylabel(_field_label(field2))
     ax.grid(alpha=0.3, lw=0.5)
-    ax.legend(fontsize=8, loc="best", framealpha=0.9)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1), framealpha=0.9)
     ax.set_title(title or f"folds of the periodic orbits in ({field}, {field2}): the region "
                           "of coexistence")
     return ps.finish(fig, path)
