@@ -75,7 +75,7 @@ def graze(br, a, b, sigma_b, iters=8):
     contact signatures differ, by bisection on sigma: (last, past, special), the corrected
     points nearest it with a's signature and with b's, the grazing recorded at past with
     last's closest approach. b None: a failed step (`diagnose`); a midpoint whose corrector
-    fails is then on the far side, and when no midpoint there converges the corrector starts
+    fails is then on the far side, and when the nearest one there fails the corrector starts
     from a short simulation just past the grazing (br.restart). None when it is not located:
     a midpoint fails or lands on another branch (b given), has a third signature, or the
     points either side are further apart than CONTINUITY bracket widths (a jump)."""
@@ -93,10 +93,12 @@ def graze(br, a, b, sigma_b, iters=8):
                 b["contact"]["signature"]:
             return None
         hi, past = s, pt or past
+    if b is None and (past is None or past["sigma"] > hi):   # failed next to the grazing
+        near = br.restart(a, hi)
+        if near is not None and near["contact"]["signature"] != sig_a:
+            past = near
     if past is None:
-        past = br.restart(a, hi)
-        if past is None or past["contact"]["signature"] == sig_a:
-            return None
+        return None
     s_past = past.get("sigma", sigma_b)
     if np.linalg.norm(past["u"] - last["u"]) > CONTINUITY * max(s_past - lo, 1e-12):
         return None
