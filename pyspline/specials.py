@@ -72,53 +72,60 @@ def _at(br, a, sigma):
 
 def graze(br, a, b, sigma_b, iters=8):
     """The grazing between branch point a (sigma 0) and b (sigma_b along a's tangent), whose
-    contact signatures differ, by bisection on sigma: (last, past, special), the corrected
-    points nearest it with a's signature and with b's, the grazing recorded at past with
-    last's closest approach. b None: a failed step (`diagnose`); a midpoint whose corrector
-    fails is then on the far side, and when the nearest one there fails the corrector starts
-    from a short simulation just past the grazing (br.restart). None when it is not located:
-    a midpoint fails or lands on another branch (b given), has a third signature, or the
-    points either side are further apart than CONTINUITY bracket widths (a jump)."""
+    contact signatures differ, by bisection on sigma: (last, past, beyond, special): the
+    corrected points nearest it with a's signature (last) and with another (past), the one
+    furthest past it (beyond: b, or in a failed step the first midpoint past it), the grazing
+    recorded at past (at last when the correctors between it and the bracket failed) with
+    last's closest approach. A midpoint whose corrector fails ends the
+    bisection; in a failed step (b None) it is corrected again from a short simulation there
+    (br.restart) and is past the grazing when that fails too. None when it is not located: no
+    corrected point past it, a midpoint with a third signature, or last and past further
+    apart than CONTINUITY bracket widths (a jump to another branch, not a grazing)."""
     sig_a = a["contact"]["signature"]
-    lo, hi, last, past = 0.0, sigma_b, a, b
+    lo, hi, last, past, beyond = 0.0, sigma_b, a, b, b
     for _ in range(iters):
         s = (lo + hi) / 2
         pt = _at(br, a, s)
-        if pt is None and b is not None:
-            return None
-        if pt is not None and pt["contact"]["signature"] == sig_a:
+        if pt is None and b is None:
+            pt = br.restart(a, s)
+            if pt is None:
+                hi = s
+                continue
+        if pt is None:
+            break
+        sig = pt["contact"]["signature"]
+        if sig == sig_a:
             lo, last = s, pt
-            continue
-        if pt is not None and b is not None and pt["contact"]["signature"] != \
-                b["contact"]["signature"]:
+        elif b is not None and sig != b["contact"]["signature"]:
             return None
-        hi, past = s, pt or past
-    if b is None and (past is None or past["sigma"] > hi):   # failed next to the grazing
-        near = br.restart(a, hi)
-        if near is not None and near["contact"]["signature"] != sig_a:
-            past = near
+        else:
+            hi, past, beyond = s, pt, beyond or pt
     if past is None:
         return None
     s_past = past.get("sigma", sigma_b)
     if np.linalg.norm(past["u"] - last["u"]) > CONTINUITY * max(s_past - lo, 1e-12):
         return None
-    sp = special(dict(past, sigma=s_past), "grazing")
+    # at past, or at last where the correctors between past and the bracket failed
+    at = past if s_past - hi <= hi - lo else last
+    sp = special(dict(at, sigma=at.get("sigma", 0.0)), "grazing")
     sp["closest_approach"] = last["contact"]["closest_approach"]
-    return last, past, sp
+    return last, past, beyond, sp
 
 
 def diagnose(br, a, pred, ds):
     """A failed step from a to the predictor pred (ds along a's tangent): when the predicted
     orbit's contact signature differs from a's, the grazing located between them and the
-    branch points to add ([last,] past; past carries the grazing); else None."""
+    branch points to add: the last before it (unless a) and the first found past it, not the
+    nearest (at the grazing the saltation's normal speed is near zero and M near singular),
+    which carries the grazing; else None."""
     if br.signature(pred) == a["contact"]["signature"]:
         return None
     loc = graze(br, a, None, ds)
     if loc is None:
         return None
-    last, past, sp = loc
-    past["grazing"], past["diagnosed"] = sp, True
-    return ([] if last is a else [last]) + [past]
+    last, _, beyond, sp = loc
+    beyond["grazing"] = sp
+    return ([] if last is a else [last]) + [beyond]
 
 
 # --------------------------------------------------------------------------- location
