@@ -305,8 +305,11 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
         by Eq. 25 and q = (p - start) / (max(|start|, |stop|) / 10), the same whatever the
         band's width. A step whose corrector needs <= 2 iterations grows 1.5x, one that needs
         >= 4 shrinks; a failed one halves (a run of the map that fails, a point outside the
-        field's valid range or a converged point further from its predictor than the step,
-        i.e. on another branch, fail it); below ds_min the other monodromy, then the other
+        field's valid range, a converged point further from its predictor than the step or
+        whose contact sequence changed with no grazing located between, i.e. on another
+        branch, fail it), unless its predictor changes the contact sequence and the grazing
+        is located on the step: the branch goes on past it; below ds_min the other monodromy,
+        then the other
         integrator (ERK, or BDF for ERK) are tried (attrs['fallbacks']); when they fail too,
         the branch so far is returned with attrs['status'] saying where and why, and a
         SplineWarning. max_angle [rad]: a step whose tangent turns more than twice it is
@@ -315,7 +318,8 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     margin : stable means every |mu| < 1 - margin.
     switch : at a period doubling continue the doubled branch (n -> 2n) from it along the
         critical eigenvector.
-    detect : locate folds, period doublings, Neimark-Sacker points and grazing.
+    detect : report folds, period doublings, Neimark-Sacker points, grazings and non-smooth
+        folds (grazings are located while following either way).
     monodromy : 'exact' (variational equations, one run per corrector iteration) or 'fd'
         (central differences of the map, 2k + 1 runs: for checking, bench/continuation.py).
 
@@ -325,7 +329,9 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     closest_approach, switches, residual, iterations; dim 'special': type, the field's value,
     branch, the critical multiplier, Tm_pp, F_max, y0. attrs: case, field, start, stop, n,
     timing, status ('complete', or where and why it stopped), fallbacks, rejected_jumps (steps
-    whose corrector landed on another branch).
+    whose corrector landed on another branch), rejected_unlocated (steps whose contact
+    sequence changed with no grazing located), diagnosed_grazings (failed steps carried
+    across a grazing).
 
     CaseError naming the argument for bad input: start == stop, a start or stop outside the
     field's valid range, a non-finite or non-positive ds, ds_min, ds_max, max_angle or tol,

@@ -76,23 +76,21 @@ def graze(br, a, b, sigma_b, iters=8):
     corrected points nearest it with a's signature (last) and with another (past), the one
     furthest past it (beyond: b, or in a failed step the first midpoint past it), the grazing
     recorded at past (at last when the correctors between it and the bracket failed) with
-    last's closest approach. A midpoint whose corrector fails ends the
-    bisection; in a failed step (b None) it is corrected again from a short simulation there
-    (br.restart) and is past the grazing when that fails too. None when it is not located: no
-    corrected point past it, a midpoint with a third signature, or last and past further
-    apart than CONTINUITY bracket widths (a jump to another branch, not a grazing)."""
+    last's closest approach. A midpoint whose corrector fails is corrected again from a short
+    simulation there (br.restart); in a failed step (b None) it is past the grazing when that
+    fails too. None when it is not located: a midpoint that fails (b given), no corrected
+    point past it, a midpoint with a third signature, or last and past further apart than
+    CONTINUITY bracket widths (a jump to another branch, not a grazing)."""
     sig_a = a["contact"]["signature"]
     lo, hi, last, past, beyond = 0.0, sigma_b, a, b, b
     for _ in range(iters):
         s = (lo + hi) / 2
-        pt = _at(br, a, s)
+        pt = _at(br, a, s) or br.restart(a, s)
         if pt is None and b is None:
-            pt = br.restart(a, s)
-            if pt is None:
-                hi = s
-                continue
+            hi = s
+            continue
         if pt is None:
-            break
+            return None
         sig = pt["contact"]["signature"]
         if sig == sig_a:
             lo, last = s, pt
