@@ -442,12 +442,16 @@ def _follow(br, u0, tau0, q_end, ds, ds_min, ds_max, max_angle, max_points, ibra
     primary, on_fallback = (prob.how, prob.case["method"]), 0
     while len(pts) < max_points:
         a = pts[-1]
+        step = ds
         pred = a["u"] + ds * a["tau"]
         end = None
         if not lo - 1e-12 <= pred[-1] <= hi + 1e-12:
             end = hi if pred[-1] > hi else lo
-            res = br.correct(a["u"] + a["tau"] * (end - a["u"][-1]) / a["tau"][-1], e_q, end) \
-                if abs(a["tau"][-1]) > 1e-3 else None
+            res = None
+            if abs(a["tau"][-1]) > 1e-3:      # the last step: onto the end, the field fixed
+                step = (end - a["u"][-1]) / a["tau"][-1]
+                pred = a["u"] + step * a["tau"]
+                res = br.correct(pred, e_q, end)
         else:
             res = br.correct(pred, a["tau"], a["tau"] @ pred)
         if res is not None and end is None and specials.far(res[0], pred, ds):
@@ -467,7 +471,7 @@ def _follow(br, u0, tau0, q_end, ds, ds_min, ds_max, max_angle, max_points, ibra
             else:
                 new["grazing"] = loc[-1]
         if new is None:
-            crossed = specials.diagnose(br, a, pred, ds) if end is None else None
+            crossed = specials.diagnose(br, a, pred, step) if step > 0 else None
             if crossed:
                 pts += crossed
                 bar.update(len(crossed))
