@@ -115,9 +115,11 @@ def diagnose(br, a, pred, ds):
     orbit's contact signature differs from a's, the grazing located between them and the
     branch points to add: the last before it (unless a) and the first found past it, not the
     nearest (at the grazing the saltation's normal speed is near zero and M near singular),
-    which carries the grazing; else None."""
-    if br.signature(pred) == a["contact"]["signature"]:
+    which carries the grazing; else None. Once from a point: the shorter steps that follow a
+    failed diagnosis are only halved."""
+    if a.get("diagnosed") or br.signature(pred) == a["contact"]["signature"]:
         return None
+    a["diagnosed"] = True
     loc = graze(br, a, None, ds)
     if loc is None:
         return None
