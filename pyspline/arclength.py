@@ -24,16 +24,11 @@ from .core import STATE_QUANTITIES, load, sundials_said
 from .errors import CaseError, SolverError, SplineWarning
 from .orbits import (CALL_SECONDS, OrbitError, _period_map, _scale, _trajectory, fd_monodromy,
                      forcing_periods, map_and_monodromy, out_of_time, periodic_orbit, time_bound)
+from . import specials
+from .specials import SPECIAL_TYPES, contact_measures, locate, multipliers, smooth, tests
 from .summary import _version
 
 __all__ = ["continuation", "SPECIAL_TYPES"]
-
-#: special points and what each test function watches
-SPECIAL_TYPES = {"fold": "a real multiplier through +1 (det(M - I) changes sign)",
-                 "period_doubling": "a real multiplier through -1 (det(M + I) changes sign)",
-                 "neimark_sacker": "a complex pair of multipliers through the unit circle",
-                 "grazing": "the contact sequence of a tooth over the period changes (a "
-                            "closest approach |dn_j| - c_j reaches zero)"}
 
 #: run-control and identity fields: not physical parameters of the orbit
 _NOT_CONTINUABLE = {"t0", "t_end", "t_transient", "rtol", "atol", "revolutions",
@@ -120,10 +115,13 @@ class _Problem:
         # scaling and the difference step of dF/dp do not depend on the band's width
         self.p0, self.pscale = float(start), 0.1 * max(abs(float(start)), abs(float(stop)))
         self.t0 = t0
-        self.models, self.log, self.jumps = {}, [], 0
+        self.models, self.log, self.jumps, self.unlocated, self.diagnosed = {}, [], 0, 0, 0
         self.d0 = _scale(self.model(self.p0))
         self.rtol = case["rtol"]
-        self.h = self.rtol ** (1 / 3)
+        # dF/dp's difference step: rtol^(1/2), not the smooth optimum rtol^(1/3) (+-5 r/min
+        # at 2400 r/min and rtol 1e-8), which straddles a grazing next to a fold and stalls
+        # Newton there (M is exact; dF/dp enters the step and the first tangent only)
+        self.h = self.rtol ** 0.5
 
     def set_monodromy(self, monodromy):
         self.how = monodromy
@@ -157,11 +155,16 @@ class _Problem:
     def p_of(self, q: float) -> float:
         return self.p0 + q * self.pscale
 
+    def state(self, y_fixed, u):
+        """The state (14,), SI, of u = (z, q): y_fixed with z in the integrated states."""
+        y = np.array(y_fixed, float)
+        y[self.free] = u[:-1] * self.d0[self.free]
+        return y
+
     def evaluate(self, y_fixed, u, n):
         """At u = (z, q): F (k,), J = [M - I, dF/dq] (k, k+1), M (k, k), the state y (14,)."""
         p = self.p_of(u[-1])
-        y = y_fixed.copy()
-        y[self.free] = u[:-1] * self.d0[self.free]
+        y = self.state(y_fixed, u)
         model = self.model(p)
         y1, Mp, free = self.monodromy(model, self.t0, self.t1(p, n), y)
         d = _scale(model)[free] / self.d0[free]     # M in the start's scales
@@ -188,36 +191,6 @@ def _map_only(model, t0, t1, y):
     """The core's map alone (no monodromy): (y1, None, free)."""
     y1, free = _period_map(model, t0, t1, np.asarray(y, float)[:, None])
     return y1[:, 0], None, free
-
-
-# --------------------------------------------------------------------------- test functions
-
-def _multipliers(M) -> np.ndarray:
-    mu = np.linalg.eigvals(M)
-    return mu[np.argsort(-np.abs(mu), kind="stable")]
-
-
-def _tests(mu) -> dict:
-    """Test functions of the multipliers (their sign changes between points mark a point)."""
-    pairs = mu[mu.imag > 1e-9 * np.maximum(1, np.abs(mu))]
-    return {"fold": float(np.prod(mu - 1).real), "period_doubling": float(np.prod(mu + 1).real),
-            "neimark_sacker": float(np.prod(np.abs(pairs) ** 2 - 1)) if len(pairs) else np.nan,
-            "_pairs": len(pairs)}
-
-
-def contact_measures(tr) -> dict:
-    """From one period of the orbit's trajectory (a Result): s_j(t) = |dn_j| - c_j, the contact
-    deflection of tooth j (> 0 in contact on either flank, < 0 its gap): the signature of the
-    contact sequence (per tooth: the sign at t0 and the number of sign changes over the period,
-    at the case's output samples), and the closest approach: the smallest |s_j| over the
-    teeth whose contact does not change over the period (NaN if every tooth switches)."""
-    s = np.abs(tr.dn) - tr.c
-    pos = s > 0
-    changes = (pos[1:] != pos[:-1]).sum(axis=0)
-    steady = changes == 0
-    closest = float(np.abs(s[:, steady]).min()) if steady.any() else np.nan
-    return {"signature": tuple(map(int, np.r_[pos[0], changes])), "closest_approach": closest,
-            "switches": int(changes.sum())}
 
 
 # --------------------------------------------------------------------------- the branch
@@ -254,24 +227,66 @@ class _Branch:
         self.last_hist = hist
         return None
 
-    def point(self, u, J, M, y, it, hist, tau_prev):
-        """The record of a converged point and its tangent (oriented along tau_prev)."""
-        k = len(u)
-        try:
-            tau = np.linalg.solve(np.vstack([J, tau_prev]), np.eye(k)[-1])
-        except np.linalg.LinAlgError:
-            tau = tau_prev.copy()
+    def point(self, res, prev):
+        """The record of the corrector's converged point res and its tangent: the secant from
+        prev, the branch point before it; at a branch's first point (prev the direction to
+        head in) the null vector of J oriented along prev. (The secant is what the predictor
+        follows: near a grazing dF/dp by differences of the map over +-h is a secant across
+        contact changes, and the null vector of J is off the branch.)"""
+        u, F, J, M, y, it, hist = res
+        if isinstance(prev, dict):
+            tau = u - prev["u"]
+            if not np.linalg.norm(tau) > 0:
+                tau = prev["tau"].copy()
+        else:
+            try:
+                tau = np.linalg.solve(np.vstack([J, prev]), np.eye(len(u))[-1])
+            except np.linalg.LinAlgError:
+                tau = np.array(prev, float)
         tau /= np.linalg.norm(tau)
-        mu = _multipliers(M)
-        prob = self.prob
-        p = prob.p_of(u[-1])
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", SplineWarning)
-            tr = _trajectory(prob.case_at(p), prob.t0, prob.t1(p, self.n), y)
-        return dict(u=u, tau=tau, p=p, y=y, M=M, mu=mu, tests=_tests(mu),
+        mu = multipliers(M)
+        p = self.prob.p_of(u[-1])
+        tr = self.trajectory(y, p)
+        return dict(u=u, tau=tau, p=p, y=y, M=M, mu=mu, tests=tests(mu),
                     contact=contact_measures(tr), Tm_pp=float(np.ptp(tr.Tm)),
                     F_max=float(np.abs(tr.tooth["F"]).max()), D2_pp=float(np.ptp(tr.D2)),
                     residual=hist[-1], iterations=it, n=self.n)
+
+    def trajectory(self, y, p):
+        """One period of the run from state y at the field's value p (the core's Result)."""
+        prob = self.prob
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SplineWarning)
+            return _trajectory(prob.case_at(p), prob.t0, prob.t1(p, self.n), y)
+
+    def signature(self, u):
+        """The contact signature of the run of one period from u (a predictor); None when the
+        run fails or u is outside the field's valid range."""
+        try:
+            return contact_measures(self.trajectory(self.prob.state(self.y_fixed, u),
+                                                    self.prob.p_of(u[-1])))["signature"]
+        except (SolverError, CaseError):
+            return None
+
+    def restart(self, a, sigma, periods=3):
+        """The branch point at sigma along a's tangent, the corrector started from the state a
+        short simulation (`periods` periods of the map) reaches from the predictor: for a
+        predictor just past a grazing that the corrector fails from. None when it fails or
+        lands further than sigma from the predictor."""
+        prob = self.prob
+        pred = a["u"] + sigma * a["tau"]
+        p = prob.p_of(pred[-1])
+        try:
+            y = prob.state(self.y_fixed, pred)
+            for _ in range(periods):
+                y = _map_only(prob.model(p), prob.t0, prob.t1(p, self.n), y)[0]
+        except (SolverError, CaseError):
+            return None
+        res = self.correct(np.r_[y[prob.free] / prob.d0[prob.free], pred[-1]], a["tau"],
+                           a["tau"] @ pred)
+        if res is None or specials.far(res[0], pred, sigma):
+            return None
+        return dict(self.point(res, a), sigma=sigma)
 
 
 def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=None, *,
@@ -291,8 +306,11 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
         by Eq. 25 and q = (p - start) / (max(|start|, |stop|) / 10), the same whatever the
         band's width. A step whose corrector needs <= 2 iterations grows 1.5x, one that needs
         >= 4 shrinks; a failed one halves (a run of the map that fails, a point outside the
-        field's valid range or a converged point further from its predictor than the step,
-        i.e. on another branch, fail it); below ds_min the other monodromy, then the other
+        field's valid range, a converged point further from its predictor than the step or
+        whose contact sequence changed with no grazing located between, i.e. on another
+        branch, fail it), unless its predictor changes the contact sequence and the grazing
+        is located on the step: the branch goes on past it; below ds_min the other monodromy,
+        then the other
         integrator (ERK, or BDF for ERK) are tried (attrs['fallbacks']); when they fail too,
         the branch so far is returned with attrs['status'] saying where and why, and a
         SplineWarning. max_angle [rad]: a step whose tangent turns more than twice it is
@@ -301,7 +319,8 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     margin : stable means every |mu| < 1 - margin.
     switch : at a period doubling continue the doubled branch (n -> 2n) from it along the
         critical eigenvector.
-    detect : locate folds, period doublings, Neimark-Sacker points and grazing.
+    detect : report folds, period doublings, Neimark-Sacker points, grazings and non-smooth
+        folds (grazings are located while following either way).
     monodromy : 'exact' (variational equations, one run per corrector iteration) or 'fd'
         (central differences of the map, 2k + 1 runs: for checking, bench/continuation.py).
     max_seconds : the wall time of the call (orbits.CALL_SECONDS; math.inf: none): past it the
@@ -314,7 +333,9 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     closest_approach, switches, residual, iterations; dim 'special': type, the field's value,
     branch, the critical multiplier, Tm_pp, F_max, y0. attrs: case, field, start, stop, n,
     timing, status ('complete', or where and why it stopped), fallbacks, rejected_jumps (steps
-    whose corrector landed on another branch).
+    whose corrector landed on another branch), rejected_unlocated (steps whose contact
+    sequence changed with no grazing located), diagnosed_grazings (failed steps carried
+    across a grazing).
 
     CaseError naming the argument for bad input: start == stop, a start or stop outside the
     field's valid range, a non-finite or non-positive ds, ds_min, ds_max, max_angle or tol,
@@ -348,7 +369,7 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
         orbit = periodic_orbit(c0, n=n, guess=guess, tol=tol, monodromy=monodromy)
         prob.free = _map_only(prob.model(start), t0, prob.t1(start, n), orbit.y0)[2]
         k = int(prob.free.sum())
-        branches, specials, status = [], [], "complete"
+        branches, found, status = [], [], "complete"
         bar = tqdm(total=max_points, desc=f"continue {label}", unit="point", disable=not progress,
                    dynamic_ncols=True)
         try:
@@ -365,22 +386,22 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
                     status = why
                 branches.append(pts)
                 if detect and not out_of_time():   # past it every map run fails
-                    for a, b in zip(pts, pts[1:]):
-                        for sp in _locate_all(br, a, b, k):
-                            sp["branch"] = len(branches) - 1
-                            specials.append(sp)
-                            if (sp["type"] == "period_doubling" and switch and len(branches) < 4
-                                    and nb <= 4 * n and _smooth(sp)):
-                                todo.append(_doubled_start(sp, nb, y_fixed))
+                    for sp in locate(br, pts):
+                        sp["branch"] = len(branches) - 1
+                        found.append(sp)
+                        if (sp["type"] == "period_doubling" and switch and len(branches) < 4
+                                and nb <= 4 * n and smooth(sp)):
+                            todo.append(_doubled_start(sp, nb, y_fixed))
         finally:
             bar.close()
     wall = time.perf_counter() - wall0
     if status != "complete":
         warnings.warn(f"{status}: the branch so far is returned ({sum(map(len, branches))} "
                       "points; attrs['status'])", SplineWarning, stacklevel=2)
-    return continuation_dataset(base, prob, label, branches, specials, margin, k, dict(
+    return continuation_dataset(base, prob, label, branches, found, margin, k, dict(
         start=start, stop=stop, n=n, tol=tol, wall_s=wall, monodromy=monodromy, status=status,
         fallbacks="; ".join(prob.log) or "none", rejected_jumps=prob.jumps,
+        rejected_unlocated=prob.unlocated, diagnosed_grazings=prob.diagnosed,
         sundials_warnings=said["runs"],
         command=command or f"pyspline.continuation({base.name!r}, {label!r}, {start:g}, "
                            f"{stop:g}, n={n})"))
@@ -400,7 +421,9 @@ def _follow(br, u0, tau0, q_end, ds, ds_min, ds_max, max_angle, max_points, ibra
     [0, q_end] (the last point put on its end: 'complete'), max_points, or a step that fails
     below ds_min with every fallback (the other monodromy, then the other integrator): a
     sentence saying where and why. A converged point further from its predictor than the step
-    itself is a jump to another branch: a rejected step."""
+    itself, or whose contact sequence changed with no grazing located between (specials.graze),
+    is on another branch: a rejected step. A failed step whose predictor changes the contact
+    sequence is carried across the grazing (specials.diagnose) before it is shrunk."""
     prob = br.prob
     k = len(u0)
     e_q = np.eye(k)[-1]
@@ -408,10 +431,7 @@ def _follow(br, u0, tau0, q_end, ds, ds_min, ds_max, max_angle, max_points, ibra
         first = br.correct(u0, e_q, u0[-1])
         if first is None:
             _fail(br, u0, ds, "at the start")
-        u, F, J, M, y, it, hist = first
-        tau0 = np.sign(q_end) * e_q
-        pts = [br.point(u, J, M, y, it, hist, tau0)]
-        tau = pts[0]["tau"]
+        pts = [br.point(first, np.sign(q_end) * e_q)]
     else:                             # a doubled branch: off the point along tau0
         tau = tau0
         res = br.correct(u0 + ds * tau, tau, tau @ (u0 + ds * tau))
@@ -420,9 +440,7 @@ def _follow(br, u0, tau0, q_end, ds, ds_min, ds_max, max_angle, max_points, ibra
                           f"period doubling at {prob.name} = {prob.p_of(u0[-1]):.6g}",
                           SplineWarning, stacklevel=3)
             return [], "complete"
-        u, F, J, M, y, it, hist = res
-        pts = [br.point(u, J, M, y, it, hist, tau)]
-        tau = pts[0]["tau"]
+        pts = [br.point(res, tau)]
     bar.update(1)
     lo, hi = min(0.0, q_end), max(0.0, q_end)
     fallbacks = _fallbacks(prob)
@@ -431,20 +449,41 @@ def _follow(br, u0, tau0, q_end, ds, ds_min, ds_max, max_angle, max_points, ibra
         if late := out_of_time():
             return pts, f"{late} was reached at {prob.name} = {pts[-1]['p']:.6g}"
         a = pts[-1]
+        step = ds
         pred = a["u"] + ds * a["tau"]
         end = None
         if not lo - 1e-12 <= pred[-1] <= hi + 1e-12:
             end = hi if pred[-1] > hi else lo
-            res = br.correct(a["u"] + a["tau"] * (end - a["u"][-1]) / a["tau"][-1], e_q, end) \
-                if abs(a["tau"][-1]) > 1e-3 else None
+            res = None
+            if abs(a["tau"][-1]) > 1e-3:      # the last step: onto the end, the field fixed
+                step = (end - a["u"][-1]) / a["tau"][-1]
+                pred = a["u"] + step * a["tau"]
+                res = br.correct(pred, e_q, end)
         else:
             res = br.correct(pred, a["tau"], a["tau"] @ pred)
-        if res is not None and end is None and np.linalg.norm(res[0] - pred) > ds:
+        if res is not None and end is None and specials.far(res[0], pred, ds):
             br.last_hist, br.last_error = res[6], (
                 f"the corrector went {np.linalg.norm(res[0] - pred):.3g} from a predictor "
                 f"{ds:.3g} along the branch (another branch)")
             res, prob.jumps = None, prob.jumps + 1
-        if res is None:
+        new = None if res is None else br.point(res, a)
+        if new is not None and new["contact"]["signature"] != a["contact"]["signature"]:
+            loc = specials.graze(br, a, new, float(a["tau"] @ (new["u"] - a["u"])))
+            if loc is None:
+                br.last_hist, br.last_error = res[6], (
+                    f"the contact sequence changed ({a['contact']['switches']} to "
+                    f"{new['contact']['switches']} switches a period) with no grazing located "
+                    "between (another branch)")
+                new, prob.unlocated = None, prob.unlocated + 1
+            else:
+                new["grazing"] = loc[-1]
+        if new is None:
+            crossed = specials.diagnose(br, a, pred, step) if step > 0 else None
+            if crossed:
+                pts += crossed
+                bar.update(len(crossed))
+                prob.diagnosed += 1
+                continue
             ds /= 2
             if ds < ds_min:
                 if not fallbacks:
@@ -454,8 +493,7 @@ def _follow(br, u0, tau0, q_end, ds, ds_min, ds_max, max_angle, max_points, ibra
                                 f"{prob.case['method']} ({getattr(br, 'last_error', '')})")
                 ds, on_fallback = min(ds_max, 64 * ds_min), 5
             continue
-        u, F, J, M, y, it, hist = res
-        new = br.point(u, J, M, y, it, hist, a["tau"])
+        it = res[5]
         angle = np.arccos(np.clip(new["tau"] @ a["tau"], -1, 1))
         if angle > 2 * max_angle and ds > ds_min:      # the branch turns: a shorter step
             ds = max(ds_min, ds / 2)
@@ -513,107 +551,6 @@ def _where(br, u, ds, where):
         + (f" (last failure: {br.last_error})" if getattr(br, "last_error", "") else ""))
 
 
-# --------------------------------------------------------------------------- special points
-
-def _at(br, a, sigma):
-    """The branch point at arclength sigma from point a (along a's tangent)."""
-    tau = a["tau"]
-    pred = a["u"] + sigma * tau
-    res = br.correct(pred, tau, tau @ pred)
-    if res is None:
-        return None
-    u, F, J, M, y, it, hist = res
-    return br.point(u, J, M, y, it, hist, tau)
-
-
-def _locate_all(br, a, b, k):
-    """The special points between branch points a and b."""
-    out = []
-    sigma_b = float(a["tau"] @ (b["u"] - a["u"]))
-    if sigma_b <= 0:
-        return out
-    ta, tb = a["tests"], b["tests"]
-    for kind in ("fold", "period_doubling", "neimark_sacker"):
-        fa, fb = ta[kind], tb[kind]
-        if kind == "neimark_sacker" and ta["_pairs"] != tb["_pairs"]:
-            continue
-        if np.isfinite(fa) and np.isfinite(fb) and np.sign(fa) != np.sign(fb) and fa != 0:
-            sp = _secant(br, a, b, sigma_b, kind)
-            if sp is not None:
-                out.append(sp)
-    if a["contact"]["signature"] != b["contact"]["signature"]:
-        sp = _bisect_grazing(br, a, b, sigma_b)
-        if sp is not None:
-            out.append(sp)
-    return sorted(out, key=lambda s: s["sigma"])
-
-
-def _secant(br, a, b, sigma_b, kind, iters=12):
-    """Illinois secant on sigma for a test function's zero between a (sigma 0) and b."""
-    lo, hi, flo, fhi = 0.0, sigma_b, a["tests"][kind], b["tests"][kind]
-    best, side = (a if abs(flo) < abs(fhi) else b), 0
-    for _ in range(iters):
-        s = hi - fhi * (hi - lo) / (fhi - flo)
-        if not lo < s < hi:
-            s = (lo + hi) / 2
-        pt = _at(br, a, s)
-        if pt is None:
-            break
-        f = pt["tests"][kind]
-        best = pt
-        best["sigma"] = s
-        if np.sign(f) == np.sign(fhi):
-            hi, fhi = s, f
-            if side == -1:
-                flo /= 2
-            side = -1
-        else:
-            lo, flo = s, f
-            if side == 1:
-                fhi /= 2
-            side = 1
-        if hi - lo < 1e-6 * sigma_b:
-            break
-    best.setdefault("sigma", 0.0)
-    return _special(best, kind)
-
-
-def _bisect_grazing(br, a, b, sigma_b, iters=8):
-    lo, hi = 0.0, sigma_b
-    sig_a = a["contact"]["signature"]
-    best = b
-    best.setdefault("sigma", sigma_b)
-    for _ in range(iters):
-        s = (lo + hi) / 2
-        pt = _at(br, a, s)
-        if pt is None:
-            break
-        if pt["contact"]["signature"] == sig_a:
-            lo = s
-        else:
-            hi, best = s, pt
-            best["sigma"] = s
-    # the last point with a's contact sequence: its closest approach is the one that closes
-    last = _at(br, a, lo) if lo > 0 else a
-    sp = _special(best, "grazing")
-    sp["closest_approach"] = (last or a)["contact"]["closest_approach"]
-    return sp
-
-
-def _special(pt, kind):
-    mu = pt["mu"]
-    target = {"fold": 1.0, "period_doubling": -1.0}.get(kind)
-    if target is not None:
-        crit = mu[np.argmin(np.abs(mu - target))]
-    elif kind == "neimark_sacker":
-        pairs = mu[np.abs(mu.imag) > 1e-9]
-        crit = pairs[np.argmin(np.abs(np.abs(pairs) - 1))] if len(pairs) else np.nan
-    else:
-        crit = mu[0]
-    return dict(pt, type=kind, critical=complex(crit),
-                closest_approach=pt["contact"]["closest_approach"])
-
-
 # --------------------------------------------------------------------------- the dataset
 
 _POINT_VARS = {"Tm_pp": ("T_m peak-to-peak over the period", "N m"),
@@ -626,12 +563,12 @@ _POINT_VARS = {"Tm_pp": ("T_m peak-to-peak over the period", "N m"),
                "iterations": ("corrector iterations", "1")}
 
 
-def continuation_dataset(case, prob, label, branches, specials, margin, k, attrs):
+def continuation_dataset(case, prob, label, branches, found, margin, k, attrs):
     """The branches and special points as an xarray.Dataset (docs/continuation.md)."""
     import xarray as xr
     from .dataset import _field_attrs
     pts = [(ib, p) for ib, b in enumerate(branches) for p in b]
-    npt, nsp = len(pts), len(specials)
+    npt, nsp = len(pts), len(found)
     mu = np.full((npt, k), np.nan, complex)
     for i, (_, p) in enumerate(pts):
         mu[i, :len(p["mu"])] = p["mu"]
@@ -657,41 +594,31 @@ def continuation_dataset(case, prob, label, branches, specials, margin, k, attrs
                        {"long_name": f"1: every |mu| < 1 - {margin:g}"})}
     for key, (long, unit) in _POINT_VARS.items():
         data[key] = (("point",), col(key, rows), {"long_name": long, "units": unit})
-    crit = np.array([s["critical"] for s in specials], complex).reshape(nsp)
+    crit = np.array([s["critical"] for s in found], complex).reshape(nsp)
     data.update({
-        "special_type": (("special",), np.array([s["type"] for s in specials], dtype=object
+        "special_type": (("special",), np.array([s["type"] for s in found], dtype=object
                                                 ).astype(str) if nsp else np.zeros(0, "<U1"),
                          {"long_name": "special point: " + "; ".join(
                              f"{t}: {d}" for t, d in SPECIAL_TYPES.items())}),
-        f"special_{label}": (("special",), col("p", specials), fa),
-        "special_branch": (("special",), np.array([s["branch"] for s in specials], int)),
-        "special_n": (("special",), np.array([s["n"] for s in specials], int)),
+        f"special_{label}": (("special",), col("p", found), fa),
+        "special_branch": (("special",), np.array([s["branch"] for s in found], int)),
+        "special_n": (("special",), np.array([s["n"] for s in found], int)),
         "special_mu_real": (("special",), crit.real, {"long_name": "critical multiplier, real part"}),
         "special_mu_imag": (("special",), crit.imag, {"long_name": "critical multiplier, imaginary part"}),
-        "special_smooth": (("special",), np.array([_smooth(s) for s in specials], np.int8),
+        "special_smooth": (("special",), np.array([smooth(s) for s in found], np.int8),
                            {"long_name": "1: the critical multiplier is at +1, -1 or on the unit "
                                          "circle (within 0.01); 0: it jumped across (a "
                                          "non-smooth bifurcation, e.g. at a grazing)"}),
-        "special_y0": (("special", "state"), np.array([s["y"] for s in specials]).reshape(nsp, 14),
+        "special_y0": (("special", "state"), np.array([s["y"] for s in found]).reshape(nsp, 14),
                        {"long_name": "section state at t0 (SI)"}),
     })
     for key in ("Tm_pp", "F_max", "D2_pp", "closest_approach"):
         long, unit = _POINT_VARS[key]
-        data[f"special_{key}"] = (("special",), np.array([s[key] for s in specials], float),
+        data[f"special_{key}"] = (("special",), np.array([s[key] for s in found], float),
                                   {"long_name": long, "units": unit})
     ds = xr.Dataset(data, coords={"state": state})
     ds.attrs.update(case=case.text(), field=label, field_name=prob.name,
                     pyspline_version=_version(), n_points=npt, n_special=nsp,
                     n_branches=len(branches), **attrs)
     return ds
-
-
-def _smooth(sp) -> bool:
-    mu = sp["critical"]
-    target = {"fold": 1.0, "period_doubling": -1.0}.get(sp["type"])
-    if target is not None:
-        return abs(mu - target) < 1e-2
-    if sp["type"] == "neimark_sacker":
-        return abs(abs(mu) - 1) < 1e-2
-    return True
 

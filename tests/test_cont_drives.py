@@ -94,7 +94,17 @@ def test_s_curve_folds_where_the_follow_sweeps_jump(s_curve, follow_sweeps):
     """Two folds, each with a multiplier at +1, within 0.5 % of where the follow sweeps jump
     (up: off the full-contact branch at the upper fold; down: off the contact-loss branch at
     the lower fold); the branch is traced from start to stop and turns back only there."""
-    ds = s_curve
+    folds_at_the_jumps(s_curve, follow_sweeps)
+
+
+def test_erk_traces_the_s_curve(follow_sweeps):
+    """With ERK too (its map less smooth near a grazing: the null vector of the differenced
+    Jacobian put the predictor off the saddle branch, which stalled at 2436 r/min before the
+    predictor followed the secant): the whole S-curve, folds where the follow sweeps jump."""
+    folds_at_the_jumps(continued("erk"), follow_sweeps)
+
+
+def folds_at_the_jumps(ds, follow_sweeps):
     lo, hi = folds(ds)
     speeds, pp = follow_sweeps
     up = speeds[np.argmax(np.diff(pp[0])) + 1]      # the first speed on the upper branch
@@ -136,19 +146,22 @@ def test_s_curve_middle_branch_has_a_real_multiplier_beyond_one(s_curve):
     assert stable[:i1 - 1].all() and not stable[i1 + 1:i2].any() and stable[i2 + 1:].all()
 
 
-def test_a_step_onto_another_branch_is_rejected(monkeypatch):
-    """Inside the hysteresis two orbits coexist. A corrector made to converge on the upper
-    branch's orbit (as a long step across a fold can) lands far from its predictor: the step is rejected (attrs['rejected_jumps']), halved, and the full-contact
-    branch is still traced from start to stop; without the check the branch would go on along
-    the upper one (contact lost every revolution)."""
-    cont = importlib.import_module("pyspline.arclength")
+@pytest.fixture(scope="module")
+def upper_orbit():
+    """The upper branch's orbit at 2400 r/min (contact lost every revolution), continued down
+    from 2500 r/min, above the upper fold, where a 1 s run from the equilibrium settles on it."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pyspline.SplineWarning)
-        # above the upper fold one orbit: a 1 s run from the equilibrium settles on it
         upper = pyspline.continuation(DRIVE.replace(t_end=1.0), "speed_rpm", 2500, 2400,
                                       progress=False)
     assert upper.attrs["status"] == "complete" and (upper.switches > 0).all()
-    y_up = upper.y0.values[-1]
+    return upper.y0.values[-1]
+
+
+def onto_the_upper_orbit(monkeypatch, y_up):
+    """Makes the first corrector from a predictor within 2395-2415 r/min converge on the upper
+    orbit at 2400 r/min (as a long step across a fold can); the speeds it did so at."""
+    cont = importlib.import_module("pyspline.arclength")
     original, jumped = cont._Branch.correct, []
 
     def onto_the_upper_branch(self, u_pred, row, target):
@@ -159,7 +172,66 @@ def test_a_step_onto_another_branch_is_rejected(monkeypatch):
             row[-1] = 1
         return original(self, u_pred, row, target)
     monkeypatch.setattr(cont._Branch, "correct", onto_the_upper_branch)
-    ds = pyspline.continuation(DRIVE, "speed_rpm", 2380, 2420, progress=False)
-    assert jumped and ds.attrs["rejected_jumps"] == 1
+    return jumped
+
+
+def full_contact_to_the_end(ds):
     assert ds.attrs["status"] == "complete" and ds.speed_rpm[-1] == pytest.approx(2420, rel=1e-12)
     assert (ds.switches == 0).all() and np.all(np.diff(ds.speed_rpm) > 0)
+
+
+def test_a_step_onto_another_branch_is_rejected(monkeypatch, upper_orbit):
+    """Inside the hysteresis two orbits coexist. A corrector made to converge on the upper
+    branch's orbit lands far from its predictor: the step is rejected
+    (attrs['rejected_jumps']), halved, and the full-contact branch is still traced from start
+    to stop; without the check the branch would go on along the upper one."""
+    jumped = onto_the_upper_orbit(monkeypatch, upper_orbit)
+    ds = pyspline.continuation(DRIVE, "speed_rpm", 2380, 2420, progress=False)
+    assert jumped and ds.attrs["rejected_jumps"] == 1 and ds.attrs["rejected_unlocated"] == 0
+    full_contact_to_the_end(ds)
+
+
+def test_a_changed_contact_sequence_needs_its_grazing(monkeypatch, upper_orbit):
+    """The same jump with the distance check disabled: the converged point's contact sequence
+    (32 switches a period, from none) changed with no grazing located between (bisection on
+    the step finds the full-contact orbit up to the point, and the two either side of the
+    bracket a branch apart), so the step is rejected (attrs['rejected_unlocated']) and the
+    full-contact branch traced to the end."""
+    spec = importlib.import_module("pyspline.specials")
+    jumped = onto_the_upper_orbit(monkeypatch, upper_orbit)
+    monkeypatch.setattr(spec, "far", lambda u, pred, ds: False)
+    ds = pyspline.continuation(DRIVE, "speed_rpm", 2380, 2420, progress=False, detect=False)
+    assert jumped and ds.attrs["rejected_jumps"] == 0 and ds.attrs["rejected_unlocated"] == 1
+    full_contact_to_the_end(ds)
+
+
+def test_a_failed_step_across_the_grazing_is_diagnosed(monkeypatch):
+    """A step from the full-contact branch across the grazing (2436.05 r/min) whose corrector
+    is made to fail: the predicted orbit loses contact where the last point did not, so the
+    grazing is located by bisection on the step and the branch goes on past it
+    (attrs['diagnosed_grazings']), not by halving the step; the grazing and the end point are
+    those of the undisturbed continuation (whose step across converges, and whose grazing is
+    located by the same-branch check)."""
+    cont = importlib.import_module("pyspline.arclength")
+    original, failed = cont._Branch.correct, []
+
+    def fails_once_past_the_grazing(self, u_pred, row, target):
+        if not failed and self.prob.p_of(u_pred[-1]) > 2436.2:
+            failed.append(self.prob.p_of(u_pred[-1]))
+            self.last_hist = [np.nan]
+            return None
+        return original(self, u_pred, row, target)
+
+    def graze_to_end():
+        ds = pyspline.continuation(DRIVE, "speed_rpm", 2380, 2438, ds=0.25,
+                                   progress=False)
+        assert ds.attrs["status"] == "complete" and list(ds.special_type.values) == ["grazing"]
+        return ds
+    plain = graze_to_end()
+    monkeypatch.setattr(cont._Branch, "correct", fails_once_past_the_grazing)
+    ds = graze_to_end()
+    assert failed and ds.attrs["diagnosed_grazings"] == 1 and plain.attrs["diagnosed_grazings"] == 0
+    g, g0 = float(ds.special_speed_rpm[0]), float(plain.special_speed_rpm[0])
+    assert g == pytest.approx(grazing_closed_form(), abs=0.1) and g == pytest.approx(g0, abs=0.05)
+    s = scale_of(DRIVE)
+    assert np.abs((ds.y0.values[-1] - plain.y0.values[-1]) / s).max() < 1e-5

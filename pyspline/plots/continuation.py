@@ -19,7 +19,8 @@ MEASURES = {"Tm_pp": ("T_m peak-to-peak", "N m", lambda d: d["Tm_max"] - d["Tm_m
 SPECIAL_MARKS = {"fold": ("o", "#D55E00", "fold (mu = +1)"),
                  "period_doubling": ("s", "#009E73", "period doubling (mu = -1)"),
                  "neimark_sacker": ("D", "#CC79A7", "Neimark-Sacker (|mu| = 1, complex)"),
-                 "grazing": ("X", "0.15", "grazing (contact sequence changes)")}
+                 "grazing": ("X", "0.15", "grazing (contact sequence changes)"),
+                 "nonsmooth_fold": ("P", "#0072B2", "non-smooth fold (turns at a grazing)")}
 DIRECTION_MARKS = {"up": ("^", "#56B4E9", "follow up"), "down": ("v", "#E69F00", "follow down")}
 
 
