@@ -293,7 +293,8 @@ contains
   !> line each (blank if none): a nominal stress of tooth_stresses beyond its limit
   !> (sigma_root_limit, sigma_flank_limit, tau_pitch_limit); the contact temperature beyond
   !> scuffing_temp or tempering_temp (flash_warning). The executable prints them to
-  !> stderr, Python raises pyspline.SplineWarning (api_warnings stage 2): the same words.
+  !> stderr, Python raises pyspline.SplineWarning (api_simulate, through spline_run::
+  !> run_results): the same words.
   function stress_warnings(m, loads) result(text)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: loads(nload)
