@@ -254,12 +254,14 @@ def periodic_orbit(case, n: int = 1, guess=None, t0: float | None = None, tol: f
         try:
             y = _settled_state(model, t0, period) if guess is None else guess
             return _newton(model, n, t0, t1, y, tol, max_iter, margin, monodromy)
-        except SolverError as exc:
+        except SolverError:
             late = out_of_time()
             if not late:
                 raise
             raise OrbitError(f"case {case.name}: no period-{n} orbit found (period {period:.6g} "
-                             f"s from t0 = {t0:.6g} s): {late} was reached ({exc})") from None
+                             f"s from t0 = {t0:.6g} s): {late} was reached in a run of the "
+                             "map (the settling run of the default guess or a Newton step)"
+                             ) from None
 
 
 def _newton(model, n, t0, t1, y, tol, max_iter, margin, monodromy) -> Orbit:
