@@ -30,6 +30,7 @@ def test_stability_quick(tmp_path):
     assert all(r["status"] == "ok" for r in table if r["method"].startswith("CVODE"))
 
 
+@pytest.mark.xdist_group("numbalsoda")       # its peer: numbalsoda, imported once a worker
 def test_work_precision_quick(tmp_path):
     rows, notes = bench.work_precision(tmp_path, quick=True, progress=False)
     assert (tmp_path / "work_precision.png").stat().st_size > 20_000

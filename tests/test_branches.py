@@ -110,23 +110,24 @@ def test_bad_input_is_a_case_error():
 
 
 def test_cli_all_and_fold_input(tmp_path, every_branch):
-    """`pyspline continue --all` writes the branches (the Python call's folds), the seeding
-    sweep and the figure, exit 0; `--fold` the folds at one amplitude (the same) with the
-    follow sweeps' verdict (20 r/min steps: two orbits exactly between them); a --fold
-    without numbers is a CaseError naming it, exit 2."""
+    """`pyspline continue --all` writes the branches (the Python call's folds, from a seeding
+    sweep of 5 speeds over 2300-2500 r/min), the seeding sweep and the figure, exit 0; `--fold`
+    the folds at one amplitude (the same) with the follow sweeps' verdict (2320, 2400, 2480
+    r/min: two orbits exactly between the folds, 2354.6 and 2439.3); a --fold without numbers
+    is a CaseError naming it, exit 2."""
     import xarray as xr
     from test_continuation import cli
     path = tmp_path / "drive.nml"
     path.write_text(SETTLED.text())
-    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
-              "--stop", "2500", "--all", "--out", "out", "--quiet")
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2300",
+              "--stop", "2500", "--all", "--sweep", "5", "--out", "out", "--quiet")
     assert run.returncode == 0, run.stderr
     ds = xr.open_dataset(tmp_path / "out" / "branches.nc", engine="h5netcdf")
     assert folds(ds) == pytest.approx(folds(every_branch[0]), abs=1e-3)
     assert (tmp_path / "out" / "branches.png").stat().st_size > 10_000
-    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2300",
-              "--stop", "2500", "--fold", "ripple_amp(1)=0.25", "--check", "0.25", "--sweep",
-              "11", "--out", "fold", "--quiet")
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2320",
+              "--stop", "2480", "--fold", "ripple_amp(1)=0.25", "--check", "0.25", "--sweep",
+              "3", "--out", "fold", "--quiet")
     assert run.returncode == 0, run.stderr
     fc = xr.open_dataset(tmp_path / "fold" / "fold_curve.nc", engine="h5netcdf")
     assert fc.fold.values[0] == pytest.approx(folds(every_branch[0]), abs=1e-2)
