@@ -11,7 +11,7 @@ module spline_mesh
   implicit none
   private
   public :: mesh_eval, mesh_forces, mesh_outputs, mesh_switch_functions, coupling_stats_t, tooth_approach
-  public :: eq11_gradient, eq16_mode, eq16_root_mode, slice_offset
+  public :: eq11_gradient, eq16_mode, eq16_root_mode, eq16_root_directions, slice_offset
 
   integer, parameter :: max_coupling_iter = 60
   real(wp), parameter :: coupling_tol = 1.0e-14_wp   !< relative step tolerance on T_f
@@ -483,5 +483,19 @@ contains
     if (root_back == -1) new = -1
     if (root_back == 1) new = 0
   end function eq16_root_mode
+
+  !> The crossing directions of a contact's switch functions (g_drive, g_back) that change its
+  !> contact state mode by eq16_root_mode, as SUNDIALS' root directions (+1 rising, -1 falling):
+  !> g_drive falling if the drive flank is engaged (+1), else rising; g_back rising if the back
+  !> flank is engaged (-1), else falling. A crossing the other way leaves mode as it is (a
+  !> switch function at round-off level on a grazing tooth: located, it changed nothing but
+  !> cost a restart, and restarts there chained without end).
+  pure function eq16_root_directions(mode) result(dirs)
+    integer, intent(in) :: mode
+    integer :: dirs(2)
+    dirs = [1, -1]
+    if (mode == 1) dirs(1) = -1
+    if (mode == -1) dirs(2) = 1
+  end function eq16_root_directions
 
 end module spline_mesh
