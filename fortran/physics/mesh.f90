@@ -485,17 +485,23 @@ contains
   end function eq16_root_mode
 
   !> The crossing directions of a contact's switch functions (g_drive, g_back) that change its
-  !> contact state mode by eq16_root_mode, as SUNDIALS' root directions (+1 rising, -1 falling):
-  !> g_drive falling if the drive flank is engaged (+1), else rising; g_back rising if the back
-  !> flank is engaged (-1), else falling. A crossing the other way leaves mode as it is (a
-  !> switch function at round-off level on a grazing tooth: located, it changed nothing but
-  !> cost a restart, and restarts there chained without end).
+  !> contact state mode by eq16_root_mode, as SUNDIALS' root directions (+1 rising, -1 falling,
+  !> 0 either): free (0), g_drive rising and g_back falling; on the drive flank (+1), g_drive
+  !> falling, g_back either; on the back flank (-1), g_back rising, g_drive either. The other
+  !> way (a free tooth's g_drive falling, say) leaves the state as it is: at round-off level on a
+  !> grazing tooth such a crossing, located, changed nothing but cost a restart, and restarts
+  !> there chained without end (spline_solver::root_directions).
   pure function eq16_root_directions(mode) result(dirs)
     integer, intent(in) :: mode
     integer :: dirs(2)
-    dirs = [1, -1]
-    if (mode == 1) dirs(1) = -1
-    if (mode == -1) dirs(2) = 1
+    select case (mode)
+    case (1)
+      dirs = [-1, 0]
+    case (-1)
+      dirs = [0, 1]
+    case default
+      dirs = [1, -1]
+    end select
   end function eq16_root_directions
 
 end module spline_mesh
