@@ -120,7 +120,7 @@ class _Problem:
         self.rtol = case["rtol"]
         # dF/dp's difference step: rtol^(1/2), not the smooth optimum rtol^(1/3) (+-5 r/min
         # at 2400 r/min and rtol 1e-8), which straddles a grazing next to a fold and stalls
-        # Newton there (M is exact; dF/dp enters the step and the first tangent only)
+        # Newton there (M is exact; dF/dp enters the Newton step and the null-vector tangent)
         self.h = self.rtol ** 0.5
 
     def set_monodromy(self, monodromy):
