@@ -25,14 +25,16 @@ module spline_api
   use spline_run, only: run_case, tooth_quantities, output_times, run_warnings
   use spline_quantities, only: quantity_t, nstats, stat_q, ntooth_q, tooth_q, state_q, nout_q, &
        output_q, nload, load_q, nload_tooth, load_tooth_q
-  use spline_loads, only: run_loads, stress_warnings
+  use spline_loads, only: stress_warnings
+  use spline_realisations, only: copy_model, transient_state, run_copy, combined_loads, &
+       combined_stats
   use spline_sections, only: section_count
   use spline_lyapunov, only: lyapunov_count, lyapunov_benettin, lyapunov_tangent
   use spline_orbits, only: period_map, map_and_monodromy
   implicit none
   private
   public :: api_load_file, api_load_fields, api_load_text, api_read_text, api_model_size
-  public :: api_simulate
+  public :: api_simulate, api_transient, api_combine_stats
   public :: api_rhs, api_rhs_mesh, api_start_state, api_loads
   public :: api_output_times, api_model_info, api_defaults, api_names, api_tooth_stiffness
   public :: api_field_hint, api_warnings, api_period_map, api_map_monodromy, api_lyapunov
@@ -168,7 +170,8 @@ contains
     end if
     if (ierr /= err_ok) return
     model = transfer(m, model)
-    sizes = [m%z, m%n_out, section_count(m), lyapunov_count(m), merge(m%n_slices, 0, m%n_slices > 1)]
+    sizes = [m%z, m%n_out, section_count(copy_model(m)), lyapunov_count(m), &
+         merge(m%n_slices, 0, m%n_slices > 1)]       ! realisations > 1: one copy's
     warn = model_warnings(m)
   end subroutine load_model
 
@@ -233,10 +236,13 @@ contains
   !> tilt(nt, 2) (M_x, M_y) on spline 1 [N m]. nqw: the quantities written into tooth, 4 for a
   !> level without flash temperature or slices (F, F_x, F_y, dn; its c_j, T_f, r_c1, r_c2 are
   !> the constants consts, run_case's nq), else nq (consts 0).
+  !> A case with realisations = K > 1 runs copy `copy` (1..K) from ya, the state at the end of
+  !> the transient (api_transient), over its window (spline_realisations::run_copy).
   !> A SIGINT during the run stops it (ierr 4). Called without the GIL.
   subroutine api_simulate(model, nb, z, nt, nq, ns, nsec, nlyap, nft, nslice, t, y, tooth, tm, &
-       stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, nqw, consts, ierr, errmsg)
-    integer(c_int), intent(in) :: nb, z, nt, nq, ns, nsec, nlyap, nft, nslice
+       stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, nqw, consts, copy, ya, ierr, errmsg)
+    integer(c_int), intent(in) :: nb, z, nt, nq, ns, nsec, nlyap, nft, nslice, copy
+    real(c_double), intent(in) :: ya(14)
     integer(c_int), intent(in) :: model(nb)
     real(c_double), intent(out) :: t(nt), y(14, nt), tooth(nt, z, nq), tm(nt), stats(ns)
     real(c_double), intent(out) :: sec_t(nsec), sec_y(nsec, 14), lyap_t(nlyap), lyap_g(nlyap)
@@ -250,14 +256,21 @@ contains
     face = 0; tilt = 0; nqw = nq; consts = 0
     call unpack(model, m, ie, errmsg)
     if (ie == err_ok .and. (m%z /= z .or. m%n_out /= nt .or. nq /= ntooth_q .or. ns /= nstats &
-         .or. nsec /= section_count(m) .or. nlyap /= lyapunov_count(m) .or. &
+         .or. nsec /= section_count(copy_model(m)) .or. (m%realisations > 1 .and. &
+         (copy < 1 .or. copy > m%realisations)) .or. nlyap /= lyapunov_count(m) .or. &
          nslice /= merge(m%n_slices, 0, m%n_slices > 1) .or. nft /= merge(nt, 0, nslice > 0))) then
       ie = err_case
       errmsg = 'api_simulate: array sizes do not match the loaded case'
     end if
     if (ie == err_ok) then
       allocate(scol(nstate, nsec))
-      if (nslice > 0) then
+      if (m%realisations > 1 .and. nslice > 0) then
+        call run_copy(m, copy, ya, t, y, tooth, tm, stats, ie, errmsg, interruptible=.true., &
+             sec_t=sec_t, sec_y=scol, face=face, tilt=tilt, nq=nw, consts=consts)
+      else if (m%realisations > 1) then
+        call run_copy(m, copy, ya, t, y, tooth, tm, stats, ie, errmsg, interruptible=.true., &
+             sec_t=sec_t, sec_y=scol, nq=nw, consts=consts)
+      else if (nslice > 0) then
         call run_case(m, t, y, tooth, tm, stats, ie, errmsg, interruptible=.true., &
              sec_t=sec_t, sec_y=scol, lyap_t=lyap_t, lyap_g=lyap_g, face=face, tilt=tilt, &
              nq=nw, consts=consts)
@@ -292,9 +305,35 @@ contains
          ntl /= nload_tooth)) then
       ie = err_case; errmsg = 'api_loads: array sizes do not match the loaded case'
     end if
-    if (ie == err_ok) call run_loads(m, t, y, tooth, tm, loads, tload)
+    if (ie == err_ok) call combined_loads(m, t, y, tooth, tm, loads, tload)
     ierr = ie
   end subroutine api_loads
+
+  !> realisations = K > 1: the state ya at the end of the transient (spline_realisations), from
+  !> which api_simulate runs each copy. Called without the GIL.
+  subroutine api_transient(model, nb, ya, ierr, errmsg)
+    integer(c_int), intent(in) :: nb
+    integer(c_int), intent(in) :: model(nb)
+    real(c_double), intent(out) :: ya(14)
+    integer(c_int), intent(out) :: ierr
+    character(len=msglen), intent(out) :: errmsg
+    type(model_t) :: m
+    integer :: ie
+    ya = 0
+    call unpack(model, m, ie, errmsg)
+    if (ie == err_ok) call transient_state(m, ya, ie, errmsg, interruptible=.true.)
+    ierr = ie
+  end subroutine api_transient
+
+  !> The statistics of a case's K copies, stats(:, k) as api_simulate gives them
+  !> (spline_realisations::combined_stats).
+  subroutine api_combine_stats(ns, k, stats, st)
+    integer(c_int), intent(in) :: ns, k
+    real(c_double), intent(in) :: stats(ns, k)
+    real(c_double), intent(out) :: st(ns)
+    st = 0
+    if (ns == nstats .and. k > 0) call combined_stats(stats, st)
+  end subroutine api_combine_stats
 
   !> SI right-hand side dy/dt at (t, y) of a loaded model, contact states from the state:
   !> the project's Fortran RHS for solvers driven from Python (the benchmarks' peers).

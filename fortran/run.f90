@@ -59,8 +59,9 @@ contains
   !> nq, consts (both or neither): a run whose quantities c_j, T_f, r_c1, r_c2 (tooth_q 5..8)
   !> are the level's constants (no flash temperature, no slices) writes only tooth(:, :, 1:4),
   !> nq = 4, consts = (c_j, T_f, r_c1, r_c2); else every quantity, nq = ntooth_q, consts = 0.
+  !> y_start (optional): the start state at t0 instead of start_state's (a realisation's copy).
   subroutine run_case(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-       lyap_t, lyap_g, face, tilt, nq, consts)
+       lyap_t, lyap_g, face, tilt, nq, consts, y_start)
     type(model_t), intent(in) :: m
     real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
     real(wp), intent(out) :: tm(m%n_out), stats(nstats)
@@ -71,6 +72,7 @@ contains
     real(wp), intent(out), optional :: face(:, :, :), tilt(:, :)
     integer, intent(out), optional :: nq
     real(wp), intent(out), optional :: consts(ntooth_q - 4)
+    real(wp), intent(in), optional :: y_start(nstate)
     type(model_t) :: run
     real(wp) :: eps_lat, eps_th, closed, t_closed, cq(ntooth_q - 4), est(3)
     type(lib_log_t) :: lib                   !< SUNDIALS' warnings over the call's runs
@@ -124,13 +126,13 @@ contains
     !> its flash temperature's estimate exceeds auto_tol).
     subroutine run_once()
     call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-         face, tilt, present(nq), nw, cq, fin, lib)
+         face, tilt, present(nq), nw, cq, fin, lib, y_start)
     if (ierr == err_ok .and. m%auto .and. m%thermal == thermal_coupled .and. nw >= iq_tf) then
       eps_th = backlash_estimate(m, maxval(abs(tooth(:, :, iq_tf))))
       if (eps_th > auto_tol(m)) then
         call set_thermal_level(run, thermal_coupled)
         call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-             face, tilt, present(nq), nw, cq, fin, lib)
+             face, tilt, present(nq), nw, cq, fin, lib, y_start)
       end if
     end if
     end subroutine run_once
@@ -346,9 +348,9 @@ contains
   end function restart_warning
 
   !> One run of the model at the level m sets (lazy, nw, consts: run_case's nq, consts; fin:
-  !> tooth_outputs' finite).
+  !> tooth_outputs' finite; y_start: run_case's).
   subroutine run_level(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-       face, tilt, lazy, nw, consts, fin, lib)
+       face, tilt, lazy, nw, consts, fin, lib, y_start)
     type(model_t), intent(in) :: m
     real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
     real(wp), intent(out) :: tm(m%n_out), stats(nstats)
@@ -361,6 +363,7 @@ contains
     real(wp), intent(out) :: consts(ntooth_q - 4)
     logical, intent(out) :: fin
     type(lib_log_t), intent(inout), optional :: lib   !< SUNDIALS' warnings, counted on
+    real(wp), intent(in), optional :: y_start(nstate)
     real(wp) :: y0(nstate)
     real(wp), allocatable :: ts(:), ysec(:, :)
     integer, allocatable :: modes(:, :)
@@ -371,7 +374,11 @@ contains
     t = 0.0_wp; y = 0.0_wp
     allocate(modes(m%z*m%n_slices, m%n_out))
     call output_times(m, t)
-    call start_state(m, y0, ierr, errmsg)
+    if (present(y_start)) then
+      y0 = y_start; ierr = err_ok
+    else
+      call start_state(m, y0, ierr, errmsg)
+    end if
     if (ierr == err_ok) call integrate_level()
     ! tooth and tm are zero where the run did not reach (every output is written otherwise)
     if (ierr /= err_ok) then

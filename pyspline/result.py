@@ -6,8 +6,10 @@ but errors, so that case and core both build on it.
 """
 from __future__ import annotations
 
+import concurrent.futures as cf
 import contextlib
 import functools
+import os
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -267,17 +269,60 @@ class Result:
 
 
 
-def run(model) -> Result:
-    """Run a loaded Model (pyspline.simulate: any case) and return a Result. Raises CaseError, SolverError or ThermalInterferenceError with a message naming the
-    case; KeyboardInterrupt if SIGINT arrives during the run. Releases the GIL while it runs."""
-    q, s = _names("tooth"), _names("stats")
-    t0 = time.perf_counter()
+class SerialExecutor(cf.Executor):
+    """An executor that runs each call at once in the caller's thread (a sweep's point: the
+    sweep's workers are its parallelism)."""
+
+    def submit(self, fn, /, *args, **kwargs):
+        f = cf.Future()
+        f.set_result(fn(*args, **kwargs))
+        return f
+
+
+def _simulate(model, copy: int = 0, ya=None) -> tuple:
+    """api_simulate on a loaded Model (copy k of realisations = K > 1 from ya, the state at the
+    end of the transient): (t, y columns, tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face,
+    tilt, nqw, consts, ierr, msg). Module level, so a process executor can take it."""
+    nq, ns = len(_names("tooth")), len(_names("stats"))
     nft = model.n_out if model.n_slices else 0
     # the per-tooth array (the largest) is allocated here, not zeroed (f2py zeroes its own)
-    tooth = np.empty((model.n_out, model.z, len(q)), order="F")
-    t, ycol, tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, nqw, consts, ierr, msg = \
-        _api.api_simulate(model.bytes, model.z, model.n_out, len(q), len(s), model.n_section,
-                          model.n_lyapunov, nft, model.n_slices, tooth)
+    tooth = np.empty((model.n_out, model.z, nq), order="F")
+    return _api.api_simulate(model.bytes, model.z, model.n_out, nq, ns, model.n_section,
+                             model.n_lyapunov, nft, model.n_slices, tooth, copy,
+                             np.zeros(14) if ya is None else ya)
+
+
+def _copies(model, executor) -> tuple:
+    """realisations = K > 1 (docs/accuracy.md): the transient, then the K copies on the executor
+    (None: a thread each, at most os.cpu_count(); the core releases the GIL), their outputs one
+    after another and their statistics combined (spline_realisations, as spline-dyn)."""
+    k = model.case["realisations"]
+    ya, ierr, msg = _api.api_transient(model.bytes)
+    raise_for(ierr, msg)
+    own = executor is None
+    if own:
+        executor = cf.ThreadPoolExecutor(min(k, os.cpu_count() or 1))
+    try:
+        outs = list(executor.map(_simulate, [model] * k, range(1, k + 1), [ya] * k))
+    finally:
+        if own:
+            executor.shutdown()
+    for o in outs:
+        run_outcome(o[-2], o[-1])            # the first failed copy raises, each one's warnings
+    cat = [np.concatenate([o[i] for o in outs], axis=1 if i == 1 else 0) for i in range(11)]
+    cat[4] = _api.api_combine_stats(np.stack([o[4] for o in outs], axis=1))
+    return (*cat, outs[0][11], outs[0][12], 0, b"")
+
+
+def run(model, executor=None) -> Result:
+    """Run a loaded Model (pyspline.simulate: any case) and return a Result. Raises CaseError, SolverError or ThermalInterferenceError with a message naming the
+    case; KeyboardInterrupt if SIGINT arrives during the run. Releases the GIL while it runs.
+    realisations = K > 1: the copies run on `executor` (None: threads), their outputs one
+    after another in the Result (t restarts at each copy's start)."""
+    q, s = _names("tooth"), _names("stats")
+    t0 = time.perf_counter()
+    out = _copies(model, executor) if model.case["realisations"] > 1 else _simulate(model)
+    t, ycol, tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, nqw, consts, ierr, msg = out
     wall = time.perf_counter() - t0
     run_outcome(ierr, msg)
     y = ycol.T                # (nt, 14), a view of the core's columns (no transposed copy)
