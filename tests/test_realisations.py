@@ -9,6 +9,7 @@ import pytest
 
 import pyspline
 from conftest import CASES, assert_executable_matches_python
+from pyspline.cli import _summary
 
 
 def chaos(**fields):
@@ -45,6 +46,7 @@ def test_realisations_combine_to_one_long_runs_statistics():
         assert 0 < three.loads[se] < np.inf, se
         spread = np.hypot(one.loads[se], three.loads[se])
         assert abs(value(three) - value(one)) <= 3 * spread, se
+    assert "; 3 realisations, standard errors from their spread" in _summary(three)
 
 
 def test_executable_gives_the_realisations_of_python(exe, tmp_path):
