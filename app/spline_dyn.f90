@@ -30,7 +30,7 @@ program spline_dyn
        il_sigma_flank, il_tau_pitch, il_batches, il_tm_rms_se, il_sharing_rev, il_sharing_rev_se, &
        il_free_mean_se, il_impacts_rev_se, il_tf_rev, il_tf_rev_se, il_stress_ratio
   use spline_loads, only: stress_warnings
-  use spline_realisations, only: copy_model, transient_state, run_copy, combined_loads, &
+  use spline_realisations, only: copy_model, copy_start, transient_state, combined_loads, &
        combined_stats
   use spline_sections, only: section_count
   use spline_lyapunov, only: lyapunov_count
@@ -336,9 +336,10 @@ contains
     !$omp parallel do schedule(static, 1) private(a)
     do kk = 1, m%realisations
       a = (kk - 1)*n
-      call run_copy(m, kk, ya, t(a + 1:a + n), y(:, a + 1:a + n), tooth(a + 1:a + n, :, :), &
+      call run_case(copy_model(m), t(a + 1:a + n), y(:, a + 1:a + n), tooth(a + 1:a + n, :, :), &
            tm(a + 1:a + n), st(:, kk), ie(kk), msg(kk), interruptible=.true., &
-           sec_t=sec_t((kk - 1)*ns + 1:kk*ns), sec_y=sec_y(:, (kk - 1)*ns + 1:kk*ns))
+           sec_t=sec_t((kk - 1)*ns + 1:kk*ns), sec_y=sec_y(:, (kk - 1)*ns + 1:kk*ns), &
+           y_start=copy_start(kk, ya))
     end do
     !$omp end parallel do
     call combined_stats(st, stats)

@@ -189,7 +189,7 @@ def _race_pointwise(scene, case, accuracies, peer, repeat, quick, progress):
         for i, rt in enumerate(rungs):
             rec = dict(scene=scene, side=side, setting=label, atol_ratio=ar, rtol=rt, kind="scan")
             try:
-                cpu, wall, _, F = runner(side, kw, rt, rt * ar)
+                cpu, wall, _, F, _ = runner(side, kw, rt, rt * ar)
                 rec.update(cpu_s=cpu, wall_s=wall, err=float(np.abs(F - ref.F).max() / fmax))
             except Exception as exc:     # noqa: BLE001  (a failed run is kept, with its reason)
                 cpu = 0.0

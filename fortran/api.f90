@@ -26,7 +26,7 @@ module spline_api
   use spline_quantities, only: quantity_t, nstats, stat_q, ntooth_q, tooth_q, state_q, nout_q, &
        output_q, nload, load_q, nload_tooth, load_tooth_q
   use spline_loads, only: stress_warnings
-  use spline_realisations, only: copy_model, transient_state, run_copy, combined_loads, &
+  use spline_realisations, only: copy_model, copy_start, transient_state, combined_loads, &
        combined_stats
   use spline_sections, only: section_count
   use spline_lyapunov, only: lyapunov_count, lyapunov_benettin, lyapunov_tangent
@@ -34,7 +34,7 @@ module spline_api
   implicit none
   private
   public :: api_load_file, api_load_fields, api_load_text, api_read_text, api_model_size
-  public :: api_simulate, api_transient, api_combine_stats
+  public :: api_simulate, api_combine_stats
   public :: api_rhs, api_rhs_mesh, api_start_state, api_loads
   public :: api_output_times, api_model_info, api_defaults, api_names, api_tooth_stiffness
   public :: api_field_hint, api_warnings, api_period_map, api_map_monodromy, api_lyapunov
@@ -237,7 +237,7 @@ contains
   !> level without flash temperature or slices (F, F_x, F_y, dn; its c_j, T_f, r_c1, r_c2 are
   !> the constants consts, run_case's nq), else nq (consts 0).
   !> A case with realisations = K > 1 runs copy `copy` (1..K) from ya, the state at the end of
-  !> the transient (api_transient), over its window (spline_realisations::run_copy).
+  !> the transient (api_start_state), over its window (spline_realisations).
   !> A SIGINT during the run stops it (ierr 4). Called without the GIL.
   subroutine api_simulate(model, nb, z, nt, nq, ns, nsec, nlyap, nft, nslice, t, y, tooth, tm, &
        stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, nqw, consts, copy, ya, ierr, errmsg)
@@ -265,11 +265,12 @@ contains
     if (ie == err_ok) then
       allocate(scol(nstate, nsec))
       if (m%realisations > 1 .and. nslice > 0) then
-        call run_copy(m, copy, ya, t, y, tooth, tm, stats, ie, errmsg, interruptible=.true., &
-             sec_t=sec_t, sec_y=scol, face=face, tilt=tilt, nq=nw, consts=consts)
+        call run_case(copy_model(m), t, y, tooth, tm, stats, ie, errmsg, interruptible=.true., &
+             sec_t=sec_t, sec_y=scol, face=face, tilt=tilt, nq=nw, consts=consts, &
+             y_start=copy_start(copy, ya))
       else if (m%realisations > 1) then
-        call run_copy(m, copy, ya, t, y, tooth, tm, stats, ie, errmsg, interruptible=.true., &
-             sec_t=sec_t, sec_y=scol, nq=nw, consts=consts)
+        call run_case(copy_model(m), t, y, tooth, tm, stats, ie, errmsg, interruptible=.true., &
+             sec_t=sec_t, sec_y=scol, nq=nw, consts=consts, y_start=copy_start(copy, ya))
       else if (nslice > 0) then
         call run_case(m, t, y, tooth, tm, stats, ie, errmsg, interruptible=.true., &
              sec_t=sec_t, sec_y=scol, lyap_t=lyap_t, lyap_g=lyap_g, face=face, tilt=tilt, &
@@ -308,22 +309,6 @@ contains
     if (ie == err_ok) call combined_loads(m, t, y, tooth, tm, loads, tload)
     ierr = ie
   end subroutine api_loads
-
-  !> realisations = K > 1: the state ya at the end of the transient (spline_realisations), from
-  !> which api_simulate runs each copy. Called without the GIL.
-  subroutine api_transient(model, nb, ya, ierr, errmsg)
-    integer(c_int), intent(in) :: nb
-    integer(c_int), intent(in) :: model(nb)
-    real(c_double), intent(out) :: ya(14)
-    integer(c_int), intent(out) :: ierr
-    character(len=msglen), intent(out) :: errmsg
-    type(model_t) :: m
-    integer :: ie
-    ya = 0
-    call unpack(model, m, ie, errmsg)
-    if (ie == err_ok) call transient_state(m, ya, ie, errmsg, interruptible=.true.)
-    ierr = ie
-  end subroutine api_transient
 
   !> The statistics of a case's K copies, stats(:, k) as api_simulate gives them
   !> (spline_realisations::combined_stats).
@@ -379,9 +364,11 @@ contains
     ierr = ie
   end subroutine api_rhs_mesh
 
-  !> The start state of a loaded model (SI): static equilibrium or rest, plus dq0, dv0.
-  subroutine api_start_state(model, nb, y, ierr, errmsg)
-    integer(c_int), intent(in) :: nb
+  !> The start state of a loaded model (SI): static equilibrium or rest, plus dq0, dv0; with
+  !> transient = 1 the state at the end of the transient (spline_realisations::transient_state,
+  !> from which realisations = K > 1 runs its copies; a SIGINT stops it, ierr 4).
+  subroutine api_start_state(model, nb, transient, y, ierr, errmsg)
+    integer(c_int), intent(in) :: nb, transient
     integer(c_int), intent(in) :: model(nb)
     real(c_double), intent(out) :: y(14)
     integer(c_int), intent(out) :: ierr
@@ -390,7 +377,11 @@ contains
     integer :: ie
     y = 0
     call unpack(model, m, ie, errmsg)
-    if (ie == err_ok) call start_state(m, y, ie, errmsg)
+    if (ie == err_ok .and. transient == 1) then
+      call transient_state(m, y, ie, errmsg, interruptible=.true.)
+    else if (ie == err_ok) then
+      call start_state(m, y, ie, errmsg)
+    end if
     ierr = ie
   end subroutine api_start_state
 

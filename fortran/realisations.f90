@@ -3,7 +3,8 @@
 !> with each component multiplied by 1 + d0 u_ki (copy 1 unperturbed; u_ki in [-1, 1) from a hash
 !> of k and i: the same bits on every machine and thread). Their statistics are combined, with
 !> standard errors from the spread between the copies. The executable runs the copies on OpenMP
-!> threads, Python on its executor: both call transient_state, run_copy and combined_loads.
+!> threads, Python on its executor: both run copy k as spline_run::run_case(copy_model(m), ...,
+!> y_start = copy_start(k, transient_state)) and combine with combined_loads, combined_stats.
 module spline_realisations
   use spline_kinds, only: wp
   use spline_errors, only: err_ok
@@ -23,7 +24,7 @@ module spline_realisations
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   implicit none
   private
-  public :: copy_model, transient_state, copy_start, run_copy, combined_loads, combined_stats
+  public :: copy_model, transient_state, copy_start, combined_loads, combined_stats
   public :: realisation_d0
 
   !> the relative perturbation of a copy's start state: tiny against the state, yet a chaotic
@@ -32,7 +33,7 @@ module spline_realisations
 
 contains
 
-  !> A copy of m: from t0 + t_transient (no transient) over its window, without the exponent.
+  !> A copy of m: from t0 + t_transient (no transient) over its window (m%n_out outputs).
   pure function copy_model(m) result(mk)
     type(model_t), intent(in) :: m
     type(model_t) :: mk
@@ -75,25 +76,6 @@ contains
       y0(i) = ya(i)*(1.0_wp + realisation_d0*(real(h, wp)/2147483648.0_wp - 1.0_wp))
     end do
   end function copy_start
-
-  !> Copy k of m (m%realisations copies) from ya, the state at the transient's end: run_case's
-  !> outputs over the copy's window (m%n_out of them).
-  subroutine run_copy(m, k, ya, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, &
-       sec_y, face, tilt, nq, consts)
-    type(model_t), intent(in) :: m
-    integer, intent(in) :: k
-    real(wp), intent(in) :: ya(nstate)
-    real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
-    real(wp), intent(out) :: tm(m%n_out), stats(nstats)
-    integer, intent(out) :: ierr
-    character(len=*), intent(out) :: errmsg
-    logical, intent(in), optional :: interruptible
-    real(wp), intent(out), optional :: sec_t(:), sec_y(:, :), face(:, :, :), tilt(:, :)
-    integer, intent(out), optional :: nq
-    real(wp), intent(out), optional :: consts(ntooth_q - 4)
-    call run_case(copy_model(m), t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, &
-         sec_y, face=face, tilt=tilt, nq=nq, consts=consts, y_start=copy_start(k, ya))
-  end subroutine run_copy
 
   !> The statistics of K runs (stats(:, k), K = size(stats, 2)): the counters and core time
   !> summed, the rest copy 1's.

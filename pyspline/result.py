@@ -297,7 +297,7 @@ def _copies(model, executor) -> tuple:
     (None: a thread each, at most os.cpu_count(); the core releases the GIL), their outputs one
     after another and their statistics combined (spline_realisations, as spline-dyn)."""
     k = model.case["realisations"]
-    ya, ierr, msg = _api.api_transient(model.bytes)
+    ya, ierr, msg = _api.api_start_state(model.bytes, 1)
     raise_for(ierr, msg)
     own = executor is None
     if own:
