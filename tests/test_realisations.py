@@ -81,3 +81,14 @@ def test_executable_gives_the_realisations_of_python(exe, tmp_path):
 def test_bad_realisations_are_refused_naming_the_field(fields, message):
     with pytest.raises(pyspline.CaseError, match=message):
         chaos(**fields).model
+
+
+def test_sweep_points_run_their_copies():
+    """A sweep's point runs its copies one after another: the numbers of simulate's threads."""
+    case = chaos(t_transient=0.05, t_end=0.15, n_out=1001, realisations=2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds = pyspline.sweep(case, l_x=[1.5e-4, 2e-4], progress=False)
+    one = simulate(case.replace(l_x=2e-4))
+    for name in ("Tm_rms_se", "impacts_per_rev"):
+        assert ds[name].sel(l_x=2e-4).item() == one.loads[name], name
