@@ -26,8 +26,8 @@ module spline_api
   use spline_quantities, only: quantity_t, nstats, stat_q, ntooth_q, tooth_q, state_q, nout_q, &
        output_q, nload, load_q, nload_tooth, load_tooth_q
   use spline_loads, only: stress_warnings
-  use spline_realisations, only: copy_model, copy_start, transient_state, combined_loads, &
-       combined_stats
+  use spline_realisations, only: copy_model, copy_start, run_sections, transient_state, &
+       combined_loads, combined_stats
   use spline_sections, only: section_count
   use spline_lyapunov, only: lyapunov_count, lyapunov_benettin, lyapunov_tangent
   use spline_orbits, only: period_map, map_and_monodromy
@@ -170,7 +170,7 @@ contains
     end if
     if (ierr /= err_ok) return
     model = transfer(m, model)
-    sizes = [m%z, m%n_out, section_count(copy_model(m)), lyapunov_count(m), &
+    sizes = [m%z, m%n_out, run_sections(m), lyapunov_count(m), &
          merge(m%n_slices, 0, m%n_slices > 1)]       ! realisations > 1: one copy's
     warn = model_warnings(m)
   end subroutine load_model
@@ -256,7 +256,7 @@ contains
     face = 0; tilt = 0; nqw = nq; consts = 0
     call unpack(model, m, ie, errmsg)
     if (ie == err_ok .and. (m%z /= z .or. m%n_out /= nt .or. nq /= ntooth_q .or. ns /= nstats &
-         .or. nsec /= section_count(copy_model(m)) .or. (m%realisations > 1 .and. &
+         .or. nsec /= run_sections(m) .or. (m%realisations > 1 .and. &
          (copy < 1 .or. copy > m%realisations)) .or. nlyap /= lyapunov_count(m) .or. &
          nslice /= merge(m%n_slices, 0, m%n_slices > 1) .or. nft /= merge(nt, 0, nslice > 0))) then
       ie = err_case

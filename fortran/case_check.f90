@@ -314,7 +314,7 @@ contains
         call fail('realisations', '= '//itoa(c%realisations)//' with lyapunov = .true.: the '// &
              'exponent is a property of one trajectory; set realisations = 1'); return
       end if
-      if (n_out/c%realisations < 2) then
+      if (c%realisations > 1 .and. n_out/c%realisations < 2) then
         call fail('realisations', '= '//itoa(c%realisations)//' leaves fewer than 2 of the '// &
              itoa(n_out)//' outputs to each copy: at most '//itoa(max(n_out/2, 1)))
         return
