@@ -92,3 +92,13 @@ def test_sweep_points_run_their_copies():
     one = simulate(case.replace(l_x=2e-4))
     for name in ("Tm_rms_se", "impacts_per_rev"):
         assert ds[name].sel(l_x=2e-4).item() == one.loads[name], name
+
+
+def test_section_instants_of_one_run_and_of_copies():
+    """The transient ends on a section instant (chaos_z24's shaft period is 0.01 s): one run keeps
+    it, a copy starts there and leaves it out; the arrays hold exactly the points run."""
+    case = chaos(t_transient=0.05, t_end=0.1, n_out=101, section="shaft")
+    one, two = simulate(case), simulate(case.replace(realisations=2))
+    assert len(one.section_t) == pyspline.load(case).n_section == 6
+    assert one.section_t[0] == pytest.approx(0.05)
+    np.testing.assert_allclose(two.section_t, [0.06, 0.07, 0.06, 0.07])

@@ -13,11 +13,12 @@ module spline_realisations
   use spline_model, only: model_t, nstate
   use spline_run, only: run_case
   use spline_dynamics, only: start_state
+  use spline_sections, only: section_count
   use spline_quantities, only: nstats, ntooth_q, nsolver_stats, ist_core_wall, ist_last_step, &
        ist_coupling_residual, ist_coupling_iterations, ist_linear_tail_t
   implicit none
   private
-  public :: copy_model, transient_state, copy_start, combined_stats
+  public :: copy_model, run_sections, transient_state, copy_start, combined_stats
   public :: realisation_d0
 
   !> the relative perturbation of a copy's start state: tiny against the state, yet a chaotic
@@ -33,6 +34,17 @@ contains
     mk = m
     mk%t0 = m%t0 + m%t_transient; mk%t_transient = 0.0_wp
   end function copy_model
+
+  !> The Poincare section points of one run of m (of one copy with realisations > 1, which
+  !> leaves out a section instant at the transient's end, where its run starts).
+  pure integer function run_sections(m) result(n)
+    type(model_t), intent(in) :: m
+    if (m%realisations > 1) then
+      n = section_count(copy_model(m))
+    else
+      n = section_count(m)
+    end if
+  end function run_sections
 
   !> The state at the end of m's transient, t0 + t_transient (the start state if there is none).
   subroutine transient_state(m, ya, ierr, errmsg, interruptible)

@@ -25,7 +25,8 @@ module spline_api
   use spline_run, only: run_case, run_results, tooth_quantities, output_times
   use spline_quantities, only: quantity_t, nstats, stat_q, ntooth_q, tooth_q, state_q, nout_q, &
        output_q, nload, load_q, nload_tooth, load_tooth_q, nextreme, extreme_q
-  use spline_realisations, only: copy_model, copy_start, transient_state, combined_stats
+  use spline_realisations, only: copy_model, copy_start, run_sections, transient_state, &
+       combined_stats
   use spline_sections, only: section_count
   use spline_lyapunov, only: lyapunov_count, lyapunov_benettin, lyapunov_tangent
   use spline_orbits, only: period_map, map_and_monodromy
@@ -168,21 +169,10 @@ contains
     end if
     if (ierr /= err_ok) return
     model = transfer(m, model)
-    sizes = [m%z, m%n_out, call_sections(m), lyapunov_count(m), &
+    sizes = [m%z, m%n_out, run_sections(m), lyapunov_count(m), &
          merge(m%n_slices, 0, m%n_slices > 1)]       ! realisations > 1: one copy's
     warn = model_warnings(m)
   end subroutine load_model
-
-  !> The Poincare section points of one api_simulate call: the run's, or with realisations = K > 1
-  !> one copy's (from the transient's end, itself not a point of the copy: sections are after t0).
-  integer function call_sections(m) result(n)
-    type(model_t), intent(in) :: m
-    if (m%realisations > 1) then
-      n = section_count(copy_model(m))
-    else
-      n = section_count(m)
-    end if
-  end function call_sections
 
   !> The case field nearest to a misspelt name (blank if none is near): the suggestion of the
   !> reader's 'did you mean', for the fields Python is given as a dict.
@@ -250,7 +240,7 @@ contains
     face = 0; tilt = 0; nqw = nq; consts = 0; loads = 0; tload = 0; ext = 0; warnings = ''
     call unpack(model, m, ie, errmsg)
     if (ie == err_ok .and. (m%z /= z .or. m%n_out /= nt .or. nq /= ntooth_q .or. ns /= nstats &
-         .or. nsec /= call_sections(m) .or. (m%realisations > 1 .and. &
+         .or. nsec /= run_sections(m) .or. (m%realisations > 1 .and. &
          (copy < 1 .or. copy > m%realisations)) .or. nlyap /= lyapunov_count(m) .or. &
          nslice /= merge(m%n_slices, 0, m%n_slices > 1) .or. nft /= merge(nt, 0, nslice > 0) &
          .or. nl /= nload .or. ntl /= nload_tooth .or. nx /= nextreme)) then

@@ -30,7 +30,8 @@ program spline_dyn
        il_sigma_flank, il_tau_pitch, il_batches, il_tm_rms_se, il_sharing_rev, il_sharing_rev_se, &
        il_free_mean_se, il_impacts_rev_se, il_tf_rev, il_tf_rev_se, il_stress_ratio, nextreme, &
        extreme_q
-  use spline_realisations, only: copy_model, copy_start, transient_state, combined_stats
+  use spline_realisations, only: copy_model, copy_start, run_sections, transient_state, &
+       combined_stats
   use spline_sections, only: section_count
   use spline_lyapunov, only: lyapunov_count
   implicit none
@@ -327,7 +328,7 @@ contains
     real(wp) :: ya(nstate), st(nstats, m%realisations)
     integer :: kk, a, ns, ie(m%realisations)
     character(len=msglen) :: msg(m%realisations)
-    ns = section_count(copy_model(m))
+    ns = run_sections(m)
     allocate(sec_t(ns*m%realisations), sec_y(nstate, ns*m%realisations), lyap_t(0), lyap_g(0))
     call transient_state(m, ya, ierr, errmsg, interruptible=.true.)
     if (ierr /= err_ok) return
