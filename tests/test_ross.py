@@ -2,7 +2,7 @@
 ross/gear_element.py: Ma et al. 2014 slice beam + Sainsot et al. 2004 fillet foundation).
 
 No package build: tests/stiffness_check.f90 is compiled with gfortran into tmp_path (with
-fortran/kinds.f90 and fortran/stiffness.f90) and its '@' lines (key=value) are parsed. ROSS is a
+fortran/kinds.f90, errors.f90 and stiffness.f90) and its '@' lines (key=value) are parsed. ROSS is a
 test-only dependency: the module is skipped if it is missing or does not import (ross 2.3.0 does
 not import with plotly >= 6: its theme names the removed 'scattermapbox'; plotly < 6 works).
 
@@ -49,7 +49,8 @@ def check(tmp_path_factory):
         pytest.skip("gfortran not found")
     tmp = tmp_path_factory.mktemp("stiffness_check")
     exe = tmp / "stiffness_check"
-    src = [ROOT / "fortran" / "kinds.f90", ROOT / "fortran" / "stiffness.f90",
+    src = [ROOT / "fortran" / "kinds.f90", ROOT / "fortran" / "errors.f90",
+           ROOT / "fortran" / "stiffness.f90",
            ROOT / "tests" / "stiffness_check.f90"]
     subprocess.run([fc, "-O2", "-J", str(tmp), *map(str, src), "-o", str(exe)], check=True,
                    cwd=tmp, capture_output=True, text=True)
