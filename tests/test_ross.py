@@ -30,8 +30,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 # ROSS takes 11 s of CPU to import: imported by the first test that runs, not at collection
-# (every pytest-xdist worker collects every module), and these tests kept on one worker
-pytestmark = pytest.mark.xdist_group("ross")
+# (every pytest-xdist worker collects every module)
 ge = Material = None
 
 
