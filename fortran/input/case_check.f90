@@ -5,12 +5,12 @@
 !> here; the order of the checks decides which message a case with several faults gets.
 module spline_case_check
   use spline_kinds, only: wp, pi, max_teeth
-  use spline_errors, only: err_ok, err_case, itoa
+  use spline_errors, only: err_ok, err_case, itoa, num
   use spline_case_type, only: case_t, fields, nfields, field_index, ndof_case, nripple, &
        option_index, case_output_bytes, case_run_times, max_output_bytes, thermal_values, method_values, &
        nonlinear_values, start_values, fidelity_values, jacobian_values, section_values, &
        lyapunov_method_values, goal_values
-  use spline_case_text, only: num, size_text
+  use spline_case_text, only: size_text
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private

@@ -5,7 +5,7 @@
 !> thermal levels that have it, Eqs. 1-7) at every output time, and the checks of the result.
 module spline_run
   use spline_kinds, only: wp
-  use spline_errors, only: err_ok, err_solver, itoa
+  use spline_errors, only: err_ok, err_solver, itoa, num
   use spline_model, only: model_t, nstate, ndof, thermal_oneway, thermal_coupled, set_thermal_level
   use spline_dynamics, only: start_state
   use spline_mesh, only: mesh_eval, mesh_outputs
@@ -15,7 +15,6 @@ module spline_run
        ist_closed_t, ist_roots_found, ist_f_error, ist_f_error_t, ist_f_parted_t, ist_rtol_used, &
        ist_outputs_fallback, ist_linear_tail_t, nload, nload_tooth, nextreme
   use spline_accuracy, only: force_error, check_factor, max_tighten
-  use spline_case_text, only: num
   use spline_fidelity, only: auto_level, auto_tol, backlash_estimate
   use spline_sections, only: section_count, section_times
   use spline_lyapunov, only: lyapunov_benettin, lyapunov_tangent
