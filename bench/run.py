@@ -120,7 +120,8 @@ def main(argv=None) -> int:
         from speed import _write_csv
         Path(args.out).mkdir(parents=True, exist_ok=True)
         _write_csv(Path(args.out) / "race.csv", [
-            {k: (" ".join(f"{x:.6g}" for x in v) if isinstance(v, list) else v)
+            {k: (" ".join(f"{x:.6g}" if isinstance(x, float) else str(x) for x in v)
+                 if isinstance(v, list) else v)
              for k, v in r.items()} for r in runs])
         print(f"wrote {args.out}/race.csv")
         return 0

@@ -120,7 +120,7 @@ class _Problem:
         self.rtol = case["rtol"]
         # dF/dp's difference step: rtol^(1/2), not the smooth optimum rtol^(1/3) (+-5 r/min
         # at 2400 r/min and rtol 1e-8), which straddles a grazing next to a fold and stalls
-        # Newton there (M is exact; dF/dp enters the step and the first tangent only)
+        # Newton there (M is exact; dF/dp enters the Newton step and the null-vector tangent)
         self.h = self.rtol ** 0.5
 
     def set_monodromy(self, monodromy):
@@ -187,6 +187,16 @@ class _Problem:
         return F, J, M, y
 
 
+def _null_tangent(J, orient):
+    """The unit null vector of J (k, k+1), oriented along orient (orient itself when the
+    bordered system is singular)."""
+    try:
+        tau = np.linalg.solve(np.vstack([J, orient]), np.eye(J.shape[1])[-1])
+    except np.linalg.LinAlgError:
+        tau = np.array(orient, float)
+    return tau / np.linalg.norm(tau)
+
+
 def _map_only(model, t0, t1, y):
     """The core's map alone (no monodromy): (y1, None, free)."""
     y1, free = _period_map(model, t0, t1, np.asarray(y, float)[:, None])
@@ -234,20 +244,13 @@ class _Branch:
         follows: near a grazing dF/dp by differences of the map over +-h is a secant across
         contact changes, and the null vector of J is off the branch.)"""
         u, F, J, M, y, it, hist = res
-        if isinstance(prev, dict):
-            tau = u - prev["u"]
-            if not np.linalg.norm(tau) > 0:
-                tau = prev["tau"].copy()
-        else:
-            try:
-                tau = np.linalg.solve(np.vstack([J, prev]), np.eye(len(u))[-1])
-            except np.linalg.LinAlgError:
-                tau = np.array(prev, float)
-        tau /= np.linalg.norm(tau)
+        tau = u - prev["u"] if isinstance(prev, dict) else np.zeros_like(u)
+        tau = tau / np.linalg.norm(tau) if np.linalg.norm(tau) > 0 else \
+            _null_tangent(J, prev["tau"] if isinstance(prev, dict) else prev)
         mu = multipliers(M)
         p = self.prob.p_of(u[-1])
         tr = self.trajectory(y, p)
-        return dict(u=u, tau=tau, p=p, y=y, M=M, mu=mu, tests=tests(mu),
+        return dict(u=u, tau=tau, p=p, y=y, M=M, J=J, mu=mu, tests=tests(mu),
                     contact=contact_measures(tr), Tm_pp=float(np.ptp(tr.Tm)),
                     F_max=float(np.abs(tr.tooth["F"]).max()), D2_pp=float(np.ptp(tr.D2)),
                     residual=hist[-1], iterations=it, n=self.n)
@@ -483,6 +486,9 @@ def _follow(br, u0, tau0, q_end, ds, ds_min, ds_max, max_angle, max_points, ibra
                 pts += crossed
                 bar.update(len(crossed))
                 prob.diagnosed += 1
+                continue
+            if not a.get("null"):   # the secant can be off after a kink: the null vector once
+                a["tau"], a["null"] = _null_tangent(a["J"], a["tau"]), True
                 continue
             ds /= 2
             if ds < ds_min:

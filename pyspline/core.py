@@ -25,11 +25,13 @@ def load(case) -> Model:
     return case if isinstance(case, Model) else load_case(case).model
 
 
-def simulate(case) -> Result:
+def simulate(case, executor=None) -> Result:
     """Run one case (a Case, a dict of fields, a namelist path or a loaded Model) and return a
     Result. Raises CaseError, SolverError or ThermalInterferenceError with a message naming the
-    case; KeyboardInterrupt if SIGINT arrives during the run. Releases the GIL while it runs."""
-    return run(load(case))
+    case; KeyboardInterrupt if SIGINT arrives during the run. Releases the GIL while it runs.
+    realisations = K > 1 (docs/accuracy.md): its K copies run on `executor` (a
+    concurrent.futures.Executor; None: a thread each, at most os.cpu_count())."""
+    return run(load(case), executor)
 
 
 def rhs(case, t: float, y) -> tuple[np.ndarray, dict, float]:

@@ -6,8 +6,10 @@ but errors, so that case and core both build on it.
 """
 from __future__ import annotations
 
+import concurrent.futures as cf
 import contextlib
 import functools
+import os
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -273,21 +275,75 @@ class Result:
 
 
 
-def run(model) -> Result:
+class SerialExecutor(cf.Executor):
+    """An executor that runs each call at once in the caller's thread (a sweep's point: the
+    sweep's workers are its parallelism)."""
+
+    def submit(self, fn, /, *args, **kwargs):
+        f = cf.Future()
+        f.set_result(fn(*args, **kwargs))
+        return f
+
+
+def _simulate(model, copy: int = 0, ya=None) -> tuple:
+    """api_simulate on a loaded Model (copy k of realisations = K > 1 from ya, the state at the
+    end of the transient): (t, y columns, tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face,
+    tilt, nqw, consts, loads, tload, ext, warnings, ierr, msg); a copy's loads, tload, ext and
+    warnings are 0 and blank (the copies' together: _copies). Module level, so a process
+    executor can take it."""
+    nq, ns = len(_names("tooth")), len(_names("stats"))
+    nft = model.n_out if model.n_slices else 0
+    # the per-tooth array (the largest) is allocated here, not zeroed (f2py zeroes its own)
+    tooth = np.empty((model.n_out, model.z, nq), order="F")
+    return _api.api_simulate(model.bytes, model.z, model.n_out, nq, ns, model.n_section,
+                             model.n_lyapunov, nft, model.n_slices, len(LOAD_QUANTITIES),
+                             len(TOOTH_LOAD_QUANTITIES), len(EXTREMES), tooth, copy,
+                             np.zeros(14) if ya is None else ya)
+
+
+def _copies(model, executor) -> tuple:
+    """realisations = K > 1 (docs/accuracy.md): the transient, then the K copies on the executor
+    (None: a thread each, at most os.cpu_count(); the core releases the GIL), their outputs one
+    after another, and what follows from them in one call of the core (api_results: the
+    statistics combined, the loads with standard errors from the copies' spread, the extremes
+    and RMS, the warnings; spline_run::run_results, as spline-dyn): _simulate's tuple."""
+    k, n = model.case["realisations"], model.n_out
+    ya, ierr, msg = _api.api_start_state(model.bytes, 1)
+    raise_for(ierr, msg)
+    own = executor is None
+    if own:
+        executor = cf.ThreadPoolExecutor(min(k, os.cpu_count() or 1))
+    try:
+        outs = list(executor.map(_simulate, [model] * k, range(1, k + 1), [ya] * k))
+    finally:
+        if own:
+            executor.shutdown()
+    for o in outs:
+        run_outcome(o[-2], o[-1])            # the first failed copy raises, each one's warnings
+    nqw, consts = outs[0][11], outs[0][12]
+    cat = [np.concatenate([o[i] for o in outs], axis=1 if i == 1 else 0) for i in range(11)]
+    cat[2] = np.empty((k * n, model.z, nqw), order="F")   # the quantities written (nqw)
+    for j, o in enumerate(outs):
+        cat[2][j * n:(j + 1) * n] = o[2][:, :, :nqw]
+    cat[4], loads, tload, ext, warned, ierr, msg = _api.api_results(
+        model.bytes, len(LOAD_QUANTITIES), len(TOOTH_LOAD_QUANTITIES), len(EXTREMES), cat[0],
+        cat[1], cat[2], cat[3], np.stack([o[4] for o in outs], axis=1), consts)
+    raise_for(ierr, msg)
+    return (*cat, nqw, consts, loads, tload, ext, warned, 0, b"")
+
+
+def run(model, executor=None) -> Result:
     """Run a loaded Model (pyspline.simulate: any case) and return a Result. Raises CaseError, SolverError or ThermalInterferenceError with a message naming the
     case; KeyboardInterrupt if SIGINT arrives during the run. Releases the GIL while it runs.
     One call of the core (api_simulate) gives the outputs, the loads, the extremes and the
-    run's warnings."""
+    run's warnings. realisations = K > 1: the copies run on `executor` (None: threads), their
+    outputs one after another in the Result (t restarts at each copy's start), the loads,
+    extremes and warnings from them together (one more call: api_results)."""
     q, s = _names("tooth"), _names("stats")
     t0 = time.perf_counter()
-    nft = model.n_out if model.n_slices else 0
-    # the per-tooth array (the largest) is allocated here, not zeroed (f2py zeroes its own)
-    tooth = np.empty((model.n_out, model.z, len(q)), order="F")
+    out = _copies(model, executor) if model.case["realisations"] > 1 else _simulate(model)
     (t, ycol, tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, nqw, consts, loads,
-     tload, ext, warned, ierr, msg) = _api.api_simulate(
-        model.bytes, model.z, model.n_out, len(q), len(s), model.n_section, model.n_lyapunov,
-        nft, model.n_slices, len(LOAD_QUANTITIES), len(TOOTH_LOAD_QUANTITIES), len(EXTREMES),
-        tooth)
+     tload, ext, warned, ierr, msg) = out
     wall = time.perf_counter() - t0
     run_outcome(ierr, msg)
     y = ycol.T                # (nt, 14), a view of the core's columns (no transposed copy)

@@ -188,6 +188,9 @@ def _secant(br, a, b, sigma_b, kind, iters=12):
         if not lo < s < hi:
             s = (lo + hi) / 2
         pt = _at(br, a, s)
+        if pt is None and s != (lo + hi) / 2:     # the secant's point failed: the middle
+            s = (lo + hi) / 2
+            pt = _at(br, a, s)
         if pt is None:
             break
         f = pt["tests"][kind]

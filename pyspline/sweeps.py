@@ -216,10 +216,13 @@ def run_point(case: Case, options: dict) -> dict:
     """The task of one sweep point (module level, picklable arguments and result): simulate
     the point's case and return its summary. A failure of the case (any Exception: CaseError,
     SolverError, ThermalInterferenceError, ...) is returned as a summary with NaN values and the
-    message in 'error' and the class name in 'error_class'; KeyboardInterrupt propagates."""
+    message in 'error' and the class name in 'error_class'; KeyboardInterrupt propagates.
+    A case with realisations > 1 runs its copies one after another (the sweep's workers are the
+    parallelism)."""
     from .core import simulate
+    from .result import SerialExecutor
     try:
-        return summarise(simulate(case), options)
+        return summarise(simulate(case, SerialExecutor()), options)
     except Exception as exc:              # noqa: BLE001 -- a failed point is a result
         return failed_summary(exc, options)
 

@@ -1,5 +1,5 @@
 !> Standalone check of module spline_stiffness (docs/model.md section 7, Eq. 18). Build and run:
-!>   gfortran -O2 fortran/common/kinds.f90 fortran/physics/stiffness.f90 tests/stiffness_check.f90 -o /tmp/stiff && /tmp/stiff
+!>   gfortran -O2 fortran/common/kinds.f90 fortran/common/errors.f90 fortran/physics/stiffness.f90 tests/stiffness_check.f90 -o /tmp/stiff && /tmp/stiff
 !> (add -J /tmp to keep the .mod files out of the source tree)
 !> Prints: the spline's terms (docs/model.md section 12), a convergence table in nquad, the spur gear
 !> of Tian (2004) / Chen & Shao (2011) at its pitch point, two independent cross-checks

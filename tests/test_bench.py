@@ -30,7 +30,6 @@ def test_stability_quick(tmp_path):
     assert all(r["status"] == "ok" for r in table if r["method"].startswith("CVODE"))
 
 
-@pytest.mark.xdist_group("numbalsoda")       # its peer: numbalsoda, imported once a worker
 def test_work_precision_quick(tmp_path):
     rows, notes = bench.work_precision(tmp_path, quick=True, progress=False)
     assert (tmp_path / "work_precision.png").stat().st_size > 20_000
@@ -166,7 +165,6 @@ def test_race_candidate_is_the_loosest_rung_that_passes_twice():
     assert np.allclose(np.diff(rungs), -0.25)          # quarter decades, both sides alike
 
 
-@pytest.mark.xdist_group("numbalsoda")       # the worker of tests/test_numba_peer.py's solves
 def test_race_quick_times_the_peer_with_its_forces(tmp_path):
     """A quick race of the paper scene: both sides reach each accuracy with a candidate timed
     in every round, the peer's error from its own forces, and the ratio is of their medians."""

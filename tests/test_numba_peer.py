@@ -103,7 +103,6 @@ def test_default_fields_match_template():
             assert float(tmpl[k]) == float(v), k
 
 
-@pytest.mark.xdist_group("numbalsoda")       # one worker imports numbalsoda
 @pytest.mark.parametrize("method", ["lsoda", "dop853"])
 @pytest.mark.parametrize("name", ["misaligned", "z7", "bulk", "coupled", "spacing"])
 def test_peer_agrees_with_scipy_lsoda_on_oracle(name, method):

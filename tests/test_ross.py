@@ -2,7 +2,8 @@
 ross/gear_element.py: Ma et al. 2014 slice beam + Sainsot et al. 2004 fillet foundation).
 
 No package build: tests/stiffness_check.f90 is compiled with gfortran into tmp_path (with
-fortran/common/kinds.f90 and fortran/physics/stiffness.f90) and its '@' lines (key=value) are parsed. ROSS is a
+fortran/common/kinds.f90, fortran/common/errors.f90 and
+fortran/physics/stiffness.f90) and its '@' lines (key=value) are parsed. ROSS is a
 test-only dependency: the module is skipped if it is missing or does not import (ross 2.3.0 does
 not import with plotly >= 6: its theme names the removed 'scattermapbox'; plotly < 6 works).
 
@@ -30,8 +31,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 # ROSS takes 11 s of CPU to import: imported by the first test that runs, not at collection
-# (every pytest-xdist worker collects every module), and these tests kept on one worker
-pytestmark = pytest.mark.xdist_group("ross")
+# (every pytest-xdist worker collects every module)
 ge = Material = None
 
 
@@ -49,7 +49,7 @@ def check(tmp_path_factory):
         pytest.skip("gfortran not found")
     tmp = tmp_path_factory.mktemp("stiffness_check")
     exe = tmp / "stiffness_check"
-    src = [ROOT / "fortran" / "common" / "kinds.f90",
+    src = [ROOT / "fortran" / "common" / "kinds.f90", ROOT / "fortran" / "common" / "errors.f90",
            ROOT / "fortran" / "physics" / "stiffness.f90", ROOT / "tests" / "stiffness_check.f90"]
     subprocess.run([fc, "-O2", "-J", str(tmp), *map(str, src), "-o", str(exe)], check=True,
                    cwd=tmp, capture_output=True, text=True)

@@ -7,7 +7,7 @@ module spline_errors
   implicit none
   private
   public :: err_ok, err_case, err_solver, err_thermal, err_interrupted, nerr, err_names
-  public :: msglen, err_exit_code, itoa, ftoa
+  public :: msglen, err_exit_code, itoa, ftoa, num
 
   integer, parameter :: err_ok = 0           !< success
   integer, parameter :: err_case = 1         !< bad case: field missing, ill-typed, out of range
@@ -56,5 +56,24 @@ contains
     write(buf, f) x
     s = trim(adjustl(buf))
   end function ftoa
+
+  !> A number for messages: 3 decimals (or digits), a three-digit exponent where needed.
+  pure function num(x, digits) result(s)
+    real(wp), intent(in) :: x
+    integer, intent(in), optional :: digits
+    character(len=:), allocatable :: s
+    character(len=24) :: buf
+    character(len=16) :: fmt
+    integer :: d
+    d = 3
+    if (present(digits)) d = digits
+    if (x /= 0.0_wp .and. (abs(x) >= 1.0e100_wp .or. abs(x) < 1.0e-99_wp)) then
+      write(fmt, '(a,i0,a,i0,a)') '(es', d + 9, '.', d, 'e3)'
+    else
+      write(fmt, '(a,i0,a,i0,a)') '(es', d + 8, '.', d, ')'
+    end if
+    write(buf, fmt) x
+    s = trim(adjustl(buf))
+  end function num
 
 end module spline_errors

@@ -5,12 +5,12 @@
 !> here; the order of the checks decides which message a case with several faults gets.
 module spline_case_check
   use spline_kinds, only: wp, pi, max_teeth
-  use spline_errors, only: err_ok, err_case, itoa
+  use spline_errors, only: err_ok, err_case, itoa, num
   use spline_case_type, only: case_t, fields, nfields, field_index, ndof_case, nripple, &
        option_index, case_output_bytes, case_run_times, max_output_bytes, thermal_values, method_values, &
        nonlinear_values, start_values, fidelity_values, jacobian_values, section_values, &
        lyapunov_method_values, goal_values
-  use spline_case_text, only: num, size_text
+  use spline_case_text, only: size_text
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -214,6 +214,7 @@ contains
            '''statistics'' does not resolve the trajectory (its statistics carry standard errors): '// &
            'set check = .false. or goal = ''trajectory'''); return
     end if
+    if (.not. realisations_ok()) return
     if (.not. ranges('lyapunov_interval', 'lyapunov_d0')) return  ! d0 = 0: chosen from rtol
     if ((c%lyapunov .or. option_index(section_values, c%section) > 1) .and. c%speed_rpm <= 0.0_wp) then
       call fail('speed_rpm', 'must be positive for a Poincare section or a Lyapunov exponent '// &
@@ -294,6 +295,32 @@ contains
     ierr = err_ok
 
   contains
+
+    !> realisations = K (spline_realisations): at least 1; K > 1 reads statistics over copies of
+    !> the drive whose trajectories differ (goal = 'statistics'), without the Lyapunov exponent (a
+    !> property of one trajectory), each copy with at least 2 of the n_out outputs.
+    logical function realisations_ok() result(ok)
+      ok = .false.
+      if (c%realisations < 1) then
+        call fail('realisations', '= '//itoa(c%realisations)//' must be at least 1 (the '// &
+             'number of perturbed copies the sampling window is split into)'); return
+      end if
+      if (c%realisations > 1 .and. option_index(goal_values, c%goal) /= 2) then
+        call fail('realisations', '= '//itoa(c%realisations)//' runs perturbed copies whose '// &
+             'trajectories part: it reads statistics, set goal = ''statistics'' (or '// &
+             'realisations = 1 for one trajectory)'); return
+      end if
+      if (c%realisations > 1 .and. c%lyapunov) then
+        call fail('realisations', '= '//itoa(c%realisations)//' with lyapunov = .true.: the '// &
+             'exponent is a property of one trajectory; set realisations = 1'); return
+      end if
+      if (c%realisations > 1 .and. n_out/c%realisations < 2) then   ! K = 1: any n_out
+        call fail('realisations', '= '//itoa(c%realisations)//' leaves fewer than 2 of the '// &
+             itoa(n_out)//' outputs to each copy: at most '//itoa(max(n_out/2, 1)))
+        return
+      end if
+      ok = .true.
+    end function realisations_ok
 
     logical function finite(g)
       integer, intent(in) :: g

@@ -7,7 +7,7 @@ module spline_case_text
   use spline_case_type, only: fields, nfields
   implicit none
   private
-  public :: lower, unquote, quoted, shown, clip, num, size_text, hint, case_suggest
+  public :: lower, unquote, quoted, shown, clip, size_text, hint, case_suggest
   public :: word_char, is_digits, is_integer, is_real, is_logical, is_value, expected, kind_word, &
        element
 
@@ -293,25 +293,6 @@ contains
       c = s
     end if
   end function clip
-
-  !> A number for messages: 3 decimals (or digits), a three-digit exponent where needed.
-  pure function num(x, digits) result(s)
-    real(wp), intent(in) :: x
-    integer, intent(in), optional :: digits
-    character(len=:), allocatable :: s
-    character(len=24) :: buf
-    character(len=16) :: fmt
-    integer :: d
-    d = 3
-    if (present(digits)) d = digits
-    if (x /= 0.0_wp .and. (abs(x) >= 1.0e100_wp .or. abs(x) < 1.0e-99_wp)) then
-      write(fmt, '(a,i0,a,i0,a)') '(es', d + 9, '.', d, 'e3)'
-    else
-      write(fmt, '(a,i0,a,i0,a)') '(es', d + 8, '.', d, ')'
-    end if
-    write(buf, fmt) x
-    s = trim(adjustl(buf))
-  end function num
 
   !> A byte count in kB, MB, GB or TB (powers of 1000).
   pure function size_text(bytes) result(s)

@@ -69,6 +69,8 @@ module spline_case_type
     real(wp) :: accuracy = 0.0_wp
     character(len=optlen) :: goal = 'trajectory'
     logical  :: check = .false.
+    !> goal = 'statistics': perturbed copies after the transient (spline_realisations)
+    integer  :: realisations = 1
     real(wp) :: t0 = 0.0_wp, t_end = 0.1_wp, t_transient = 0.0_wp
     integer  :: n_out = 1001
     !> The run in shaft revolutions (0: t_end, t_transient, n_out as given); case_run_times.
@@ -114,7 +116,7 @@ module spline_case_type
     real(wp) :: lo = 0.0_wp, hi = 0.0_wp
     character(len=80) :: note = ''
   end type field_t
-  integer, parameter :: nfields = 89
+  integer, parameter :: nfields = 90
   real(wp), parameter :: inf_ = huge(1.0_wp)
   type(field_t), parameter :: fields(nfields) = [ &
        field_t('name', 'c', namelen, '', 'case name, used in messages (default: the file name)'), &
@@ -202,6 +204,8 @@ module spline_case_type
                'and atol as given)'), &
        field_t('goal', 'c', optlen, '', 'trajectory | statistics (cheapest unbiased settings)'), &
        field_t('check', 'l', 1, '', 'estimate the error of F_j against a tighter run (F_error_est)'), &
+       field_t('realisations', 'i', 1, '', 'goal statistics: perturbed copies after the '// &
+               'transient, 1/K of the window each'), &
        ! times: within a million seconds (11.6 days) of 0, where a double still resolves the
        ! tooth angle omega t to 1e-5 rad at the largest speed
        field_t('t0', 'r', 1, 's', 'start time', 'r', -1.0e6_wp, 1.0e6_wp, &

@@ -109,6 +109,7 @@ contains
     call ch(c%method); call ch(c%jacobian); call ch(c%nonlinear); call l(c%roots)
     call l(c%stald); call l(c%linear_tail); call r(c%rtol); call r(c%atol); call i(c%max_steps)
     call i(c%max_total_steps); call r(c%accuracy); call ch(c%goal); call l(c%check)
+    call i(c%realisations)
     call r(c%t0); call r(c%t_end); call r(c%t_transient)
     call i(c%n_out); call r(c%revolutions); call r(c%transient_revolutions)
     call r(c%outputs_per_revolution); call ch(c%start); call ra(c%dq0); call ra(c%dv0); call r(c%l_ref)

@@ -25,13 +25,15 @@ module spline_api
   use spline_run, only: run_case, run_results, tooth_quantities, output_times
   use spline_quantities, only: quantity_t, nstats, stat_q, ntooth_q, tooth_q, state_q, nout_q, &
        output_q, nload, load_q, nload_tooth, load_tooth_q, nextreme, extreme_q
+  use spline_realisations, only: copy_model, copy_start, run_sections, transient_state, &
+       combined_stats
   use spline_sections, only: section_count
   use spline_lyapunov, only: lyapunov_count, lyapunov_benettin, lyapunov_tangent
   use spline_orbits, only: period_map, map_and_monodromy
   implicit none
   private
   public :: api_load_file, api_load_fields, api_load_text, api_read_text, api_model_size
-  public :: api_simulate
+  public :: api_simulate, api_results
   public :: api_rhs, api_rhs_mesh, api_start_state
   public :: api_output_times, api_model_info, api_defaults, api_names, api_tooth_stiffness
   public :: api_field_hint, api_period_map, api_map_monodromy, api_lyapunov
@@ -167,7 +169,8 @@ contains
     end if
     if (ierr /= err_ok) return
     model = transfer(m, model)
-    sizes = [m%z, m%n_out, section_count(m), lyapunov_count(m), merge(m%n_slices, 0, m%n_slices > 1)]
+    sizes = [m%z, m%n_out, run_sections(m), lyapunov_count(m), &
+         merge(m%n_slices, 0, m%n_slices > 1)]       ! realisations > 1: one copy's
     warn = model_warnings(m)
   end subroutine load_model
 
@@ -212,11 +215,15 @@ contains
   !> the outputs (spline_run::run_results): the loads (order of api_names('loads')), tload(z, :)
   !> (api_names('tooth_loads')), the extremes and RMS ext (api_names('extremes')) and the run's
   !> warnings, one per line (blank if none; the integrator's are errmsg's on success).
+  !> A case with realisations = K > 1 runs copy `copy` (1..K) from ya, the state at the end of
+  !> the transient (api_start_state), over its window (spline_realisations); loads, tload, ext
+  !> and warnings stay 0 and blank: they are the K copies' together (api_results).
   !> A SIGINT during the run stops it (ierr 4). Called without the GIL.
   subroutine api_simulate(model, nb, z, nt, nq, ns, nsec, nlyap, nft, nslice, nl, ntl, nx, t, y, &
        tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, nqw, consts, loads, tload, ext, &
-       warnings, ierr, errmsg)
-    integer(c_int), intent(in) :: nb, z, nt, nq, ns, nsec, nlyap, nft, nslice, nl, ntl, nx
+       warnings, copy, ya, ierr, errmsg)
+    integer(c_int), intent(in) :: nb, z, nt, nq, ns, nsec, nlyap, nft, nslice, nl, ntl, nx, copy
+    real(c_double), intent(in) :: ya(14)
     integer(c_int), intent(in) :: model(nb)
     real(c_double), intent(out) :: t(nt), y(14, nt), tooth(nt, z, nq), tm(nt), stats(ns)
     real(c_double), intent(out) :: sec_t(nsec), sec_y(nsec, 14), lyap_t(nlyap), lyap_g(nlyap)
@@ -233,7 +240,8 @@ contains
     face = 0; tilt = 0; nqw = nq; consts = 0; loads = 0; tload = 0; ext = 0; warnings = ''
     call unpack(model, m, ie, errmsg)
     if (ie == err_ok .and. (m%z /= z .or. m%n_out /= nt .or. nq /= ntooth_q .or. ns /= nstats &
-         .or. nsec /= section_count(m) .or. nlyap /= lyapunov_count(m) .or. &
+         .or. nsec /= run_sections(m) .or. (m%realisations > 1 .and. &
+         (copy < 1 .or. copy > m%realisations)) .or. nlyap /= lyapunov_count(m) .or. &
          nslice /= merge(m%n_slices, 0, m%n_slices > 1) .or. nft /= merge(nt, 0, nslice > 0) &
          .or. nl /= nload .or. ntl /= nload_tooth .or. nx /= nextreme)) then
       ie = err_case
@@ -241,7 +249,14 @@ contains
     end if
     if (ie == err_ok) then
       allocate(scol(nstate, nsec))
-      if (nslice > 0) then
+      if (m%realisations > 1 .and. nslice > 0) then
+        call run_case(copy_model(m), t, y, tooth, tm, stats, ie, errmsg, interruptible=.true., &
+             sec_t=sec_t, sec_y=scol, face=face, tilt=tilt, nq=nw, consts=consts, &
+             y_start=copy_start(copy, ya))
+      else if (m%realisations > 1) then
+        call run_case(copy_model(m), t, y, tooth, tm, stats, ie, errmsg, interruptible=.true., &
+             sec_t=sec_t, sec_y=scol, nq=nw, consts=consts, y_start=copy_start(copy, ya))
+      else if (nslice > 0) then
         call run_case(m, t, y, tooth, tm, stats, ie, errmsg, interruptible=.true., &
              sec_t=sec_t, sec_y=scol, lyap_t=lyap_t, lyap_g=lyap_g, face=face, tilt=tilt, &
              nq=nw, consts=consts)
@@ -251,7 +266,7 @@ contains
       end if
       nqw = nw
       sec_y = transpose(scol)
-      if (ie == err_ok) then
+      if (ie == err_ok .and. m%realisations == 1) then
         call run_results(m, t, y, tooth(:, :, 1:nw), tm, stats, consts, loads, tload, ext, text)
         warnings = text
       end if
@@ -260,6 +275,40 @@ contains
     end if
     ierr = ie
   end subroutine api_simulate
+
+  !> What follows from the outputs of a case with realisations = K (spline_run::run_results):
+  !> t, y, tooth(:, :, 1:nq), tm the K copies' outputs one after another as api_simulate gave
+  !> them (nq: its nqw, consts: its consts), stats(:, k) copy k's statistics. st: the copies'
+  !> statistics combined (spline_realisations::combined_stats); loads, tload, ext and warnings
+  !> as api_simulate gives them for one run, from the copies' outputs together (the loads:
+  !> spline_loads::combined_loads, standard errors from the spread between the copies).
+  subroutine api_results(model, nb, z, nt, nq, ns, k, nl, ntl, nx, t, y, tooth, tm, stats, &
+       consts, st, loads, tload, ext, warnings, ierr, errmsg)
+    integer(c_int), intent(in) :: nb, z, nt, nq, ns, k, nl, ntl, nx
+    integer(c_int), intent(in) :: model(nb)
+    real(c_double), intent(in) :: t(nt), y(14, nt), tooth(nt, z, nq), tm(nt), stats(ns, k)
+    real(c_double), intent(in) :: consts(4)
+    real(c_double), intent(out) :: st(ns), loads(nl), tload(z, ntl), ext(nx)
+    character(len=8192), intent(out) :: warnings
+    integer(c_int), intent(out) :: ierr
+    character(len=msglen), intent(out) :: errmsg
+    type(model_t) :: m
+    character(len=:), allocatable :: text
+    integer :: ie
+    st = 0; loads = 0; tload = 0; ext = 0; warnings = ''
+    call unpack(model, m, ie, errmsg)
+    if (ie == err_ok .and. (m%z /= z .or. (nq /= ntooth_q .and. nq /= 4) .or. ns /= nstats .or. &
+         k /= m%realisations .or. nt /= k*m%n_out .or. nl /= nload .or. ntl /= nload_tooth .or. &
+         nx /= nextreme)) then
+      ie = err_case; errmsg = 'api_results: array sizes do not match the loaded case'
+    end if
+    if (ie == err_ok) then
+      call combined_stats(stats, st)
+      call run_results(m, t, y, tooth, tm, st, consts, loads, tload, ext, text)
+      warnings = text
+    end if
+    ierr = ie
+  end subroutine api_results
 
   !> SI right-hand side dy/dt at (t, y) of a loaded model, contact states from the state:
   !> the project's Fortran RHS for solvers driven from Python (the benchmarks' peers).
@@ -305,9 +354,11 @@ contains
     ierr = ie
   end subroutine api_rhs_mesh
 
-  !> The start state of a loaded model (SI): static equilibrium or rest, plus dq0, dv0.
-  subroutine api_start_state(model, nb, y, ierr, errmsg)
-    integer(c_int), intent(in) :: nb
+  !> The start state of a loaded model (SI): static equilibrium or rest, plus dq0, dv0; with
+  !> transient = 1 the state at the end of the transient (spline_realisations::transient_state,
+  !> from which realisations = K > 1 runs its copies; a SIGINT stops it, ierr 4).
+  subroutine api_start_state(model, nb, transient, y, ierr, errmsg)
+    integer(c_int), intent(in) :: nb, transient
     integer(c_int), intent(in) :: model(nb)
     real(c_double), intent(out) :: y(14)
     integer(c_int), intent(out) :: ierr
@@ -316,7 +367,11 @@ contains
     integer :: ie
     y = 0
     call unpack(model, m, ie, errmsg)
-    if (ie == err_ok) call start_state(m, y, ie, errmsg)
+    if (ie == err_ok .and. transient == 1) then
+      call transient_state(m, y, ie, errmsg, interruptible=.true.)
+    else if (ie == err_ok) then
+      call start_state(m, y, ie, errmsg)
+    end if
     ierr = ie
   end subroutine api_start_state
 

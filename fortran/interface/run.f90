@@ -5,7 +5,7 @@
 !> thermal levels that have it, Eqs. 1-7) at every output time, and the checks of the result.
 module spline_run
   use spline_kinds, only: wp
-  use spline_errors, only: err_ok, err_solver, itoa
+  use spline_errors, only: err_ok, err_solver, itoa, num
   use spline_model, only: model_t, nstate, ndof, thermal_oneway, thermal_coupled, set_thermal_level
   use spline_dynamics, only: start_state
   use spline_mesh, only: mesh_eval, mesh_outputs
@@ -15,12 +15,11 @@ module spline_run
        ist_closed_t, ist_roots_found, ist_f_error, ist_f_error_t, ist_f_parted_t, ist_rtol_used, &
        ist_outputs_fallback, ist_linear_tail_t, nload, nload_tooth, nextreme
   use spline_accuracy, only: force_error, check_factor, max_tighten
-  use spline_case_text, only: num
   use spline_fidelity, only: auto_level, auto_tol, backlash_estimate
   use spline_sections, only: section_count, section_times
   use spline_lyapunov, only: lyapunov_benettin, lyapunov_tangent
   use spline_integrator, only: lib_log_t, integrator_warnings
-  use spline_loads, only: run_loads, run_extremes, stress_warnings
+  use spline_loads, only: combined_loads, run_extremes, stress_warnings
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
@@ -60,8 +59,9 @@ contains
   !> nq, consts (both or neither): a run whose quantities c_j, T_f, r_c1, r_c2 (tooth_q 5..8)
   !> are the level's constants (no flash temperature, no slices) writes only tooth(:, :, 1:4),
   !> nq = 4, consts = (c_j, T_f, r_c1, r_c2); else every quantity, nq = ntooth_q, consts = 0.
+  !> y_start (optional): the start state at t0 instead of start_state's (a realisation's copy).
   subroutine run_case(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-       lyap_t, lyap_g, face, tilt, nq, consts)
+       lyap_t, lyap_g, face, tilt, nq, consts, y_start)
     type(model_t), intent(in) :: m
     real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
     real(wp), intent(out) :: tm(m%n_out), stats(nstats)
@@ -72,6 +72,7 @@ contains
     real(wp), intent(out), optional :: face(:, :, :), tilt(:, :)
     integer, intent(out), optional :: nq
     real(wp), intent(out), optional :: consts(ntooth_q - 4)
+    real(wp), intent(in), optional :: y_start(nstate)
     type(model_t) :: run
     real(wp) :: eps_lat, eps_th, closed, t_closed, cq(ntooth_q - 4), est(3)
     type(lib_log_t) :: lib                   !< SUNDIALS' warnings over the call's runs
@@ -125,13 +126,13 @@ contains
     !> its flash temperature's estimate exceeds auto_tol).
     subroutine run_once()
     call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-         face, tilt, present(nq), nw, cq, fin, lib)
+         face, tilt, present(nq), nw, cq, fin, lib, y_start)
     if (ierr == err_ok .and. m%auto .and. m%thermal == thermal_coupled .and. nw >= iq_tf) then
       eps_th = backlash_estimate(m, maxval(abs(tooth(:, :, iq_tf))))
       if (eps_th > auto_tol(m)) then
         call set_thermal_level(run, thermal_coupled)
         call run_level(run, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-             face, tilt, present(nq), nw, cq, fin, lib)
+             face, tilt, present(nq), nw, cq, fin, lib, y_start)
       end if
     end if
     end subroutine run_once
@@ -140,16 +141,19 @@ contains
   !> What follows from a finished run's outputs (t, y, tooth, tm, stats as run_case gives them;
   !> tooth(:, :, 1:nq): every quantity of tooth_q, or F, F_x, F_y, dn alone with the constants
   !> consts = (c_j, T_f, r_c1, r_c2), run_case's nq and consts): the loads (spline_loads::
-  !> run_loads: loads, tload(z, nload_tooth)), the extremes and RMS (run_extremes: ext) and the
-  !> run's warnings, one per line ('' if none: run_warnings, then stress_warnings). The
-  !> executable and Python (api_simulate, in the same call as the run) alike.
+  !> combined_loads, run_loads for one run: loads, tload(z, nload_tooth)), the extremes and RMS
+  !> (run_extremes: ext) and the run's warnings, one per line ('' if none: run_warnings, then
+  !> stress_warnings). The executable and Python (api_simulate, in the same call as the run)
+  !> alike. realisations = K > 1: the K copies' outputs one after another and their combined
+  !> statistics (spline_realisations::combined_stats; Python: api_results); the extremes and
+  !> RMS are those of all the copies' outputs together.
   subroutine run_results(m, t, y, tooth, tm, stats, consts, loads, tload, ext, warnings)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t(:), y(:, :), tm(:), stats(nstats), consts(ntooth_q - 4)
     real(wp), intent(in), contiguous :: tooth(:, :, :)
     real(wp), intent(out) :: loads(nload), tload(m%z, nload_tooth), ext(nextreme)
     character(len=:), allocatable, intent(out) :: warnings
-    call run_loads(m, t, y, tooth, tm, loads, tload)
+    call combined_loads(m, t, y, tooth, tm, loads, tload)
     if (size(tooth, 3) >= iq_tf) then
       call run_extremes(m, y, tm, tooth(:, :, 1), tooth(:, :, iq_tf), ext)
     else                               ! T_f a constant of the level: as its every output
@@ -369,9 +373,9 @@ contains
   end function restart_warning
 
   !> One run of the model at the level m sets (lazy, nw, consts: run_case's nq, consts; fin:
-  !> tooth_outputs' finite).
+  !> tooth_outputs' finite; y_start: run_case's).
   subroutine run_level(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
-       face, tilt, lazy, nw, consts, fin, lib)
+       face, tilt, lazy, nw, consts, fin, lib, y_start)
     type(model_t), intent(in) :: m
     real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
     real(wp), intent(out) :: tm(m%n_out), stats(nstats)
@@ -384,6 +388,7 @@ contains
     real(wp), intent(out) :: consts(ntooth_q - 4)
     logical, intent(out) :: fin
     type(lib_log_t), intent(inout), optional :: lib   !< SUNDIALS' warnings, counted on
+    real(wp), intent(in), optional :: y_start(nstate)
     real(wp) :: y0(nstate)
     real(wp), allocatable :: ts(:), ysec(:, :)
     integer, allocatable :: modes(:, :)
@@ -394,7 +399,11 @@ contains
     t = 0.0_wp; y = 0.0_wp
     allocate(modes(m%z*m%n_slices, m%n_out))
     call output_times(m, t)
-    call start_state(m, y0, ierr, errmsg)
+    if (present(y_start)) then
+      y0 = y_start; ierr = err_ok
+    else
+      call start_state(m, y0, ierr, errmsg)
+    end if
     if (ierr == err_ok) call integrate_level()
     ! tooth and tm are zero where the run did not reach (every output is written otherwise)
     if (ierr /= err_ok) then

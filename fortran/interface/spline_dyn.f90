@@ -30,6 +30,8 @@ program spline_dyn
        il_sigma_flank, il_tau_pitch, il_batches, il_tm_rms_se, il_sharing_rev, il_sharing_rev_se, &
        il_free_mean_se, il_impacts_rev_se, il_tf_rev, il_tf_rev_se, il_stress_ratio, nextreme, &
        extreme_q
+  use spline_realisations, only: copy_model, copy_start, run_sections, transient_state, &
+       combined_stats
   use spline_sections, only: section_count
   use spline_lyapunov, only: lyapunov_count
   implicit none
@@ -86,7 +88,7 @@ program spline_dyn
   real(wp) :: stats(nstats), loads(nload), ext(nextreme)
   real(wp), allocatable :: tload(:, :), sec_t(:), sec_y(:, :), lyap_t(:), lyap_g(:)
   real(wp) :: wall
-  integer :: ierr, i, j, k, n, q, u, su, nargs, nsets, ios
+  integer :: ierr, i, j, k, n, q, u, su, nargs, nsets, ios, nt
   integer(8) :: c0, c1, rate
   integer(c_int) :: sigint0
   logical :: have_out, have_summary, write_csv, options_done, have_case, summary_open
@@ -197,9 +199,12 @@ program spline_dyn
   sigint0 = c_sigint_watch()
 
   call print_warnings(model_warnings(m))
-  allocate(t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q), tm(m%n_out))
+  nt = m%n_out*m%realisations    ! realisations = K: K copies of n_out outputs, one after another
+  allocate(t(nt), y(nstate, nt), tooth(nt, m%z, ntooth_q), tm(nt))
   call system_clock(c0, rate)
-  if (have_summary) then       ! the section and the Benettin record, as Python's api_simulate
+  if (m%realisations > 1) then
+    call run_copies()
+  else if (have_summary) then  ! the section and the Benettin record, as Python's api_simulate
     allocate(sec_t(section_count(m)), sec_y(nstate, section_count(m)), &
          lyap_t(lyapunov_count(m)), lyap_g(lyapunov_count(m)))
     call run_case(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible=.true., sec_t=sec_t, &
@@ -217,7 +222,7 @@ program spline_dyn
   call print_warnings(trim(errmsg))            ! the integrator's (SUNDIALS') warnings, counted
   allocate(tload(m%z, nload_tooth))
   call run_results(m, t, y, tooth, tm, stats, [(0.0_wp, i = 1, ntooth_q - 4)], loads, tload, ext, &
-       text)
+       text)                                   ! K > 1: all copies' outputs, combined stats
   call print_warnings(text)                    ! the run's, then its loads' (stresses, T_f)
   if (have_summary) call write_summary(.true., '', err_ok)
   if (.not. write_csv) then
@@ -269,7 +274,7 @@ program spline_dyn
   ! time of an ES edit descriptor
   allocate(row(1 + nstate + 2 + m%z*ntooth_q))
   allocate(character(len=26*size(row)) :: record)
-  do k = 1, m%n_out
+  do k = 1, size(t)
     if (ios /= 0) exit
     row = [t(k), y(:, k), tm(k), abs(tm(k))/m%t_d, &   ! the columns of output_q
          ((tooth(k, j, q), j = 1, m%z), q = 1, ntooth_q)]
@@ -304,7 +309,7 @@ program spline_dyn
   write(*, '(a)') ''
   write(*, '(a,es11.4,a)') '  k_m used: ', m%k_m, merge(' N/m (computed)', ' N/m (case)    ', &
        m%k_m_computed)
-  write(*, '(a,i0,a,es10.3,a,es10.3,a)') '  outputs ', m%n_out, ' on [', t(1), ', ', t(m%n_out), '] s'
+  write(*, '(a,i0,a,es10.3,a,es10.3,a)') '  outputs ', size(t), ' on [', minval(t), ', ', maxval(t), '] s'
   write(*, '(a,2es12.4)') '  meshing torque T_m min/max [N m]: ', minval(tm), maxval(tm)
   write(*, '(a,2es12.4)') '  tooth force F_j min/max [N]:      ', minval(tooth(:, :, 1)), &
        maxval(tooth(:, :, 1))
@@ -314,6 +319,39 @@ program spline_dyn
   end do
 
 contains
+
+  !> realisations = K > 1 (spline_realisations, docs/accuracy.md): the transient once, then the
+  !> K copies on OpenMP threads (OMP_NUM_THREADS), copy k into outputs (k - 1) n_out + 1 .. k n_out
+  !> of t, y, tooth, tm and its section after the one before; stats the copies' combined; ierr,
+  !> errmsg the first failed copy's (its SUNDIALS warnings printed, as Python warns them).
+  subroutine run_copies()
+    real(wp) :: ya(nstate), st(nstats, m%realisations)
+    integer :: kk, a, ns, ie(m%realisations)
+    character(len=msglen) :: msg(m%realisations)
+    ns = run_sections(m)
+    allocate(sec_t(ns*m%realisations), sec_y(nstate, ns*m%realisations), lyap_t(0), lyap_g(0))
+    call transient_state(m, ya, ierr, errmsg, interruptible=.true.)
+    if (ierr /= err_ok) return
+    n = m%n_out
+    !$omp parallel do schedule(static, 1) private(a)
+    do kk = 1, m%realisations
+      a = (kk - 1)*n
+      call run_case(copy_model(m), t(a + 1:a + n), y(:, a + 1:a + n), tooth(a + 1:a + n, :, :), &
+           tm(a + 1:a + n), st(:, kk), ie(kk), msg(kk), interruptible=.true., &
+           sec_t=sec_t((kk - 1)*ns + 1:kk*ns), sec_y=sec_y(:, (kk - 1)*ns + 1:kk*ns), &
+           y_start=copy_start(kk, ya))
+    end do
+    !$omp end parallel do
+    call combined_stats(st, stats)
+    errmsg = ''
+    do kk = 1, m%realisations
+      ierr = ie(kk)
+      if (ierr /= err_ok) then
+        errmsg = msg(kk); return
+      end if
+      call print_warnings(trim(msg(kk)))
+    end do
+  end subroutine run_copies
 
   !> The loads of the run on stdout (spline_loads::run_loads, docs/model.md section 15): which
   !> teeth carry what, rattle, flash temperature, stresses and their limits, standard errors.
@@ -427,7 +465,7 @@ contains
         call put('tooth_loads.'//load_tooth_q(i2)%name, load_tooth_q(i2)%unit, tload(:, i2))
       end do
       call put('model.spacing_error', 'm', m%spacing_error(1:m%z))   ! in use: list + seeded
-      nt = m%n_out
+      nt = size(t)
       call put('run.t_first', 's', t(1:min(1, nt)))
       do i2 = 1, nextreme                  ! spline_run::run_results' (Python's too)
         call put('run.'//extreme_q(i2)%name, extreme_q(i2)%unit, [ext(i2)])

@@ -22,7 +22,8 @@ module spline_loads
        ilt_back, ilt_onsets, ilt_free_se, ilt_back_se
   implicit none
   private
-  public :: run_loads, run_extremes, drive_flank, approach_speed, tooth_stresses, stress_warnings
+  public :: run_loads, combined_loads, run_extremes, drive_flank, approach_speed, tooth_stresses, &
+       stress_warnings
 
   !> Limits of stress_warnings [Pa] (docs/model.md section 15, "Tooth stresses"): typical
   !> allowables of case-hardened steel splines (58-63 HRC) at full load, 10^4 torque cycles,
@@ -241,6 +242,87 @@ contains
       loads(il_tf_max_t) = t(k)
     end if
   end subroutine run_loads
+
+  !> The loads of a run's outputs (run_loads); with m%realisations = K > 1 (spline_realisations:
+  !> the case's K perturbed copies) the outputs are K copies' of m%n_out each, one after the
+  !> other, and their loads combine (spline_run::run_results calls this for both): extremes
+  !> the largest, means and fractions the mean, counts the sum; the standard errors are the spread
+  !> between the copies, sd / sqrt(K), of the value each is about (the RMS of T_m, k_v, F_j over
+  !> all teeth and D_2 from each copy's outputs; the rest from its loads). With K = 1, or
+  !> outputs that are not K copies' (one copy's), run_loads.
+  pure subroutine combined_loads(m, t, y, tooth, tm, loads, tload)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in), contiguous :: t(:), tooth(:, :, :), tm(:)
+    real(wp), intent(in) :: y(:, :)
+    real(wp), intent(out) :: loads(nload), tload(m%z, nload_tooth)
+    real(wp) :: lk(nload, m%realisations), tk(m%z, nload_tooth, m%realisations)
+    real(wp) :: rms(m%realisations, 3), nan
+    integer :: k, n, a, j, kmax
+    n = m%n_out
+    if (m%realisations == 1 .or. size(t) /= n*m%realisations) then
+      call run_loads(m, t, y, tooth, tm, loads, tload); return
+    end if
+    nan = ieee_value(0.0_wp, ieee_quiet_nan)
+    do k = 1, m%realisations
+      a = (k - 1)*n
+      call run_loads(m, t(a + 1:a + n), y(:, a + 1:a + n), tooth(a + 1:a + n, :, :), &
+           tm(a + 1:a + n), lk(:, k), tk(:, :, k))
+      rms(k, 1) = sqrt(sum(tm(a + 1:a + n)**2)/n)
+      rms(k, 2) = sqrt(sum(tooth(a + 1:a + n, :, 1)**2)/(n*m%z))
+      rms(k, 3) = sqrt(sum(y(6, a + 1:a + n)**2)/n)
+    end do
+    loads = lk(:, 1)
+    tload = tk(:, :, 1)
+    do j = 1, m%z                               ! per tooth
+      tload(j, ilt_f_peak) = maxval(tk(j, ilt_f_peak, :))
+      tload(j, ilt_load_factor) = biggest(tk(j, ilt_load_factor, :))
+      tload(j, ilt_free) = sum(tk(j, ilt_free, :))/m%realisations
+      tload(j, ilt_back) = sum(tk(j, ilt_back, :))/m%realisations
+      tload(j, ilt_onsets) = sum(tk(j, ilt_onsets, :))
+      tload(j, ilt_free_se) = spread_se(tk(j, ilt_free, :))
+      tload(j, ilt_back_se) = spread_se(tk(j, ilt_back, :))
+    end do
+    do j = 1, nload                             ! the run's
+      if (any(j == [il_load_sharing, il_closing_speed, il_tf_max, il_sigma_root, il_sigma_flank, &
+           il_tau_pitch, il_stress_ratio])) loads(j) = biggest(lk(j, :))
+      if (any(j == [il_free_mean, il_impacts_rev, il_sharing_rev, il_tf_rev])) &
+           loads(j) = sum(lk(j, :))/m%realisations
+      if (any(j == [il_revolutions, il_batches])) loads(j) = sum(lk(j, :))
+    end do
+    kmax = maxloc(lk(il_tf_max, :), 1)
+    loads(il_tf_max_tooth) = lk(il_tf_max_tooth, kmax)
+    loads(il_tf_max_t) = lk(il_tf_max_t, kmax)
+    loads(il_load_sharing_tooth) = maxloc(tload(:, ilt_f_peak), 1)
+    loads(il_free_max) = maxval(tload(:, ilt_free))
+    loads(il_back_max) = maxval(tload(:, ilt_back))
+    loads(il_unloaded) = count(tload(:, ilt_free) == 1.0_wp)
+    loads(il_back_teeth) = count(tload(:, ilt_back) > 0.0_wp)
+    loads(il_tm_rms_se) = spread_se(rms(:, 1))
+    loads(il_kv_rms_se) = nan
+    if (m%t_d /= 0.0_wp) loads(il_kv_rms_se) = spread_se(rms(:, 1)/abs(m%t_d))
+    loads(il_f_rms_se) = spread_se(rms(:, 2))
+    loads(il_d2_rms_se) = spread_se(rms(:, 3))
+    loads(il_sharing_rev_se) = spread_se(lk(il_sharing_rev, :))
+    loads(il_free_mean_se) = spread_se(lk(il_free_mean, :))
+    loads(il_impacts_rev_se) = spread_se(lk(il_impacts_rev, :))
+    loads(il_tf_rev_se) = spread_se(lk(il_tf_rev, :))
+    loads(il_free_max_se) = tload(maxloc(tload(:, ilt_free), 1), ilt_free_se)
+    loads(il_back_max_se) = tload(maxloc(tload(:, ilt_back), 1), ilt_back_se)
+  contains
+    !> the largest of x, NaN if one is (a load sharing without drive torque)
+    pure real(wp) function biggest(x)
+      real(wp), intent(in) :: x(:)
+      biggest = maxval(x)
+      if (any(x /= x)) biggest = nan
+    end function biggest
+    !> the standard error of the mean of the copies' values x: sd(x) / sqrt(K)
+    pure real(wp) function spread_se(x)
+      real(wp), intent(in) :: x(:)
+      real(wp) :: mean
+      mean = sum(x)/size(x)
+      spread_se = sqrt(sum((x - mean)**2)/(size(x) - 1)/size(x))
+    end function spread_se
+  end subroutine combined_loads
 
 
   !> The extremes and RMS of a run's outputs x(nextreme), spline_quantities' extreme_q: max, min

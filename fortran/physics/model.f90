@@ -69,6 +69,9 @@ module spline_model
     logical  :: estimate = .false., goal_statistics = .false.
     integer  :: max_steps, max_total_steps, n_out
     real(wp) :: t0, t_end, t_transient
+    !> realisations = K > 1 (spline_realisations): n_out and t_end are one copy's, the first
+    !> n_out / K outputs of the case's (the K copies together span what one run would)
+    integer  :: realisations = 1
     logical  :: start_equilibrium = .true.
     real(wp) :: dq0(ndof), dv0(ndof)
     real(wp) :: l_ref, w_ref                !< scales of Eq. 25
@@ -140,6 +143,12 @@ contains
     m%max_total_steps = c%max_total_steps
     m%t0 = c%t0      ! t_end, t_transient, n_out: as given, or from the shaft revolutions
     call case_run_times(c, m%t_end, m%t_transient, m%n_out)
+    m%realisations = c%realisations
+    if (m%realisations > 1) then
+      m%t_end = m%t0 + m%t_transient + (m%t_end - m%t0 - m%t_transient)* &
+           (m%n_out/m%realisations - 1)/real(m%n_out - 1, wp)
+      m%n_out = m%n_out/m%realisations
+    end if
     m%roots = c%roots; m%stald = c%stald; m%linear_tail = c%linear_tail; m%dq0 = c%dq0; m%dv0 = c%dv0
     m%dof = c%dof; m%fidelity_tol = c%fidelity_tol
     m%auto = option_index(fidelity_values, c%fidelity) == 2

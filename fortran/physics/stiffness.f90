@@ -27,6 +27,7 @@
 !> (spline_mesh_stiffness: one rule for both teeth).
 module spline_stiffness
   use spline_kinds, only: wp, pi
+  use spline_errors, only: num
   implicit none
   private
   public :: hertz_stiffness, external_tooth_stiffness, internal_tooth_stiffness, &
@@ -125,23 +126,23 @@ contains
     psi0 = pi/(2.0_wp*z) + involute(alpha)                 ! alpha_2 of Tian
     ierr = 1
     if (.not. (r_root > 0.0_wp)) then
-      errmsg = 'external_tooth_stiffness: r_root must be > 0, got '//num(r_root)
+      errmsg = 'external_tooth_stiffness: r_root must be > 0, got '//num(r_root, 5)
       return
     end if
     if (.not. (r_contact > r_root .and. r_contact >= rb)) then
-      errmsg = 'external_tooth_stiffness: r_contact = '//num(r_contact)//' must be above the root'// &
-           ' circle r_root = '//num(r_root)//' and on the involute (>= base radius '//num(rb)//')'
+      errmsg = 'external_tooth_stiffness: r_contact = '//num(r_contact, 5)//' must be above the root'// &
+           ' circle r_root = '//num(r_root, 5)//' and on the involute (>= base radius '//num(rb, 5)//')'
       return
     end if
     tc = roll(r_contact, rb)
     psic = half_angle(ext_tooth, psi0, tc)
     if (.not. (psic > 0.0_wp)) then
-      errmsg = 'external_tooth_stiffness: r_contact = '//num(r_contact)// &
+      errmsg = 'external_tooth_stiffness: r_contact = '//num(r_contact, 5)// &
            ' lies beyond the pointed tip of the tooth (zero thickness)'
       return
     end if
     if (r_root < rb .and. .not. (r_root > rb*sin(psi0))) then
-      errmsg = 'external_tooth_stiffness: r_root = '//num(r_root)// &
+      errmsg = 'external_tooth_stiffness: r_root = '//num(r_root, 5)// &
            ' is smaller than the half thickness of the tooth at the base circle'
       return
     end if
@@ -205,26 +206,26 @@ contains
     psi0 = pi/(2.0_wp*z) - involute(alpha)     ! ring tooth half angle extrapolated to t = 0
     ierr = 1
     if (.not. (r_tip >= rb)) then
-      errmsg = 'internal_tooth_stiffness: r_tip = '//num(r_tip)// &
-           ' must not be inside the base circle (base radius '//num(rb)//')'
+      errmsg = 'internal_tooth_stiffness: r_tip = '//num(r_tip, 5)// &
+           ' must not be inside the base circle (base radius '//num(rb, 5)//')'
       return
     end if
     if (.not. (r_root > r_tip)) then
-      errmsg = 'internal_tooth_stiffness: r_root = '//num(r_root)// &
-           ' must be larger than r_tip = '//num(r_tip)
+      errmsg = 'internal_tooth_stiffness: r_root = '//num(r_root, 5)// &
+           ' must be larger than r_tip = '//num(r_tip, 5)
       return
     end if
     if (.not. (r_contact >= r_tip .and. r_contact < r_root)) then
-      errmsg = 'internal_tooth_stiffness: r_contact = '//num(r_contact)// &
+      errmsg = 'internal_tooth_stiffness: r_contact = '//num(r_contact, 5)// &
            ' must lie on the active flank [r_tip, r_root)'
       return
     end if
     if (.not. (half_angle(int_tooth, psi0, roll(r_tip, rb)) > 0.0_wp)) then
-      errmsg = 'internal_tooth_stiffness: the ring tooth has no thickness at r_tip = '//num(r_tip)
+      errmsg = 'internal_tooth_stiffness: the ring tooth has no thickness at r_tip = '//num(r_tip, 5)
       return
     end if
     if (.not. (half_angle(int_tooth, psi0, roll(r_root, rb)) < pi/z)) then
-      errmsg = 'internal_tooth_stiffness: r_root = '//num(r_root)// &
+      errmsg = 'internal_tooth_stiffness: r_root = '//num(r_root, 5)// &
            ' lies beyond the radius where the tooth space closes'
       return
     end if
@@ -342,14 +343,14 @@ contains
     if (ierr /= 0) return
     ierr = 1
     if (.not. (r_int > 0.0_wp .and. r_int < r_root)) then
-      errmsg = who//': r_int (bore radius) = '//num(r_int)//' must be in (0, r_root = '//num(r_root)//')'
+      errmsg = who//': r_int (bore radius) = '//num(r_int, 5)//' must be in (0, r_root = '//num(r_root, 5)//')'
       return
     end if
     tc = roll(r_contact, rb)
     psic = half_angle(ext_tooth, psi0, tc)
     if (.not. (r_contact > r_root .and. r_contact >= rb .and. psic > 0.0_wp)) then
-      errmsg = who//': r_contact = '//num(r_contact)//' must be on the flank: above r_root = '// &
-           num(r_root)//', >= base radius '//num(rb)//', below the pointed tip'
+      errmsg = who//': r_contact = '//num(r_contact, 5)//' must be on the flank: above r_root = '// &
+           num(r_root, 5)//', >= base radius '//num(rb, 5)//', below the pointed tip'
       return
     end if
     ierr = 0; errmsg = ''
@@ -392,15 +393,15 @@ contains
     if (ierr /= 0) return
     ierr = 1
     if (.not. (r_out > r_root)) then
-      errmsg = who//': r_out (outer radius of the ring body) = '//num(r_out)// &
-           ' must be larger than r_root = '//num(r_root)
+      errmsg = who//': r_out (outer radius of the ring body) = '//num(r_out, 5)// &
+           ' must be larger than r_root = '//num(r_root, 5)
       return
     end if
     tc = roll(r_contact, rb)
     psic = half_angle(int_tooth, psi0, tc)
     if (.not. (r_contact < r_root .and. r_contact >= rb .and. psic > 0.0_wp)) then
-      errmsg = who//': r_contact = '//num(r_contact)//' must be on the flank: below r_root = '// &
-           num(r_root)//', >= base radius '//num(rb)//', where the ring tooth has thickness'
+      errmsg = who//': r_contact = '//num(r_contact, 5)//' must be on the flank: below r_root = '// &
+           num(r_root, 5)//', >= base radius '//num(rb, 5)//', where the ring tooth has thickness'
       return
     end if
     ierr = 0; errmsg = ''
@@ -424,8 +425,8 @@ contains
     call sainsot_fillet_compliance(thf, hf, uf, sf, am, e, b, c, coef)
     if (.not. (c > 0.0_wp)) then      ! the fit's quadratic form left its positive range
       ierr = 1
-      errmsg = who//': Sainsot''s fit gives no positive compliance at h_f = '//num(hf)// &
-           ', theta_f = '//num(thf)//' (r_int/r_out, rho_f, r_root out of range)'
+      errmsg = who//': Sainsot''s fit gives no positive compliance at h_f = '//num(hf, 5)// &
+           ', theta_f = '//num(thf, 5)//' (r_int/r_out, rho_f, r_root out of range)'
       return
     end if
     kf = 1.0_wp/c
@@ -482,16 +483,16 @@ contains
     thf = 0.0_wp
     ierr = 1
     if (.not. (hd > 0.0_wp)) then
-      errmsg = who//': '//rname//' = '//num(r_root)//' must lie beyond the pitch circle (radius '// &
-           num(0.5_wp*m*z)//'), on the root side'
+      errmsg = who//': '//rname//' = '//num(r_root, 5)//' must lie beyond the pitch circle (radius '// &
+           num(0.5_wp*m*z, 5)//'), on the root side'
     else if (.not. (rho_f >= 0.0_wp .and. rho_f*(1.0_wp - sin(alpha)) <= hd)) then
-      errmsg = who//': rho_f (root fillet radius) = '//num(rho_f)//' must be >= 0 and fit the'// &
-           ' dedendum (rho_f (1 - sin alpha) <= '//num(hd)//')'
+      errmsg = who//': rho_f (root fillet radius) = '//num(rho_f, 5)//' must be >= 0 and fit the'// &
+           ' dedendum (rho_f (1 - sin alpha) <= '//num(hd, 5)//')'
     else
       thf = (0.25_wp*pi*m + (hd - rho_f)*tan(alpha) + rho_f/cos(alpha))/(0.5_wp*m*z)
       if (.not. (thf < pi/z)) then
-        errmsg = who//': the root fillets overlap (theta_f = '//num(thf)//' >= pi/z): rho_f = '// &
-             num(rho_f)//' or '//rname//' = '//num(r_root)//' too large'
+        errmsg = who//': the root fillets overlap (theta_f = '//num(thf, 5)//' >= pi/z): rho_f = '// &
+             num(rho_f, 5)//' or '//rname//' = '//num(r_root, 5)//' too large'
       else
         ierr = 0; errmsg = ''
       end if
@@ -509,17 +510,17 @@ contains
     character(len=*), intent(out) :: errmsg
     ierr = 1
     if (.not. (z >= 3.0_wp)) then
-      errmsg = who//': z (number of teeth) must be >= 3, got '//num(z)
+      errmsg = who//': z (number of teeth) must be >= 3, got '//num(z, 5)
     else if (.not. (m > 0.0_wp)) then
-      errmsg = who//': m (module) must be > 0, got '//num(m)
+      errmsg = who//': m (module) must be > 0, got '//num(m, 5)
     else if (.not. (alpha > 0.0_wp .and. alpha < 0.5_wp*pi)) then
-      errmsg = who//': alpha (pressure angle, rad) must be in (0, pi/2), got '//num(alpha)
+      errmsg = who//': alpha (pressure angle, rad) must be in (0, pi/2), got '//num(alpha, 5)
     else if (.not. (b > 0.0_wp)) then
-      errmsg = who//': b (face width) must be > 0, got '//num(b)
+      errmsg = who//': b (face width) must be > 0, got '//num(b, 5)
     else if (.not. (e > 0.0_wp)) then
-      errmsg = who//': e (Young modulus) must be > 0, got '//num(e)
+      errmsg = who//': e (Young modulus) must be > 0, got '//num(e, 5)
     else if (.not. (nu >= 0.0_wp .and. nu < 0.5_wp)) then
-      errmsg = who//': nu (Poisson ratio) must be in [0, 0.5), got '//num(nu)
+      errmsg = who//': nu (Poisson ratio) must be in [0, 0.5), got '//num(nu, 5)
     else if (nquad < 1) then
       errmsg = who//': nquad (Gauss points) must be >= 1'
     else
@@ -634,14 +635,5 @@ contains
     real(wp), intent(in) :: psi0, t
     half_angle = psi0 - side*(t - atan(t))
   end function half_angle
-
-  !> A number for an error message.
-  pure function num(x) result(s)
-    real(wp), intent(in) :: x
-    character(len=:), allocatable :: s
-    character(len=24) :: buf
-    write(buf, '(es12.5)') x
-    s = trim(adjustl(buf))
-  end function num
 
 end module spline_stiffness

@@ -1,0 +1,104 @@
+"""realisations = K (docs/accuracy.md): K perturbed copies after the transient read the statistics
+one long run reads, with standard errors from their spread; spline-dyn gives Python's numbers."""
+import re
+import subprocess
+import warnings
+
+import numpy as np
+import pytest
+
+import pyspline
+from conftest import CASES, assert_executable_matches_python
+from pyspline.cli import _summary
+
+
+def chaos(**fields):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)   # the case's soft shafts
+        return pyspline.load_case(CASES / "chaos_z24.nml",
+                                  **{"goal": "statistics", "lyapunov": False, **fields})
+
+
+def simulate(case):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        return pyspline.simulate(case)
+
+
+def rms(res):
+    return float(np.sqrt(np.mean(res.Tm ** 2)))
+
+
+def test_realisations_combine_to_one_long_runs_statistics():
+    """chaos_z24 after its engagement, 30 revolutions sampled: one run against 3 copies of 10
+    revolutions each; T_m RMS, free teeth and impacts per revolution agree within 3 combined
+    standard errors (the copies' from their spread), and the copies' trajectories part."""
+    case = chaos(t_end=0.6, n_out=3001)
+    one, three = simulate(case), simulate(case.replace(realisations=3))
+    assert len(three.t) == 3000 and np.count_nonzero(three.t == three.t[0]) == 3
+    n = 1000
+    assert three.t[n - 1] == pytest.approx(0.3 + 0.1, abs=1e-3)
+    assert np.max(np.abs(three.Tm[n - 100:n] - three.Tm[2 * n - 100:2 * n])) > 0.1  # parted
+    assert three.loads["revolutions"] == pytest.approx(30, abs=0.1)
+    for value, se in ((rms, "Tm_rms_se"), (lambda r: r.loads["teeth_free_mean"],
+                                            "teeth_free_mean_se"),
+                      (lambda r: r.loads["impacts_per_rev"], "impacts_per_rev_se")):
+        assert 0 < three.loads[se] < np.inf, se
+        spread = np.hypot(one.loads[se], three.loads[se])
+        assert abs(value(three) - value(one)) <= 3 * spread, se
+    assert "; 3 realisations, standard errors from their spread" in _summary(three)
+
+
+def test_executable_gives_the_realisations_of_python(exe, tmp_path):
+    """Two copies on spline-dyn's OpenMP threads and on Python's default threads: the same
+    outputs, loads and statistics, bit for bit."""
+    case = chaos(t_transient=0.05, t_end=0.15, n_out=1001, realisations=2, section="shaft")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        *_, res = assert_executable_matches_python(case, exe, tmp_path)
+    nml = tmp_path / "k2.nml"
+    case.to_namelist(nml)
+    subprocess.run([exe, str(nml), "--summary", str(tmp_path / "k2.summary")], check=True,
+                   capture_output=True, env={"OMP_NUM_THREADS": "2"})
+    text = (tmp_path / "k2.summary").read_text()
+    for name in ("Tm_rms_se", "impacts_per_rev", "impacts_per_rev_se", "teeth_free_mean_se",
+                 "revolutions", "load_sharing"):
+        got = float(re.search(rf"loads\.{name} \[.*\] = +(\S+)", text).group(1))
+        assert got == res.loads[name], name
+    got = float(re.search(r"stats\.rhs_evals \[.*\] = +(\S+)", text).group(1))
+    assert got == res.stats["rhs_evals"]
+    assert len(res.section_t) == 2 * pyspline.load(case).n_section > 0
+
+
+@pytest.mark.parametrize("fields, message", [
+    (dict(realisations=0), r"field realisations = 0 must be at least 1"),
+    (dict(realisations=1.5), r"field realisations = 1\.5 must be a whole number"),
+    (dict(realisations=2, goal="trajectory"), r"field realisations = 2 runs perturbed copies "
+     r"whose trajectories part: it reads statistics, set goal = 'statistics'"),
+    (dict(realisations=2, lyapunov=True), r"field realisations = 2 with lyapunov = \.true\."),
+    (dict(realisations=5000), r"field realisations = 5000 leaves fewer than 2 of the 8001 "
+     r"outputs to each copy: at most 4000")])
+def test_bad_realisations_are_refused_naming_the_field(fields, message):
+    with pytest.raises(pyspline.CaseError, match=message):
+        chaos(**fields).model
+
+
+def test_sweep_points_run_their_copies():
+    """A sweep's point runs its copies one after another: the numbers of simulate's threads."""
+    case = chaos(t_transient=0.05, t_end=0.15, n_out=1001, realisations=2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds = pyspline.sweep(case, l_x=[1.5e-4, 2e-4], progress=False)
+    one = simulate(case.replace(l_x=2e-4))
+    for name in ("Tm_rms_se", "impacts_per_rev"):
+        assert ds[name].sel(l_x=2e-4).item() == one.loads[name], name
+
+
+def test_section_instants_of_one_run_and_of_copies():
+    """The transient ends on a section instant (chaos_z24's shaft period is 0.01 s): one run keeps
+    it, a copy starts there and leaves it out; the arrays hold exactly the points run."""
+    case = chaos(t_transient=0.05, t_end=0.1, n_out=101, section="shaft")
+    one, two = simulate(case), simulate(case.replace(realisations=2))
+    assert len(one.section_t) == pyspline.load(case).n_section == 6
+    assert one.section_t[0] == pytest.approx(0.05)
+    np.testing.assert_allclose(two.section_t, [0.06, 0.07, 0.06, 0.07])
