@@ -152,7 +152,7 @@ contains
           exit
         end if
         stage = 'restarting at a contact switch'
-        flag = integrator_restart(cv, tau)
+        flag = integrator_restart(cv, tau, floored=.false.)
       else
         flag = 0
       end if
