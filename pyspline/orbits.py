@@ -354,16 +354,10 @@ def _settled_state(model, t0: float, period: float) -> np.ndarray:
 
 
 def _trajectory(case: Case, t0: float, t1: float, y0: np.ndarray) -> Result:
-    """simulate from (t0, y0) to t1: start at rest plus the state as dq0, dv0 (exact: 0 + y).
-    A run that fails is tried once more at half the case's rtol: the core's state run can fail
-    with CV_ILL_INPUT ("tout too far back") where the map run from the same state does not
-    (measured on the Z16 drive of tests/test_cont_drives.py, a = 0.13, near 2488.47 r/min)."""
+    """simulate from (t0, y0) to t1: start at rest plus the state as dq0, dv0 (exact: 0 + y)."""
     run = _run(case, start="rest", dq0=list(y0[:7]), dv0=list(y0[7:]), t0=t0, t_end=t1,
                t_transient=0.0)
     with warnings.catch_warnings():
         # the orbit may start in contact: the start-at-rest overlap warning says nothing here
         warnings.filterwarnings("ignore", message=r".*start = 'rest' with", category=SplineWarning)
-        try:
-            return simulate(run)
-        except SolverError:
-            return simulate(run.replace(rtol=run["rtol"] / 2))
+        return simulate(run)

@@ -125,3 +125,45 @@ def test_executable_prints_the_restart_warning(exe, tmp_path):
         pyspline.simulate(case)
     said = [str(w.message) for w in rec if "restarts at order 1" in str(w.message)]
     assert len(said) == 1 and f"spline-dyn: warning: {said[0]}" in run.stderr.splitlines()
+
+
+# A state on the periodic orbit of the Z16 drive of tests/test_cont_drives.py with the order-1
+# ripple at 0.13, at 2488.47 r/min (pyspline.continuation over 2300-2650 r/min reached it), SI:
+# x1 y1 x2 y2 D1 D2 D3 [m], their velocities [m/s]. Its period is one of the aligned drive's
+# grazing contacts: every tooth opens and closes within 1e-13 s of the others, split by round-off.
+GRAZING_Y0 = np.array([
+    -6.806181792828899e-19, -3.923999999999805e-06, 6.806205563914763e-19, -3.92400000000018e-06,
+    -0.00012950613884059645, 0.00017992683777840837, 0.0001287048488843166,
+    -3.5463502337578286e-16, 2.1317722072931414e-16, 3.546192960824782e-16,
+    -2.373171762308127e-16, -0.07373123213643412, 0.05940836230047624, 0.06285891968201351])
+GRAZING = pyspline.load_case(CASES / "paper_ideal.nml", rtol=1e-8, atol=1e-10, roots=True, dof=7,
+                             k_t1=1e3, k_t2=1e3, zeta_m=0.01, ripple_order=[1, 0, 0, 0],
+                             ripple_amp=[0.13, 0, 0, 0], speed_rpm=2488.469669472484)
+
+
+@pytest.mark.parametrize("method", ["adams", "bdf"])
+def test_period_run_through_a_grazing_cluster_of_switches(method):
+    """The state run over one forcing period from GRAZING_Y0 (what orbits._trajectory runs for
+    a branch point) failed with CV_ILL_INPUT "tout too far back" at the case's rtol, with Adams
+    and BDF: a free tooth's switch function at round-off level (exactly 0 at a restart) was
+    located crossing back the way that changes nothing, restart after restart at one instant,
+    each cutting the first step tenfold, until the step fell below round-off of t and CVODE
+    'reached' the next output without a state there (BDF's period map 'succeeded' that way,
+    6 % of the state off its orbit). Now only the crossings that change a contact state are
+    located: the run succeeds, its end state is the period map's to the continuation's
+    tolerance (100 rtol on the scaled states of Eq. 25), and CVODE says nothing."""
+    from pyspline.orbits import _period_map
+    from test_orbits import scale_of
+    case = GRAZING.replace(method=method)
+    period = 60 / case["speed_rpm"]
+    run = case.replace(start="rest", dq0=list(GRAZING_Y0[:7]), dv0=list(GRAZING_Y0[7:]),
+                       t0=0.0, t_end=period, t_transient=0.0, n_out=1001)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", pyspline.SplineWarning)
+        res = pyspline.simulate(run)
+        y1 = _period_map(case.model, 0.0, period, GRAZING_Y0[:, None])[0][:, 0]
+    s = scale_of(case)
+    tol = 100 * case["rtol"] * max(1.0, np.abs(GRAZING_Y0 / s).max())
+    assert res.t[-1] == period and res.stats["roots_found"] > 32
+    assert np.abs((res.y[-1] - y1) / s).max() < tol
+    assert np.abs((y1 - GRAZING_Y0) / s).max() < tol        # the orbit closes: on the branch

@@ -44,9 +44,9 @@ module spline_integrator
   implicit none
   private
   public :: integrator_t, lib_log_t, integrator_open, cvode_create, erk_create, integrator_advance, &
-       integrator_root_info, integrator_land_on_root, integrator_restart, integrator_steps_done, &
-       integrator_last_step, integrator_fail_text, integrator_warnings, add_counters, &
-       integrator_free
+       integrator_root_info, integrator_root_directions, integrator_land_on_root, &
+       integrator_restart, integrator_steps_done, integrator_last_step, integrator_fail_text, &
+       integrator_warnings, add_counters, integrator_free
 
   !> SUNDIALS' own messages of a run (lib_handler), kept instead of printed: the last error's
   !> text, and the warnings (how many, the first one's text).
@@ -79,6 +79,10 @@ module spline_integrator
     real(wp) :: max_seconds = 0.0_wp        !< wall-time bound (s) of the run; 0: none
     integer(8) :: clock0 = 0, rate = 1      !< system_clock at the start, its rate
     logical :: wall_bound = .false.         !< the run stopped at max_seconds
+    !> a call 'succeeded' short of its tout: the step had fallen below round-off of t, the
+    !> state returned is not the state there (integrator_evolve); t_stalled: where it stood
+    logical :: stalled = .false.
+    real(c_double) :: t_stalled = 0.0_c_double
     type(lib_log_t) :: log                  !< SUNDIALS' messages (lib_handler's user data)
   end type integrator_t
 
@@ -93,8 +97,17 @@ module spline_integrator
   !> 0.1: 16 900 switches in 0.15 s; with 0.01 it chattered again; with 1 (order 1 on a step
   !> sized for a higher order) BDF on physical_z24 took 15-20 % longer. docs/performance.md.
   real(c_double), parameter :: cvode_restart_fraction = 0.1_c_double
+  !> ... but never below this many times CVODE's root tolerance at the restart, 100 uround
+  !> (|t| + |h|): in a cluster of switches each restart's first step is the step that crossed
+  !> the next one, so the fraction compounds (the 16 teeth of an aligned Z16 drive switch
+  !> within 1e-13 s of each other, split by round-off: 1e-16 of the step), and a step below the
+  !> tolerance cannot tell a root from its start; with 10 of it CVODE's look just past a
+  !> switch function that is zero at the restart (0.1 of the step) passes the tolerance.
+  real(c_double), parameter :: cvode_restart_floor = 10*100*epsilon(1.0_c_double)
   !> steps per integrator call in a run with a wall-time bound (the clock is read between calls)
   integer(8), parameter :: wall_chunk = 20000
+  !> integrator_evolve's flag for a call that returned short of its tout (not a SUNDIALS code)
+  integer(c_int), parameter :: stalled_flag = -9999_c_int
 
 contains
 
@@ -316,7 +329,29 @@ contains
       flag = FCVodeSetMaxNumSteps(cv%mem, int(allow, c_long))
       if (flag == 0) flag = FCVode(cv%mem, tout, cv%sv, tret, CV_NORMAL)
     end if
+    if (flag == 0) call check_reached(cv, tout, flag)
   end function integrator_evolve
+
+  !> A successful call in normal mode stands at or past tout. One that does not was fooled by
+  !> a step below round-off: CVODE's test (t_n - tout) h >= 0 underflows to -0 for a
+  !> subnormal h, and it returns 'success' at tout with its interpolation's error ignored (the
+  !> state left as it was, not the state at tout; the next call fails with CV_ILL_INPUT, "tout
+  !> too far back"). Then flag = stalled_flag, cv%stalled and where it stood, for the message.
+  subroutine check_reached(cv, tout, flag)
+    type(integrator_t), intent(inout) :: cv
+    real(c_double), intent(in) :: tout
+    integer(c_int), intent(inout) :: flag
+    real(c_double) :: tn(1)
+    if (cv%erk) then
+      if (FERKStepGetCurrentTime(cv%mem, tn) /= 0) return
+    else
+      if (FCVodeGetCurrentTime(cv%mem, tn) /= 0) return
+    end if
+    if (tn(1) >= tout) return
+    cv%stalled = .true.
+    cv%t_stalled = tn(1)
+    flag = stalled_flag
+  end subroutine check_reached
 
   !> ERKStep returned at a root troot: redo its last step from its start (tn - h) to land on
   !> troot exactly (stop time), root functions off, contact states still the old ones. The state
@@ -344,6 +379,20 @@ contains
     if (flag == ARK_TSTOP_RETURN) flag = 0
     if (flag == 0) flag = root_init(cv, cv%nroot, cv%groots)
   end function integrator_land_on_root
+
+  !> Locate only the crossings of root function i in direction dirs(i) (+1 rising, -1 falling,
+  !> 0 either) from the next call on. CVODE only: ERKStep's landing on a root
+  !> (integrator_land_on_root) switches root finding off and on, which resets the directions,
+  !> and settle_roots (spline_solver) counts on seeing a landed root again later.
+  integer(c_int) function integrator_root_directions(cv, dirs) result(flag)
+    type(integrator_t), intent(inout) :: cv
+    integer, intent(in) :: dirs(:)
+    integer(c_int), target :: d(size(dirs))
+    flag = 0
+    if (cv%erk .or. .not. cv%roots) return
+    d = int(dirs, c_int)
+    flag = FCVodeSetRootDirection(cv%mem, d)
+  end function integrator_root_directions
 
   integer(c_int) function integrator_root_info(cv, rootsfound) result(flag)
     type(integrator_t), intent(inout) :: cv
@@ -375,10 +424,19 @@ contains
   !> starts afresh at order 1 with cvode_restart_fraction of the step that crossed the switch.
   !> ERKStep: ERKStepReset, counters kept, with the step that crossed (not the landing's
   !> remainder, which its growth limit took several steps to recover).
-  integer(c_int) function integrator_restart(cv, tau, stats) result(flag)
+  !> floored (default .true.): CVODE's first step at least cvode_restart_floor (|tau| + |h|).
+  !> The variational run passes .false.: with the floor there the ERK S-curve continuation's
+  !> corrector failed near 2355.58 r/min (tests/test_cont_drives.py::test_erk_traces_the_s_curve;
+  !> why not analysed); the state run (and the period map on it) needs it, without it BDF's map
+  !> through the Z16 drive's grazing cluster closed 6.6 % off the orbit (tests/test_solver.py).
+  integer(c_int) function integrator_restart(cv, tau, stats, floored) result(flag)
     type(integrator_t), intent(inout) :: cv
     real(c_double), intent(in) :: tau
     real(wp), intent(inout), optional :: stats(nstats)
+    logical, intent(in), optional :: floored
+    logical :: fl
+    fl = .true.
+    if (present(floored)) fl = floored
     if (cv%erk) then
       flag = FERKStepReset(cv%mem, tau, cv%sv)
       if (flag == 0 .and. cv%h_cross > 0.0_c_double) flag = FERKStepSetInitStep(cv%mem, cv%h_cross)
@@ -386,19 +444,23 @@ contains
     else
       cv%steps0 = integrator_steps_done(cv)
       if (present(stats)) call add_counters(cv, stats)
-      flag = cvode_restart(cv%mem, tau, cv%sv)
+      flag = cvode_restart(cv%mem, tau, cv%sv, fl)
     end if
   end function integrator_restart
 
   !> CVODE (mem) restarted at tau from sv after a contact switch: CVodeReInit, at order 1 with
-  !> cvode_restart_fraction of the step that crossed the switch.
-  integer(c_int) function cvode_restart(mem, tau, sv) result(flag)
+  !> cvode_restart_fraction of the step that crossed the switch, if floored at least
+  !> cvode_restart_floor (|tau| + |h|).
+  integer(c_int) function cvode_restart(mem, tau, sv, floored) result(flag)
     type(c_ptr), intent(in) :: mem
     real(c_double), intent(in) :: tau
     type(N_Vector), intent(inout) :: sv
-    real(c_double) :: hl(1)
+    logical, intent(in) :: floored
+    real(c_double) :: hl(1), h0
     flag = FCVodeGetLastStep(mem, hl)
-    if (flag == 0) flag = FCVodeSetInitStep(mem, cvode_restart_fraction*hl(1))
+    h0 = cvode_restart_fraction*hl(1)
+    if (floored) h0 = max(h0, cvode_restart_floor*(abs(tau) + abs(hl(1))))
+    if (flag == 0) flag = FCVodeSetInitStep(mem, h0)
     if (flag == 0) flag = FCVodeReInit(mem, tau, sv)
   end function cvode_restart
 
@@ -477,7 +539,12 @@ contains
     head = 'case '//trim(m%name)//': '//trim(cv%run)
     name = integrator_name(cv)
     write(at, '(es12.5)') tau/m%w_ref
-    if (flag == CV_TOO_MUCH_WORK .and. cv%wall_bound) then
+    if (flag == stalled_flag .and. cv%stalled) then
+      errmsg = head//': the '//name//' step fell below round-off of t at t = '// &
+           ftoa(cv%t_stalled/m%w_ref, '(es12.5)')//' s, short of t = '//at// &
+           ' s where the state was asked for (no state there: a chain of restarts at contact '// &
+           'switches)'
+    else if (flag == CV_TOO_MUCH_WORK .and. cv%wall_bound) then
       errmsg = head//' took longer than its wall-time bound max_seconds = '// &
            ftoa(cv%max_seconds, '(es9.2)')//' s, at t = '//at//' s, after '// &
            itoa(int(integrator_steps_done(cv)))//' '//name//' steps'

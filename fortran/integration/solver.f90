@@ -15,12 +15,13 @@ module spline_solver
   use spline_errors, only: err_ok, err_solver, err_interrupted, msglen
   use spline_model, only: model_t, nstate, ndof
   use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, integrated_states
-  use spline_mesh, only: mesh_switch_functions, coupling_stats_t, eq16_mode, eq16_root_mode
+  use spline_mesh, only: mesh_switch_functions, coupling_stats_t, eq16_mode, eq16_root_mode, &
+       eq16_root_directions
   use spline_linear, only: tail_t, tail_possible, tail_try, tail_state, tail_states
   use spline_integrator, only: integrator_t, lib_log_t, integrator_open, cvode_create, &
-       erk_create, integrator_advance, integrator_root_info, integrator_land_on_root, &
-       integrator_restart, integrator_steps_done, integrator_last_step, integrator_fail_text, &
-       integrator_warnings, add_counters, integrator_free
+       erk_create, integrator_advance, integrator_root_info, integrator_root_directions, &
+       integrator_land_on_root, integrator_restart, integrator_steps_done, integrator_last_step, &
+       integrator_fail_text, integrator_warnings, add_counters, integrator_free
   use spline_quantities, only: nstats => nsolver_stats, ist_roots_found, &
        ist_last_step, ist_mode_resyncs, ist_coupling_residual, ist_coupling_iterations, &
        ist_linear_tail_t
@@ -200,6 +201,14 @@ contains
         ! work bounds across restarts: max_steps per output interval, max_total_steps over the
         ! run (spline_integrator::integrator_advance)
         tau_to = next_stop(tau_out)
+        if (ctx%frozen) then
+          ! only the crossings that change a contact state are switches (CVODE)
+          flag = integrator_root_directions(cv, root_directions(ctx))
+          if (flag /= 0) then
+            call fail(flag, tau, 'setting the directions of the contact switches')
+            return
+          end if
+        end if
         flag = integrator_advance(cv, tau, tau_to, done_k, tret)
         if (flag < 0) then
           call fail(flag, tret(1), 'integrating')
@@ -393,6 +402,26 @@ contains
       end if
     end do
   end subroutine sync_modes
+
+  !> The directions of the root functions (copy after copy) whose crossings change the contact
+  !> states ctx%modes (spline_mesh::eq16_root_directions). Without them a crossing the other
+  !> way, at round-off level on a grazing tooth (g exactly 0 at the restart, then +-1e-20 m),
+  !> was located, changed no state and restarted CVODE, whose search found it again within its
+  !> root tolerance: restarts without end at one instant, each cutting the first step tenfold,
+  !> until the step fell below round-off (the Z16 drive of tests/test_cont_drives.py, ripple
+  !> 0.13 at 2488.47 r/min: CV_ILL_INPUT, "tout too far back").
+  pure function root_directions(ctx) result(dirs)
+    type(solver_ctx_t), intent(in) :: ctx
+    integer :: dirs(ctx%nrc*ctx%ncopy)
+    integer :: j, c, nc
+    nc = ctx%m%z*ctx%m%n_slices
+    do c = 1, ctx%ncopy
+      do j = 1, nc
+        dirs((c - 1)*ctx%nrc + 2*j - 1:(c - 1)*ctx%nrc + 2*j) = &
+             eq16_root_directions(ctx%modes(j, c))
+      end do
+    end do
+  end function root_directions
 
   !> A located root of g_{2j-1} = dn_j - c_j (rising: drive flank engages, falling: it opens)
   !> or of g_{2j} = dn_j + c_j (falling: back flank engages, rising: it opens).

@@ -25,10 +25,10 @@ module spline_variational
   use spline_geometry, only: tooth_angles
   use spline_dynamics, only: rhs_scaled, rhs_jacobian, to_scaled, from_scaled, integrated_states
   use spline_mesh, only: mesh_switch_functions, eq11_gradient, eq16_mode, eq16_root_mode, &
-       slice_offset
+       eq16_root_directions, slice_offset
   use spline_integrator, only: integrator_t, lib_log_t, integrator_open, cvode_create, &
-       integrator_advance, integrator_root_info, integrator_restart, integrator_fail_text, &
-       integrator_warnings, integrator_free
+       integrator_advance, integrator_root_info, integrator_root_directions, integrator_restart, &
+       integrator_fail_text, integrator_warnings, integrator_free
   implicit none
   private
   public :: tangent_flow, variational_check
@@ -95,7 +95,7 @@ contains
     real(c_double) :: tau, tau1, tret(1)
     integer(c_int) :: flag, nroot
     integer(c_int), allocatable :: rootsfound(:)
-    integer :: n, k, nsw
+    integer :: n, k, nsw, j
     logical :: salt
     character(len=48) :: stage
     salt = .true.
@@ -133,6 +133,10 @@ contains
     if (flag == 0) call cvode_create(m, tau, nroot, c_funloc(tan_rhs_cb), c_funloc(tan_roots_cb), &
          c_funloc(tan_jac_cb), n - 1, c_loc(ctx), cv, flag, stage)
     do while (flag == 0 .and. tau < tau1)
+      ! only the crossings that change a contact state are switches (as in spline_solver)
+      stage = 'setting the directions of the contact switches'
+      flag = integrator_root_directions(cv, [(eq16_root_directions(ctx%modes(j)), j = 1, ctx%nc)])
+      if (flag /= 0) exit
       ! max_steps and max_total_steps over the run (its one output interval), across restarts
       stage = 'integrating'
       flag = integrator_advance(cv, tau, tau1, 0_8, tret)
@@ -148,7 +152,7 @@ contains
           exit
         end if
         stage = 'restarting at a contact switch'
-        flag = integrator_restart(cv, tau)
+        flag = integrator_restart(cv, tau, floored=.false.)
       else
         flag = 0
       end if

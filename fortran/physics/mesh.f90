@@ -11,7 +11,7 @@ module spline_mesh
   implicit none
   private
   public :: mesh_eval, mesh_forces, mesh_outputs, mesh_switch_functions, coupling_stats_t, tooth_approach
-  public :: eq11_gradient, eq16_mode, eq16_root_mode, slice_offset
+  public :: eq11_gradient, eq16_mode, eq16_root_mode, eq16_root_directions, slice_offset
 
   integer, parameter :: max_coupling_iter = 60
   real(wp), parameter :: coupling_tol = 1.0e-14_wp   !< relative step tolerance on T_f
@@ -483,5 +483,25 @@ contains
     if (root_back == -1) new = -1
     if (root_back == 1) new = 0
   end function eq16_root_mode
+
+  !> The crossing directions of a contact's switch functions (g_drive, g_back) that change its
+  !> contact state mode by eq16_root_mode, as SUNDIALS' root directions (+1 rising, -1 falling,
+  !> 0 either): free (0), g_drive rising and g_back falling; on the drive flank (+1), g_drive
+  !> falling, g_back either; on the back flank (-1), g_back rising, g_drive either. The other
+  !> way (a free tooth's g_drive falling, say) leaves the state as it is: at round-off level on a
+  !> grazing tooth such a crossing, located, changed nothing but cost a restart, and restarts
+  !> there chained without end (spline_solver::root_directions).
+  pure function eq16_root_directions(mode) result(dirs)
+    integer, intent(in) :: mode
+    integer :: dirs(2)
+    select case (mode)
+    case (1)
+      dirs = [-1, 0]
+    case (-1)
+      dirs = [0, 1]
+    case default
+      dirs = [1, -1]
+    end select
+  end function eq16_root_directions
 
 end module spline_mesh

@@ -6,7 +6,8 @@
 program test_mesh
   use spline_kinds, only: wp, pi
   use spline_model, only: model_t
-  use spline_mesh, only: mesh_eval, mesh_forces, mesh_switch_functions, tooth_approach
+  use spline_mesh, only: mesh_eval, mesh_forces, mesh_switch_functions, tooth_approach, &
+       eq16_root_mode, eq16_root_directions
   use check, only: check_true, check_close, check_done, default_case_model
   implicit none
   real(wp), parameter :: eps = epsilon(1.0_wp)
@@ -193,6 +194,26 @@ program test_mesh
        '(40 states)', ok)
   call check_true('those states have teeth on both flanks and free', n_pos > 0 .and. n_neg > 0 &
        .and. n_pos + n_neg < md%z)
+
+  ! the root directions the runs locate are exactly the crossings that change the contact state
+  block
+    integer :: mode, fn, dir, r(2), dirs(2)
+    logical :: agree
+    agree = .true.
+    do mode = -1, 1
+      dirs = eq16_root_directions(mode)
+      do fn = 1, 2                        ! g_drive, g_back
+        do dir = -1, 1, 2                 ! falling, rising
+          r = 0
+          r(fn) = dir
+          agree = agree .and. ((eq16_root_mode(mode, r(1), r(2)) /= mode) .eqv. &
+               (dirs(fn) == 0 .or. dir == dirs(fn)))
+        end do
+      end do
+    end do
+    call check_true('Eq. 16 root directions: a crossing changes the contact state (-1, 0, +1) '// &
+         'exactly when it is in a direction located (0: either)', agree)
+  end block
 
   call check_done('test_mesh')
 
