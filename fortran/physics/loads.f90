@@ -267,9 +267,8 @@ contains
       a = (k - 1)*n
       call run_loads(m, t(a + 1:a + n), y(:, a + 1:a + n), tooth(a + 1:a + n, :, :), &
            tm(a + 1:a + n), lk(:, k), tk(:, :, k))
-      rms(k, 1) = sqrt(sum(tm(a + 1:a + n)**2)/n)
-      rms(k, 2) = sqrt(sum(tooth(a + 1:a + n, :, 1)**2)/(n*m%z))
-      rms(k, 3) = sqrt(sum(y(6, a + 1:a + n)**2)/n)
+      rms(k, :) = [rms_of(tm(a + 1:a + n)), rms_of(reshape(tooth(a + 1:a + n, :, 1), [n*m%z])), &
+           rms_of(y(6, a + 1:a + n))]
     end do
     loads = lk(:, 1)
     tload = tk(:, :, 1)
@@ -344,9 +343,15 @@ contains
     pure function three(v) result(r)
       real(wp), intent(in) :: v(:)
       real(wp) :: r(3)
-      r = [maxval(v), minval(v), sqrt(sum(v**2)/size(v))]
+      r = [maxval(v), minval(v), rms_of(v)]
     end function three
   end subroutine run_extremes
+
+  !> The root mean square of v (run_extremes; combined_loads' per-copy values).
+  pure real(wp) function rms_of(v)
+    real(wp), intent(in) :: v(:)
+    rms_of = sqrt(sum(v**2)/size(v))
+  end function rms_of
 
   !> Nominal stresses of a tooth carrying the load f along its line of action (docs/model.md
   !> section 15, "Tooth stresses"), from its tangential part at the pitch circle
