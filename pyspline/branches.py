@@ -165,7 +165,7 @@ def branches(case, field: str, start: float, stop: float, points: int = 31, *,
     Returns (Dataset, sweep): the Dataset of `continuation` for all the branches (dim 'point',
     'branch' numbered through, 'seed' the seed's index; dims 'special' likewise; attrs
     'seeds': field value, direction and period of each seed continued, 'status' each seed's),
-    and the follow sweep's Dataset (frplots.frequency_response(ds, sweep=sw) draws both)."""
+    and the follow sweep's Dataset (pyspline.plots.frequency_response(ds, sweep=sw) draws both)."""
     with time_bound(max_seconds, "branches"):
         return _branches(case, field, start, stop, points, max_n, progress, command,
                          sweep_case, cont)
@@ -244,7 +244,7 @@ def _branches(case, field, start, stop, points, max_n, progress, command, sweep_
                           f"{_spans(no_period) or 'none'})")
     keep = merged(pieces, field, scale)
     ds = _concat([pieces[i] for i in keep])
-    if no_period:       # frplots.frequency_response shades them
+    if no_period:       # plots.frequency_response shades them
         ds["no_period_range"] = (("stretch", "end"), np.sort([[a, b] for _, a, b in no_period]))
     ds.attrs.update(start=start, stop=stop, seeds="; ".join(seeds[i] for i in keep),
                     no_period=_spans(no_period), status="; ".join(status) or "complete",

@@ -116,9 +116,11 @@ TOOTH_LOAD_QUANTITIES = {n: (d, u) for n, u, d in _names("tooth_loads")}
 EXTREMES = {n: (d, u) for n, u, d in _names("extremes")}
 
 
-def _attrs(name: str) -> dict:
-    """xarray attrs of an output quantity of the core's table: long_name, units (if any)."""
-    long, unit = QUANTITIES.get(name) or LOAD_QUANTITIES.get(name) or TOOTH_LOAD_QUANTITIES[name]
+def _attrs(name: str, table: dict = None) -> dict:
+    """xarray attrs of a quantity of the core's tables (an output or a load, or one of `table`):
+    long_name, units (if any)."""
+    long, unit = (table[name] if table else QUANTITIES.get(name) or LOAD_QUANTITIES.get(name)
+                  or TOOTH_LOAD_QUANTITIES[name])
     return {"long_name": long, "units": cf_units(unit)} if unit else {"long_name": long}
 
 
@@ -218,8 +220,10 @@ class Result:
         tooth on the tooth dim, the scalars without a dim); section_t and the states on the
         section section_x1 .. section_vD3 (section_point); lyapunov_log_growth
         (renormalisation, with coordinate lyapunov_t [s]); a sliced face (n_slices > 1): face
-        (time, tooth, slice) [N] and tilt (time, moment: M_x, M_y) [N m]. attrs: case (namelist text), name, level, pyspline_version, the
-        exponent as lyapunov_exponent [1/s], and the run statistics as stat_<name>."""
+        (time, tooth, slice) [N] and tilt (time, moment: M_x, M_y) [N m]; the extremes and RMS
+        (``extremes``) as run_<name> without a dim (run_Tm_max, run_F_rms, ...: spline-dyn's
+        summary lines run.<name>). attrs: case (namelist text), name, level, pyspline_version,
+        the exponent as lyapunov_exponent [1/s], and the run statistics as stat_<name>."""
         import xarray as xr
         from . import __version__
         z = next(iter(self.tooth.values())).shape[1] if self.tooth else 0
@@ -233,6 +237,8 @@ class Result:
             data[n] = (("time", "tooth"), arr, _attrs(n))
         for n, v in (self.loads or {}).items():     # per tooth on the tooth dim, scalars 0-d
             data[n] = (("tooth",) if n in TOOTH_LOAD_QUANTITIES else (), v, _attrs(n))
+        for n, v in (self.extremes or {}).items():
+            data["run_" + n] = ((), v, _attrs(n, EXTREMES))
         if self.spacing_error is not None:
             long, unit = FIELDS["spacing_error"]
             data["spacing_error"] = ("tooth", self.spacing_error,

@@ -150,6 +150,16 @@ def test_heartbeat_ticks_during_a_simulate():
     assert ticks[0] > 0.3 * wall / 1.1e-3, (ticks[0], wall)
 
 
+@pytest.fixture
+def sigint_raises():
+    """SIGINT acts as in an interactive Python (KeyboardInterrupt) during the test, also when
+    pytest was started with SIGINT ignored (nohup, `&` in a non-interactive shell, a batch
+    system), which the core's watch respects (fortran/integration/interrupt.c)."""
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, old)
+
+
 def _sigint_after(delay):
     timer = threading.Timer(delay, os.kill, (os.getpid(), signal.SIGINT))
     timer.start()
@@ -160,7 +170,7 @@ LONG = dict(t_end=60.0, n_out=3, max_steps=10**8)   # about 20 s of work (max_st
 # outputs): the test fails by time if SIGINT is lost
 
 
-def test_sigint_stops_a_long_run_quickly():
+def test_sigint_stops_a_long_run_quickly(sigint_raises):
     case = pyspline.load_case(CASES / "paper_T100.nml", **LONG)
     case.model
     timer = _sigint_after(0.3)
@@ -174,7 +184,7 @@ def test_sigint_stops_a_long_run_quickly():
     assert np.isfinite(pyspline.simulate(SCENES["lx1e-4"]).Tm).all()
 
 
-def test_sigint_stops_runs_in_worker_threads():
+def test_sigint_stops_runs_in_worker_threads(sigint_raises):
     case = pyspline.load_case(CASES / "paper_T100.nml", **LONG)
     case.model
     with cf.ThreadPoolExecutor(2) as pool:

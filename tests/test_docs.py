@@ -11,7 +11,7 @@ import pytest
 from conftest import ROOT
 
 DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
-TOP = ("cases/", "fortran/", "pyspline/", "tests/", "bench/", "docs/", "scripts/", "app/", ".ci/")
+TOP = ("cases/", "fortran/", "pyspline/", "tests/", "bench/", "docs/", "scripts/", ".ci/")
 
 
 def named_paths(doc):

@@ -294,12 +294,14 @@ def test_total_work_bound_names_the_field():
 
 def test_executable_sigint_exits_130_and_leaves_no_file(exe, tmp_path):
     """SIGINT during a run: exit status 130, the partial output never appears (the CSV is
-    written to a temporary name and renamed only when complete)."""
+    written to a temporary name and renamed only when complete). SIGINT's default action in
+    the child, also when pytest was started with it ignored (nohup, `&` in a script)."""
     import signal
     import time
     out = tmp_path / "out.csv"
     proc = subprocess.Popen([exe, str(CASES / "paper_T100.nml"), "--set", "t_end=30.0", "-o", str(out)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     time.sleep(1.0)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)

@@ -43,3 +43,25 @@ def test_no_output_falls_back_to_mesh_eval(path):
                               revolutions=0.0, transient_revolutions=0.0,
                               outputs_per_revolution=0.0)
     assert pyspline.simulate(case).stats["outputs_fallback"] == 0
+
+
+def test_extremes_in_xarray_round_trip(tmp_path):
+    """Result.extremes (the core's run_extremes) in to_xarray as run_<name>, with units, through
+    a netCDF file and back; the largest, smallest and RMS are those of the outputs themselves."""
+    import xarray as xr
+    from pyspline.result import EXTREMES, cf_units
+    res = pyspline.simulate(pyspline.load_case(CASES / "paper_flash_lx1e-4.nml", t_end=0.02,
+                                               n_out=81))
+    path = tmp_path / "run.nc"
+    res.to_xarray().to_netcdf(path, engine="h5netcdf")
+    with xr.open_dataset(path, engine="h5netcdf") as ds:
+        assert {n: float(ds["run_" + n]) for n in EXTREMES} == res.extremes
+        for n, (long, unit) in EXTREMES.items():
+            assert ds["run_" + n].dims == () and ds["run_" + n].attrs["long_name"] == long
+            assert ds["run_" + n].attrs.get("units", "") == cf_units(unit), n
+        for q in ("Tm", "kv", "F", "Tf", "D2", "vD2"):
+            v = ds[q].values.ravel()
+            assert float(ds[f"run_{q}_max"]) == v.max() and float(ds[f"run_{q}_min"]) == v.min()
+            np.testing.assert_allclose(float(ds[f"run_{q}_rms"]), np.sqrt(np.mean(v**2)),
+                                       rtol=1e-12, err_msg=q)
+        assert float(ds["run_Tf_max"]) > 0 and float(ds["run_Tm_min"]) < float(ds["run_Tm_max"])

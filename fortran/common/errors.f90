@@ -57,17 +57,27 @@ contains
     s = trim(adjustl(buf))
   end function ftoa
 
-  !> A number for messages: 3 decimals (or digits), a three-digit exponent where needed.
-  pure function num(x, digits) result(s)
+  !> A number for messages: 3 decimals (or digits) in E form, a three-digit exponent where
+  !> needed (5.000E+06, 1.000E-100). readable (spline_model's plausibility warnings): from 1e-2
+  !> to 1e4 fixed, 4 decimals below 10, then 3, 2, 1 (0.2546, 19.096, 1234.5); else the E form
+  !> with 3 decimals, as Fortran's es writes it (5.000E+06, 1.000-100).
+  pure function num(x, digits, readable) result(s)
     real(wp), intent(in) :: x
     integer, intent(in), optional :: digits
+    logical, intent(in), optional :: readable
     character(len=:), allocatable :: s
     character(len=24) :: buf
     character(len=16) :: fmt
     integer :: d
+    logical :: fixed
     d = 3
     if (present(digits)) d = digits
-    if (x /= 0.0_wp .and. (abs(x) >= 1.0e100_wp .or. abs(x) < 1.0e-99_wp)) then
+    fixed = .false.
+    if (present(readable)) fixed = readable
+    if (fixed .and. abs(x) >= 1.0e-2_wp .and. abs(x) < 1.0e4_wp) then
+      write(fmt, '(a,i0,a)') '(f12.', 4 - count(abs(x) >= [10.0_wp, 100.0_wp, 1000.0_wp]), ')'
+    else if (.not. fixed .and. x /= 0.0_wp .and. &
+         (abs(x) >= 1.0e100_wp .or. abs(x) < 1.0e-99_wp)) then
       write(fmt, '(a,i0,a,i0,a)') '(es', d + 9, '.', d, 'e3)'
     else
       write(fmt, '(a,i0,a,i0,a)') '(es', d + 8, '.', d, ')'

@@ -98,6 +98,7 @@ contains
     real(c_double) :: tau_chk, dchk                !< next linear-tail check, and their spacing
     integer(c_int) :: flag, nroot
     integer :: k, nroots, nresync   !< output; switches located; missed switches resynchronised
+    integer, allocatable :: dirs(:), dirs_set(:)   !< root directions wanted, and set in CVODE
     integer :: ks, nsec             !< next section to store; sections
     logical :: use_tail, fresh      !< the linear tail is tried; CVODE has just (re)started
     character(len=40) :: stage
@@ -156,6 +157,8 @@ contains
       end if
       ctx%nrc = nroot
       nroot = nroot*ctx%ncopy
+      allocate(dirs(nroot), dirs_set(nroot))
+      dirs_set = 2                               ! none set yet
       nsec = 0
       if (present(tsec)) nsec = size(tsec)
       if (present(ysec)) ysec = 0.0_wp
@@ -202,11 +205,17 @@ contains
         ! run (spline_integrator::integrator_advance)
         tau_to = next_stop(tau_out)
         if (ctx%frozen) then
-          ! only the crossings that change a contact state are switches (CVODE)
-          flag = integrator_root_directions(cv, root_directions(ctx))
-          if (flag /= 0) then
-            call fail(flag, tau, 'setting the directions of the contact switches')
-            return
+          ! only the crossings that change a contact state are switches (CVODE): the
+          ! directions follow the contact states, set again only when these changed (the
+          ! start, a switch, a resynchronisation; CVODE keeps them across restarts)
+          dirs = root_directions(ctx)
+          if (any(dirs /= dirs_set)) then
+            flag = integrator_root_directions(cv, dirs)
+            if (flag /= 0) then
+              call fail(flag, tau, 'setting the directions of the contact switches')
+              return
+            end if
+            dirs_set = dirs
           end if
         end if
         flag = integrator_advance(cv, tau, tau_to, done_k, tret)

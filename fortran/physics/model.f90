@@ -5,7 +5,7 @@
 module spline_model
   use spline_kinds, only: wp, pi, max_teeth
   use, intrinsic :: iso_fortran_env, only: int64
-  use spline_errors, only: err_ok, err_case, err_thermal, itoa, ftoa
+  use spline_errors, only: err_ok, err_case, err_thermal, itoa, ftoa, num
   use spline_case, only: case_t, case_validate, case_run_times, namelen, option_index, thermal_values, &
        method_values, nonlinear_values, start_values, fidelity_values, section_values, nripple, &
        lyapunov_method_values, goal_values
@@ -339,8 +339,8 @@ contains
     if (m%lyap_d0 >= d) return
     why = 'roots = .false.'
     if (m%erk) why = 'method = ''erk'''
-    text = 'case '//trim(m%name)//': field lyapunov_d0 = '//num(m%lyap_d0)//' is below the '// &
-         'default separation '//num(d)//' (1e4 rtol) with '// &
+    text = 'case '//trim(m%name)//': field lyapunov_d0 = '//num(m%lyap_d0, readable=.true.)// &
+         ' is below the default separation '//num(d, readable=.true.)//' (1e4 rtol) with '// &
          trim(why)//': the separated copy '// &
          'does not see its own contact switches and can read nonsense (+11 to +334 1/s '// &
          'measured for a true -1.8 1/s); lyapunov_d0 = 0 or lyapunov_method = ''tangent''? '// &
@@ -369,13 +369,16 @@ contains
     e = l*k_s/(k_mesh + k_s)
     delta = static_tooth_load(m)/m%k_m
     if (l <= delta .or. e > support_limit*delta) return
-    text = 'case '//trim(m%name)//': fields k_p1 = '//num(m%k_p1)//', k_p2 = '//num(m%k_p2)// &
-         ' N/m: the supports (in series '//num(k_s)//' N/m, the mesh Z k_m / 2 = '//num(k_mesh)// &
-         ' N/m) leave e = '//num(e)//' m of the offset |l| = '//num(l)//' m at the mesh, '// &
-         num(100.0_wp*e/delta)//' % of the static tooth deflection |T_d| / (Z r_b k_m) = '// &
-         num(delta)//' m (limit '//itoa(nint(100.0_wp*support_limit))//' %): the teeth barely '// &
-         'see the misalignment: it raises the static load-sharing factor to 1 + e / delta = '// &
-         num(1.0_wp + e/delta)// &
+    text = 'case '//trim(m%name)//': fields k_p1 = '//num(m%k_p1, readable=.true.)// &
+         ', k_p2 = '//num(m%k_p2, readable=.true.)//' N/m: the supports (in series '// &
+         num(k_s, readable=.true.)//' N/m, the mesh Z k_m / 2 = '// &
+         num(k_mesh, readable=.true.)//' N/m) leave e = '//num(e, readable=.true.)// &
+         ' m of the offset |l| = '//num(l, readable=.true.)//' m at the mesh, '// &
+         num(100.0_wp*e/delta, readable=.true.)// &
+         ' % of the static tooth deflection |T_d| / (Z r_b k_m) = '// &
+         num(delta, readable=.true.)//' m (limit '//itoa(nint(100.0_wp*support_limit))// &
+         ' %): the teeth barely see the misalignment: it raises the static load-sharing '// &
+         'factor to 1 + e / delta = '//num(1.0_wp + e/delta, readable=.true.)// &
          '. Run as given'//new_line('a')
   end function support_warning
 
@@ -396,8 +399,9 @@ contains
       real(wp), intent(in) :: k, t
       if (k <= 0.0_wp .or. abs(t) <= windup_limit*k) return
       if (len(text) > 0) text = text//'; '
-      text = text//'field '//kname//' = '//num(k)//' N m/rad winds its shaft '//num(abs(t)/k)// &
-           ' rad under '//tname//' = '//num(t)//' N m'
+      text = text//'field '//kname//' = '//num(k, readable=.true.)// &
+           ' N m/rad winds its shaft '//num(abs(t)/k, readable=.true.)//' rad under '// &
+           tname//' = '//num(t, readable=.true.)//' N m'
     end subroutine shaft
   end function windup_warning
 
@@ -414,10 +418,12 @@ contains
     dn = abs((m%dq0(1) + m%l_x - m%dq0(3))*sp - (m%dq0(2) + m%l_y - m%dq0(4))*cp + m%dq0(6))
     j = maxloc(dn, 1)
     if (dn(j) <= m%c_bulk) return
-    text = 'case '//trim(m%name)//': start = ''rest'' with l_x = '//num(m%l_x)//', l_y = '// &
-         num(m%l_y)//' m starts tooth '//itoa(j)//' overlapping its backlash c = '// &
-         num(m%c_bulk)//' m by '//num(dn(j) - m%c_bulk)//' m (Eq. 11 at t0): an impact made '// &
-         'by the start, not the drive; start = ''equilibrium''? Run as given'//new_line('a')
+    text = 'case '//trim(m%name)//': start = ''rest'' with l_x = '// &
+         num(m%l_x, readable=.true.)//', l_y = '//num(m%l_y, readable=.true.)// &
+         ' m starts tooth '//itoa(j)//' overlapping its backlash c = '// &
+         num(m%c_bulk, readable=.true.)//' m by '//num(dn(j) - m%c_bulk, readable=.true.)// &
+         ' m (Eq. 11 at t0): an impact made by the start, not the drive; '// &
+         'start = ''equilibrium''? Run as given'//new_line('a')
   end function start_warning
 
   !> The static tooth load T / (Z r_b) of the larger torque, all teeth sharing it, deflects a
@@ -438,9 +444,11 @@ contains
     f = static_tooth_load(m, t)
     d = f/k
     if (d <= deflection_limit*m%m_n) return
-    text = 'case '//trim(m%name)//': field '//tname//' = '//num(t)//' N m loads each tooth '// &
-         'with '//num(f)//' N (T / (Z r_b)) and deflects it '//num(d)//' m (Eq. 18: '//num(k)// &
-         ' N/m), '//num(100.0_wp*d/m%m_n)//' % of the module (limit '// &
+    text = 'case '//trim(m%name)//': field '//tname//' = '//num(t, readable=.true.)// &
+         ' N m loads each tooth with '//num(f, readable=.true.)// &
+         ' N (T / (Z r_b)) and deflects it '//num(d, readable=.true.)//' m (Eq. 18: '// &
+         num(k, readable=.true.)//' N/m), '//num(100.0_wp*d/m%m_n, readable=.true.)// &
+         ' % of the module (limit '// &
          itoa(nint(100.0_wp*deflection_limit))//' %): a torque in N mm? Run as given'//new_line('a')
   end function load_warning
 
@@ -453,20 +461,6 @@ contains
     if (present(t)) f0 = abs(t)
     f0 = f0/(m%z*m%r_b)
   end function static_tooth_load
-
-  !> x without blanks: 4 decimals to 10, then 3, 2, 1 to 1e4 (19.096, 0.2546), else 5.000E+06.
-  function num(x) result(s)
-    real(wp), intent(in) :: x
-    character(len=:), allocatable :: s
-    if (abs(x) >= 1.0e-2_wp .and. abs(x) < 1.0e4_wp) then
-      s = ftoa(x, '(f12.4)')
-      if (abs(x) >= 10.0_wp) s = ftoa(x, '(f12.3)')
-      if (abs(x) >= 100.0_wp) s = ftoa(x, '(f12.2)')
-      if (abs(x) >= 1000.0_wp) s = ftoa(x, '(f12.1)')
-    else
-      s = ftoa(x, '(es10.3)')
-    end if
-  end function num
 
   !> The integrator of a case, as its position in method_values (1 bdf, 2 adams, 3 erk): the
   !> case's, or for method = 'auto' the one that won on the shipped scenes at their own settings
