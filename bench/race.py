@@ -345,8 +345,10 @@ def _race_statistics(scene, case, peer, repeat, quick, variants):
 
     recs = [dict(scene=scene, side=kind, setting=label, rtol=rt, atol_ratio=ar, kind="timed",
                  cpu_runs=[], wall=[], stats=[]) for kind, label, _, rt, ar in settings]
-    for k in range(repeat):          # every setting once per round, realisation k
-        for rec, (kind, label, kw, rt, ar) in zip(recs, settings):
+    pairs = list(zip(recs, settings))
+    for k in range(repeat):          # every setting once per round, realisation k, the order rotated
+        r = k * len(pairs) // repeat
+        for rec, (kind, label, kw, rt, ar) in pairs[r:] + pairs[:r]:
             if "failed" in rec:
                 continue
             try:
