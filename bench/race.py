@@ -119,10 +119,10 @@ def statistics_of(case, t, tm):
     return per.mean(axis=0), np.array([std_error(c) for c in per.T])
 
 
-def _families(peer):
+def _families(peer, variants=PYSPLINE_VARIANTS):
     """(side, label, fields, atol ratio) of every setting family of the pointwise scenes."""
     fam = [("pyspline", f"CVODE {v}{' + roots' if roots else ''}", dict(roots=roots, **_cvode_kw(v)),
-            ar) for v in PYSPLINE_VARIANTS for roots in (False, True) for ar in ATOL_RATIOS]
+            ar) for v in variants for roots in (False, True) for ar in ATOL_RATIOS]
     if peer is not None:
         fam += [("peer", m, dict(method=m.lower()), ar) for m in ("DOP853", "LSODA")
                 for ar in ATOL_RATIOS]
@@ -180,7 +180,7 @@ def _best(recs):
     return min(recs, key=lambda r: r["cpu_s"]) if recs else None
 
 
-def _race_pointwise(scene, case, accuracies, peer, repeat, quick, progress):
+def _race_pointwise(scene, case, accuracies, peer, repeat, quick, progress, variants):
     ref = _reference(case, 1e-13)
     fmax = np.abs(ref.F).max()
     runner = _Runner(case, [case], peer, ref.t)
@@ -190,7 +190,8 @@ def _race_pointwise(scene, case, accuracies, peer, repeat, quick, progress):
                  f"1e-13: F error {np.abs(F_peer - ref.F).max() / fmax:.1e}")
     rungs = RUNGS[::4] if quick else RUNGS          # quick: decades
     scans, cands, errmap = [], {}, {}    # cands: (family index, rung) -> accuracies
-    for fi, (side, label, kw, ar) in enumerate(_families(peer)):
+    fams = _families(peer, variants)
+    for fi, (side, label, kw, ar) in enumerate(fams):
         errs = []
         for i, rt in enumerate(rungs):
             rec = dict(scene=scene, side=side, setting=label, atol_ratio=ar, rtol=rt, kind="scan")
@@ -210,7 +211,6 @@ def _race_pointwise(scene, case, accuracies, peer, repeat, quick, progress):
             cands.setdefault((fi, i), []).append(a)
         progress(f"{scene}: {side} {label}, atol {ar:g} rtol: scanned to rtol {rt:.2g}; "
                  + ", ".join(f"<= {a:g} from rtol {rungs[i]:.2g}" for a, i in found.items()))
-    fams = _families(peer)
     keys = sorted(cands)
     # the accuracy settings (docs/accuracy.md): pyspline picks the method, rtol and roots and
     # estimates the error; timed in the same rounds as the hand-tuned candidates
@@ -272,15 +272,17 @@ def _row(scene, accuracy, ok, autos):
     return row
 
 
-def _pyspline_settings(rtols):
+def _pyspline_settings(rtols, variants=PYSPLINE_VARIANTS):
     return [("pyspline", f"CVODE {v}{' + roots' if roots else ''}", dict(roots=roots, **_cvode_kw(v)),
-             rt, ar) for v in PYSPLINE_VARIANTS for roots in (False, True) for ar in ATOL_RATIOS
+             rt, ar) for v in variants for roots in (False, True) for ar in ATOL_RATIOS
             for rt in rtols]
 
 
-def race(quick=False, repeat=5, progress=print, cases=None):
+def race(quick=False, repeat=5, progress=print, cases=None, variants=None):
     """Rows of the table (one per scene and accuracy) and every run's record; cases: only the
-    scenes of these case names."""
+    scenes of these case names; variants: only these of pyspline's setting families
+    (speed.PYSPLINE_VARIANTS; the accuracy and goal settings always run)."""
+    variants = tuple(variants or PYSPLINE_VARIANTS)
     peer = _numba_peer()
     rows, runs = [], []
     for scene, name, fields, accuracies in SCENES:
@@ -288,15 +290,16 @@ def race(quick=False, repeat=5, progress=print, cases=None):
             continue
         case = _case(name, fields, quick)
         if accuracies != ("statistics",):
-            r, rec = _race_pointwise(scene, case, accuracies, peer, repeat, quick, progress)
+            r, rec = _race_pointwise(scene, case, accuracies, peer, repeat, quick, progress,
+                                     variants)
         else:
-            r, rec = _race_statistics(scene, case, peer, repeat, quick)
+            r, rec = _race_statistics(scene, case, peer, repeat, quick, variants)
         rows += r
         runs += rec
     return rows, runs
 
 
-def _race_statistics(scene, case, peer, repeat, quick):
+def _race_statistics(scene, case, peer, repeat, quick, variants):
     """chaos_z24: every setting of a decade-and-a-half ladder timed in every round, each round
     another realisation; the statistics level by Welch's t against the reference's."""
     # down to rtol 1e-1, so the cheapest passing run is found, not bounded by the ladder (every
@@ -306,7 +309,7 @@ def _race_statistics(scene, case, peer, repeat, quick):
     rtols = [1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4]
     if quick:
         rtols = rtols[:2]
-    settings = _pyspline_settings(rtols)
+    settings = _pyspline_settings(rtols, variants)
     if peer is not None:
         settings += [("peer", m, dict(method=m.lower()), rt, ar)
                      for m in ("DOP853", "LSODA") for ar in ATOL_RATIOS for rt in rtols]
@@ -342,8 +345,10 @@ def _race_statistics(scene, case, peer, repeat, quick):
 
     recs = [dict(scene=scene, side=kind, setting=label, rtol=rt, atol_ratio=ar, kind="timed",
                  cpu_runs=[], wall=[], stats=[]) for kind, label, _, rt, ar in settings]
-    for k in range(repeat):          # every setting once per round, realisation k
-        for rec, (kind, label, kw, rt, ar) in zip(recs, settings):
+    pairs = list(zip(recs, settings))
+    for k in range(repeat):          # every setting once per round, realisation k, the order rotated
+        r = k * len(pairs) // repeat
+        for rec, (kind, label, kw, rt, ar) in pairs[r:] + pairs[:r]:
             if "failed" in rec:
                 continue
             try:

@@ -104,6 +104,10 @@ def main(argv=None) -> int:
                    "speed-up, from runs of the standalone executable one and two at a time")
     p.add_argument("--accuracy", action="store_true", help="bifurcation: the diagram's section "
                    "error, periods, steps and wall time over rtol (every 10th point)")
+    from speed import PYSPLINE_VARIANTS
+    p.add_argument("--variants", nargs="+", choices=PYSPLINE_VARIANTS, help="race: only these "
+                   "of pyspline's setting families (default: all; the accuracy and goal settings "
+                   "always run)")
     p.add_argument("--out", default="out/bench", help="output directory (default out/bench)")
     p.add_argument("--quick", action="store_true", help="small sizes (for CI)")
     args = p.parse_args(argv)
@@ -114,7 +118,8 @@ def main(argv=None) -> int:
                                 text=True, cwd=Path(__file__).resolve().parent).stdout.strip()
         print(f"race at commit {commit or '?'}; {race.load()}", flush=True)
         rows, runs = race.race(quick=args.quick, repeat=args.repeats or (2 if args.quick else 5),
-                               cases=args.cases, progress=lambda m: print(m, flush=True))
+                               cases=args.cases, variants=args.variants,
+                               progress=lambda m: print(m, flush=True))
         print(f"{race.load()} (at the end)")
         print("\n".join(race.format_rows(rows)))
         from speed import _write_csv

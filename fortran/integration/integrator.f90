@@ -46,6 +46,7 @@ module spline_integrator
   public :: integrator_t, lib_log_t, integrator_open, cvode_create, erk_create, integrator_advance, &
        integrator_root_info, integrator_root_directions, integrator_land_on_root, &
        integrator_restart, integrator_steps_done, integrator_last_step, integrator_fail_text, &
+       integrator_tolerances, &
        integrator_warnings, add_counters, integrator_free
 
   !> SUNDIALS' own messages of a run (lib_handler), kept instead of printed: the last error's
@@ -463,6 +464,17 @@ contains
     if (flag == 0) flag = FCVodeSetInitStep(mem, h0)
     if (flag == 0) flag = FCVodeReInit(mem, tau, sv)
   end function cvode_restart
+
+  !> New tolerances from the next step on (the step size and the integrator's history kept).
+  integer(c_int) function integrator_tolerances(cv, rtol, atol) result(flag)
+    type(integrator_t), intent(inout) :: cv
+    real(wp), intent(in) :: rtol, atol
+    if (cv%erk) then
+      flag = FERKStepSStolerances(cv%mem, real(rtol, c_double), real(atol, c_double))
+    else
+      flag = FCVodeSStolerances(cv%mem, real(rtol, c_double), real(atol, c_double))
+    end if
+  end function integrator_tolerances
 
   integer(c_int) function integrator_last_step(cv, h) result(flag)
     type(integrator_t), intent(inout) :: cv

@@ -21,7 +21,8 @@ module spline_solver
   use spline_integrator, only: integrator_t, lib_log_t, integrator_open, cvode_create, &
        erk_create, integrator_advance, integrator_root_info, integrator_root_directions, &
        integrator_land_on_root, integrator_restart, integrator_steps_done, integrator_last_step, &
-       integrator_fail_text, integrator_warnings, add_counters, integrator_free
+       integrator_fail_text, integrator_warnings, add_counters, integrator_free, &
+       integrator_tolerances
   use spline_quantities, only: nstats => nsolver_stats, ist_roots_found, &
        ist_last_step, ist_mode_resyncs, ist_coupling_residual, ist_coupling_iterations, &
        ist_linear_tail_t
@@ -101,6 +102,7 @@ contains
     integer, allocatable :: dirs(:), dirs_set(:)   !< root directions wanted, and set in CVODE
     integer :: ks, nsec             !< next section to store; sections
     logical :: use_tail, fresh      !< the linear tail is tried; CVODE has just (re)started
+    logical :: loose                !< the transient runs at its own tolerances (m%rtol_transient)
     character(len=40) :: stage
     type(tail_t) :: tail
 
@@ -115,11 +117,24 @@ contains
            c_loc(ctx), cv, flag, stage)
     end if
     call schedule_tail_checks()
+    ! the transient, up to the first output (the window's start), at its own tolerances
+    loose = m%t_transient > 0.0_wp .and. nt > 1 .and. m%rtol_transient /= m%rtol
+    if (flag == 0 .and. loose) then
+      flag = integrator_tolerances(cv, m%rtol_transient, m%atol_transient)
+      stage = 'setting the tolerances'
+    end if
     if (flag /= 0) then
       call fail(flag, tau, trim(stage))
     else if (.not. take_linear_tail(0)) then
       outputs: do k = 1, nt
         if (.not. integrate_to_output(k)) exit outputs
+        if (k == 1 .and. loose) then
+          flag = integrator_tolerances(cv, m%rtol, m%atol)
+          if (flag /= 0) then
+            call fail(flag, tau, 'setting the tolerances')
+            exit outputs
+          end if
+        end if
         if (.not. store_output(k)) exit outputs
         if (k < nt) then
           if (take_linear_tail(k)) exit outputs

@@ -12,7 +12,7 @@ module spline_model
   use spline_geometry, only: iso4156_radii, pitch_rotation, tooth_angles
   use spline_stiffness, only: spline_mesh_stiffness_fillet
   use spline_thermal, only: backlash_coefficient, thermal_backlash
-  use spline_accuracy, only: accuracy_settings
+  use spline_accuracy, only: accuracy_settings, stats_transient_rtol
   implicit none
   private
   public :: model_t, model_from_case, set_thermal_level, model_magic, model_warnings
@@ -63,6 +63,9 @@ module spline_model
     logical  :: stald = .false.
     logical  :: linear_tail = .true.        !< closed-form tail in proven full contact (spline_linear)
     real(wp) :: rtol, atol
+    !> the tolerances of the transient (t0 .. t0 + t_transient) when they differ (goal =
+    !> 'statistics': spline_accuracy::stats_transient_rtol), else rtol and atol
+    real(wp) :: rtol_transient, atol_transient
     !> the case's accuracy target (0: none), an error estimate asked for (accuracy or check),
     !> goal = 'statistics' (spline_accuracy)
     real(wp) :: accuracy = 0.0_wp
@@ -156,6 +159,10 @@ contains
     call accuracy_settings(c, k, m%roots, m%rtol, m%atol)
     m%accuracy = c%accuracy; m%goal_statistics = option_index(goal_values, c%goal) == 2
     m%estimate = (c%accuracy > 0.0_wp .or. c%check) .and. .not. m%goal_statistics
+    m%rtol_transient = m%rtol; m%atol_transient = m%atol
+    if (m%goal_statistics) then
+      m%rtol_transient = stats_transient_rtol; m%atol_transient = 1.0e-2_wp*stats_transient_rtol
+    end if
     m%method_bdf = merge(1, 0, k == 1)
     m%erk = k == 3
     select case (option_index(nonlinear_values, c%nonlinear))
