@@ -242,14 +242,19 @@ class _Branch:
         prev, the branch point before it; at a branch's first point (prev the direction to
         head in) the null vector of J oriented along prev. (The secant is what the predictor
         follows: near a grazing dF/dp by differences of the map over +-h is a secant across
-        contact changes, and the null vector of J is off the branch.)"""
+        contact changes, and the null vector of J is off the branch.) None when the point's
+        one-period state run fails (last_error says why): the step fails."""
         u, F, J, M, y, it, hist = res
         tau = u - prev["u"] if isinstance(prev, dict) else np.zeros_like(u)
         tau = tau / np.linalg.norm(tau) if np.linalg.norm(tau) > 0 else \
             _null_tangent(J, prev["tau"] if isinstance(prev, dict) else prev)
         mu = multipliers(M)
         p = self.prob.p_of(u[-1])
-        tr = self.trajectory(y, p)
+        try:
+            tr = self.trajectory(y, p)
+        except SolverError as exc:
+            self.last_hist, self.last_error = hist, str(exc)
+            return None
         return dict(u=u, tau=tau, p=p, y=y, M=M, J=J, mu=mu, tests=tests(mu),
                     contact=contact_measures(tr), Tm_pp=float(np.ptp(tr.Tm)),
                     F_max=float(np.abs(tr.tooth["F"]).max()), D2_pp=float(np.ptp(tr.D2)),
@@ -287,9 +292,8 @@ class _Branch:
             return None
         res = self.correct(np.r_[y[prob.free] / prob.d0[prob.free], pred[-1]], a["tau"],
                            a["tau"] @ pred)
-        if res is None or specials.far(res[0], pred, sigma):
-            return None
-        return dict(self.point(res, a), sigma=sigma)
+        pt = None if res is None or specials.far(res[0], pred, sigma) else self.point(res, a)
+        return None if pt is None else dict(pt, sigma=sigma)
 
 
 def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=None, *,
@@ -432,18 +436,20 @@ def _follow(br, u0, tau0, q_end, ds, ds_min, ds_max, max_angle, max_points, ibra
     e_q = np.eye(k)[-1]
     if tau0 is None:                  # the first branch: start on the orbit, head to stop
         first = br.correct(u0, e_q, u0[-1])
+        first = None if first is None else br.point(first, np.sign(q_end) * e_q)
         if first is None:
             _fail(br, u0, ds, "at the start")
-        pts = [br.point(first, np.sign(q_end) * e_q)]
+        pts = [first]
     else:                             # a doubled branch: off the point along tau0
         tau = tau0
         res = br.correct(u0 + ds * tau, tau, tau @ (u0 + ds * tau))
-        if res is None or not _new_orbit(br, res[4], res[0]):
+        new = None if res is None or not _new_orbit(br, res[4], res[0]) else br.point(res, tau)
+        if new is None:
             warnings.warn(f"case {prob.case.name}: no period-{br.n} branch found next to the "
                           f"period doubling at {prob.name} = {prob.p_of(u0[-1]):.6g}",
                           SplineWarning, stacklevel=3)
             return [], "complete"
-        pts = [br.point(res, tau)]
+        pts = [new]
     bar.update(1)
     lo, hi = min(0.0, q_end), max(0.0, q_end)
     fallbacks = _fallbacks(prob)

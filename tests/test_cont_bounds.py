@@ -108,6 +108,27 @@ def test_follow_sweeps_end_at_the_call_bound():
     assert "max_seconds = 3 s, was reached before the check sweeps at 0.25" in said[0]
 
 
+def test_a_failed_state_run_keeps_the_branch(monkeypatch):
+    """A point's one-period state run (its T_m, forces and contact sequence; bounded as a map
+    run) that fails past 2250 r/min fails the step, not the call: the full-contact branch from
+    2200 r/min comes back up to 2250, its status naming the failure, with a SplineWarning."""
+    import importlib
+    cont = importlib.import_module("pyspline.arclength")
+    original = cont._Branch.trajectory
+
+    def failing(self, y, p):
+        if p > 2250:
+            raise pyspline.SolverError("the state run failed here")
+        return original(self, y, p)
+    monkeypatch.setattr(cont._Branch, "trajectory", failing)
+    ds, _, said = timed(lambda: pyspline.continuation(DRIVE, "speed_rpm", 2200, 2300,
+                                                      progress=False, ds_min=0.01))
+    p = ds.speed_rpm.values
+    assert p[0] == 2200 and 2200 < p[-1] <= 2250 and (np.diff(p) > 0).all()
+    assert "(last failure: the state run failed here)" in ds.attrs["status"]
+    assert len(said) == 1 and ds.attrs["status"] in said[0]
+
+
 @pytest.mark.parametrize("bad", [0.0, -1.0, math.nan, "60", None, True])
 def test_bad_bound_is_a_case_error(bad):
     with pytest.raises(pyspline.CaseError, match="max_seconds"):
