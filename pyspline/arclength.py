@@ -92,6 +92,49 @@ def check_arguments(case, label, start, stop, n, tol, **positive):
     return out["start"], out["stop"], out["tol"]
 
 
+def _checked(base, field, start, stop, n, *, tol, max_points, max_corrector, monodromy,
+             switch=True, detect=True, **positive):
+    """continuation's arguments checked (CaseError naming the one that is bad; start and stop
+    valid values of the field, with the forcing periodic over n revolutions): (its _Problem,
+    the field's label, start, stop, tol)."""
+    name, index = parse_field(base, field)
+    label = field_label(name, index)
+    start, stop, tol = check_arguments(base, label, start, stop, n, tol, **positive)
+    for arg, whole, least in (("max_points", max_points, 1), ("max_corrector", max_corrector, 0)):
+        if isinstance(whole, bool) or not isinstance(whole, (int, np.integer)) or whole < least:
+            raise CaseError(f"case {base.name}: continuation in {label}: {arg} = {whole!r}: a "
+                            f"whole number >= {least}")
+    if monodromy not in ("exact", "fd"):
+        raise CaseError(f"case {base.name}: monodromy = {monodromy!r}: 'exact' (variational "
+                        "equations) or 'fd' (central differences of the map)")
+    prob = _Problem(base, name, index, n, start, stop, float(base["t0"]), monodromy)
+    for arg, value in (("stop", stop), ("start", start)):
+        try:
+            prob.model(value)
+        except CaseError as exc:
+            raise CaseError(f"continuation in {label}: {arg} = {value:g} is not a valid value "
+                            f"of {label}: {exc}") from None
+    return prob, label, start, stop, tol
+
+
+#: continuation's arguments that branches and fold_curve set themselves (not in their **cont)
+_OWN = ("case", "field", "start", "stop", "n", "guess", "progress", "command", "max_seconds")
+
+
+def check_handed_on(case, field, start, stop, n, cont: dict) -> None:
+    """CaseError, before anything runs, for what continuation would refuse among the keywords
+    `cont` that branches and fold_curve hand on to it: a name it does not take (or one they
+    set themselves), or a bad value (continuation's checks, its defaults for the rest)."""
+    import inspect
+    params = inspect.signature(continuation).parameters
+    for k, v in cont.items():
+        if k not in params or k in _OWN:
+            raise CaseError(f"{k} = {v!r}: not a keyword of continuation to hand on (those are "
+                            f"{', '.join(k for k in params if k not in _OWN)})")
+    _checked(load_case(case), field, start, stop, n, **{
+        k: p.default for k, p in params.items() if k not in _OWN} | cont)
+
+
 def set_field(case: Case, name: str, index, p: float) -> Case:
     """The case with field `name` (its element `index` of an array field) set to p."""
     if index is None:
@@ -350,26 +393,12 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     found at the start."""
     from tqdm import tqdm
     base = load_case(case)
-    name, index = parse_field(base, field)
-    label = field_label(name, index)
-    start, stop, tol = check_arguments(base, label, start, stop, n, tol, ds=ds, ds_min=ds_min,
-                                       ds_max=ds_max, max_angle=max_angle, margin=margin)
-    for arg, whole, least in (("max_points", max_points, 1), ("max_corrector", max_corrector, 0)):
-        if isinstance(whole, bool) or not isinstance(whole, (int, np.integer)) or whole < least:
-            raise CaseError(f"case {base.name}: continuation in {label}: {arg} = {whole!r}: a "
-                            f"whole number >= {least}")
-    if monodromy not in ("exact", "fd"):
-        raise CaseError(f"case {base.name}: monodromy = {monodromy!r}: 'exact' (variational "
-                        "equations) or 'fd' (central differences of the map)")
     wall0 = time.perf_counter()
-    t0 = float(base["t0"])
-    prob = _Problem(base, name, index, n, start, stop, t0, monodromy)
-    for arg, value in (("stop", stop), ("start", start)):
-        try:
-            prob.model(value)
-        except CaseError as exc:
-            raise CaseError(f"continuation in {label}: {arg} = {value:g} is not a valid value "
-                            f"of {label}: {exc}") from None
+    prob, label, start, stop, tol = _checked(
+        base, field, start, stop, n, tol=tol, ds=ds, ds_min=ds_min, ds_max=ds_max,
+        max_angle=max_angle, margin=margin, max_points=max_points, max_corrector=max_corrector,
+        monodromy=monodromy)
+    t0 = prob.t0
     c0 = prob.case_at(start)
     with sundials_said("the continuation's map runs") as said, \
             time_bound(max_seconds, f"continuation (case {base.name})"):

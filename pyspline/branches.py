@@ -9,7 +9,7 @@ import warnings
 
 import numpy as np
 
-from .arclength import continuation, field_label, parse_field
+from .arclength import check_handed_on, continuation, field_label, parse_field
 from .errors import CaseError, SplineError, SplineWarning
 from .follow import repeat_revolutions
 from .orbits import CALL_SECONDS, OrbitError, out_of_time, time_bound
@@ -192,8 +192,7 @@ def _branches(case, field, start, stop, points, max_n, progress, command, sweep_
                         "number >= 3")
     if isinstance(max_n, bool) or not isinstance(max_n, (int, np.integer)) or max_n < 1:
         raise CaseError(f"max_n = {max_n!r}: the longest period to seed, a whole number >= 1")
-    if not (np.isfinite(start) and np.isfinite(stop)) or start == stop:
-        raise CaseError(f"start = {start!r}, stop = {stop!r}: two different finite values")
+    check_handed_on(case, field, start, stop, 1, cont)
     values = np.linspace(min(start, stop), max(start, stop), points)
     finals = {}
     with warnings.catch_warnings():
@@ -344,15 +343,19 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
     or not run, the time bound had passed). A value at which no orbit is found at its band's
     start (OrbitError, SolverError) has no folds and says so in `status`. attrs['status']: 'complete' or what was not."""
     name2, index2 = parse_field(case, field2)
-    values2 = np.atleast_1d(np.asarray(values2, float))
-    if values2.ndim != 1 or not len(values2) or not np.isfinite(values2).all():
-        raise CaseError(f"values2 = {values2!r}: finite values of {field2}, at least one")
+    values2 = _values(case, name2, index2, "values2", values2, 1)
+    check = _values(case, name2, index2, "check", check, 0)
+    if isinstance(check_points, bool) or not isinstance(check_points, (int, np.integer)) \
+            or check_points < 2:
+        raise CaseError(f"check_points = {check_points!r}: the check sweeps' number of values, "
+                        "a whole number >= 2")
+    check_handed_on(case, field, start, stop, n, cont)
     with time_bound(max_seconds, "fold_curve"):
         out = _fold_values(case, field, start, stop, name2, index2, values2, n, narrow,
                            progress, cont)
         if len(check):
             _check(out, case if check_case is None else check_case, field, start, stop, name2,
-                   index2, np.atleast_1d(np.asarray(check, float)), check_points, progress)
+                   index2, check, check_points, progress)
     bad = [str(x) for x in out.status.values if x != "complete"]
     if "coexist" in out and (out.coexist < 0).any():
         late = out.check_value.values[(out.coexist < 0).any("check_point")]
@@ -367,6 +370,28 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
         warnings.warn(f"fold_curve: {out.attrs['status']} (attrs['status'])", SplineWarning,
                       stacklevel=2)
     return out
+
+
+def _values(case, name2, index2, what, values, least):
+    """values of the second field (field2: name2, element index2) as a 1-d float array, each
+    a valid value of it in `case`; CaseError naming `what` otherwise or when fewer than
+    `least`."""
+    from .arclength import set_field
+    from .core import load
+    label = field_label(name2, index2)
+    try:
+        v = np.atleast_1d(np.asarray(values, float))
+    except (TypeError, ValueError):
+        v = None
+    if v is None or v.ndim != 1 or len(v) < least or not np.isfinite(v).all():
+        raise CaseError(f"{what} = {values!r}: finite values of {label}"
+                        + (", at least one" if least else ""))
+    for x in v:
+        try:
+            load(set_field(case, name2, index2, x))
+        except CaseError as exc:
+            raise CaseError(f"{what}: {x:g} is not a valid value of {label}: {exc}") from None
+    return v
 
 
 def _fold_values(case, field, start, stop, name2, index2, values2, n, narrow, progress, cont):

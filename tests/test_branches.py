@@ -128,12 +128,27 @@ def test_fold_curve_grazing_below_the_upper_fold(fold_curves):
     assert np.isnan(g[4]).all()
 
 
-def test_bad_input_is_a_case_error():
-    for kw in (dict(points=2), dict(points=1.5), dict(max_n=0)):
+def test_bad_input_is_a_case_error(monkeypatch):
+    """A CaseError naming the argument before anything runs (no sweep, no continuation),
+    continuation's keywords handed on included."""
+    import sys
+
+    def never(*a, **k):
+        raise AssertionError("ran before the arguments were checked")
+    monkeypatch.setattr(sys.modules["pyspline.sweeps"], "sweep", never)
+    monkeypatch.setattr(sys.modules["pyspline.branches"], "continuation", never)
+    for kw in (dict(points=2), dict(points=1.5), dict(max_n=0), dict(ds=0.0), dict(bogus=1),
+               dict(guess=np.zeros(14)), dict(stop="x")):
+        args = dict(stop=BAND[1]) | kw
         with pytest.raises(pyspline.CaseError, match=list(kw)[0]):
-            pyspline.branches(DRIVE, "speed_rpm", *BAND, progress=False, **kw)
-    with pytest.raises(pyspline.CaseError, match="values2"):
-        pyspline.fold_curve(DRIVE, "speed_rpm", *BAND, "ripple_amp(1)", [np.nan])
+            pyspline.branches(DRIVE, "speed_rpm", BAND[0], progress=False, **args)
+    for kw in (dict(values2=[np.nan]), dict(values2="x"), dict(values2=[0.2, 1e9]),
+               dict(check=[np.nan]), dict(check="x"), dict(check_points=1),
+               dict(check_points=2.5), dict(ds_min=0.5), dict(bogus=1)):
+        args = dict(values2=[0.2]) | kw
+        with pytest.raises(pyspline.CaseError, match=list(kw)[0]):
+            pyspline.fold_curve(DRIVE, "speed_rpm", *BAND, "ripple_amp(1)", progress=False,
+                                **args)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         with pytest.raises(pyspline.CaseError, match="scalar field"):
