@@ -64,6 +64,25 @@ def test_pieces_of_the_same_branch_are_merged(every_branch):
     assert sorted(merged([off, ds], "speed_rpm", s)) == [0, 1]
 
 
+def test_a_stretch_without_a_period_is_shaded(every_branch):
+    """Sweep points whose sections give no period (n = 0: chaotic, quasi-periodic or not
+    settled) form their own stretch, none is split from its neighbours' periods; the figure
+    shades a stretch that seeded nothing (no_period_range) and says what it is."""
+    import matplotlib
+    matplotlib.use("Agg")
+    from pyspline.branches import _stretches
+    from pyspline.plots import frequency_response
+    assert _stretches([1, 1, np.nan, np.nan, 2, 2, 1]) == [(0, 1, 1), (2, 3, 0), (4, 5, 2),
+                                                           (6, 6, 1)]
+    ds = every_branch[0].copy()
+    ds["no_period_range"] = (("stretch", "end"), [[2250.0, 2280.0]])
+    ax = frequency_response(ds, sweep=every_branch[1]).axes[0]
+    spans = [pt for pt in ax.patches if pt.get_x() == 2250.0 and pt.get_width() == 30.0]
+    assert len(spans) == 1
+    assert any(t.get_text().startswith("no periodic attractor") and "chaotic" in t.get_text()
+               for t in ax.get_legend().get_texts())
+
+
 def test_branches_folds_where_the_follow_sweeps_jump(every_branch, follow_sweeps):
     """The folds of the branches within 0.5 % of the 1 r/min follow sweeps' jumps, and the
     seeding sweep's own jumps (10 r/min steps) bracket them."""
