@@ -86,6 +86,18 @@ def test_branches_and_fold_curve_end_at_their_bounds():
     assert len(said) == 1 and fc.attrs["status"] in said[0]
 
 
+def test_a_bounded_simulate_is_the_unbounded_one():
+    """A run given a wall-time bound it does not reach (the integrator then advances in
+    chunks of 20000 steps between clock reads: this run takes about 35000) gives the
+    unbounded run's numbers bit for bit."""
+    from pyspline.result import run
+    case = DRIVE.replace(speed_rpm=2450.0, t_end=3.0, n_out=301)
+    free, bound = pyspline.simulate(case), run(case.model, max_seconds=1e3)
+    assert free.stats["steps"] > 20000, free.stats["steps"]
+    np.testing.assert_array_equal(bound.y, free.y)
+    np.testing.assert_array_equal(bound.Tm, free.Tm)
+
+
 def test_follow_sweeps_end_at_the_call_bound():
     """The follow sweeps inside branches and fold_curve share the call's bound: runs of 1000 s
     without the closed-form tail (a minute each; the sweeps would take minutes) are cut where
