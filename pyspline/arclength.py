@@ -92,6 +92,49 @@ def check_arguments(case, label, start, stop, n, tol, **positive):
     return out["start"], out["stop"], out["tol"]
 
 
+def _checked(base, field, start, stop, n, *, tol, max_points, max_corrector, monodromy,
+             switch=True, detect=True, **positive):
+    """continuation's arguments checked (CaseError naming the one that is bad; start and stop
+    valid values of the field, with the forcing periodic over n revolutions): (its _Problem,
+    the field's label, start, stop, tol)."""
+    name, index = parse_field(base, field)
+    label = field_label(name, index)
+    start, stop, tol = check_arguments(base, label, start, stop, n, tol, **positive)
+    for arg, whole, least in (("max_points", max_points, 1), ("max_corrector", max_corrector, 0)):
+        if isinstance(whole, bool) or not isinstance(whole, (int, np.integer)) or whole < least:
+            raise CaseError(f"case {base.name}: continuation in {label}: {arg} = {whole!r}: a "
+                            f"whole number >= {least}")
+    if monodromy not in ("exact", "fd"):
+        raise CaseError(f"case {base.name}: monodromy = {monodromy!r}: 'exact' (variational "
+                        "equations) or 'fd' (central differences of the map)")
+    prob = _Problem(base, name, index, n, start, stop, float(base["t0"]), monodromy)
+    for arg, value in (("stop", stop), ("start", start)):
+        try:
+            prob.model(value)
+        except CaseError as exc:
+            raise CaseError(f"continuation in {label}: {arg} = {value:g} is not a valid value "
+                            f"of {label}: {exc}") from None
+    return prob, label, start, stop, tol
+
+
+#: continuation's arguments that branches and fold_curve set themselves (not in their **cont)
+_OWN = ("case", "field", "start", "stop", "n", "guess", "progress", "command", "max_seconds")
+
+
+def check_handed_on(case, field, start, stop, n, cont: dict) -> None:
+    """CaseError, before anything runs, for what continuation would refuse among the keywords
+    `cont` that branches and fold_curve hand on to it: a name it does not take (or one they
+    set themselves), or a bad value (continuation's checks, its defaults for the rest)."""
+    import inspect
+    params = inspect.signature(continuation).parameters
+    for k, v in cont.items():
+        if k not in params or k in _OWN:
+            raise CaseError(f"{k} = {v!r}: not a keyword of continuation to hand on (those are "
+                            f"{', '.join(k for k in params if k not in _OWN)})")
+    _checked(load_case(case), field, start, stop, n, **{
+        k: p.default for k, p in params.items() if k not in _OWN} | cont)
+
+
 def set_field(case: Case, name: str, index, p: float) -> Case:
     """The case with field `name` (its element `index` of an array field) set to p."""
     if index is None:
@@ -242,14 +285,19 @@ class _Branch:
         prev, the branch point before it; at a branch's first point (prev the direction to
         head in) the null vector of J oriented along prev. (The secant is what the predictor
         follows: near a grazing dF/dp by differences of the map over +-h is a secant across
-        contact changes, and the null vector of J is off the branch.)"""
+        contact changes, and the null vector of J is off the branch.) None when the point's
+        one-period state run fails (last_error says why): the step fails."""
         u, F, J, M, y, it, hist = res
         tau = u - prev["u"] if isinstance(prev, dict) else np.zeros_like(u)
         tau = tau / np.linalg.norm(tau) if np.linalg.norm(tau) > 0 else \
             _null_tangent(J, prev["tau"] if isinstance(prev, dict) else prev)
         mu = multipliers(M)
         p = self.prob.p_of(u[-1])
-        tr = self.trajectory(y, p)
+        try:
+            tr = self.trajectory(y, p)
+        except SolverError as exc:
+            self.last_hist, self.last_error = hist, str(exc)
+            return None
         return dict(u=u, tau=tau, p=p, y=y, M=M, J=J, mu=mu, tests=tests(mu),
                     contact=contact_measures(tr), Tm_pp=float(np.ptp(tr.Tm)),
                     F_max=float(np.abs(tr.tooth["F"]).max()), D2_pp=float(np.ptp(tr.D2)),
@@ -287,9 +335,8 @@ class _Branch:
             return None
         res = self.correct(np.r_[y[prob.free] / prob.d0[prob.free], pred[-1]], a["tau"],
                            a["tau"] @ pred)
-        if res is None or specials.far(res[0], pred, sigma):
-            return None
-        return dict(self.point(res, a), sigma=sigma)
+        pt = None if res is None or specials.far(res[0], pred, sigma) else self.point(res, a)
+        return None if pt is None else dict(pt, sigma=sigma)
 
 
 def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=None, *,
@@ -346,26 +393,12 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     found at the start."""
     from tqdm import tqdm
     base = load_case(case)
-    name, index = parse_field(base, field)
-    label = field_label(name, index)
-    start, stop, tol = check_arguments(base, label, start, stop, n, tol, ds=ds, ds_min=ds_min,
-                                       ds_max=ds_max, max_angle=max_angle, margin=margin)
-    for arg, whole, least in (("max_points", max_points, 1), ("max_corrector", max_corrector, 0)):
-        if isinstance(whole, bool) or not isinstance(whole, (int, np.integer)) or whole < least:
-            raise CaseError(f"case {base.name}: continuation in {label}: {arg} = {whole!r}: a "
-                            f"whole number >= {least}")
-    if monodromy not in ("exact", "fd"):
-        raise CaseError(f"case {base.name}: monodromy = {monodromy!r}: 'exact' (variational "
-                        "equations) or 'fd' (central differences of the map)")
     wall0 = time.perf_counter()
-    t0 = float(base["t0"])
-    prob = _Problem(base, name, index, n, start, stop, t0, monodromy)
-    for arg, value in (("stop", stop), ("start", start)):
-        try:
-            prob.model(value)
-        except CaseError as exc:
-            raise CaseError(f"continuation in {label}: {arg} = {value:g} is not a valid value "
-                            f"of {label}: {exc}") from None
+    prob, label, start, stop, tol = _checked(
+        base, field, start, stop, n, tol=tol, ds=ds, ds_min=ds_min, ds_max=ds_max,
+        max_angle=max_angle, margin=margin, max_points=max_points, max_corrector=max_corrector,
+        monodromy=monodromy)
+    t0 = prob.t0
     c0 = prob.case_at(start)
     with sundials_said("the continuation's map runs") as said, \
             time_bound(max_seconds, f"continuation (case {base.name})"):
@@ -432,18 +465,20 @@ def _follow(br, u0, tau0, q_end, ds, ds_min, ds_max, max_angle, max_points, ibra
     e_q = np.eye(k)[-1]
     if tau0 is None:                  # the first branch: start on the orbit, head to stop
         first = br.correct(u0, e_q, u0[-1])
+        first = None if first is None else br.point(first, np.sign(q_end) * e_q)
         if first is None:
             _fail(br, u0, ds, "at the start")
-        pts = [br.point(first, np.sign(q_end) * e_q)]
+        pts = [first]
     else:                             # a doubled branch: off the point along tau0
         tau = tau0
         res = br.correct(u0 + ds * tau, tau, tau @ (u0 + ds * tau))
-        if res is None or not _new_orbit(br, res[4], res[0]):
+        new = None if res is None or not _new_orbit(br, res[4], res[0]) else br.point(res, tau)
+        if new is None:
             warnings.warn(f"case {prob.case.name}: no period-{br.n} branch found next to the "
                           f"period doubling at {prob.name} = {prob.p_of(u0[-1]):.6g}",
                           SplineWarning, stacklevel=3)
             return [], "complete"
-        pts = [br.point(res, tau)]
+        pts = [new]
     bar.update(1)
     lo, hi = min(0.0, q_end), max(0.0, q_end)
     fallbacks = _fallbacks(prob)

@@ -9,7 +9,7 @@ import warnings
 
 import numpy as np
 
-from .arclength import continuation, field_label, parse_field
+from .arclength import check_handed_on, continuation, field_label, parse_field
 from .errors import CaseError, SplineError, SplineWarning
 from .follow import repeat_revolutions
 from .orbits import CALL_SECONDS, OrbitError, out_of_time, time_bound
@@ -25,6 +25,12 @@ def _stretches(period):
 
 def _spans(stretches):
     return "; ".join(f"{d} {a:g}..{b:g}" for d, a, b in stretches)
+
+
+def _cut(sw):
+    """Where (direction, value) the follow sweep's run was cut or not run by the call's time
+    bound (follow.run_chain: its error names the wall-time bound)."""
+    return np.char.find(sw.error.values.astype(str), "wall-time bound") >= 0
 
 
 def _split_at_jumps(pp, a, b):
@@ -158,9 +164,10 @@ def branches(case, field: str, start: float, stop: float, points: int = 31, *,
     (chaotic or quasi-periodic, or not settled) seed nothing; listed in attrs['no_period'].
 
     max_seconds : the wall time of the whole call (orbits.CALL_SECONDS; math.inf: none), shared
-        by the seeds' orbits and continuations in turn (each gets what is left; the follow
-        sweep's runs are bounded in steps only): past it the branches so far are returned,
-        'status' saying so, with a SplineWarning; OrbitError naming it when none was traced.
+        by the follow sweep's runs, then the seeds' orbits and continuations in turn (each
+        gets what is left; a run is cut where it passes, the runs after it not run): past it
+        the branches so far are returned, 'status' saying so, with a SplineWarning;
+        OrbitError naming it when none was traced.
 
     Returns (Dataset, sweep): the Dataset of `continuation` for all the branches (dim 'point',
     'branch' numbered through, 'seed' the seed's index; dims 'special' likewise; attrs
@@ -185,8 +192,7 @@ def _branches(case, field, start, stop, points, max_n, progress, command, sweep_
                         "number >= 3")
     if isinstance(max_n, bool) or not isinstance(max_n, (int, np.integer)) or max_n < 1:
         raise CaseError(f"max_n = {max_n!r}: the longest period to seed, a whole number >= 1")
-    if not (np.isfinite(start) and np.isfinite(stop)) or start == stop:
-        raise CaseError(f"start = {start!r}, stop = {stop!r}: two different finite values")
+    check_handed_on(case, field, start, stop, 1, cont)
     values = np.linspace(min(start, stop), max(start, stop), points)
     finals = {}
     with warnings.catch_warnings():
@@ -195,6 +201,9 @@ def _branches(case, field, start, stop, points, max_n, progress, command, sweep_
                    follow="both", spectrum=False, finals=finals, **{name: values})
     scale = _scale(load(case))
     pieces, seeds, no_period, status, skipped = [], [], [], [], []
+    if (cut := _cut(sw)).any():
+        status.append(f"{out_of_time()} was reached in the follow sweeps ({cut.sum()} of "
+                      f"{cut.size} runs cut or not run)")
     for d in ("up", "down"):
         idx = np.arange(points) if d == "up" else np.arange(points)[::-1]
         sub = sw.sel(direction=d)
@@ -320,7 +329,8 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
     max_seconds : the wall time of the whole call (orbits.CALL_SECONDS; math.inf: none),
         shared: each value gets what is left over the values left, so a slow value cannot take
         the others' time; its status says when its share ran out. The check sweeps run after
-        the values, while time is left (their runs are bounded in steps only).
+        the values, in what is left (a run is cut where it passes, the runs after it not
+        run: those values' verdicts -1).
     check : values of field2 at which a follow sweep up and down (`check_points` values over
     the band, runs of `check_case`, default `case`: give it a t_end that settles) gives the
     brute-force verdict per value: one orbit or two coexisting (`coexistence`).
@@ -329,24 +339,29 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
     padded), `grazing` (value2, grazing; in order along the branch from the band's start: the
     first is where the orbit there changes its contact sequence), `band` (value2, end: the
     band continued), `status` (each continuation's); with check, dims `check` and
-    `check_point`: `check_value`, `check_field`, `coexist` (-1: not run, the time bound had
-    passed). A value at which no orbit is found at its band's start (OrbitError, SolverError)
-    has no folds and says so in `status`. attrs['status']: 'complete' or what was not."""
+    `check_point`: `check_value`, `check_field`, `coexist` (-1: a run of either direction cut
+    or not run, the time bound had passed). A value at which no orbit is found at its band's
+    start (OrbitError, SolverError) has no folds and says so in `status`. attrs['status']: 'complete' or what was not."""
     name2, index2 = parse_field(case, field2)
-    values2 = np.atleast_1d(np.asarray(values2, float))
-    if values2.ndim != 1 or not len(values2) or not np.isfinite(values2).all():
-        raise CaseError(f"values2 = {values2!r}: finite values of {field2}, at least one")
+    values2 = _values(case, name2, index2, "values2", values2, 1)
+    check = _values(case, name2, index2, "check", check, 0)
+    if isinstance(check_points, bool) or not isinstance(check_points, (int, np.integer)) \
+            or check_points < 2:
+        raise CaseError(f"check_points = {check_points!r}: the check sweeps' number of values, "
+                        "a whole number >= 2")
+    check_handed_on(case, field, start, stop, n, cont)
     with time_bound(max_seconds, "fold_curve"):
         out = _fold_values(case, field, start, stop, name2, index2, values2, n, narrow,
                            progress, cont)
         if len(check):
             _check(out, case if check_case is None else check_case, field, start, stop, name2,
-                   index2, np.atleast_1d(np.asarray(check, float)), check_points, progress)
+                   index2, check, check_points, progress)
     bad = [str(x) for x in out.status.values if x != "complete"]
     if "coexist" in out and (out.coexist < 0).any():
         late = out.check_value.values[(out.coexist < 0).any("check_point")]
         bad.append(f"the wall-time bound of fold_curve, max_seconds = {max_seconds:g} s, was "
-                   f"reached before the check sweeps at {', '.join(f'{v:g}' for v in late)}")
+                   f"reached before the check sweeps at {', '.join(f'{v:g}' for v in late)} had "
+                   "run to their end")
     out.attrs.update(case=case.text(), field2=field2, start=start, stop=stop, n=n,
                      status="; ".join(bad) or "complete",
                      command=command or f"pyspline.fold_curve({case.name!r}, {field!r}, "
@@ -355,6 +370,28 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
         warnings.warn(f"fold_curve: {out.attrs['status']} (attrs['status'])", SplineWarning,
                       stacklevel=2)
     return out
+
+
+def _values(case, name2, index2, what, values, least):
+    """values of the second field (field2: name2, element index2) as a 1-d float array, each
+    a valid value of it in `case`; CaseError naming `what` otherwise or when fewer than
+    `least`."""
+    from .arclength import set_field
+    from .core import load
+    label = field_label(name2, index2)
+    try:
+        v = np.atleast_1d(np.asarray(values, float))
+    except (TypeError, ValueError):
+        v = None
+    if v is None or v.ndim != 1 or len(v) < least or not np.isfinite(v).all():
+        raise CaseError(f"{what} = {values!r}: finite values of {label}"
+                        + (", at least one" if least else ""))
+    for x in v:
+        try:
+            load(set_field(case, name2, index2, x))
+        except CaseError as exc:
+            raise CaseError(f"{what}: {x:g} is not a valid value of {label}: {exc}") from None
+    return v
 
 
 def _fold_values(case, field, start, stop, name2, index2, values2, n, narrow, progress, cont):
@@ -427,7 +464,7 @@ def _check(out, case, field, start, stop, name2, index2, check, points, progress
             warnings.simplefilter("ignore", SplineWarning)
             sw = sweep(set_field(case, name2, index2, v), progress=progress, follow="both",
                        spectrum=False, **{parse_field(case, field)[0]: pts})
-        verdict.append(coexistence(sw))
+        verdict.append(np.where(_cut(sw).any(0), -1, coexistence(sw)))
     out["check_value"] = ("check", check)
     out["check_field"] = ("check_point", pts)
     out["coexist"] = (("check", "check_point"), np.array(verdict, int))

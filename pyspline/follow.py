@@ -12,11 +12,11 @@ from __future__ import annotations
 
 import warnings
 from fractions import Fraction
-from math import lcm
+from math import inf, lcm
 
 import numpy as np
 
-from .errors import SplineWarning
+from .errors import SolverError, SplineWarning
 from .summary import failed_summary, summarise
 
 DIRECTIONS = ("up", "down", "both")
@@ -50,10 +50,16 @@ def continued(case, y, t_prev: float, omega_prev: float):
 
 def run_chain(cases: list, options: dict) -> list:
     """Summaries of the cases run in the given order, each from the previous one's final
-    state (a failed point breaks the chain: the next starts from its own start)."""
-    from .core import simulate
+    state (a failed point breaks the chain: the next starts from its own start). Within a
+    call's time bound (orbits.time_bound: pyspline.branches, fold_curve; in this thread) each
+    run is cut to the time left, and once it has passed the rest are not run: failed points
+    naming the bound."""
+    from .orbits import _wall, out_of_time
+    from .result import run as run_model
     out, prev = [], None
     for case in cases:
+        if not isinstance(case, Exception) and (late := out_of_time()):
+            case = SolverError(f"{late} was reached before this run")
         if isinstance(case, Exception):
             out.append(failed_summary(case, options))
             prev = None
@@ -63,7 +69,7 @@ def run_chain(cases: list, options: dict) -> list:
             with warnings.catch_warnings():     # the start 'rest' overlap note says nothing here
                 warnings.filterwarnings("ignore", message=r".*start = 'rest' with",
                                         category=SplineWarning)
-                res = simulate(run)
+                res = run_model(run.model, max_seconds=_wall(run.model, inf))
             out.append(summarise(res, options))
             if options.get("final_state"):     # sweep(finals=...): pyspline.branches' seeds
                 out[-1]["final"] = (res.y[-1].copy(), float(res.t[-1]))

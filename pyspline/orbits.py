@@ -20,8 +20,9 @@ from fractions import Fraction
 import numpy as np
 
 from .case import Case
-from .core import STATE_QUANTITIES, Result, _api, load, run_outcome, simulate
+from .core import STATE_QUANTITIES, Result, _api, load, run_outcome
 from .errors import CaseError, SolverError, SplineError, SplineWarning
+from .result import run as run_model
 
 NSTATE = 14
 #: wall-time bound [s] of one call of the core's map (a map_and_monodromy run, or all the runs of
@@ -354,10 +355,12 @@ def _settled_state(model, t0: float, period: float) -> np.ndarray:
 
 
 def _trajectory(case: Case, t0: float, t1: float, y0: np.ndarray) -> Result:
-    """simulate from (t0, y0) to t1: start at rest plus the state as dq0, dv0 (exact: 0 + y)."""
+    """simulate from (t0, y0) to t1: start at rest plus the state as dq0, dv0 (exact: 0 + y),
+    bounded in wall time as a map run (MAP_SECONDS, cut to the call's time left)."""
     run = _run(case, start="rest", dq0=list(y0[:7]), dv0=list(y0[7:]), t0=t0, t_end=t1,
                t_transient=0.0)
     with warnings.catch_warnings():
         # the orbit may start in contact: the start-at-rest overlap warning says nothing here
         warnings.filterwarnings("ignore", message=r".*start = 'rest' with", category=SplineWarning)
-        return simulate(run)
+        model = load(run)
+        return run_model(model, max_seconds=_wall(model, MAP_SECONDS))

@@ -291,9 +291,9 @@ class SerialExecutor(cf.Executor):
         return f
 
 
-def _simulate(model, copy: int = 0, ya=None) -> tuple:
+def _simulate(model, copy: int = 0, ya=None, max_seconds: float = 0.0) -> tuple:
     """api_simulate on a loaded Model (copy k of realisations = K > 1 from ya, the state at the
-    end of the transient): (t, y columns, tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face,
+    end of the transient; max_seconds > 0: the call's wall-time bound): (t, y columns, tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face,
     tilt, nqw, consts, loads, tload, ext, warnings, ierr, msg); a copy's loads, tload, ext and
     warnings are 0 and blank (the copies' together: _copies). Module level, so a process
     executor can take it."""
@@ -304,15 +304,16 @@ def _simulate(model, copy: int = 0, ya=None) -> tuple:
     return _api.api_simulate(model.bytes, model.z, model.n_out, nq, ns, model.n_section,
                              model.n_lyapunov, nft, model.n_slices, len(LOAD_QUANTITIES),
                              len(TOOTH_LOAD_QUANTITIES), len(EXTREMES), tooth, copy,
-                             np.zeros(14) if ya is None else ya)
+                             np.zeros(14) if ya is None else ya, max_seconds)
 
 
-def _copies(model, executor) -> tuple:
+def _copies(model, executor, max_seconds: float = 0.0) -> tuple:
     """realisations = K > 1 (docs/accuracy.md): the transient, then the K copies on the executor
     (None: a thread each, at most os.cpu_count(); the core releases the GIL), their outputs one
     after another, and what follows from them in one call of the core (api_results: the
     statistics combined, the loads with standard errors from the copies' spread, the extremes
-    and RMS, the warnings; spline_run::run_results, as spline-dyn): _simulate's tuple."""
+    and RMS, the warnings; spline_run::run_results, as spline-dyn): _simulate's tuple.
+    max_seconds > 0: each copy's wall-time bound (the transient's run has none)."""
     k, n = model.case["realisations"], model.n_out
     ya, ierr, msg = _api.api_start_state(model.bytes, 1)
     raise_for(ierr, msg)
@@ -320,7 +321,8 @@ def _copies(model, executor) -> tuple:
     if own:
         executor = cf.ThreadPoolExecutor(min(k, os.cpu_count() or 1))
     try:
-        outs = list(executor.map(_simulate, [model] * k, range(1, k + 1), [ya] * k))
+        outs = list(executor.map(_simulate, [model] * k, range(1, k + 1), [ya] * k,
+                                 [max_seconds] * k))
     finally:
         if own:
             executor.shutdown()
@@ -338,16 +340,18 @@ def _copies(model, executor) -> tuple:
     return (*cat, nqw, consts, loads, tload, ext, warned, 0, b"")
 
 
-def run(model, executor=None) -> Result:
+def run(model, executor=None, max_seconds: float = 0.0) -> Result:
     """Run a loaded Model (pyspline.simulate: any case) and return a Result. Raises CaseError, SolverError or ThermalInterferenceError with a message naming the
     case; KeyboardInterrupt if SIGINT arrives during the run. Releases the GIL while it runs.
     One call of the core (api_simulate) gives the outputs, the loads, the extremes and the
     run's warnings. realisations = K > 1: the copies run on `executor` (None: threads), their
     outputs one after another in the Result (t restarts at each copy's start), the loads,
-    extremes and warnings from them together (one more call: api_results)."""
+    extremes and warnings from them together (one more call: api_results). max_seconds > 0:
+    the run's wall-time bound (past it a SolverError naming it; 0: none)."""
     q, s = _names("tooth"), _names("stats")
     t0 = time.perf_counter()
-    out = _copies(model, executor) if model.case["realisations"] > 1 else _simulate(model)
+    out = (_copies(model, executor, max_seconds) if model.case["realisations"] > 1
+           else _simulate(model, max_seconds=max_seconds))
     (t, ycol, tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, nqw, consts, loads,
      tload, ext, warned, ierr, msg) = out
     wall = time.perf_counter() - t0

@@ -63,9 +63,8 @@ def _at(br, a, sigma):
     tau = a["tau"]
     pred = a["u"] + sigma * tau
     res = br.correct(pred, tau, tau @ pred)
-    if res is None or far(res[0], pred, sigma):
-        return None
-    return dict(br.point(res, a), sigma=sigma)
+    pt = None if res is None or far(res[0], pred, sigma) else br.point(res, a)
+    return None if pt is None else dict(pt, sigma=sigma)
 
 
 # --------------------------------------------------------------------------- grazing

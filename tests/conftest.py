@@ -94,3 +94,21 @@ def dev_null_stays_a_device():
     if os.path.exists("/dev/null") and not stat.S_ISCHR(os.stat("/dev/null").st_mode):
         pytest.fail("this test replaced /dev/null with a regular file "
                     "(restore it: rm /dev/null && mknod -m 666 /dev/null c 1 3)")
+
+
+#: how SUNDIALS prints its own messages; its error handler routes them into errors and
+#: SplineWarnings (spline_integrator::lib_handler), so none may reach fd 1 or 2
+SUNDIALS_RAW = ("[CVODE", "[ARKODE", "[KINSOL", "[SUNDIALS")
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    """No SUNDIALS text on stdout or stderr in any test's setup, call or teardown, as pytest
+    captures them: at the file-descriptor level (its default; `-s` turns this check off)."""
+    outcome = yield
+    rep = outcome.get_result()
+    text = "".join(c for key, c in rep.sections if key in (f"Captured stdout {rep.when}",
+                                                            f"Captured stderr {rep.when}"))
+    if rep.passed and any(r in text for r in SUNDIALS_RAW):
+        rep.outcome = "failed"
+        rep.longrepr = f"SUNDIALS' own text on stdout or stderr:\n{text[:2000]}"

@@ -64,6 +64,25 @@ def test_pieces_of_the_same_branch_are_merged(every_branch):
     assert sorted(merged([off, ds], "speed_rpm", s)) == [0, 1]
 
 
+def test_a_stretch_without_a_period_is_shaded(every_branch):
+    """Sweep points whose sections give no period (n = 0: chaotic, quasi-periodic or not
+    settled) form their own stretch, none is split from its neighbours' periods; the figure
+    shades a stretch that seeded nothing (no_period_range) and says what it is."""
+    import matplotlib
+    matplotlib.use("Agg")
+    from pyspline.branches import _stretches
+    from pyspline.plots import frequency_response
+    assert _stretches([1, 1, np.nan, np.nan, 2, 2, 1]) == [(0, 1, 1), (2, 3, 0), (4, 5, 2),
+                                                           (6, 6, 1)]
+    ds = every_branch[0].copy()
+    ds["no_period_range"] = (("stretch", "end"), [[2250.0, 2280.0]])
+    ax = frequency_response(ds, sweep=every_branch[1]).axes[0]
+    spans = [pt for pt in ax.patches if pt.get_x() == 2250.0 and pt.get_width() == 30.0]
+    assert len(spans) == 1
+    assert any(t.get_text().startswith("no periodic attractor") and "chaotic" in t.get_text()
+               for t in ax.get_legend().get_texts())
+
+
 def test_branches_folds_where_the_follow_sweeps_jump(every_branch, follow_sweeps):
     """The folds of the branches within 0.5 % of the 1 r/min follow sweeps' jumps, and the
     seeding sweep's own jumps (10 r/min steps) bracket them."""
@@ -77,32 +96,78 @@ def test_branches_folds_where_the_follow_sweeps_jump(every_branch, follow_sweeps
     assert coexistence(sw)[(sw.speed_rpm.values > lo + 1) & (sw.speed_rpm.values < hi - 1)].all()
 
 
-def test_fold_curve_against_follow_sweeps():
-    """The folds followed in the ripple amplitude a (repeated continuation over 2300-2500
-    r/min at a = 0.25, 0.2, 0.1): follow sweeps up and down at 10 r/min steps say two orbits
-    between the folds and one outside them (a step of margin: runs next to a fold do not
-    settle); at a = 0.1 no fold in the band and one orbit at every speed."""
-    values = [0.25, 0.2, 0.1]
-    fc = pyspline.fold_curve(DRIVE, "speed_rpm", 2300, 2500, "ripple_amp(1)", values,
-                             progress=False, check=values, check_points=21, check_case=SETTLED)
-    assert (fc.status == "complete").all()
+#: the fold curve's values of the ripple amplitude a: four with a fold pair in 2300-2500 r/min,
+#: the last with none there (its folds lie at 2549 and 2568)
+AMPS = [0.25, 0.22, 0.2, 0.18, 0.1]
+
+
+@pytest.fixture(scope="module")
+def fold_curves():
+    """The folds followed in a over 2300-2500 r/min, at rtol 1e-7 with steps up to twice the
+    default's (the folds within 1e-4 r/min of rtol 1e-8 and the default steps; half the
+    time), and fold_curve's own check sweep at the last value: 6 speeds, 40 r/min apart."""
+    return pyspline.fold_curve(DRIVE.replace(rtol=1e-7, atol=1e-9), "speed_rpm", 2300, 2500,
+                               "ripple_amp(1)", AMPS,
+                               progress=False, ds_max=0.5, max_angle=0.3, check=AMPS[-1:],
+                               check_points=6, check_case=SETTLED)
+
+
+def test_fold_curve_against_follow_sweeps(fold_curves):
+    """At each of the five values of a, follow sweeps up and down say two orbits between its
+    folds and one outside: at a with a fold pair (lo, hi), the speeds lo - 30, lo - 15 and
+    hi + 15 (one orbit) and lo + 10, the middle and hi - 10 (two: the up chain stays on the
+    full-contact branch, the down chain on the contact-loss one; 10 r/min of margin: runs
+    next to a fold do not settle); at a = 0.1 one orbit at every speed of the band. The folds
+    move up in speed as a falls."""
+    fc = fold_curves
+    assert (fc.status == "complete").all(), fc.status.values
     f = fc.fold.values
-    assert np.isfinite(f[:2, :2]).all() and np.isnan(f[:2, 2:]).all() and np.isnan(f[2]).all()
-    x = fc.check_field.values
-    for i in range(3):
-        two = fc.coexist.values[i].astype(bool)
-        inside = (x > f[i, 0] + 10) & (x < f[i, 1] - 10)
-        outside = ~((x > f[i, 0] - 10) & (x < f[i, 1] + 10))
-        assert two[inside].all() and not two[outside].any(), (values[i], x[two], f[i])
-        assert inside.any() == (i < 2)
+    assert np.isfinite(f[:4, :2]).all() and np.isnan(f[:4, 2:]).all() and np.isnan(f[4]).all()
+    assert (np.diff(f[:4, 0]) > 0).all() and (np.diff(f[:4, 1]) > 0).all()
+    assert not fc.coexist.values[0].any() and len(fc.check_field) == 6
+    for a, (lo, hi) in zip(AMPS, f[:4, :2]):
+        speeds = np.array([lo - 30, lo - 15, lo + 10, (lo + hi) / 2, hi - 10, hi + 15])
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", pyspline.SplineWarning)
+            sw = pyspline.sweep(SETTLED.replace(ripple_amp=[a, 0, 0, 0], n_out=2001),
+                                speed_rpm=speeds, follow="both", progress=False, spectrum=False)
+        assert (sw.error == "").all()
+        assert list(coexistence(sw)) == [False, False, True, True, True, False], (a, lo, hi)
 
 
-def test_bad_input_is_a_case_error():
-    for kw in (dict(points=2), dict(points=1.5), dict(max_n=0)):
+def test_fold_curve_grazing_below_the_upper_fold(fold_curves):
+    """Along each value's branch from the band's start the first grazing (where the
+    full-contact orbit opens its teeth) lies just below the upper fold (within 4 r/min), and
+    the other grazings lie on the S-curve's span, between the folds' neighbourhoods."""
+    g, f = fold_curves.grazing.values, fold_curves.fold.values
+    for k in range(4):
+        assert 0 < f[k, 1] - g[k, 0] < 4, (AMPS[k], g[k], f[k])
+        rest = g[k][1:][np.isfinite(g[k][1:])]
+        assert ((rest > f[k, 0] - 5) & (rest < f[k, 1] + 5)).all(), (AMPS[k], g[k], f[k])
+    assert np.isnan(g[4]).all()
+
+
+def test_bad_input_is_a_case_error(monkeypatch):
+    """A CaseError naming the argument before anything runs (no sweep, no continuation),
+    continuation's keywords handed on included."""
+    import sys
+
+    def never(*a, **k):
+        raise AssertionError("ran before the arguments were checked")
+    monkeypatch.setattr(sys.modules["pyspline.sweeps"], "sweep", never)
+    monkeypatch.setattr(sys.modules["pyspline.branches"], "continuation", never)
+    for kw in (dict(points=2), dict(points=1.5), dict(max_n=0), dict(ds=0.0), dict(bogus=1),
+               dict(guess=np.zeros(14)), dict(stop="x")):
+        args = dict(stop=BAND[1]) | kw
         with pytest.raises(pyspline.CaseError, match=list(kw)[0]):
-            pyspline.branches(DRIVE, "speed_rpm", *BAND, progress=False, **kw)
-    with pytest.raises(pyspline.CaseError, match="values2"):
-        pyspline.fold_curve(DRIVE, "speed_rpm", *BAND, "ripple_amp(1)", [np.nan])
+            pyspline.branches(DRIVE, "speed_rpm", BAND[0], progress=False, **args)
+    for kw in (dict(values2=[np.nan]), dict(values2="x"), dict(values2=[0.2, 1e9]),
+               dict(check=[np.nan]), dict(check="x"), dict(check_points=1),
+               dict(check_points=2.5), dict(ds_min=0.5), dict(bogus=1)):
+        args = dict(values2=[0.2]) | kw
+        with pytest.raises(pyspline.CaseError, match=list(kw)[0]):
+            pyspline.fold_curve(DRIVE, "speed_rpm", *BAND, "ripple_amp(1)", progress=False,
+                                **args)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         with pytest.raises(pyspline.CaseError, match="scalar field"):

@@ -115,7 +115,8 @@ contains
   !> The SUNDIALS context and the state vector on the caller's array yr (a target that outlives
   !> the run); the run's name in messages and its work bounds, the case's; the wall clock
   !> started (or at the system_clock count wall_start, optional: a bound over several runs),
-  !> max_seconds (optional, > 0) its bound. flag /= 0: the first failure, stage names it.
+  !> max_seconds (optional, > 0) its bound; without it, the model's call bound (m%max_seconds,
+  !> from m%wall_start) if it has one. flag /= 0: the first failure, stage names it.
   subroutine integrator_open(m, run, yr, cv, flag, stage, max_seconds, wall_start)
     type(model_t), intent(in) :: m
     character(len=*), intent(in) :: run
@@ -128,8 +129,13 @@ contains
     cv%run = run
     cv%max_steps = m%max_steps
     cv%max_total_steps = m%max_total_steps
-    if (present(max_seconds)) cv%max_seconds = max_seconds
     call system_clock(cv%clock0, cv%rate)
+    if (present(max_seconds)) then
+      cv%max_seconds = max_seconds
+    else if (m%max_seconds > 0.0_wp) then
+      cv%max_seconds = m%max_seconds
+      cv%clock0 = m%wall_start
+    end if
     if (present(wall_start)) cv%clock0 = wall_start
     stage = 'creating the SUNDIALS context'
     flag = sundials_context_new(cv%sunctx)

@@ -218,12 +218,14 @@ contains
   !> A case with realisations = K > 1 runs copy `copy` (1..K) from ya, the state at the end of
   !> the transient (api_start_state), over its window (spline_realisations); loads, tload, ext
   !> and warnings stay 0 and blank: they are the K copies' together (api_results).
-  !> A SIGINT during the run stops it (ierr 4). Called without the GIL.
+  !> A SIGINT during the run stops it (ierr 4). max_seconds > 0: the call's wall-time bound
+  !> over all its runs (a run past it fails naming it, as a solver failure; 0: none).
+  !> Called without the GIL.
   subroutine api_simulate(model, nb, z, nt, nq, ns, nsec, nlyap, nft, nslice, nl, ntl, nx, t, y, &
        tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, nqw, consts, loads, tload, ext, &
-       warnings, copy, ya, ierr, errmsg)
+       warnings, copy, ya, ierr, errmsg, max_seconds)
     integer(c_int), intent(in) :: nb, z, nt, nq, ns, nsec, nlyap, nft, nslice, nl, ntl, nx, copy
-    real(c_double), intent(in) :: ya(14)
+    real(c_double), intent(in) :: ya(14), max_seconds
     integer(c_int), intent(in) :: model(nb)
     real(c_double), intent(out) :: t(nt), y(14, nt), tooth(nt, z, nq), tm(nt), stats(ns)
     real(c_double), intent(out) :: sec_t(nsec), sec_y(nsec, 14), lyap_t(nlyap), lyap_g(nlyap)
@@ -239,6 +241,10 @@ contains
     stats = 0; sec_t = 0; sec_y = 0; lyap_t = 0; lyap_g = 0   ! t, y, tooth, tm: below
     face = 0; tilt = 0; nqw = nq; consts = 0; loads = 0; tload = 0; ext = 0; warnings = ''
     call unpack(model, m, ie, errmsg)
+    if (max_seconds > 0.0_c_double) then
+      m%max_seconds = max_seconds
+      call system_clock(m%wall_start)
+    end if
     if (ie == err_ok .and. (m%z /= z .or. m%n_out /= nt .or. nq /= ntooth_q .or. ns /= nstats &
          .or. nsec /= run_sections(m) .or. (m%realisations > 1 .and. &
          (copy < 1 .or. copy > m%realisations)) .or. nlyap /= lyapunov_count(m) .or. &

@@ -113,6 +113,10 @@ module spline_model
     !> tooth spacing (index) errors e_j of spline 1 [m] (0 beyond z), and whether any is nonzero
     real(wp) :: spacing_error(max_teeth) = 0.0_wp
     logical  :: spacing = .false.
+    !> not a case field: a call's wall-time bound [s] over all its runs (0: none) and the
+    !> system_clock count it counts from (api_simulate sets them; spline_integrator::integrator_open)
+    real(wp) :: max_seconds = 0.0_wp
+    integer(8) :: wall_start = 0
   end type model_t
 
 contains
