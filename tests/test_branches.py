@@ -9,14 +9,16 @@ import pytest
 
 import pyspline
 from pyspline.branches import coexistence
-from test_cont_drives import BAND, DRIVE, folds, follow_sweeps  # noqa: F401 (a fixture)
+from test_cont_drives import BAND, DRIVE, S_BAND, folds, follow_sweeps  # noqa: F401 (a fixture)
 
 SETTLED = DRIVE.replace(t_end=2.0, t_transient=1.0, n_out=8001)  # the seeding sweep's runs
 
 
 @pytest.fixture(scope="module")
 def every_branch():
-    return pyspline.branches(DRIVE, "speed_rpm", *BAND, points=31, progress=False,
+    """Every branch over 2330-2470 r/min (the S-curve's folds with a margin), seeded by follow
+    sweeps at 10 r/min steps."""
+    return pyspline.branches(DRIVE, "speed_rpm", *S_BAND, points=15, progress=False,
                              sweep_case=SETTLED)
 
 
@@ -34,7 +36,7 @@ def test_branches_finds_both_orbits_of_the_band_and_no_third(every_branch):
     lo, hi = folds(ds)
     assert len(folds(ds)) == 2
     speeds, swept = sw.speed_rpm.values, (sw.Tm_max - sw.Tm_min).values
-    for x in (2370.0, 2400.0, 2420.0, 2300.0, 2470.0):
+    for x in (2370.0, 2400.0, 2420.0, 2340.0, 2460.0):
         cross = [k for b in np.unique(ds.branch) for k in np.flatnonzero(ds.branch == b)[:-1]
                  if ds.branch[k + 1] == b and (p[k] - x) * (p[k + 1] - x) <= 0]
         assert len(cross) == (3 if lo < x < hi else 1), (x, cross)
@@ -109,31 +111,39 @@ def test_bad_input_is_a_case_error():
             pyspline.branches(DRIVE, "ripple_amp(1)", 0.1, 0.2, progress=False)
 
 
-def test_cli_all_and_fold_input(tmp_path, every_branch):
+def test_cli_all(tmp_path, every_branch):
     """`pyspline continue --all` writes the branches (the Python call's folds, from a seeding
-    sweep of 5 speeds over 2300-2500 r/min), the seeding sweep and the figure, exit 0; `--fold`
-    the folds at one amplitude (the same) with the follow sweeps' verdict (2320, 2400, 2480
-    r/min: two orbits exactly between the folds, 2354.6 and 2439.3); a --fold without numbers
-    is a CaseError naming it, exit 2."""
+    sweep of 3 speeds over 2330-2460 r/min), the seeding sweep and the figure, exit 0."""
     import xarray as xr
     from test_continuation import cli
     path = tmp_path / "drive.nml"
     path.write_text(SETTLED.text())
-    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2300",
-              "--stop", "2500", "--all", "--sweep", "5", "--out", "out", "--quiet")
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2330",
+              "--stop", "2460", "--all", "--sweep", "3", "--out", "out", "--quiet")
     assert run.returncode == 0, run.stderr
     ds = xr.open_dataset(tmp_path / "out" / "branches.nc", engine="h5netcdf")
     assert folds(ds) == pytest.approx(folds(every_branch[0]), abs=1e-3)
     assert (tmp_path / "out" / "branches.png").stat().st_size > 10_000
-    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2320",
-              "--stop", "2480", "--fold", "ripple_amp(1)=0.25", "--check", "0.25", "--sweep",
+
+
+def test_cli_fold_input(tmp_path, every_branch):
+    """`pyspline continue --fold` writes the folds at one amplitude (the Python --all call's)
+    with the follow sweeps' verdict (2330, 2395, 2460 r/min: two orbits exactly between the
+    folds, 2354.6 and 2439.3), exit 0; a --fold without numbers is a CaseError naming it,
+    exit 2."""
+    import xarray as xr
+    from test_continuation import cli
+    path = tmp_path / "drive.nml"
+    path.write_text(SETTLED.text())
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2330",
+              "--stop", "2460", "--fold", "ripple_amp(1)=0.25", "--check", "0.25", "--sweep",
               "3", "--out", "fold", "--quiet")
     assert run.returncode == 0, run.stderr
     fc = xr.open_dataset(tmp_path / "fold" / "fold_curve.nc", engine="h5netcdf")
     assert fc.fold.values[0] == pytest.approx(folds(every_branch[0]), abs=1e-2)
     lo, hi = fc.fold.values[0]
     x, two = fc.check_field.values, fc.coexist.values[0].astype(bool)
-    assert (two == ((x > lo) & (x < hi))).all(), (x[two], lo, hi)
+    assert len(x) == 3 and (two == ((x > lo) & (x < hi))).all(), (x[two], lo, hi)
     assert (tmp_path / "fold" / "fold_curve.png").stat().st_size > 10_000
     run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
               "--stop", "2500", "--fold", "ripple_amp(1)=0.2,x")

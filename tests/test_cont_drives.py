@@ -1,11 +1,12 @@
 """Continuation on a 7-DOF drive with clearance (docs/continuation.md): the paper's Z = 16
 spline in bending-torsion (dof 7) with shafts of k_t = 1000 N m/rad, a mesh damping ratio of
 0.01 per tooth pair and a torque ripple of 25 % at order 1 near the mesh resonance (40 Hz:
-2400 r/min). Over 2200-2500 r/min its response is an S-curve: the full-contact branch opens
-the teeth at a grazing, folds back unstable, then folds again onto an upper branch that loses
+2400 r/min). Over 2200-2500 r/min (traced over 2330-2470, its folds with a margin) its
+response is an S-curve: the full-contact branch opens the teeth at a grazing, folds back unstable, then folds again onto an upper branch that loses
 contact every revolution. rtol 1e-8 (the folds move by 1e-5 r/min from rtol 1e-9, the S-curve
 takes half the time). Held against the closed-form full-contact response, follow sweeps
 at 1 r/min steps and the multipliers' meaning."""
+import functools
 import importlib
 import warnings
 
@@ -22,15 +23,16 @@ DRIVE = pyspline.load_case(CASES / "paper_ideal.nml", start="equilibrium", rtol=
                            k_t1=1e3, k_t2=1e3, zeta_m=0.01, ripple_order=[1, 0, 0, 0],
                            ripple_amp=[0.25, 0, 0, 0])
 BAND = (2200.0, 2500.0)
+S_BAND = (2330.0, 2470.0)   # the S-curve: its folds (2354.6, 2439.3) and a margin either side
 
 
-def continued(method, **kw):
+def continued(method, band=S_BAND, **kw):
     with warnings.catch_warnings():
         warnings.simplefilter("error", pyspline.SplineWarning)   # complete: no warning but
         warnings.filterwarnings(                                  # CVODE's "t + h = t" at a
             "ignore", r"SUNDIALS warned in \d+ of the continuation's map runs",  # grazing,
             pyspline.SplineWarning)                                # said once (attrs)
-        return pyspline.continuation(DRIVE.replace(method=method), "speed_rpm", *BAND,
+        return pyspline.continuation(DRIVE.replace(method=method), "speed_rpm", *band,
                                      progress=False, **kw)
 
 
@@ -65,18 +67,30 @@ def test_full_contact_branch_is_the_closed_form(method):
     assert (ds.switches == 0).all() and ds.stable.all()
 
 
-@pytest.fixture(scope="module", params=["adams", "auto"])
-def s_curve(request):
-    """The whole S-curve over the band from one call: the case's own method (paper_ideal's
-    Adams) and 'auto' (which picks Adams for a given k_m too, by its own rule)."""
-    return continued(request.param)
-
-
 @pytest.fixture(scope="module")
-def follow_sweeps():
-    """Follow sweeps up and down over the hysteresis at 1 r/min steps: (speeds, T_m
-    peak-to-peak (direction, speed)). Up from 2340 (below the lower fold: one orbit), down
-    from 2450 (above the upper fold: one orbit)."""
+def s_curve():
+    """The whole S-curve over the band from one call with the case's own method (paper_ideal's
+    Adams; 'auto' picks it for a given k_m too: test_auto_is_this_continuation)."""
+    return continued("adams")
+
+
+def test_auto_is_this_continuation(s_curve):
+    """method = 'auto' picks Adams for a given k_m by its own rule: its continuation is the
+    Adams one bit for bit (its first 4 points here; the whole S-curve was bit for bit too)."""
+    case = DRIVE.replace(method="auto")
+    assert case["method"] == "auto" and "method = 'adams'" in s_curve.attrs["case"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)    # max_points reached
+        auto = pyspline.continuation(case, "speed_rpm", *S_BAND, max_points=4, progress=False)
+    k = auto.sizes["point"]
+    assert k == 4
+    for v in auto.data_vars:
+        if "point" in auto[v].dims:
+            assert np.array_equal(auto[v].values[:k], s_curve[v].values[:k]), v
+
+
+@functools.cache
+def _follow_sweeps():
     speeds = np.arange(2340.0, 2451.0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pyspline.SplineWarning)
@@ -84,6 +98,15 @@ def follow_sweeps():
                             speed_rpm=speeds, follow="both", progress=False, spectrum=False)
     assert (sw.error == "").all()
     return speeds, (sw.Tm_max - sw.Tm_min).values
+
+
+@pytest.fixture
+def follow_sweeps():
+    """Follow sweeps up and down over the hysteresis at 1 r/min steps: (speeds, T_m
+    peak-to-peak (direction, speed)). Up from 2340 (below the lower fold: one orbit), down
+    from 2450 (above the upper fold: one orbit). Run once per process (tests/test_branches.py
+    holds its branches against them too)."""
+    return _follow_sweeps()
 
 
 def folds(ds):
@@ -100,11 +123,13 @@ def test_s_curve_folds_where_the_follow_sweeps_jump(s_curve, follow_sweeps):
 def test_erk_traces_the_s_curve(follow_sweeps):
     """With ERK too (its map less smooth near a grazing: the null vector of the differenced
     Jacobian put the predictor off the saddle branch, which stalled at 2436 r/min before the
-    predictor followed the secant): the whole S-curve, folds where the follow sweeps jump."""
-    folds_at_the_jumps(continued("erk"), follow_sweeps)
+    predictor followed the secant): the whole S-curve, folds where the follow sweeps jump.
+    Over 2200-2500 r/min (over 2330-2470 ERK's corrector fails next to the lower fold, 2356
+    r/min: the steps scale with the band's stop)."""
+    folds_at_the_jumps(continued("erk", BAND), follow_sweeps, BAND)
 
 
-def folds_at_the_jumps(ds, follow_sweeps):
+def folds_at_the_jumps(ds, follow_sweeps, band=S_BAND):
     lo, hi = folds(ds)
     speeds, pp = follow_sweeps
     up = speeds[np.argmax(np.diff(pp[0])) + 1]      # the first speed on the upper branch
@@ -112,7 +137,7 @@ def folds_at_the_jumps(ds, follow_sweeps):
     assert hi == pytest.approx(up, rel=5e-3) and lo == pytest.approx(down, rel=5e-3)
     assert down < lo < hi < up, (down, lo, hi, up)
     p = ds.speed_rpm.values
-    assert p[0] == BAND[0] and p[-1] == pytest.approx(BAND[1], rel=1e-12)
+    assert p[0] == band[0] and p[-1] == pytest.approx(band[1], rel=1e-12)
     turns = p[np.flatnonzero(np.diff(np.sign(np.diff(p)))) + 1]
     assert len(turns) == 2 and np.allclose(turns, [hi, lo], atol=0.5)
     sp = ds.special_type.values == "fold"
