@@ -292,7 +292,7 @@ def test_neimark_sacker_pair_on_the_unit_circle():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pyspline.SplineWarning)
         ds = pyspline.continuation(RESONANCE.replace(ripple_amp=[0.5, 0, 0, 0]), "speed_rpm",
-                                   2000, 2400, ds_max=0.5, progress=False)
+                                   2000, 2300, ds_max=0.5, progress=False)
     ns = np.flatnonzero(ds.special_type.values == "neimark_sacker")
     assert len(ns) == 2
     mu = ds.special_mu_real.values[ns] + 1j * ds.special_mu_imag.values[ns]
@@ -339,13 +339,14 @@ def test_follow_chains_on_processes_are_the_serial_ones():
 # revolution); continued in speed, the period-1 orbit's multiplier moves smoothly through -1
 # at 1623.6 r/min with the contact sequence unchanged (a smooth period doubling)
 DOUBLING = RESONANCE.replace(ripple_amp=[2.0, 0, 0, 0], speed_rpm=1600.0)
+STOP = 1635.0       # the period-2 branch stable from its fold (1618.4 r/min) on
 
 
 @pytest.fixture(scope="module")
 def doubling_branch():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pyspline.SplineWarning)
-        return pyspline.continuation(DOUBLING, "speed_rpm", 1600, 1650, max_points=120,
+        return pyspline.continuation(DOUBLING, "speed_rpm", 1600, STOP, max_points=120,
                                      progress=False)
 
 
@@ -363,7 +364,7 @@ def test_period_doubling_switches_to_the_doubled_branch(doubling_branch):
     mu = complex(ds.special_mu_real[pd[0]], ds.special_mu_imag[pd[0]])
     assert abs(mu + 1) < 1e-3 and ds.special_smooth.values[pd[0]] == 1, mu
     p_pd = float(ds.special_speed_rpm[pd[0]])
-    assert 1600 < p_pd < 1650
+    assert 1600 < p_pd < STOP
     # branch 0 (period 1): stable below, a real multiplier below -1 above; one contact sequence
     b0 = ds.branch.values == 0
     p0, st0 = ds.speed_rpm.values[b0], ds.stable.values[b0].astype(bool)
@@ -376,10 +377,10 @@ def test_period_doubling_switches_to_the_doubled_branch(doubling_branch):
     assert len(b1) >= 5 and (ds.n.values[b1] == 2).all()
     assert float(ds.speed_rpm[b1[0]]) == pytest.approx(p_pd, abs=0.5)
     last = b1[-1]
-    assert float(ds.speed_rpm[last]) == pytest.approx(1650, rel=1e-12) and ds.stable[last]
-    case = DOUBLING.replace(speed_rpm=1650.0)
+    assert float(ds.speed_rpm[last]) == pytest.approx(STOP, rel=1e-12) and ds.stable[last]
+    case = DOUBLING.replace(speed_rpm=STOP)
     y = ds.y0.values[last]
-    T = 60 / 1650.0
+    T = 60 / STOP
     s = scale_of(case)
     y2, _, free = map_and_monodromy(case, 0.0, 2 * T, y)
     y1 = _period_map(case.model, 0.0, T, y[:, None])[0][:, 0]
@@ -419,7 +420,7 @@ def test_frequency_response_figure(doubling_branch):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pyspline.SplineWarning)
         sw = pyspline.sweep(DOUBLING.replace(t_end=0.5, t_transient=0.3, n_out=201),
-                            speed_rpm=np.linspace(1600, 1650, 4), follow="both",
+                            speed_rpm=np.linspace(1600, STOP, 4), follow="both",
                             progress=False, spectrum=False)
     fig = frequency_response(ds, "Tm_pp", sweep=sw)
     ax = fig.axes[0]
