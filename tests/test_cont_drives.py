@@ -172,20 +172,21 @@ def test_s_curve_middle_branch_has_a_real_multiplier_beyond_one(s_curve):
 
 
 @pytest.fixture(scope="module")
-def upper_orbit():
-    """The upper branch's orbit at 2400 r/min (contact lost every revolution), continued down
-    from 2500 r/min, above the upper fold, where a 1 s run from the equilibrium settles on it."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", pyspline.SplineWarning)
-        upper = pyspline.continuation(DRIVE.replace(t_end=1.0), "speed_rpm", 2500, 2400,
-                                      progress=False)
-    assert upper.attrs["status"] == "complete" and (upper.switches > 0).all()
-    return upper.y0.values[-1]
+def upper_orbit(s_curve):
+    """An orbit of the upper branch next to 2400 r/min (contact lost every revolution): the
+    S-curve's point nearest 2400 r/min after its second fold; the corrector below converges
+    from it onto the upper orbit at 2400 r/min."""
+    p = s_curve.speed_rpm.values
+    i2 = (np.flatnonzero(np.diff(np.sign(np.diff(p)))) + 1)[1]
+    k = i2 + 1 + np.argmin(np.abs(p[i2 + 1:] - 2400))
+    assert abs(p[k] - 2400) < 2 and s_curve.switches[k] > 0
+    return s_curve.y0.values[k]
 
 
 def onto_the_upper_orbit(monkeypatch, y_up):
     """Makes the first corrector from a predictor within 2395-2415 r/min converge on the upper
-    orbit at 2400 r/min (as a long step across a fold can); the speeds it did so at."""
+    orbit at 2400 r/min (as a long step across a fold can; from y_up, next to it); the speeds
+    it did so at."""
     cont = importlib.import_module("pyspline.arclength")
     original, jumped = cont._Branch.correct, []
 
