@@ -49,18 +49,26 @@ def resonance_branch():
 
 
 @pytest.fixture(scope="module")
-def linear_branch():
-    """The linear scene's branch over 2600-3800 r/min (steps of 0.1): the closed form's and the
-    command line's."""
+def linear_branch(tmp_path_factory):
+    """The linear scene's branch over 2600-3800 r/min (steps of 0.1) from `pyspline continue`
+    (its continuation.nc): (case, branch, the command's outcome, its directory). Held to the
+    closed form and to the Python call."""
+    import xarray as xr
     case, *_ = linear_scene(2.0)
-    return case, pyspline.continuation(case, "speed_rpm", 2600, 3800, progress=False, ds=0.1)
+    tmp = tmp_path_factory.mktemp("linear")
+    (tmp / "scene.nml").write_text(case.text())
+    run = cli(tmp, "continue", "scene.nml", "--field", "speed_rpm", "--start", "2600",
+              "--stop", "3800", "--ds", "0.1", "--out", "out", "--quiet")
+    assert run.returncode == 0, run.stderr
+    with xr.open_dataset(tmp / "out" / "continuation.nc", engine="h5netcdf") as ds:
+        return case, ds.load(), run, tmp
 
 
 def test_linear_branch_is_the_closed_form(linear_branch):
     """Full contact: every point of the branch over speed through the mesh resonance is the
     closed-form forced response y_eq + Re Y(omega), its multipliers exp(lambda_i T); all
     stable, no special point."""
-    case, ds = linear_branch
+    case, ds, *_ = linear_branch
     s = scale_of(case)
     assert ds.attrs["n_points"] >= 5 and ds.attrs["n_special"] == 0
     assert ds.speed_rpm[0] == 2600 and ds.speed_rpm[-1] == pytest.approx(3800, rel=1e-12)
@@ -162,21 +170,22 @@ def cli(tmp_path, *args):
 
 
 def test_cli_end_to_end(tmp_path, linear_branch):
-    """`pyspline continue` on the linear scene: continuation.nc holds the branch (the same
-    numbers as the Python call), frequency_response.png is drawn, exit 0; a field that
-    cannot be continued is a CaseError naming it, exit 2."""
-    import xarray as xr
-    case, want = linear_branch
-    path = tmp_path / "scene.nml"
-    path.write_text(case.text())
-    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2600",
-              "--stop", "3800", "--ds", "0.1", "--out", "out", "--quiet")
-    assert run.returncode == 0, run.stderr
+    """`pyspline continue` on the linear scene (the fixture's run): continuation.nc holds the
+    branch (the same numbers as the Python call: its first 4 points, where the Python call
+    stops at max_points = 4), frequency_response.png is drawn, exit 0; a field that cannot be
+    continued is a CaseError naming it, exit 2."""
+    case, ds, run, out = linear_branch
     assert "wrote out/continuation.nc" in run.stdout and "points on 1 branch(es)" in run.stdout
-    ds = xr.open_dataset(tmp_path / "out" / "continuation.nc", engine="h5netcdf")
-    assert np.array_equal(ds.speed_rpm, want.speed_rpm) and np.array_equal(ds.y0, want.y0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)     # max_points reached
+        want = pyspline.continuation(case, "speed_rpm", 2600, 3800, progress=False, ds=0.1,
+                                     max_points=4)
+    assert want.sizes["point"] == 4 and ds.sizes["point"] > 4
+    assert np.array_equal(ds.speed_rpm[:4], want.speed_rpm)
+    assert np.array_equal(ds.y0[:4], want.y0)
     assert ds.attrs["command"].startswith("pyspline continue")
-    assert (tmp_path / "out" / "frequency_response.png").stat().st_size > 10_000
+    assert (out / "out" / "frequency_response.png").stat().st_size > 10_000
+    path = out / "scene.nml"
     run = cli(tmp_path, "continue", str(path), "--field", "z", "--start", "16", "--stop", "20")
     assert run.returncode == 2 and "field z cannot be continued" in run.stderr, run.stderr
     # a follow sweep from the command line: both directions in sweep.nc, one overlaid figure
