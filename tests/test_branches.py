@@ -9,15 +9,17 @@ import pytest
 
 import pyspline
 from pyspline.branches import coexistence
-from test_cont_drives import BAND, DRIVE, folds, follow_sweeps  # noqa: F401 (a fixture)
+from test_cont_drives import (BAND, DRIVE, every_branch_of_the_band, folds,  # noqa: F401
+                              follow_sweeps)                                 # (a fixture)
 
 SETTLED = DRIVE.replace(t_end=2.0, t_transient=1.0, n_out=8001)  # the seeding sweep's runs
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture
 def every_branch():
-    return pyspline.branches(DRIVE, "speed_rpm", *BAND, points=31, progress=False,
-                             sweep_case=SETTLED)
+    """Every branch over 2250-2480 r/min, seeded by follow sweeps (runs of SETTLED) at 10 r/min
+    steps, computed once per process (tests/test_cont_drives.py holds its S-curve too)."""
+    return every_branch_of_the_band()
 
 
 def test_branches_finds_both_orbits_of_the_band_and_no_third(every_branch):
@@ -174,31 +176,50 @@ def test_bad_input_is_a_case_error(monkeypatch):
             pyspline.branches(DRIVE, "ripple_amp(1)", 0.1, 0.2, progress=False)
 
 
-def test_cli_all_and_fold_input(tmp_path, every_branch):
-    """`pyspline continue --all` writes the branches (the Python call's folds, from a seeding
-    sweep of 5 speeds over 2300-2500 r/min), the seeding sweep and the figure, exit 0; `--fold`
-    the folds at one amplitude (the same) with the follow sweeps' verdict (2320, 2400, 2480
-    r/min: two orbits exactly between the folds, 2354.6 and 2439.3); a --fold without numbers
-    is a CaseError naming it, exit 2."""
+def test_cli_all(tmp_path):
+    """`pyspline continue --all` writes what pyspline.branches returns, bit for bit: the
+    branches, the seeding sweep (3 speeds over 2200-2300 r/min, below the hysteresis: one
+    orbit, seeded up and down, continued once) and the figure, exit 0 (the branches of the
+    S-curve and its folds: the tests above)."""
     import xarray as xr
     from test_continuation import cli
     path = tmp_path / "drive.nml"
     path.write_text(SETTLED.text())
-    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2300",
-              "--stop", "2500", "--all", "--sweep", "5", "--out", "out", "--quiet")
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
+              "--stop", "2300", "--all", "--sweep", "3", "--out", "out", "--quiet")
     assert run.returncode == 0, run.stderr
     ds = xr.open_dataset(tmp_path / "out" / "branches.nc", engine="h5netcdf")
-    assert folds(ds) == pytest.approx(folds(every_branch[0]), abs=1e-3)
+    sw = xr.open_dataset(tmp_path / "out" / "sweep.nc", engine="h5netcdf")
+    want, want_sw = pyspline.branches(SETTLED, "speed_rpm", 2200, 2300, points=3,
+                                      progress=False)
+    assert ds.attrs["n_branches"] == 1 and ds.attrs["seeds"] == want.attrs["seeds"]
+    assert ds.attrs["command"].startswith("pyspline continue") and "--all" in ds.attrs["command"]
+    for got, ref in ((ds, want), (sw, want_sw)):
+        for v in ref.data_vars:
+            if v not in ("wall_s", "core_wall_s"):
+                assert np.array_equal(got[v].values, ref[v].values,
+                                      equal_nan=ref[v].dtype.kind == "f"), v
     assert (tmp_path / "out" / "branches.png").stat().st_size > 10_000
-    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2320",
-              "--stop", "2480", "--fold", "ripple_amp(1)=0.25", "--check", "0.25", "--sweep",
+
+
+def test_cli_fold_input(tmp_path, every_branch):
+    """`pyspline continue --fold` writes the folds at one amplitude (the Python --all call's)
+    with the follow sweeps' verdict (2330, 2395, 2460 r/min: two orbits exactly between the
+    folds, 2354.6 and 2439.3), exit 0; a --fold without numbers is a CaseError naming it,
+    exit 2."""
+    import xarray as xr
+    from test_continuation import cli
+    path = tmp_path / "drive.nml"
+    path.write_text(SETTLED.text())
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2330",
+              "--stop", "2460", "--fold", "ripple_amp(1)=0.25", "--check", "0.25", "--sweep",
               "3", "--out", "fold", "--quiet")
     assert run.returncode == 0, run.stderr
     fc = xr.open_dataset(tmp_path / "fold" / "fold_curve.nc", engine="h5netcdf")
     assert fc.fold.values[0] == pytest.approx(folds(every_branch[0]), abs=1e-2)
     lo, hi = fc.fold.values[0]
     x, two = fc.check_field.values, fc.coexist.values[0].astype(bool)
-    assert (two == ((x > lo) & (x < hi))).all(), (x[two], lo, hi)
+    assert len(x) == 3 and (two == ((x > lo) & (x < hi))).all(), (x[two], lo, hi)
     assert (tmp_path / "fold" / "fold_curve.png").stat().st_size > 10_000
     run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
               "--stop", "2500", "--fold", "ripple_amp(1)=0.2,x")

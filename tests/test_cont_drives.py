@@ -6,6 +6,7 @@ the teeth at a grazing, folds back unstable, then folds again onto an upper bran
 contact every revolution. rtol 1e-8 (the folds move by 1e-5 r/min from rtol 1e-9, the S-curve
 takes half the time). Held against the closed-form full-contact response, follow sweeps
 at 1 r/min steps and the multipliers' meaning."""
+import functools
 import importlib
 import warnings
 
@@ -22,6 +23,7 @@ DRIVE = pyspline.load_case(CASES / "paper_ideal.nml", start="equilibrium", rtol=
                            k_t1=1e3, k_t2=1e3, zeta_m=0.01, ripple_order=[1, 0, 0, 0],
                            ripple_amp=[0.25, 0, 0, 0])
 BAND = (2200.0, 2500.0)
+S_BAND = (2250.0, 2480.0)   # the S-curve of pyspline.branches (every_branch_of_the_band)
 
 
 def continued(method, **kw):
@@ -65,18 +67,45 @@ def test_full_contact_branch_is_the_closed_form(method):
     assert (ds.switches == 0).all() and ds.stable.all()
 
 
-@pytest.fixture(scope="module", params=["adams", "auto"])
-def s_curve(request):
-    """The whole S-curve over the band from one call: the case's own method (paper_ideal's
-    Adams) and 'auto' (which picks Adams for a given k_m too, by its own rule)."""
-    return continued(request.param)
+@functools.cache
+def every_branch_of_the_band():
+    """pyspline.branches over 2250-2480 r/min (S_BAND), seeded by follow sweeps at 10 r/min
+    steps (runs of 2 s, the last 1 s at 200 samples a revolution), once per process: its one
+    branch is the S-curve here, the branches' tests in tests/test_branches.py. The up sweep's
+    seed (the middle of its stretch, 2340 r/min) lies below the lower fold, so its branch is
+    the whole S-curve and the down sweep's seed lies on it (a seed inside the hysteresis would
+    trace only the part of the S-curve that stays above it, and the down sweep's the rest)."""
+    settled = DRIVE.replace(t_end=2.0, t_transient=1.0, n_out=8001)
+    return pyspline.branches(DRIVE, "speed_rpm", *S_BAND, points=24, progress=False,
+                             sweep_case=settled)
 
 
 @pytest.fixture(scope="module")
-def follow_sweeps():
-    """Follow sweeps up and down over the hysteresis at 1 r/min steps: (speeds, T_m
-    peak-to-peak (direction, speed)). Up from 2340 (below the lower fold: one orbit), down
-    from 2450 (above the upper fold: one orbit)."""
+def s_curve():
+    """The whole S-curve over the band with the case's own method (paper_ideal's Adams; 'auto'
+    picks it for a given k_m too: test_auto_is_adams_here), continued from the seed at 2340
+    r/min down to the band's start and up to its stop, complete: one branch."""
+    ds, _ = every_branch_of_the_band()
+    assert ds.attrs["status"] == "complete" and ds.attrs["n_branches"] == 1
+    return ds
+
+
+def test_auto_is_adams_here():
+    """method = 'auto' picks Adams for a given k_m by its own rule: its continuation is the
+    Adams one bit for bit (4 points here; the whole S-curve was bit for bit too)."""
+    case = DRIVE.replace(method="auto")
+    assert case["method"] == "auto" and DRIVE["method"] == "adams"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)    # max_points reached
+        auto, adams = (pyspline.continuation(c, "speed_rpm", *S_BAND, max_points=4,
+                                             progress=False) for c in (case, DRIVE))
+    assert auto.sizes["point"] == adams.sizes["point"] == 4
+    for v in adams.data_vars:
+        assert np.array_equal(auto[v].values, adams[v].values), v
+
+
+@functools.cache
+def _follow_sweeps():
     speeds = np.arange(2340.0, 2451.0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pyspline.SplineWarning)
@@ -84,6 +113,15 @@ def follow_sweeps():
                             speed_rpm=speeds, follow="both", progress=False, spectrum=False)
     assert (sw.error == "").all()
     return speeds, (sw.Tm_max - sw.Tm_min).values
+
+
+@pytest.fixture
+def follow_sweeps():
+    """Follow sweeps up and down over the hysteresis at 1 r/min steps: (speeds, T_m
+    peak-to-peak (direction, speed)). Up from 2340 (below the lower fold: one orbit), down
+    from 2450 (above the upper fold: one orbit). Run once per process (tests/test_branches.py
+    holds its branches against them too)."""
+    return _follow_sweeps()
 
 
 def folds(ds):
@@ -100,11 +138,12 @@ def test_s_curve_folds_where_the_follow_sweeps_jump(s_curve, follow_sweeps):
 def test_erk_traces_the_s_curve(follow_sweeps):
     """With ERK too (its map less smooth near a grazing: the null vector of the differenced
     Jacobian put the predictor off the saddle branch, which stalled at 2436 r/min before the
-    predictor followed the secant): the whole S-curve, folds where the follow sweeps jump."""
-    folds_at_the_jumps(continued("erk"), follow_sweeps)
+    predictor followed the secant): the whole S-curve, folds where the follow sweeps jump.
+    From the band's start, in one continuation."""
+    folds_at_the_jumps(continued("erk"), follow_sweeps, BAND)
 
 
-def folds_at_the_jumps(ds, follow_sweeps):
+def folds_at_the_jumps(ds, follow_sweeps, band=S_BAND):
     lo, hi = folds(ds)
     speeds, pp = follow_sweeps
     up = speeds[np.argmax(np.diff(pp[0])) + 1]      # the first speed on the upper branch
@@ -112,7 +151,8 @@ def folds_at_the_jumps(ds, follow_sweeps):
     assert hi == pytest.approx(up, rel=5e-3) and lo == pytest.approx(down, rel=5e-3)
     assert down < lo < hi < up, (down, lo, hi, up)
     p = ds.speed_rpm.values
-    assert p[0] == BAND[0] and p[-1] == pytest.approx(BAND[1], rel=1e-12)
+    assert p[0] == pytest.approx(band[0], rel=1e-12)
+    assert p[-1] == pytest.approx(band[1], rel=1e-12)
     turns = p[np.flatnonzero(np.diff(np.sign(np.diff(p)))) + 1]
     assert len(turns) == 2 and np.allclose(turns, [hi, lo], atol=0.5)
     sp = ds.special_type.values == "fold"
@@ -147,20 +187,21 @@ def test_s_curve_middle_branch_has_a_real_multiplier_beyond_one(s_curve):
 
 
 @pytest.fixture(scope="module")
-def upper_orbit():
-    """The upper branch's orbit at 2400 r/min (contact lost every revolution), continued down
-    from 2500 r/min, above the upper fold, where a 1 s run from the equilibrium settles on it."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", pyspline.SplineWarning)
-        upper = pyspline.continuation(DRIVE.replace(t_end=1.0), "speed_rpm", 2500, 2400,
-                                      progress=False)
-    assert upper.attrs["status"] == "complete" and (upper.switches > 0).all()
-    return upper.y0.values[-1]
+def upper_orbit(s_curve):
+    """An orbit of the upper branch next to 2400 r/min (contact lost every revolution): the
+    S-curve's point nearest 2400 r/min after its second fold; the corrector below converges
+    from it onto the upper orbit at 2400 r/min."""
+    p = s_curve.speed_rpm.values
+    i2 = (np.flatnonzero(np.diff(np.sign(np.diff(p)))) + 1)[1]
+    k = i2 + 1 + np.argmin(np.abs(p[i2 + 1:] - 2400))
+    assert abs(p[k] - 2400) < 2 and s_curve.switches[k] > 0
+    return s_curve.y0.values[k]
 
 
 def onto_the_upper_orbit(monkeypatch, y_up):
     """Makes the first corrector from a predictor within 2395-2415 r/min converge on the upper
-    orbit at 2400 r/min (as a long step across a fold can); the speeds it did so at."""
+    orbit at 2400 r/min (as a long step across a fold can; from y_up, next to it); the speeds
+    it did so at."""
     cont = importlib.import_module("pyspline.arclength")
     original, jumped = cont._Branch.correct, []
 

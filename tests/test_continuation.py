@@ -49,18 +49,26 @@ def resonance_branch():
 
 
 @pytest.fixture(scope="module")
-def linear_branch():
-    """The linear scene's branch over 2600-3800 r/min (steps of 0.1): the closed form's and the
-    command line's."""
+def linear_branch(tmp_path_factory):
+    """The linear scene's branch over 2600-3800 r/min (steps of 0.1) from `pyspline continue`
+    (its continuation.nc): (case, branch, the command's outcome, its directory). Held to the
+    closed form and to the Python call."""
+    import xarray as xr
     case, *_ = linear_scene(2.0)
-    return case, pyspline.continuation(case, "speed_rpm", 2600, 3800, progress=False, ds=0.1)
+    tmp = tmp_path_factory.mktemp("linear")
+    (tmp / "scene.nml").write_text(case.text())
+    run = cli(tmp, "continue", "scene.nml", "--field", "speed_rpm", "--start", "2600",
+              "--stop", "3800", "--ds", "0.1", "--out", "out", "--quiet")
+    assert run.returncode == 0, run.stderr
+    with xr.open_dataset(tmp / "out" / "continuation.nc", engine="h5netcdf") as ds:
+        return case, ds.load(), run, tmp
 
 
 def test_linear_branch_is_the_closed_form(linear_branch):
     """Full contact: every point of the branch over speed through the mesh resonance is the
     closed-form forced response y_eq + Re Y(omega), its multipliers exp(lambda_i T); all
     stable, no special point."""
-    case, ds = linear_branch
+    case, ds, *_ = linear_branch
     s = scale_of(case)
     assert ds.attrs["n_points"] >= 5 and ds.attrs["n_special"] == 0
     assert ds.speed_rpm[0] == 2600 and ds.speed_rpm[-1] == pytest.approx(3800, rel=1e-12)
@@ -162,21 +170,22 @@ def cli(tmp_path, *args):
 
 
 def test_cli_end_to_end(tmp_path, linear_branch):
-    """`pyspline continue` on the linear scene: continuation.nc holds the branch (the same
-    numbers as the Python call), frequency_response.png is drawn, exit 0; a field that
-    cannot be continued is a CaseError naming it, exit 2."""
-    import xarray as xr
-    case, want = linear_branch
-    path = tmp_path / "scene.nml"
-    path.write_text(case.text())
-    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2600",
-              "--stop", "3800", "--ds", "0.1", "--out", "out", "--quiet")
-    assert run.returncode == 0, run.stderr
+    """`pyspline continue` on the linear scene (the fixture's run): continuation.nc holds the
+    branch (the same numbers as the Python call: its first 4 points, where the Python call
+    stops at max_points = 4), frequency_response.png is drawn, exit 0; a field that cannot be
+    continued is a CaseError naming it, exit 2."""
+    case, ds, run, out = linear_branch
     assert "wrote out/continuation.nc" in run.stdout and "points on 1 branch(es)" in run.stdout
-    ds = xr.open_dataset(tmp_path / "out" / "continuation.nc", engine="h5netcdf")
-    assert np.array_equal(ds.speed_rpm, want.speed_rpm) and np.array_equal(ds.y0, want.y0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)     # max_points reached
+        want = pyspline.continuation(case, "speed_rpm", 2600, 3800, progress=False, ds=0.1,
+                                     max_points=4)
+    assert want.sizes["point"] == 4 and ds.sizes["point"] > 4
+    assert np.array_equal(ds.speed_rpm[:4], want.speed_rpm)
+    assert np.array_equal(ds.y0[:4], want.y0)
     assert ds.attrs["command"].startswith("pyspline continue")
-    assert (tmp_path / "out" / "frequency_response.png").stat().st_size > 10_000
+    assert (out / "out" / "frequency_response.png").stat().st_size > 10_000
+    path = out / "scene.nml"
     run = cli(tmp_path, "continue", str(path), "--field", "z", "--start", "16", "--stop", "20")
     assert run.returncode == 2 and "field z cannot be continued" in run.stderr, run.stderr
     # a follow sweep from the command line: both directions in sweep.nc, one overlaid figure
@@ -292,7 +301,7 @@ def test_neimark_sacker_pair_on_the_unit_circle():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pyspline.SplineWarning)
         ds = pyspline.continuation(RESONANCE.replace(ripple_amp=[0.5, 0, 0, 0]), "speed_rpm",
-                                   2000, 2400, ds_max=0.5, progress=False)
+                                   2000, 2300, ds_max=0.5, progress=False)
     ns = np.flatnonzero(ds.special_type.values == "neimark_sacker")
     assert len(ns) == 2
     mu = ds.special_mu_real.values[ns] + 1j * ds.special_mu_imag.values[ns]
@@ -339,13 +348,14 @@ def test_follow_chains_on_processes_are_the_serial_ones():
 # revolution); continued in speed, the period-1 orbit's multiplier moves smoothly through -1
 # at 1623.6 r/min with the contact sequence unchanged (a smooth period doubling)
 DOUBLING = RESONANCE.replace(ripple_amp=[2.0, 0, 0, 0], speed_rpm=1600.0)
+STOP = 1635.0       # the period-2 branch stable from its fold (1618.4 r/min) on
 
 
 @pytest.fixture(scope="module")
 def doubling_branch():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pyspline.SplineWarning)
-        return pyspline.continuation(DOUBLING, "speed_rpm", 1600, 1650, max_points=120,
+        return pyspline.continuation(DOUBLING, "speed_rpm", 1600, STOP, max_points=120,
                                      progress=False)
 
 
@@ -363,7 +373,7 @@ def test_period_doubling_switches_to_the_doubled_branch(doubling_branch):
     mu = complex(ds.special_mu_real[pd[0]], ds.special_mu_imag[pd[0]])
     assert abs(mu + 1) < 1e-3 and ds.special_smooth.values[pd[0]] == 1, mu
     p_pd = float(ds.special_speed_rpm[pd[0]])
-    assert 1600 < p_pd < 1650
+    assert 1600 < p_pd < STOP
     # branch 0 (period 1): stable below, a real multiplier below -1 above; one contact sequence
     b0 = ds.branch.values == 0
     p0, st0 = ds.speed_rpm.values[b0], ds.stable.values[b0].astype(bool)
@@ -376,10 +386,10 @@ def test_period_doubling_switches_to_the_doubled_branch(doubling_branch):
     assert len(b1) >= 5 and (ds.n.values[b1] == 2).all()
     assert float(ds.speed_rpm[b1[0]]) == pytest.approx(p_pd, abs=0.5)
     last = b1[-1]
-    assert float(ds.speed_rpm[last]) == pytest.approx(1650, rel=1e-12) and ds.stable[last]
-    case = DOUBLING.replace(speed_rpm=1650.0)
+    assert float(ds.speed_rpm[last]) == pytest.approx(STOP, rel=1e-12) and ds.stable[last]
+    case = DOUBLING.replace(speed_rpm=STOP)
     y = ds.y0.values[last]
-    T = 60 / 1650.0
+    T = 60 / STOP
     s = scale_of(case)
     y2, _, free = map_and_monodromy(case, 0.0, 2 * T, y)
     y1 = _period_map(case.model, 0.0, T, y[:, None])[0][:, 0]
@@ -419,7 +429,7 @@ def test_frequency_response_figure(doubling_branch):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pyspline.SplineWarning)
         sw = pyspline.sweep(DOUBLING.replace(t_end=0.5, t_transient=0.3, n_out=201),
-                            speed_rpm=np.linspace(1600, 1650, 4), follow="both",
+                            speed_rpm=np.linspace(1600, STOP, 4), follow="both",
                             progress=False, spectrum=False)
     fig = frequency_response(ds, "Tm_pp", sweep=sw)
     ax = fig.axes[0]
