@@ -119,9 +119,10 @@ def run_scipy(case, method, rtol, rhs_kind, oracle, budget):
 def _numba_peer():
     """bench/numba_peer.py (compiled LSODA from numbalsoda on a numba RHS), or None without
     numba/numbalsoda."""
+    if importlib.util.find_spec("numbalsoda") is None:   # not imported: numba_peer._driver
+        return None
     try:
         import numba_peer
-        import numbalsoda  # noqa: F401
     except ImportError:
         return None
     return numba_peer
