@@ -182,7 +182,7 @@ PYSPLINE_LABEL = {"erk": "ARKODE", "auto": "pyspline"}
 
 
 def work_precision(out, quick=False, progress=True, cases=None):
-    """The work-precision chart and table (WP_CASES; quick: the two paper scenes, 0.02 s)."""
+    """The work-precision chart and table (WP_CASES; quick: the two paper scenes, 0.01 s)."""
     from tqdm import tqdm
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -195,7 +195,7 @@ def work_precision(out, quick=False, progress=True, cases=None):
     rows, notes = [], []
     names = cases or (("paper_lx1e-4", "paper_T100") if quick else tuple(WP_CASES))
     for name in names:
-        t_end = 0.02 if quick else WP_CASES[name]
+        t_end = 0.01 if quick else WP_CASES[name]
         case = load_case(cases_dir() / f"{name}.nml", t_end=t_end, t_transient=0.0,
                          section="none", n_out=int(round(640 * t_end)) + 1,
                          linear_tail=False)      # integrators compared: no closed-form tail
