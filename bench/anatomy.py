@@ -1,7 +1,8 @@
 """Cost anatomy (`python bench/run.py anatomy`): where the time of a run goes.
 
 For each case: the time per right-hand-side call (ns) measured in a Fortran loop (bench/time_rhs.f90,
-the meson target time-rhs, built on demand with meson into bench/build/meson), against the flop floor (bench/floor.f90: a branch-free
+the meson target time-rhs, installed beside pyspline's extension; for an editable install built
+on demand with meson into bench/build/meson), against the flop floor (bench/floor.f90: a branch-free
 kernel doing only the arithmetic the mesh cannot avoid, with its flop count; built here on
 demand with f2py into bench/build/); then one run's time per step and its shares: RHS (the
 integrator's calls), Jacobian (difference-quotient calls), roots (root-function evaluations,
@@ -44,11 +45,16 @@ def _floor_module():
 
 @functools.lru_cache(maxsize=None)
 def _time_rhs_exe() -> Path:
-    """bench/time_rhs.f90 linked with the core (meson target time-rhs, built with the SUNDIALS
-    the installed pyspline links, into bench/build/meson; rebuilt when the sources change)."""
+    """bench/time_rhs.f90 linked with the core (meson target time-rhs): the one pip installed
+    beside pyspline's extension, else (an editable install) built with the SUNDIALS the
+    installed pyspline links, into bench/build/meson (rebuilt when the sources change)."""
     import subprocess
     import sys
+    import pyspline
     from pyspline import _build_info
+    installed = Path(pyspline.__file__).with_name("time-rhs")
+    if installed.is_file():
+        return installed
     build = HERE / "build" / "meson"
     meson = [sys.executable, "-m", "mesonbuild.mesonmain"]
     prefix = (str(Path(_build_info.SUNDIALS_LIBDIR).parent) if _build_info.SUNDIALS_LIBDIR

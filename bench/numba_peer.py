@@ -147,14 +147,14 @@ def _pack(params, scaled):
 # --------------------------------------------------------------------------------------------
 # Compiled pieces
 # --------------------------------------------------------------------------------------------
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _contact_radius(delta, R, cos_a, r_lo, r_hi):
     """Eq. 13 for both splines (one contact point per tooth pair, docs/model.md s.6), held on the
     active profile [r_lo, r_hi]."""
     return min(max(math.sqrt(delta * delta + R * R - 2.0 * R * delta * cos_a), r_lo), r_hi)
 
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _h(f, A, Req, dn, ddn, sigma, k_m, c_m, b, eta, hertz, c0, th, tb):
     """Residual f - G(f) of the coupled tooth force (bisection fallback)."""
     fe = abs(f) / b
@@ -164,7 +164,7 @@ def _h(f, A, Req, dn, ddn, sigma, k_m, c_m, b, eta, hertz, c0, th, tb):
     return f - (k_m * (dn - sigma * (c0 - th * (tb + Tf))) + c_m * ddn)
 
 
-@nb.njit(cache=False)
+@nb.njit(cache=True)
 def _coupled_force(d, dn, ddn, sp, cp, X1, Y1, x2, y2, vx1, vy1, vx2, vy2):
     """Thermally coupled tooth force of one tooth in contact (docs/model.md s.6; Eqs. 1-7, 12-17).
 
@@ -439,7 +439,7 @@ def _rhs_fast_py(tau, u, du, d):
     du[13] = -d[_AS3] * S - d[_A63] * u[6] - d[_A133] * u[13] + d[_E3]
 
 
-@nb.njit(cache=False, fastmath=True, error_model="numpy")
+@nb.njit(cache=True, fastmath=True, error_model="numpy")
 def _forces(d, tau, u):
     """T_m and F_j (SI) at the outputs from the scaled states u (n, 14): the only outputs the race
     compares, formed as the RHS forms them (branch-free and fastmath: 3x faster than with
@@ -482,16 +482,17 @@ def _forces(d, tau, u):
 
 
 _CFUNC = {}
-COMPILE_SECONDS = []      # wall time of each numba compilation of an RHS (cfunc + helpers)
+COMPILE_SECONDS = []      # wall time of each numba compilation (or cache load) of an RHS
 
 
 def _compiled(kind="fast"):
-    """The RHS compiled once per process (numba cfunc with numbalsoda's signature): 'fast' (every
-    thermal level but coupled) or 'general' (the coupled level; the reference form)."""
+    """The RHS compiled once per process (numba cfunc with numbalsoda's signature; numba's cache
+    in bench/__pycache__ keeps the machine code for the next process): 'fast' (every thermal
+    level but coupled) or 'general' (the coupled level; the reference form)."""
     if kind not in _CFUNC:
         t0 = time.perf_counter()
         fast = kind == "fast"        # fastmath: 10 % faster, within 1e-12 of the oracle
-        _CFUNC[kind] = cfunc(lsoda_sig, nopython=True, cache=False, error_model="numpy",
+        _CFUNC[kind] = cfunc(lsoda_sig, nopython=True, cache=True, error_model="numpy",
                              fastmath=fast)(_rhs_fast_py if fast else _rhs_py)
         COMPILE_SECONDS.append(time.perf_counter() - t0)
     return _CFUNC[kind]
@@ -531,6 +532,27 @@ def make_rhs(params, scaled=True, kind=None):
     return _compiled("general"), _pack(p, scaled)
 
 
+def _driver(method):
+    """numbalsoda.lsoda or numbalsoda.dop853, from numbalsoda's driver modules (driver.py,
+    driver_dop853.py) loaded on their own: `import numbalsoda` also compiles its solve_ivp,
+    unused here, for about 9 s of CPU."""
+    if method not in _DRIVERS:
+        import importlib.util
+        name = {"lsoda": "driver", "dop853": "driver_dop853"}[method]
+        spec = importlib.util.find_spec("numbalsoda")
+        if spec is None:
+            raise ImportError("numbalsoda is not installed")
+        spec = importlib.util.spec_from_file_location(
+            f"numbalsoda_{name}", Path(spec.origin).parent / f"{name}.py")
+        mod = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(mod)
+        _DRIVERS[method] = getattr(mod, method)
+    return _DRIVERS[method]
+
+
+_DRIVERS = {}
+
+
 class Setup:
     """A case made ready to solve: the compiled RHS, its `data`, the scales of Eq. 25."""
 
@@ -543,11 +565,10 @@ class Setup:
 
     def integrate(self, y0, t_eval, rtol, atol, method="dop853", mxstep=1_000_000):
         """Scaled states at t_eval (tau = w t_eval) from y0 (SI): (u, success)."""
-        import numbalsoda
         if method not in ("lsoda", "dop853"):
             raise ValueError(f"method {method!r}: 'lsoda' or 'dop853'")
         self.data[0] = 0.0
-        u, ok = getattr(numbalsoda, method)(self.fn.address, np.asarray(y0, float) / self.scale,
+        u, ok = _driver(method)(self.fn.address, np.asarray(y0, float) / self.scale,
                                             np.asarray(t_eval, float) * self.w, data=self.data,
                                             rtol=float(rtol), atol=float(atol),
                                             mxstep=int(mxstep))

@@ -1,8 +1,8 @@
 !> Instrumentation for the cost anatomy (bench/anatomy.py): elapsed seconds per call of the scaled
 !> right-hand side (Eq. 25) of a loaded model at its static equilibrium (every tooth in contact,
 !> time advanced per call), and of the root functions. No physics of its own: it calls the core.
-!> Not installed: the meson target time-rhs (build_by_default false), which bench/anatomy.py
-!> builds on demand in bench/build/meson, linked with the core as spline-dyn is.
+!> The meson target time-rhs, linked with the core as spline-dyn is and installed into the package
+!> directory (not on PATH), where bench/anatomy.py finds it (an editable install: built on demand).
 !>   usage: time-rhs MODEL.bin N   (MODEL.bin: the bytes of a loaded case, pyspline.Model.bytes)
 !>   prints: seconds per RHS call, seconds per root-function evaluation
 program time_rhs
