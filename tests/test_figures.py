@@ -12,8 +12,10 @@ from matplotlib.colors import TwoSlopeNorm
 from matplotlib.text import Text
 
 import pyspline
-from pyspline import dataset
+from pyspline import analysis, dataset
 from pyspline.plots import continuation as pc
+from pyspline.plots import eng
+from pyspline.plots import run as pr
 from pyspline.plots import sweeps as sw
 
 from conftest import CASES  # noqa: E402
@@ -317,6 +319,41 @@ def test_fold_plane_shades_the_band_between_the_folds():
     for words in ("between the folds: two stable orbits coexist", "lower fold (mu = +1)",
                   "first grazing", "the other grazings", "two orbits", "one orbit"):
         assert words in legend
+    assert _cut_off(fig) == []
+
+
+# --------------------------------------------------------------------------- one run
+
+def test_scene_shows_a_run_with_its_start_transient_left_out():
+    """A run's page: D_2 falling from 0 to -0.8 mm in the first 5 % and then ringing 20 um at
+    the shaft frequency; 16 teeth; the section once per revolution."""
+    rpm, z = 6000.0, 16
+    t = np.linspace(0.0, 0.2, 2001)
+    w = 2 * np.pi * rpm / 60
+    D2 = -8e-4 * (1 - np.exp(-t / 0.01)) + 2e-5 * np.sin(w * t)
+    vD2 = np.gradient(D2, t)
+    Tm = 40.0 * D2 / 8e-4
+    F = Tm[:, None] / z * (1 + 0.1 * np.sin(w * t[:, None] + np.arange(z)))
+    k = np.arange(100, 2001, 100)                     # once per revolution (0.01 s)
+    fig = pr.scene(t, D2, vD2, Tm, F, Tf=np.abs(F) / 10, section=np.c_[D2[k], vD2[k]],
+                   spectrum=analysis.amplitude_spectrum(t, Tm), speed_rpm=rpm, z=z,
+                   title="a run: 6000 rpm")
+    ax_d, ax_t, ax_p, ax_f, ax_tf, ax_s = fig.axes[:6]
+    assert ax_d.get_ylabel() == "D_2 [µm]" and ax_t.get_ylabel() == "T_m [N m]"
+    assert ax_t.get_xlabel() == "time t [s]"
+    late = t >= 0.02                                  # the first tenth left out ...
+    assert _inside(ax_d, t[late], D2[late] * 1e6) and ax_d.get_ylim()[1] < -600   # ... not 0
+    assert f"start transient clipped ({eng(D2.min(), 3)} to 0 m)" in _words(ax_d, ["notes"])
+    assert _inside(ax_t, t[late], Tm[late]) and "start transient clipped" in _words(ax_t)
+    assert (ax_p.get_xlabel(), ax_p.get_ylabel()) == ("D_2 [µm]", "dD_2/dt [mm/s]")
+    (marks,) = [ln for ln in ax_p.get_lines() if ln.get_marker() == "o"]
+    assert len(marks.get_xdata()) == len(k) and "section points (20)" in _words(ax_p)
+    assert "dD_2/dt: range of t >= 0.02 s" in _words(ax_p, ["notes"])
+    assert "tooth load F_j [N]" in _words(fig) and "flash temperature T_f [°C]" in _words(fig)
+    assert ax_f.get_images()[0].get_array().shape == (z, len(t))
+    assert ax_s.get_xlabel() == "frequency [Hz]" and ax_s.get_xlim()[1] == pytest.approx(
+        2.5 * z * rpm / 60)                           # up to 2.5 Z shaft orders
+    assert _words(ax_s, ["legend"]) == "shaft orders 1x, 2x | tooth pass 16x, 32x"
     assert _cut_off(fig) == []
 
 
