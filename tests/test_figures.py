@@ -18,7 +18,7 @@ from pyspline.plots import eng
 from pyspline.plots import run as pr
 from pyspline.plots import sweeps as sw
 
-from conftest import CASES  # noqa: E402
+from conftest import CASES, PAPER_SHAFTS  # noqa: E402
 
 xr = pytest.importorskip("xarray")
 
@@ -398,3 +398,37 @@ def test_sweep_figures_show_the_sweep(tiny_sweep, tmp_path, monkeypatch, capsys)
     assert wf.get_xlabel() == "frequency [Hz]" and wf.get_ylabel() == "shaft speed [r/min]"
     assert "16x" in _words(wf, ["notes"])          # the tooth pass of the Z = 16 case
     assert _cut_off(figs["bifurcation.png"]) == []        # the sweep's own titles
+
+
+# --------------------------------------------------------------------------- the paper's
+
+@PAPER_SHAFTS
+def test_paper_dynamics_figure_shows_the_run(monkeypatch, tmp_path):
+    """Fig. 4's page of a 0.2 s run of paper_ideal: the Poincare panel's points and its count of
+    distinct ones, one bar per tooth at the instant of the largest load, the time panels."""
+    from pyspline import paper
+    from pyspline.paper import figures as pf
+    res = pyspline.simulate(pyspline.load_case(CASES / "paper_ideal.nml", t_end=0.2))
+    close, figs = pf.plt.close, []
+    monkeypatch.setattr(pf.plt, "close", figs.append)       # keep the figure to read it
+    pf.dynamics_figure(res, tmp_path / "fig4.png", "Ideal spline pair (paper Fig. 4)")
+    (fig,) = figs
+    try:
+        d, phase, poinc, f, fx, tm = fig.axes
+        p, nd = paper.poincare(res), paper.poincare_count(res)
+        (pts,) = poinc.get_lines()
+        assert len(pts.get_xdata()) == len(p) > 5 and _inside(poinc, p[:, 0] * 1e3, p[:, 1])
+        assert f"{nd} distinct point" in poinc.get_title().replace("\n", " ")
+        k = int(np.argmax(np.abs(res.Tm)))
+        for ax, q in ((f, res.F), (fx, res.Fx)):
+            assert [b.get_height() for b in ax.patches] == q[k].tolist()    # one bar a tooth
+            ticks = [v for v in ax.get_xticks() if 1 <= v <= res.F.shape[1]]
+            assert len(ticks) <= 10 and all(v == int(v) for v in ticks)
+        assert f"at t = {res.t[k]:.4f} s (largest load)" in _words(f, ["legend"])
+        assert d.get_ylabel() == "relative displacement D_2 (line of action) [mm]"
+        assert _inside(d, res.t, res.D2 * 1e3) and _inside(tm, res.t, res.Tm)
+        assert tm.get_ylabel() == "meshing torque T_m [N m]" and tm.get_xlabel() == "time t [s]"
+        assert (phase.get_xlabel(), phase.get_ylabel()) == ("D_2 [mm]", "dD_2/dt [m/s]")
+        assert _cut_off(fig) == []
+    finally:
+        close(fig)
