@@ -20,14 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-try:
-    from . import _core
-except ImportError as exc:  # the source tree shadows the installed package
-    raise ImportError(
-        f"pyspline's compiled core (_core) is not next to {__file__}: this is the source tree, "
-        "not the installed package. Run `bash scripts/setup.sh` (pip install .) and import "
-        "pyspline from outside the repository root (or use the `pyspline` command).") from exc
-
+from . import bridge
+from .bridge import _api  # noqa: F401 -- the tests that call the core's routines directly
 from .errors import CaseError, decode
 from .result import _names, _warn, raise_for, run
 
@@ -37,8 +31,7 @@ NAME_BYTES = 128   #: longest case name (UTF-8 bytes; fortran/input/case.f90 nam
 #: list fields with one number per tooth (as many as the most teeth): a shorter list gives the
 #: first teeth, as in a namelist file
 PER_TOOTH = frozenset({"spacing_error"})
-_api = _core.spline_api
-_MODEL_BYTES = int(_api.api_model_size())
+_MODEL_BYTES = bridge.MODEL_BYTES
 
 
 @functools.cache
@@ -47,7 +40,7 @@ def _layout() -> tuple:
     order of the value arrays, and the sizes of the real array and the character buffer."""
     rows, nv, nc = [], 0, 0
     for i in range(1, 1000):
-        name, layout, _ = (x.decode().strip() for x in _api.api_names("layout", i))
+        name, layout, _ = (x.decode().strip() for x in bridge.name_entry("layout", i))
         if not name:
             break
         kind, n = layout[0], int(layout[1:] or 1)
@@ -113,7 +106,7 @@ def _values_of(fields: Mapping):
 def defaults() -> dict:
     """Every case field with its default, as the Fortran core defines them."""
     rows, nv, nc = _layout()
-    values, chars, ierr, msg = _api.api_defaults(nv, nc)
+    values, chars, ierr, msg = bridge.defaults(nv, nc)
     if ierr:
         raise CaseError(decode(msg))
     return _fields_of(values, chars)[0]
@@ -126,7 +119,7 @@ def _shown(path: str) -> str:
 
 def field_hint(word: str) -> str:
     """The case field nearest to a misspelt name ('' if none is near): the core's suggestion."""
-    return _core.spline_api.api_field_hint(str(word).encode("utf-8", "replace")[:64]).decode().strip()
+    return bridge.field_hint(str(word).encode("utf-8", "replace")[:64]).decode().strip()
 
 
 def _fortran(v) -> str:
@@ -278,7 +271,7 @@ def case_from_text(text: str, source: str | None = None) -> Case:
     """A case from namelist text held in memory, read by the core's reader (api_read_text) but
     neither validated nor built (``.model`` does both); CaseError with the reader's message."""
     rows, nv, nc = _layout()
-    values, chars, ierr, msg = _api.api_read_text(text.encode("utf-8"), nv, nc)
+    values, chars, ierr, msg = bridge.read_text(text.encode("utf-8"), nv, nc)
     if ierr:
         raise CaseError(decode(msg))
     fields = _fields_of(values, chars)[0]
@@ -304,7 +297,7 @@ def load_case(source, **overrides) -> Case:
     if "\0" in path:                   # C would see a shorter path
         raise CaseError(f"case file {_shown(path)!r}: embedded null byte")
     rows, nv, nc = _layout()
-    model, sizes, values, chars, warn, stage, ierr, msg = _api.api_load_file(
+    model, sizes, values, chars, warn, stage, ierr, msg = bridge.load_file(
         os.fsencode(path), 0 if overrides else 1, _MODEL_BYTES, nv, nc)
     if stage == 0:
         raise CaseError(decode(msg))
@@ -340,10 +333,10 @@ class Model:
         else:                                    # one core call: validate and build
             packed = _values_of(case._fields)
             if packed is None:                   # a value only the reader can judge
-                data, sizes, warn, ierr, msg = _api.api_load_text(case.text().encode("utf-8"),
-                                                                  _MODEL_BYTES)
+                data, sizes, warn, ierr, msg = bridge.load_text(case.text().encode("utf-8"),
+                                                                _MODEL_BYTES)
             else:
-                data, sizes, warn, ierr, msg = _api.api_load_fields(*packed, _MODEL_BYTES)
+                data, sizes, warn, ierr, msg = bridge.load_fields(*packed, _MODEL_BYTES)
             raise_for(ierr, msg)
             data.flags.writeable = False
         self.case, self.bytes = case, data
@@ -365,13 +358,13 @@ class Model:
 
     def start_state(self) -> np.ndarray:
         """The start state (SI): the static equilibrium (default) or rest, plus dq0, dv0."""
-        y, ierr, msg = _api.api_start_state(self.bytes)
+        y, ierr, msg = bridge.start_state(self.bytes)
         raise_for(ierr, msg)
         return y
 
     def rhs(self, t: float, y) -> np.ndarray:
         """dy/dt in SI units at (t, y), contact states decided by the state (Eqs. 8-24)."""
-        ydot, ierr = _api.api_rhs(self.bytes, t, y)
+        ydot, ierr = bridge.rhs(self.bytes, t, y)
         if ierr:
             raise_for(ierr, f"case {self.case.name}: the right-hand side failed at t = {t} s "
                       "(thermal interference)")
@@ -382,13 +375,13 @@ class Model:
     def rhs_mesh(self, t: float, y) -> tuple[np.ndarray, dict, float]:
         """rhs plus the mesh at (t, y): (dy/dt, per-tooth dict as Result.tooth but 1-D, T_m)."""
         q = _names("tooth")
-        ydot, mesh, tm, ierr, msg = _api.api_rhs_mesh(self.bytes, self.z, len(q), t,
-                                                      np.asarray(y, dtype=float))
+        ydot, mesh, tm, ierr, msg = bridge.rhs_mesh(self.bytes, self.z, len(q), t,
+                                                    np.asarray(y, dtype=float))
         raise_for(ierr, msg)
         return ydot, {n: mesh[:, i] for i, (n, *_) in enumerate(q)}, float(tm)
 
     def output_times(self) -> np.ndarray:
-        t, ierr, msg = _api.api_output_times(self.bytes, self.n_out)
+        t, ierr, msg = bridge.output_times(self.bytes, self.n_out)
         raise_for(ierr, msg)
         return t
 
@@ -398,7 +391,7 @@ class Model:
         pair's effective mass m_e, the Eq. 18 terms as a dict 'k_terms' (k_h, k_b1, ..., k_m
         of the geometry), and 'spacing_error', the tooth spacing errors in use e_j [m] of teeth
         1 .. Z, shape (Z,): the case's list plus the seeded ones (docs/model.md section 11)."""
-        info, terms, spacing, ierr, msg = _api.api_model_info(self.bytes, self.z)
+        info, terms, spacing, ierr, msg = bridge.model_info(self.bytes, self.z)
         raise_for(ierr, msg)
         out = {n: float(v) for (n, *_), v in zip(_names("info"), info)}
         out["k_m_computed"] = bool(out["k_m_computed"])

@@ -8,15 +8,19 @@ parallel. A SIGINT during a run stops it within one right-hand-side call (Keyboa
 
 The layers below this public face: ``Model`` is pyspline.case's (``Case.model``), ``Result`` and
 the run itself pyspline.result's; each imports only the ones below it (tests/test_imports.py).
+They, this module and orbits.py call the compiled core (pyspline._core) only through
+pyspline.bridge.
 """
 from __future__ import annotations
 
 import numpy as np
 
+from . import bridge
+from .bridge import _api  # noqa: F401 -- the tests that call the core's routines directly
 from .case import Model, load_case
 from .result import (FIELDS, LOAD_QUANTITIES, QUANTITIES, STATE_NAMES,  # noqa: F401 -- the
                      STATE_QUANTITIES, THERMAL_LEVELS, TOOTH_LOAD_QUANTITIES,  # public names
-                     TOOTH_QUANTITIES, Result, _api, _names, cf_units, level_name, raise_for,
+                     TOOTH_QUANTITIES, Result, _names, cf_units, level_name, raise_for,
                      run, run_outcome, sundials_said)
 
 
@@ -59,7 +63,7 @@ def tooth_stiffness(z, module, alpha_deg, b, r_root, r_contact, e_mod=2.1e11, nu
                     internal=False, r_tip=0.0, nquad=32) -> dict:
     """Bending, shear and axial-compression stiffness [N/m] of one involute tooth of any gear
     (potential energy method; fortran/physics/stiffness.f90), loaded at radius r_contact."""
-    kb, ks, ka, ierr, msg = _api.api_tooth_stiffness(
+    kb, ks, ka, ierr, msg = bridge.tooth_stiffness(
         int(internal), float(z), module, np.radians(alpha_deg), b, r_root, r_tip, e_mod, nu,
         r_contact, nquad)
     raise_for(ierr, msg)

@@ -19,8 +19,9 @@ from fractions import Fraction
 
 import numpy as np
 
+from . import bridge
 from .case import Case
-from .core import STATE_QUANTITIES, Result, _api, load, run_outcome
+from .core import STATE_QUANTITIES, Result, load, run_outcome
 from .errors import CaseError, SolverError, SplineError, SplineWarning
 from .result import run as run_model
 
@@ -109,8 +110,8 @@ def _period_map(model, t0: float, t1: float, ys: np.ndarray, max_seconds: float 
                 ) -> tuple[np.ndarray, np.ndarray]:
     """The core's map of the columns of ys (14, k), SI: (their states at t1, the mask of the
     integrated states). SolverError when the runs take more than max_seconds in all."""
-    y1, mask, ierr, msg = _api.api_period_map(model.bytes, t0, t1, np.asfortranarray(ys),
-                                              _wall(model, max_seconds))
+    y1, mask, ierr, msg = bridge.period_map(model.bytes, t0, t1, np.asfortranarray(ys),
+                                            _wall(model, max_seconds))
     run_outcome(ierr, msg)
     if not np.isfinite(y1).all():
         raise SolverError(f"case {model.case.name}: the period map from t = {t0} s to {t1} s "
@@ -144,9 +145,9 @@ def map_and_monodromy(model, t0: float, t1: float, y: np.ndarray, saltation: boo
     if y.shape != (NSTATE,) or not np.isfinite(y).all():
         raise CaseError(f"case {model.case.name}: y (shape {y.shape}) must be a state of "
                         f"{NSTATE} finite SI values ({', '.join(STATE_QUANTITIES)})")
-    y1, phi, mask, _nsw, ierr, msg = _api.api_map_monodromy(model.bytes, float(t0), float(t1), y,
-                                                            int(bool(saltation)),
-                                                            _wall(model, max_seconds))
+    y1, phi, mask, _nsw, ierr, msg = bridge.map_monodromy(model.bytes, float(t0), float(t1), y,
+                                                          int(bool(saltation)),
+                                                          _wall(model, max_seconds))
     run_outcome(ierr, msg)
     if not np.isfinite(y1).all() or not np.isfinite(phi).all():
         raise SolverError(f"case {model.case.name}: the variational run from t = {t0} s to {t1} s "

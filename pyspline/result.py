@@ -2,7 +2,7 @@
 quantities, states, loads, statistics), its errors and warnings as Python's, and ``run``: a
 loaded Model (pyspline.case) through api_simulate into a Result. pyspline.core is the public
 face (``simulate`` takes a Case, a dict or a path); this module imports no other of pyspline's
-but errors, so that case and core both build on it.
+but errors and bridge (the calls of the compiled core), so that case and core both build on it.
 """
 from __future__ import annotations
 
@@ -16,10 +16,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _core
+from . import bridge
 from .errors import BY_NAME, SplineError, SplineWarning, decode
 
-_api = _core.spline_api
 THERMAL_LEVELS = ("none", "bulk", "oneway", "coupled")   #: stats["thermal_level"] 0..3
 
 
@@ -30,7 +29,7 @@ def _names(kind: str) -> tuple:
     of fortran/common/quantities.f90, the case fields that of fortran/input/case_type.f90."""
     out = []
     for i in range(1, 1000):
-        name, unit, descr = (decode(s) for s in _api.api_names(kind, i))
+        name, unit, descr = (decode(s) for s in bridge.name_entry(kind, i))
         if not name:
             break
         out.append((name, unit, descr))
@@ -301,10 +300,10 @@ def _simulate(model, copy: int = 0, ya=None, max_seconds: float = 0.0) -> tuple:
     nft = model.n_out if model.n_slices else 0
     # the per-tooth array (the largest) is allocated here, not zeroed (f2py zeroes its own)
     tooth = np.empty((model.n_out, model.z, nq), order="F")
-    return _api.api_simulate(model.bytes, model.z, model.n_out, nq, ns, model.n_section,
-                             model.n_lyapunov, nft, model.n_slices, len(LOAD_QUANTITIES),
-                             len(TOOTH_LOAD_QUANTITIES), len(EXTREMES), tooth, copy,
-                             np.zeros(14) if ya is None else ya, max_seconds)
+    return bridge.simulate(model.bytes, model.z, model.n_out, nq, ns, model.n_section,
+                           model.n_lyapunov, nft, model.n_slices, len(LOAD_QUANTITIES),
+                           len(TOOTH_LOAD_QUANTITIES), len(EXTREMES), tooth, copy,
+                           np.zeros(14) if ya is None else ya, max_seconds)
 
 
 def _copies(model, executor, max_seconds: float = 0.0) -> tuple:
@@ -315,7 +314,7 @@ def _copies(model, executor, max_seconds: float = 0.0) -> tuple:
     and RMS, the warnings; spline_run::run_results, as spline-dyn): _simulate's tuple.
     max_seconds > 0: each copy's wall-time bound (the transient's run has none)."""
     k, n = model.case["realisations"], model.n_out
-    ya, ierr, msg = _api.api_start_state(model.bytes, 1)
+    ya, ierr, msg = bridge.start_state(model.bytes, 1)
     raise_for(ierr, msg)
     own = executor is None
     if own:
@@ -333,7 +332,7 @@ def _copies(model, executor, max_seconds: float = 0.0) -> tuple:
     cat[2] = np.empty((k * n, model.z, nqw), order="F")   # the quantities written (nqw)
     for j, o in enumerate(outs):
         cat[2][j * n:(j + 1) * n] = o[2][:, :, :nqw]
-    cat[4], loads, tload, ext, warned, ierr, msg = _api.api_results(
+    cat[4], loads, tload, ext, warned, ierr, msg = bridge.results(
         model.bytes, len(LOAD_QUANTITIES), len(TOOTH_LOAD_QUANTITIES), len(EXTREMES), cat[0],
         cat[1], cat[2], cat[3], np.stack([o[4] for o in outs], axis=1), consts)
     raise_for(ierr, msg)

@@ -1,7 +1,8 @@
 """The package's modules import alone, and none imports another that imports it back (issue 33:
-no import circles). The graph counts every import of a module, at its top or inside a function,
-since a deferred import only hides a circle; a module's imports of the packages it is in
-(``from . import __version__``) are left out: a package is loaded before any of its modules."""
+no import circles); one module, pyspline.bridge, talks to the compiled core (pyspline._core).
+The graph counts every import of a module, at its top or inside a function, since a deferred
+import only hides a circle; a module's imports of the packages it is in (``from . import
+__version__``) are left out: a package is loaded before any of its modules."""
 import ast
 import subprocess
 import sys
@@ -16,12 +17,17 @@ MODULES = sorted(".".join(("pyspline",) + p.relative_to(ROOT).with_suffix("").pa
                  .removesuffix(".__init__") for p in ROOT.rglob("*.py"))
 
 
-def _imports(module: str) -> set:
-    """The package's modules that `module` imports, anywhere in its source."""
+def _source(module: str) -> tuple:
+    """The parsed source of `module` and the package its relative imports start from."""
     path = ROOT.joinpath(*module.split(".")[1:])
     is_pkg = path.is_dir()
     tree = ast.parse((path / "__init__.py" if is_pkg else path.with_suffix(".py")).read_text())
-    here = module.split(".") if is_pkg else module.split(".")[:-1]
+    return tree, module.split(".") if is_pkg else module.split(".")[:-1]
+
+
+def _imports(module: str, within: list = MODULES) -> set:
+    """The modules of `within` (the package's) that `module` imports, anywhere in its source."""
+    tree, here = _source(module)
     out = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
@@ -31,7 +37,19 @@ def _imports(module: str) -> set:
             name = ".".join(base + ([node.module] if node.module else []))
             out.add(name)
             out |= {f"{name}.{a.name}" for a in node.names}      # from . import analysis
-    return {m for m in out if m in MODULES and m != module and not module.startswith(m + ".")}
+    return {m for m in out if m in within and m != module and not module.startswith(m + ".")}
+
+
+def _core_callers() -> set:
+    """The package's modules that import the compiled core or call one of its routines (an
+    attribute api_*, the names of fortran/interface/api.f90), anywhere in their source."""
+    out = set()
+    for m in MODULES:
+        calls = any(isinstance(n, ast.Attribute) and n.attr.startswith("api_")
+                    for n in ast.walk(_source(m)[0]))
+        if calls or _imports(m, ["pyspline._core"]):
+            out.add(m)
+    return out
 
 
 def _cycle(graph: dict) -> list:
@@ -65,6 +83,10 @@ def test_graph_sees_deferred_imports():
     assert "pyspline.core" in _imports("pyspline.summary")
     assert "pyspline.analysis" in _imports("pyspline.summary")     # from . import analysis
     assert "pyspline.paper" in _imports("pyspline.cli")            # inside a function
+
+
+def test_one_module_talks_to_the_core():
+    assert _core_callers() == {"pyspline.bridge"}
 
 
 def test_no_import_cycle():

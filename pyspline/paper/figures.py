@@ -8,6 +8,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
 
 from ..plots import style as ps  # noqa: E402
 from ..plots import eng  # noqa: E402
@@ -38,7 +39,7 @@ def _tooth_bars(ax_f, ax_fx, res):
             ax.plot(j, q[late].min(axis=0), "^", color="tab:green", ms=4, label="min over time")
         ax.set_xlabel("tooth j")
         ax.set_ylabel(f"{name} [N]")
-        ax.set_xticks(j)
+        ax.xaxis.set_major_locator(MaxNLocator(nbins=9, integer=True))   # 16 numbers crowd
         ax.axhline(0, color="k", lw=0.5)
     ax_f.legend(fontsize=7, loc="lower right")
     ax_fx.set_title(f"sum of F_jx at that instant: {eng(res.Fx[k].sum(), 3)} N", fontsize=8)
@@ -58,8 +59,9 @@ def dynamics_figure(res, path, title):
     axs[2].plot(p[:, 0] * 1e3, p[:, 1], "o", ms=3)
     axs[2].set_xlabel("D_2 [mm]")
     axs[2].set_ylabel("dD_2/dt [m/s]")
-    axs[2].set_title(f"Poincare map (once per revolution, t > {SETTLE} s); second half: {nd} "
-                     f"distinct point{'s' if nd != 1 else ''}", fontsize=9)
+    axs[2].set_title(ps.wrap(f"Poincare map (once per revolution, t > {SETTLE} s); second half: "
+                             f"{nd} distinct point{'s' if nd != 1 else ''}", 4.2, 9), fontsize=9)
+    axs[2].xaxis.set_major_locator(MaxNLocator(nbins=5))
     _tooth_bars(axs[3], axs[4], res)
     _time_panel(axs[5], res, res.Tm, "meshing torque T_m", "N m")
     fig.suptitle(title)

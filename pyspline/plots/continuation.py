@@ -56,7 +56,9 @@ def frequency_response(branch, measure: str = "Tm_pp", sweep=None, path=None,
             seg = rows[max(i - 1, 0):j]      # overlap one point: the line has no gaps
             ax.plot(p[seg] / fx, y[seg] / fy, color=colour, lw=1.6,
                     ls="-" if stable[i] else (0, (4, 2.5)), zorder=3)
-        handles.append(Line2D([], [], color=colour, lw=1.6, label=f"period-{n} orbits, stable"))
+        if stable.any():
+            handles.append(Line2D([], [], color=colour, lw=1.6,
+                                  label=f"period-{n} orbits, stable"))
         if not stable.all():
             handles.append(Line2D([], [], color=colour, lw=1.6, ls=(0, (4, 2.5)),
                                   label=f"period-{n} orbits, unstable"))
@@ -124,8 +126,8 @@ def bifurcation_follow(ds, param: str, coord: str = "section_D2", path=None,
     ax.grid(alpha=0.3, lw=0.5)
     ax.legend(handles=handles, fontsize=8, loc="best", title="each run from the one before",
               title_fontsize=8)
-    ax.set_title(title or f"bifurcation diagram: {ps.long_name(ds, coord)} vs {param}, "
-                          "both directions")
+    ax.set_title(ps.wrap(title or f"bifurcation diagram: {ps.long_name(ds, coord)} vs {param}, "
+                         "both directions", 8.5, 12))
     return ps.finish(fig, path)
 
 

@@ -200,8 +200,8 @@ def _phase_plane(ax, D2, vD2, section, d_axis, v_scale, t=None, rtol=1e-8):
         if late:
             setlim(late[0] / k, late[1] / k)
             words.append(f"{label}: {late[2]}")
-    if words:
-        ps.note(ax, "\n".join(words), loc="lower left")
+    if words:                               # the panel is about 4.5 in wide
+        ps.note(ax, "\n".join(ps.wrap(w, 4.2, 8) for w in words), loc="lower left")
 
 
 def _spectrum(ax, spectrum, f_shaft, z, speed_rpm, duration, tm_flat):

@@ -9,6 +9,7 @@ Imports only numpy, matplotlib and pyspline.errors (no compiled core).
 from __future__ import annotations
 
 import math
+import textwrap
 import warnings
 from pathlib import Path
 
@@ -165,6 +166,12 @@ def note(ax, text, loc="upper left", **kw):
     y, va = (0.97, "top") if "upper" in loc else (0.03, "bottom")
     return ax.text(x, y, text, transform=ax.transAxes, ha=ha, va=va, fontsize=8,
                    bbox=NOTE_BOX, zorder=5, **kw)
+
+
+def wrap(text: str, inches: float, size: float = 10.0) -> str:
+    """`text` broken at spaces into lines that fit `inches` at font size `size` [pt] (a
+    character about 0.55 size wide): a long name in a label or title stays inside the figure."""
+    return textwrap.fill(text, max(20, int(inches * 72 / (0.55 * size))))
 
 
 def no_content(span, unit) -> str:

@@ -69,10 +69,11 @@ def bifurcation(ds, param: str, coord: str = "section_D2", period: str = "period
     ax = fig.add_subplot()
     handles = _bifurcation_points(ax, p / px, y / factor, per)
     ax.set_xlabel(ps.label(ds, param, factor_unit=ux))
-    ax.set_ylabel(ps.label(ds, coord, factor_unit=unit))
+    ax.set_ylabel(ps.wrap(ps.label(ds, coord, factor_unit=unit), 4.5))
     ax.legend(handles=handles, fontsize=8, loc="best", title="runs by period",
               title_fontsize=8, framealpha=0.9)
-    ax.set_title(title or f"bifurcation diagram: {long} vs {ps.long_name(ds, param)}")
+    ax.set_title(ps.wrap(title or f"bifurcation diagram: {long} vs {ps.long_name(ds, param)}",
+                         8.5, 12))
     return ps.finish(fig, path)
 
 
@@ -104,6 +105,8 @@ def _bifurcation_points(ax, x, y, per, counts=True, ms=9) -> list:
         label = f"{_period_name(c)} ({rows.sum()})" if counts else _period_name(c)
         handles.append(Line2D([], [], ls="", marker="o", ms=6, color=colour, label=label))
     ax.grid(alpha=0.3, lw=0.5)
+    if not drawn.all():                     # say it: an empty stretch is no finding
+        ps.note(ax, f"{(~drawn).sum()} of {len(drawn)} runs without a result", loc="lower right")
     return handles
 
 
@@ -159,14 +162,14 @@ def bifurcation_grid(ds, param: str, by: str, coord: str = "section_D2",
         axes.flat[k].tick_params(labelbottom=True)
         axes.flat[k].set_xlabel(ps.label(ds, param, factor_unit=ux), fontsize=9)
     for ax in axes[:, 0]:
-        ax.set_ylabel(ps.label(ds, coord, factor_unit=unit), fontsize=9)
+        ax.set_ylabel(ps.wrap(ps.label(ds, coord, factor_unit=unit), 2.5, 9), fontsize=9)
     order = [_period_name(c) for c in (1, 2, 3, 4, 5, 0)]
     handles = [seen[name] for name in order if name in seen]
     fig.legend(handles=handles, fontsize=8, loc="outside lower center", ncols=len(handles),
                frameon=False)
     shown = "" if n == len(b) else f" ({n} of {len(b)} values of {by})"
-    fig.suptitle((title or f"bifurcation diagrams: {ps.long_name(ds, coord)} vs "
-                  f"{ps.long_name(ds, param)}") + shown)
+    fig.suptitle(ps.wrap((title or f"bifurcation diagrams: {ps.long_name(ds, coord)} vs "
+                          f"{ps.long_name(ds, param)}") + shown, 3.6 * ncols + 0.5, 12))
     return ps.finish(fig, path)
 
 
@@ -176,7 +179,8 @@ def param_map(ds, var: str, x: str, y: str, path=None, title: str | None = None,
     with ``ds[x]`` across and ``ds[y]`` up, one cell per run. A period (`var` named
     'period...') is drawn in the period colours of `bifurcation` (not periodic grey, no result
     white); a quantity of both signs (e.g. a Lyapunov exponent) on a blue-red scale centred on
-    zero; anything else on viridis. Cells without a value (NaN: failed runs) stay white."""
+    zero; anything else on viridis. Cells without a value (NaN: failed runs) are hatched (white
+    is a colour of the blue-red scale: zero)."""
     v = ps.array(ds, var, dims=(x, y) if hasattr(ds, "dims") else None)
     xv, xlab, _, xu = _axis_values(ds, x, units)
     yv, ylab, _, yu = _axis_values(ds, y, units)
@@ -185,6 +189,7 @@ def param_map(ds, var: str, x: str, y: str, path=None, title: str | None = None,
     fig = Figure(figsize=(9, 6.5), layout="constrained")
     ax = fig.add_subplot()
     ax.set_facecolor("white")
+    ax.patch.set(hatch="xx", edgecolor="0.75")     # shows where a cell has no value
     X, Y = np.meshgrid(xv, yv, indexing="ij")
     if var.startswith("period"):
         cls = np.where(np.isfinite(v), _period_class(v), -1).astype(float)
@@ -196,7 +201,7 @@ def param_map(ds, var: str, x: str, y: str, path=None, title: str | None = None,
                              linewidth=0.3 if max(v.shape) <= 30 else 0, rasterized=True)
         cb = fig.colorbar(mesh, ax=ax, pad=0.01, ticks=np.arange(6))
         cb.ax.set_yticklabels(["not periodic", "1", "2", "3", "4", "> 4"])
-        cb.set_label("period of the section sequence (white: no result)")
+        cb.set_label("period of the section sequence (hatched: no result)")
     else:
         finite = v[np.isfinite(v)]
         lo, hi = (finite.min(), finite.max()) if finite.size else (0.0, 1.0)
@@ -207,7 +212,8 @@ def param_map(ds, var: str, x: str, y: str, path=None, title: str | None = None,
         mesh = ax.pcolormesh(X, Y, np.ma.masked_invalid(v), shading="nearest", cmap=cmap,
                              norm=norm, rasterized=True)
         cb = fig.colorbar(mesh, ax=ax, pad=0.01)
-        cb.set_label(ps.label(ds, var, units=units))
+        cb.set_label(ps.label(ds, var, units=units)
+                     + (" (hatched: no result)" if np.isnan(v).any() else ""))
     for lab, set_ticks, set_labels, pos in ((xlab, ax.set_xticks, ax.set_xticklabels, xv),
                                             (ylab, ax.set_yticks, ax.set_yticklabels, yv)):
         if lab:
@@ -215,7 +221,7 @@ def param_map(ds, var: str, x: str, y: str, path=None, title: str | None = None,
             set_labels(lab)
     ax.set_xlabel(ps.label(ds, x, factor_unit=xu))
     ax.set_ylabel(ps.label(ds, y, factor_unit=yu))
-    ax.set_title(title or f"{ps.long_name(ds, var)} over {x} and {y}")
+    ax.set_title(ps.wrap(title or f"{ps.long_name(ds, var)} over {x} and {y}", 8.5, 12))
     return ps.finish(fig, path)
 
 
