@@ -21,7 +21,6 @@ from pathlib import Path
 import numpy as np
 
 from . import bridge
-from .bridge import _api  # noqa: F401 -- the tests that call the core's routines directly
 from .errors import CaseError, decode
 from .result import _names, _warn, raise_for, run
 

@@ -16,7 +16,6 @@ from __future__ import annotations
 import numpy as np
 
 from . import bridge
-from .bridge import _api  # noqa: F401 -- the tests that call the core's routines directly
 from .case import Model, load_case
 from .result import (FIELDS, LOAD_QUANTITIES, QUANTITIES, STATE_NAMES,  # noqa: F401 -- the
                      STATE_QUANTITIES, THERMAL_LEVELS, TOOTH_LOAD_QUANTITIES,  # public names

@@ -76,18 +76,18 @@ def test_cases_load_in_parallel_threads():
     y = base.model.start_state()
 
     def said(model, sizes):
-        info, terms, spacing, ierr, msg = core._api.api_model_info(model, base.model.z)
-        ydot, ierr2 = core._api.api_rhs(model, 1e-3, y)
+        info, terms, spacing, ierr, msg = pyspline.bridge._api.api_model_info(model, base.model.z)
+        ydot, ierr2 = pyspline.bridge._api.api_rhs(model, 1e-3, y)
         return (sizes.tolist(), info.tolist(), terms.tolist(), spacing.tolist(), ydot.tolist(),
                 int(ierr), int(ierr2))
 
-    alone = [said(*core._api.api_load_text(t, pyspline.case._MODEL_BYTES)[:2]) for t in texts]
+    alone = [said(*pyspline.bridge._api.api_load_text(t, pyspline.bridge.MODEL_BYTES)[:2]) for t in texts]
     bad = []
 
     def load_all(first):
         for _ in range(100):
             for i in range(first, len(texts), 2):
-                model, sizes, warn, ierr, msg = core._api.api_load_text(texts[i], pyspline.case._MODEL_BYTES)
+                model, sizes, warn, ierr, msg = pyspline.bridge._api.api_load_text(texts[i], pyspline.bridge.MODEL_BYTES)
                 if ierr or sizes[1] != 801 + i or said(model, sizes) != alone[i]:
                     bad.append((i, int(ierr), bytes(msg).decode(errors="replace").strip()))
 

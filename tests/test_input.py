@@ -400,7 +400,7 @@ def test_file_load_builds_the_model_its_fields_build(name):
     from pyspline import core
     case = pyspline.load_case(CASES / name)
     built, fields = case.model, core.Model(dict(case))
-    model, sizes, warn, ierr, msg = core._api.api_load_text(case.text().encode(), pyspline.case._MODEL_BYTES)
+    model, sizes, warn, ierr, msg = pyspline.bridge._api.api_load_text(case.text().encode(), pyspline.bridge.MODEL_BYTES)
     assert ierr == 0
     text = core.Model.__new__(core.Model)
     for k, v in dict(case=case, bytes=model, z=sizes[0], n_out=sizes[1], n_section=sizes[2],
@@ -473,7 +473,7 @@ def test_reader_puts_every_element_in_its_field(tmp_path):
                 lines += [f"  {name}({j}) = {v!r}" for j, v in enumerate(x, start=1)]
     path = tmp_path / "every.nml"
     path.write_text("\n".join(lines + ["/", ""]))
-    _, _, values, chars, _, stage, ierr, msg = pc._api.api_load_file(
+    _, _, values, chars, _, stage, ierr, msg = pyspline.bridge._api.api_load_file(
         os.fsencode(path), 0, pc._MODEL_BYTES, nv, nc)
     assert stage == 1 and ierr == 0, msg
     assert pc._fields_of(values, chars)[0] == want

@@ -218,7 +218,7 @@ def test_saltation_of_a_single_switch(impacting):
     flow across it (h = 1e-5: measured 1.3e-4 and 1.8e-5 on two such switches, against
     entries up to 15); without the saltation matrix it is off by more than 1 (3.4-3.7). Over an
     interval without a switch the saltation changes nothing."""
-    from pyspline.core import _api
+    from pyspline.bridge import _api
     orbit, model = impacting
     tr = orbit.trajectory
     pos = np.abs(tr.dn) - tr.c > 0
