@@ -9,7 +9,7 @@ from .dataset import open_sweep
 from .errors import CaseError, SolverError, SplineError, SplineWarning, ThermalInterferenceError
 from .orbits import Orbit, OrbitError, periodic_orbit
 from .arclength import continuation
-from .branches import branches, fold_curve
+from .diagram import branches, fold_curve
 from .sweeps import sweep
 
 __all__ = ["Case", "CaseError", "Model", "Result", "SolverError", "SplineError", "SplineWarning",

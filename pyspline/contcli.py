@@ -111,7 +111,7 @@ def _values(text: str, what: str):
 
 def _other(args, case, name, index, command, out) -> int:
     """`continue --all` (pyspline.branches) and `continue --fold` (pyspline.fold_curve)."""
-    from .branches import branches, fold_curve
+    from .diagram import branches, fold_curve
     from .dataset import write_netcdf
     from .plots import fold_plane, frequency_response
     if args.all and args.fold:

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import pyspline
-from pyspline.branches import coexistence
+from pyspline.diagram import coexistence
 from test_cont_drives import (BAND, DRIVE, every_branch_of_the_band, folds,  # noqa: F401
                               follow_sweeps)                                 # (a fixture)
 
@@ -52,7 +52,7 @@ def test_pieces_of_the_same_branch_are_merged(every_branch):
     """A piece of a branch (points 30-70 of the S-curve) is the same branch and goes; two
     pieces that share no orbit (the points before 30 and after 70) are both kept; a piece
     moved off the branch by 5 % of each state's swing along it is another branch."""
-    from pyspline.branches import merged
+    from pyspline.diagram import merged
     from test_orbits import scale_of
     ds, _ = every_branch
     s = scale_of(DRIVE)
@@ -72,7 +72,7 @@ def test_a_stretch_without_a_period_is_shaded(every_branch):
     shades a stretch that seeded nothing (no_period_range) and says what it is."""
     import matplotlib
     matplotlib.use("Agg")
-    from pyspline.branches import _stretches
+    from pyspline.diagram import _stretches
     from pyspline.plots import frequency_response
     assert _stretches([1, 1, np.nan, np.nan, 2, 2, 1]) == [(0, 1, 1), (2, 3, 0), (4, 5, 2),
                                                            (6, 6, 1)]

@@ -129,7 +129,7 @@ def test_special_points_lie_on_their_branch(branch):
     values sampled on either side of it, where interpolating at the same field value found
     no bracket and a seed's branch that ended there was kept as a second branch. Moved off by
     5 % of each state's swing along the branch, none is on it."""
-    from pyspline.branches import _on_branch
+    from pyspline.diagram import _on_branch
     from test_orbits import scale_of
     ds, s = branch, scale_of(Z24)
     swing = np.ptp(ds.y0.values, axis=0)

@@ -132,3 +132,14 @@ def test_a_module_that_does_not_import_alone_is_named():
                          capture_output=True, text=True, timeout=120)
     assert run.stdout.startswith("pyspline.no_such_module does not import alone"), run.stdout
     assert "ModuleNotFoundError" in run.stdout and "json" not in run.stdout.split(":")[0]
+
+
+def test_no_public_name_shadows_a_module():
+    """No name the package exports is also one of its modules (issue 33): `pyspline.sweep` is the
+    function and pyspline.sweeps its module, `pyspline.branches` the function and
+    pyspline.diagram its module; a name that were both would make `import pyspline.X` and
+    `pyspline.X` two different things, depending on what was imported first."""
+    modules = {m.split(".")[1] for m in MODULES if m.count(".") >= 1}
+    assert sorted(set(pyspline.__all__) & modules) == []
+    assert all(callable(getattr(pyspline, name)) or isinstance(getattr(pyspline, name), type)
+               for name in pyspline.__all__)
