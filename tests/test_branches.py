@@ -157,7 +157,7 @@ def test_bad_input_is_a_case_error(monkeypatch):
     def never(*a, **k):
         raise AssertionError("ran before the arguments were checked")
     monkeypatch.setattr(sys.modules["pyspline.sweeps"], "sweep", never)
-    monkeypatch.setattr(sys.modules["pyspline.branches"], "continuation", never)
+    monkeypatch.setattr(sys.modules["pyspline.diagram"], "continuation", never)
     for kw in (dict(points=2), dict(points=1.5), dict(max_n=0), dict(ds=0.0), dict(bogus=1),
                dict(guess=np.zeros(14)), dict(stop="x")):
         args = dict(stop=BAND[1]) | kw
