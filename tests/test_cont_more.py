@@ -98,3 +98,30 @@ def test_cli_all_and_fold_keep_what_they_have(tmp_path):
         fc = xr.open_dataset(out / "fold_curve.nc", engine="h5netcdf")
         assert why in fc.attrs["status"] and np.isnan(fc.fold.values).all()
         assert (out / "fold_curve.png").exists()
+
+
+def test_predictor_within_the_fields_range(monkeypatch):
+    """Continued to the end of its valid range (zeta_m in 0..1) with steps of 0.05 and up to
+    0.2 in zeta_m: every map run, predictor or corrector, is at a zeta_m within the range
+    (a predictor past stop is put onto it; dF/dzeta_m one-sided at 1), the branch ends on 1,
+    complete, no CaseError; and a corrector started outside the range is a rejected step
+    (None, its error naming the range), not a CaseError."""
+    import pyspline.arclength as arc
+    from test_continuation import RESONANCE
+    seen, evaluate = [], arc._Problem.evaluate
+    monkeypatch.setattr(arc._Problem, "evaluate", lambda self, y, u, n: seen.append(
+        self.p_of(u[-1])) or evaluate(self, y, u, n))
+    case = RESONANCE.replace(zeta_m=0.9)
+    ds = pyspline.continuation(case, "zeta_m", 0.9, 1.0, ds=0.5, ds_max=2.0, progress=False)
+    p = ds.zeta_m.values
+    assert ds.attrs["status"] == "complete" and ds.attrs["fallbacks"] == "none"
+    assert p[0] == 0.9 and p[-1] == 1.0 and (np.diff(p) > 0).all() and len(p) >= 3
+    assert len(seen) > len(p) and max(seen) == 1.0 and min(seen) == 0.9
+    prob = arc._Problem(case, "zeta_m", None, 1, 0.9, 1.0, 0.0)
+    y = ds.y0.values[-1]
+    prob.free = arc._map_only(prob.model(1.0), 0.0, prob.t1(1.0, 1), y)[2]
+    br = arc._Branch(prob, 1, y, 1e-7, 6)
+    u = np.r_[y[prob.free] / prob.d0[prob.free], (1.05 - prob.p0) / prob.pscale]
+    assert br.correct(u, np.eye(len(u))[-1], u[-1]) is None
+    assert "zeta_m = 1.050E+00 is outside 0.00E+00 .. 1.00E+00" in br.last_error, \
+        br.last_error
