@@ -125,3 +125,29 @@ def test_predictor_within_the_fields_range(monkeypatch):
     assert br.correct(u, np.eye(len(u))[-1], u[-1]) is None
     assert "zeta_m = 1.050E+00 is outside 0.00E+00 .. 1.00E+00" in br.last_error, \
         br.last_error
+
+
+def test_realisations_transient_within_the_bound():
+    """A realisations = 2 case whose transient alone would take minutes (1e5 s of the Z16
+    drive, about 3 minutes; max_steps out of the way): a bounded run stops in its transient naming the bound,
+    and inside a call's bound (orbits.time_bound, as branches and fold_curve) a follow sweep's
+    first run is cut there and the next not run."""
+    import time
+    from pyspline.result import run
+    from test_cont_bounds import SLACK
+    from test_cont_drives import DRIVE
+    case = DRIVE.replace(realisations=2, goal="statistics", t_transient=1e5,
+                         t_end=1e5 + 0.05, n_out=201, linear_tail=False, max_steps=10_000_000)
+    t = time.perf_counter()
+    with pytest.raises(pyspline.SolverError, match=r"the run took longer than its wall-time "
+                       r"bound max_seconds = 5.00E-01 s, at t = +\d"):
+        run(case.model, max_seconds=0.5)
+    assert time.perf_counter() - t < 0.5 + SLACK
+    t = time.perf_counter()
+    with pyspline.orbits.time_bound(1.0, "the test"):
+        sw = pyspline.sweep(case, speed_rpm=[2200.0, 2210.0], follow="up", progress=False,
+                            spectrum=False)
+    assert time.perf_counter() - t < 1 + SLACK
+    assert "the run took longer than its wall-time bound" in str(sw.error.values[0])
+    assert str(sw.error.values[1]) == "the wall-time bound of the test, max_seconds = 1 s, " \
+        "was reached before this run"
