@@ -306,22 +306,30 @@ def _simulate(model, copy: int = 0, ya=None, max_seconds: float = 0.0) -> tuple:
                            np.zeros(14) if ya is None else ya, max_seconds)
 
 
+def _copy(model, copy: int, ya, end: float) -> tuple:
+    """_simulate of copy `copy` within the time left until `end` (time.time(); 0: no bound; a
+    microsecond once it has passed: the run stops at once). Module level, for a process
+    executor."""
+    return _simulate(model, copy, ya, max(end - time.time(), 1e-6) if end else 0.0)
+
+
 def _copies(model, executor, max_seconds: float = 0.0) -> tuple:
     """realisations = K > 1 (docs/accuracy.md): the transient, then the K copies on the executor
     (None: a thread each, at most os.cpu_count(); the core releases the GIL), their outputs one
     after another, and what follows from them in one call of the core (api_results: the
     statistics combined, the loads with standard errors from the copies' spread, the extremes
     and RMS, the warnings; spline_run::run_results, as spline-dyn): _simulate's tuple.
-    max_seconds > 0: each copy's wall-time bound (the transient's run has none)."""
+    max_seconds > 0: the wall-time bound of the transient and the copies together (each copy
+    gets what is left when it starts: _copy)."""
     k, n = model.case["realisations"], model.n_out
-    ya, ierr, msg = bridge.start_state(model.bytes, 1)
+    end = time.time() + max_seconds if max_seconds > 0 else 0.0
+    ya, ierr, msg = bridge.start_state(model.bytes, 1, max_seconds)
     raise_for(ierr, msg)
     own = executor is None
     if own:
         executor = cf.ThreadPoolExecutor(min(k, os.cpu_count() or 1))
     try:
-        outs = list(executor.map(_simulate, [model] * k, range(1, k + 1), [ya] * k,
-                                 [max_seconds] * k))
+        outs = list(executor.map(_copy, [model] * k, range(1, k + 1), [ya] * k, [end] * k))
     finally:
         if own:
             executor.shutdown()

@@ -362,17 +362,23 @@ contains
 
   !> The start state of a loaded model (SI): static equilibrium or rest, plus dq0, dv0; with
   !> transient = 1 the state at the end of the transient (spline_realisations::transient_state,
-  !> from which realisations = K > 1 runs its copies; a SIGINT stops it, ierr 4).
-  subroutine api_start_state(model, nb, transient, y, ierr, errmsg)
+  !> from which realisations = K > 1 runs its copies; a SIGINT stops it, ierr 4; max_seconds > 0:
+  !> its wall-time bound, a run past it fails naming it, as api_simulate's; 0: none).
+  subroutine api_start_state(model, nb, transient, y, ierr, errmsg, max_seconds)
     integer(c_int), intent(in) :: nb, transient
     integer(c_int), intent(in) :: model(nb)
     real(c_double), intent(out) :: y(14)
     integer(c_int), intent(out) :: ierr
     character(len=msglen), intent(out) :: errmsg
+    real(c_double), intent(in) :: max_seconds
     type(model_t) :: m
     integer :: ie
     y = 0
     call unpack(model, m, ie, errmsg)
+    if (max_seconds > 0.0_c_double) then
+      m%max_seconds = max_seconds
+      call system_clock(m%wall_start)
+    end if
     if (ie == err_ok .and. transient == 1) then
       call transient_state(m, y, ie, errmsg, interruptible=.true.)
     else if (ie == err_ok) then

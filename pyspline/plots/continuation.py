@@ -4,6 +4,8 @@ special points marked, follow-up / follow-down sweep points over it) and the bif
 diagram of a follow='both' sweep (both directions overlaid)."""
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
@@ -144,7 +146,8 @@ def fold_plane(fc, path=None, title: str | None = None) -> Figure:
     verdicts of follow sweeps (one orbit / two coexisting) overlaid."""
     field, field2 = fc.attrs["field"], fc.attrs["field2"]
     v = fc.value2.values
-    folds = fc.fold.values
+    folds = fc.fold.values      # at least two columns (NaN: no fold found)
+    folds = np.c_[folds, np.full((len(v), max(0, 2 - folds.shape[1])), np.nan)]
     fig = Figure(figsize=(12, 5.5), layout="constrained")
     ax = fig.add_subplot()
     pair = np.isfinite(folds[:, :2]).all(axis=1)
@@ -155,7 +158,7 @@ def fold_plane(fc, path=None, title: str | None = None) -> Figure:
                                                             range(2, folds.shape[1])]):
         ok = np.isfinite(folds[:, j])
         ax.plot(folds[ok, j], v[ok], "o-", color="#D55E00", mfc="white" if j else "#D55E00",
-                ms=5, lw=1.4, label=f"{name} (mu = +1)" if j < 2 else None)
+                ms=5, lw=1.4, label=f"{name} (mu = +1)" if j < 2 and ok.any() else None)
     g = fc.grazing.values[:, 0]
     ok = np.isfinite(g)
     if ok.any():
@@ -173,10 +176,17 @@ def fold_plane(fc, path=None, title: str | None = None) -> Figure:
                 label="follow sweeps up and down differ: two orbits")
         ax.plot(xs[one], ys[one], "s", mfc="none", mec="0.5", ms=5,
                 label="follow sweeps agree: one orbit")
+    if not np.isfinite(folds).any():    # nothing to draw: the band and what stopped it
+        ax.set_xlim(np.nanmin(fc.band.values), np.nanmax(fc.band.values))
+        ax.set_ylim(v.min() - 0.5 * (np.ptp(v) or abs(v[0]) or 1),
+                    v.max() + 0.5 * (np.ptp(v) or abs(v[0]) or 1))
+        ax.text(0.5, 0.5, "no fold found\n" + textwrap.fill(fc.attrs.get("status", ""), 90),
+                transform=ax.transAxes, ha="center", va="center", fontsize=9)
     ax.set_xlabel(_field_label(field))
     ax.set_ylabel(_field_label(field2))
     ax.grid(alpha=0.3, lw=0.5)
-    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1), framealpha=0.9)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1), framealpha=0.9)
     ax.set_title(title or f"folds of the periodic orbits in ({field}, {field2}): the region "
                           "of coexistence")
     return ps.finish(fig, path)

@@ -1,0 +1,153 @@
+"""pyspline.branches and continuation (docs/continuation.md), the last gaps of their tests: a
+chaotic drive's sweep seeds no branch and is reported as such, a period-2 attractor seeds
+with the period its sections give, the predictor within a field's range, the command line's
+--all and --fold keeping what they have when cut, and the follow sweep's bound on a
+realisations run."""
+import re
+import sys
+import warnings
+
+import numpy as np
+import pytest
+
+import pyspline
+import pyspline.orbits
+from conftest import CASES
+from test_continuation import DOUBLING
+
+BRANCHES = sys.modules["pyspline.diagram"]     # the module of pyspline.branches
+
+
+def test_chaotic_drive_seeds_no_branch(monkeypatch):
+    """chaos_z24 (a vibro-impact drive with a Lyapunov exponent near 900 1/s,
+    tests/test_chaos.py) swept up and down over 5900-6100 r/min: no run's sections give a
+    period, Newton from its final state finds no stable period-1 orbit, so the whole band is
+    one stretch without a period each way, named in the error, and no continuation runs
+    (runs of 5 revolutions after 2: the follow chains carry the motion on)."""
+    case = pyspline.load_case(CASES / "chaos_z24.nml", lyapunov=False, t_transient=0.02,
+                              t_end=0.07, n_out=201)
+    tried = []
+    orbit = pyspline.orbits.periodic_orbit
+    monkeypatch.setattr(pyspline.orbits, "periodic_orbit",
+                        lambda c, n=1, **kw: tried.append(n) or orbit(c, n, **kw))
+    monkeypatch.setattr(BRANCHES, "continuation", lambda *a, **k: pytest.fail(
+        "a branch was continued from a chaotic stretch"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        with pytest.raises(pyspline.SplineError, match=r"no periodic attractor found by the "
+                           r"follow sweeps over speed_rpm = 5900..6100 \(stretches without a "
+                           r"period: up 5900..6100; down 6100..5900\)"):
+            pyspline.branches(case, "speed_rpm", 5900, 6100, points=3, max_n=1,
+                              progress=False)
+    assert tried == [1, 1]      # one seed tried per stretch, at its middle
+
+
+def test_period_two_seed_from_the_sections(monkeypatch):
+    """DOUBLING above its period doubling (1623.6 r/min; the period-1 orbit unstable, a stable
+    period-2 orbit, tests/test_continuation.py): the follow sweeps' runs that settled give
+    period 2 from their exact sections, and the seed there is Newton on n = 2 alone (n = 1 not
+    tried); a chain's first run, from the equilibrium, has not settled (no period): there the
+    first n whose orbit is stable, 1 tried and refused (the unstable period-1 orbit). The
+    branches are period 2 and stable over the band."""
+    T = 60 / 1650
+    settled = DOUBLING.replace(t_end=60 * T, t_transient=40 * T, n_out=201, section="shaft",
+                               max_steps=10_000_000)
+    tried = []
+    orbit = pyspline.orbits.periodic_orbit
+    monkeypatch.setattr(pyspline.orbits, "periodic_orbit", lambda c, n=1, **kw: tried.append(
+        (c["speed_rpm"], n)) or orbit(c, n, **kw))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds, sw = pyspline.branches(DOUBLING, "speed_rpm", 1646, 1650, points=3, max_n=2,
+                                   progress=False, sweep_case=settled)
+    per = sw.period.values          # (direction up, down) x speed 1646, 1648, 1650
+    assert per.tolist() == [[0, 2, 2], [2, 2, 0]], per
+    # the middle of each period-2 stretch (1648, both ways): n = 2 only; the unsettled
+    # first runs (1646 up, 1650 down): n = 1 refused, then 2
+    assert tried == [(1646, 1), (1646, 2), (1648, 2), (1650, 1), (1650, 2), (1648, 2)]
+    assert ds.attrs["status"] == "complete" and ds.attrs["no_period"] == ""
+    assert (ds.n == 2).all() and ds.stable.all()
+    assert float(ds.speed_rpm[0]) == 1646 and float(ds.speed_rpm[-1]) == pytest.approx(1650, rel=1e-12)
+
+
+def test_cli_all_and_fold_keep_what_they_have(tmp_path):
+    """`pyspline continue --all` and `--fold` whose continuations stop short (--max-points 3, steps of
+    0.23 r/min)
+    or whose time bound passes at once (--max-seconds 1e-3) write what they have (the
+    Datasets with their status, the figures), say where they stopped and exit 1."""
+    import xarray as xr
+    from test_continuation import RESONANCE, cli
+    path = tmp_path / "drive.nml"
+    path.write_text(RESONANCE.text())
+    args = ("continue", path, "--field", "speed_rpm", "--start", "2300", "--stop", "2320",
+            "--quiet", "--ds", "0.01")
+    run = cli(tmp_path, *args, "--max-points", "3", "--all", "--sweep", "3", "--out", "all")
+    assert run.returncode == 1, run.stderr
+    assert re.search(r"stopped: seed \w+ speed_rpm = 23\d+ to 23\d+: max_points = 3 reached",
+                     run.stderr), run.stderr
+    ds = xr.open_dataset(tmp_path / "all" / "branches.nc", engine="h5netcdf")
+    assert ds.attrs["status"] in run.stderr and ds.sizes["point"] >= 3
+    assert (tmp_path / "all" / "branches.png").stat().st_size > 10_000
+    assert (tmp_path / "all" / "sweep.nc").exists()
+    for extra, why in ((("--max-points", "3"), "max_points = 3 reached at speed_rpm"),
+                       (("--max-seconds", "1e-3"), "max_seconds = 0.001 s")):
+        out = tmp_path / f"fold{len(why)}"
+        run = cli(tmp_path, *args, *extra, "--fold", "ripple_amp(1)=0.15", "--out", out)
+        assert run.returncode == 1 and "stopped: " in run.stderr and why in run.stderr, \
+            run.stderr
+        fc = xr.open_dataset(out / "fold_curve.nc", engine="h5netcdf")
+        assert why in fc.attrs["status"] and np.isnan(fc.fold.values).all()
+        assert (out / "fold_curve.png").exists()
+
+
+def test_predictor_within_the_fields_range(monkeypatch):
+    """Continued to the end of its valid range (zeta_m in 0..1) with steps of 0.05 and up to
+    0.2 in zeta_m: every map run, predictor or corrector, is at a zeta_m within the range
+    (a predictor past stop is put onto it; dF/dzeta_m one-sided at 1), the branch ends on 1,
+    complete, no CaseError; and a corrector started outside the range is a rejected step
+    (None, its error naming the range), not a CaseError."""
+    import pyspline.arclength as arc
+    from test_continuation import RESONANCE
+    seen, evaluate = [], arc._Problem.evaluate
+    monkeypatch.setattr(arc._Problem, "evaluate", lambda self, y, u, n: seen.append(
+        self.p_of(u[-1])) or evaluate(self, y, u, n))
+    case = RESONANCE.replace(zeta_m=0.9)
+    ds = pyspline.continuation(case, "zeta_m", 0.9, 1.0, ds=0.5, ds_max=2.0, progress=False)
+    p = ds.zeta_m.values
+    assert ds.attrs["status"] == "complete" and ds.attrs["fallbacks"] == "none"
+    assert p[0] == 0.9 and p[-1] == 1.0 and (np.diff(p) > 0).all() and len(p) >= 3
+    assert len(seen) > len(p) and max(seen) == 1.0 and min(seen) == 0.9
+    prob = arc._Problem(case, "zeta_m", None, 1, 0.9, 1.0, 0.0)
+    y = ds.y0.values[-1]
+    prob.free = arc._map_only(prob.model(1.0), 0.0, prob.t1(1.0, 1), y)[2]
+    br = arc._Branch(prob, 1, y, 1e-7, 6)
+    u = np.r_[y[prob.free] / prob.d0[prob.free], (1.05 - prob.p0) / prob.pscale]
+    assert br.correct(u, np.eye(len(u))[-1], u[-1]) is None
+    assert "zeta_m = 1.050E+00 is outside 0.00E+00 .. 1.00E+00" in br.last_error, \
+        br.last_error
+
+
+def test_realisations_transient_within_the_bound():
+    """A realisations = 2 case whose transient alone would take minutes (1e5 s of the Z16
+    drive, about 3 minutes; max_steps out of the way): a bounded run stops in its transient naming the bound,
+    and inside a call's bound (orbits.time_bound, as branches and fold_curve) a follow sweep's
+    first run is cut there and the next not run."""
+    import time
+    from pyspline.result import run
+    from test_cont_bounds import SLACK
+    from test_cont_drives import DRIVE
+    case = DRIVE.replace(realisations=2, goal="statistics", t_transient=1e5,
+                         t_end=1e5 + 0.05, n_out=201, linear_tail=False, max_steps=10_000_000)
+    t = time.perf_counter()
+    with pytest.raises(pyspline.SolverError, match=r"the run took longer than its wall-time "
+                       r"bound max_seconds = 5.00E-01 s, at t = +\d"):
+        run(case.model, max_seconds=0.5)
+    assert time.perf_counter() - t < 0.5 + SLACK
+    t = time.perf_counter()
+    with pyspline.orbits.time_bound(1.0, "the test"):
+        sw = pyspline.sweep(case, speed_rpm=[2200.0, 2210.0], follow="up", progress=False,
+                            spectrum=False)
+    assert time.perf_counter() - t < 1 + SLACK
+    assert "the run took longer than its wall-time bound" in str(sw.error.values[0])
+    assert str(sw.error.values[1]) == "the wall-time bound of the test, max_seconds = 1 s, " \
+        "was reached before this run"
