@@ -14,7 +14,8 @@ repeat to repeat; the median wall time and the median of the speed-ups within ea
 printed, with their ranges.
 
 With --blocks K the sweep is cut into K interleaved subsets (l_x[b::K]); every executor runs
-each subset, in an order that rotates from subset to subset, and its times are summed. On a
+each subset, in an order that rotates from subset to subset, and its times are summed; the
+executors are started once and stay up together for every block and repeat. On a
 machine whose speed drifts (a shared host: the same serial sweep took 35-42 s within an hour),
 the executors then share the drift, and the ratios mean something; the per-block speed-ups show
 the spread that remains.
@@ -231,13 +232,14 @@ def main(args) -> int:
     # Every repeat and every block runs the executors in an order that rotates, so that a
     # machine whose speed drifts during the benchmark slows all of them alike. blocks > 1: every
     # executor runs the same interleaved subsets l_x[b::blocks] (each sizes its own tasks),
-    # and the executors stay up together. blocks = 1: each executor exists only for its own run
-    # (an idle Dask cluster takes CPU from the others: docs/performance.md).
-    for rep in range(repeats):
-        with contextlib.ExitStack() as keep:
-            started = {}
-            if blocks > 1:
-                started = {label: _start(*executors[label], keep) for label in labels}
+    # and the executors stay up together, started once for all repeats. blocks = 1: each
+    # executor exists only for its own run (an idle Dask cluster takes CPU from the others:
+    # docs/performance.md).
+    with contextlib.ExitStack() as keep:
+        started = {}
+        if blocks > 1:
+            started = {label: _start(*executors[label], keep) for label in labels}
+        for rep in range(repeats):
             for b in range(blocks):
                 values = l_x[b::blocks]
                 turn = (rep * blocks + b) % len(labels)
@@ -259,8 +261,8 @@ def main(args) -> int:
                         first_error[label] = str(errors[0])
                     if blocks == 1 and label == "serial" and ds is None:
                         ds = part
-        print(f"repeat {rep + 1}: " + ", ".join(f"{label} {wall[label][rep]:.2f} s"
-                                                for label in labels), flush=True)
+            print(f"repeat {rep + 1}: " + ", ".join(f"{label} {wall[label][rep]:.2f} s"
+                                                    for label in labels), flush=True)
     rows = []
     for label in labels:
         kind, workers = executors[label]

@@ -112,13 +112,14 @@ def test_bifurcation_scaling_labels():
 
 
 def test_bifurcation_repeats_quick(tmp_path, exe, monkeypatch):
-    """--repeats: every executor's walls per repeat, medians and the same diagram; --host: the
-    standalone executable's runs one and two at a time beside them."""
+    """--repeats: every executor's walls per repeat (summed over --blocks, the executors started
+    once for all of them) and medians; --host: the standalone executable's runs one and two at
+    a time beside them."""
     import argparse
 
     import bifurcation
     monkeypatch.setenv("SPLINE_DYN", exe)
-    args = argparse.Namespace(out=str(tmp_path), accuracy=False, points=4, blocks=1, repeats=2,
+    args = argparse.Namespace(out=str(tmp_path), accuracy=False, points=4, blocks=2, repeats=2,
                               rtol=1e-6, quick=True, scaling=False, host=True)
     assert bifurcation.main(args) == 0
     table = list(csv.DictReader(open(tmp_path / "bifurcation.csv")))

@@ -75,18 +75,30 @@ def test_benettin_copy_carries_no_solver_noise():
         assert abs(r.lyapunov["exponent"]) < 5, r.lyapunov["exponent"]
 
 
-def test_benettin_separation_needs_located_switches_when_tiny():
+def unbalanced_drive():
+    """physical_z24 at 15000 r/min, 5 N m, with an unbalance: contact switches, exponent -2 1/s."""
+    return pyspline.load_case(CASES / "physical_z24.nml", speed_rpm=15000.0, t_d=5.0, t_l=5.0,
+                              unbalance=[2e-4, 0.0], t_transient=0.3, t_end=0.6, n_out=2001,
+                              max_steps=10**7, lyapunov=True)
+
+
+@pytest.fixture(scope="module")
+def auto_copy():
+    """The unbalanced drive with method = 'auto', switches located, a copy at d0 = 1e-8: one
+    run for the two tests below."""
+    return pyspline.simulate(unbalanced_drive().replace(lyapunov_d0=1e-8))
+
+
+def test_benettin_separation_needs_located_switches_when_tiny(auto_copy):
     """Where teeth switch contact (an unbalanced drive at 15000 r/min: k_v 0.35-1.94), the
     exponent is about -2 1/s with the switches located (roots), for d0 = 1e-8 and the default
     alike (-2.18 over these 0.3 s, -1.80 over 0.5 s). Without roots a switch falls inside a
     step, and a separation below rtol is then meaningless: d0 = rtol / 10 reads tens of 1/s (79
     here; 49-82 over 0.5 s at d0 = 1e-9 and 3e-9, on two builds that differ at round-off), the
     reason the default d0 is 1e4 rtol, which gives the right answer either way."""
-    case = pyspline.load_case(CASES / "physical_z24.nml", speed_rpm=15000.0, t_d=5.0, t_l=5.0,
-                              unbalance=[2e-4, 0.0], t_transient=0.3, t_end=0.6, n_out=2001,
-                              max_steps=10**7, lyapunov=True, method="adams", roots=False)
-    located = [pyspline.simulate(case.replace(roots=True, lyapunov_d0=d0)).lyapunov["exponent"]
-               for d0 in (1e-8, 0.0)]
+    case = unbalanced_drive().replace(method="adams", roots=False)
+    located = [auto_copy.lyapunov["exponent"],      # CVODE (auto keeps the copy on it), d0 1e-8
+               pyspline.simulate(case.replace(roots=True)).lyapunov["exponent"]]
     assert all(abs(lam) < 5 for lam in located), located
     assert abs(located[0] - located[1]) < 0.5, located
     assert abs(pyspline.simulate(case).lyapunov["exponent"]) < 5          # default d0, no roots
@@ -141,16 +153,14 @@ def test_tangent_exponent_locates_the_switches_itself():
     assert blind > 100 and abs(ref) < 5 and abs(lam - ref) < 0.05, (blind, lam, ref)
 
 
-def test_auto_method_keeps_the_copy_on_cvode():
+def test_auto_method_keeps_the_copy_on_cvode(auto_copy):
     """method = 'auto' picks ERK for a stiff drive from rest, but not for Benettin's separated
     copy: ERK decides the copy's switches in the state it lands on for the reference's, and a
     small separation then reads hundreds of 1/s (402 over these 0.3 s) on the unbalanced drive
     (steel shafts) whose exponent CVODE, the tangent and a larger separation all read as about
     -2 1/s."""
-    case = pyspline.load_case(CASES / "physical_z24.nml", speed_rpm=15000.0, t_d=5.0, t_l=5.0,
-                              unbalance=[2e-4, 0.0], t_transient=0.3, t_end=0.6, n_out=2001,
-                              max_steps=10**7, lyapunov=True, lyapunov_d0=1e-8)
-    auto = pyspline.simulate(case)
+    case = unbalanced_drive().replace(lyapunov_d0=1e-8)
+    auto = auto_copy
     with pytest.warns(pyspline.SplineWarning, match="with method = 'erk'"):
         erk = pyspline.simulate(case.replace(method="erk"))
     tangent = pyspline.simulate(case.replace(lyapunov_method="tangent"))

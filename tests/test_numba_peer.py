@@ -2,6 +2,7 @@
 (tests/oracle.py): both compiled RHS (the fast one and the general one) equal oracle.rhs to 1e-12
 relative, the forces the race times equal oracle.mesh's, and short numbalsoda LSODA and DOP853
 solves agree with scipy's LSODA on the oracle RHS. Does not import pyspline."""
+import functools
 import importlib.util
 import sys
 import zlib
@@ -103,27 +104,36 @@ def test_default_fields_match_template():
             assert float(tmpl[k]) == float(v), k
 
 
+Y0 = np.zeros(14)                                 # start from rest: engagement transient
+T_EVAL = np.linspace(0.0, 0.01, 41)
+RTOL, ATOL = 1e-10, 1e-12                         # atol on the scaled states (Eq. 25)
+
+
+@functools.cache
+def scipy_reference(name):
+    """scipy's LSODA on the oracle RHS, and its T_m: one solve serves both peer methods."""
+    from scipy.integrate import solve_ivp
+    case = numba_peer.load_case(dict(CASES[name], name=name))
+    p = oracle.prepare(case)
+    sc = np.r_[np.full(7, case["c0"]), np.full(7, case["c0"] * p.omega)]
+    ref = solve_ivp(lambda t, yy: oracle.rhs(t, yy, p), (0.0, T_EVAL[-1]), Y0,
+                    method="LSODA", rtol=RTOL, atol=ATOL * sc, t_eval=T_EVAL)
+    tmr = np.array([oracle.mesh(t, yy, p)["Tm"] for t, yy in zip(T_EVAL, ref.y.T)])
+    return case, p, ref, tmr
+
+
 @pytest.mark.parametrize("method", ["lsoda", "dop853"])
 @pytest.mark.parametrize("name", ["misaligned", "z7", "bulk", "coupled", "spacing"])
 def test_peer_agrees_with_scipy_lsoda_on_oracle(name, method):
     """numbalsoda's LSODA and DOP853 on the numba RHS against scipy's LSODA on the oracle."""
-    from scipy.integrate import solve_ivp
-    case = numba_peer.load_case(dict(CASES[name], name=name))
-    p = oracle.prepare(case)
-    y0 = np.zeros(14)                             # start from rest: engagement transient
-    t_eval = np.linspace(0.0, 0.01, 41)
-    rtol, atol = 1e-10, 1e-12                     # atol on the scaled states (Eq. 25)
-    y, ok, nrhs = numba_peer.solve(case, y0, t_eval, rtol=rtol, atol=atol, method=method,
+    case, p, ref, tmr = scipy_reference(name)
+    y, ok, nrhs = numba_peer.solve(case, Y0, T_EVAL, rtol=RTOL, atol=ATOL, method=method,
                                    mxstep=10**7)
     assert ok and nrhs > 100
-    sc = np.r_[np.full(7, case["c0"]), np.full(7, case["c0"] * p.omega)]
-    ref = solve_ivp(lambda t, yy: oracle.rhs(t, yy, p), (0.0, t_eval[-1]), y0,
-                    method="LSODA", rtol=rtol, atol=atol * sc, t_eval=t_eval)
     assert ref.success
     scale = np.abs(ref.y).max(axis=1)             # per state over the run
     err = np.abs(y - ref.y.T).max(axis=0) / scale
     assert err.max() < 1e-6, err
     # tooth load: T_m agrees too
-    tm = np.array([oracle.mesh(t, yy, p)["Tm"] for t, yy in zip(t_eval, y)])
-    tmr = np.array([oracle.mesh(t, yy, p)["Tm"] for t, yy in zip(t_eval, ref.y.T)])
+    tm = np.array([oracle.mesh(t, yy, p)["Tm"] for t, yy in zip(T_EVAL, y)])
     assert np.abs(tm - tmr).max() < 1e-6 * np.abs(tmr).max()
