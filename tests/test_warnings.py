@@ -9,8 +9,10 @@ import math
 import subprocess
 import warnings
 
+import numpy as np
 import pytest
 
+import oracle
 import pyspline as ps
 from conftest import CASES
 
@@ -50,12 +52,14 @@ def closed_forms(case) -> dict:
     """The numbers each warning tests, from the case's fields by the formulas of docs/model.md
     (independent of the core's code): the offset the supports leave at the mesh over the static
     tooth deflection (seen; inf where the warning does not apply), the shafts' wind-up,
-    the largest tooth overlap at a start from rest, the static tooth deflection / module."""
+    the largest tooth overlap at a start from rest (Eq. 11 with the spacing errors e_j), the
+    static tooth deflection / module."""
     g = case.get
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ps.SplineWarning)
         stiff = ps.mesh_stiffness(case)
-        c = ps.load(case).info()["c_bulk"]
+        info = ps.load(case).info()
+    c, e_j = info["c_bulk"], info["spacing_error"]
     z, alpha = g("z"), math.radians(g("alpha_deg"))
     r_b = g("module_m") * z / 2 * math.cos(alpha)
     k_mesh = z * stiff["k_m_used"] / 2
@@ -72,9 +76,9 @@ def closed_forms(case) -> dict:
         dq = g("dq0")
         ex, ey = dq[0] + g("l_x") - dq[2], dq[1] + g("l_y") - dq[3]
         omega = g("speed_rpm") * 2 * math.pi / 60
-        dn = [abs(ex * math.sin(p) - ey * math.cos(p) + dq[5])
-              for p in (2 * math.pi * j / z + omega * g("t0") + math.pi / (2 * z) - alpha
-                        for j in range(1, z + 1))]
+        phi = [2 * math.pi * j / z + omega * g("t0") + math.pi / (2 * z) - alpha
+               for j in range(1, z + 1)]
+        dn = [abs(ex * math.sin(p) - ey * math.cos(p) + dq[5] + ej) for p, ej in zip(phi, e_j)]
         j = max(range(z), key=lambda i: dn[i])
         overlap = dn[j] - c
     force = max(abs(g("t_d")), abs(g("t_l"))) / (z * r_b)
@@ -158,6 +162,27 @@ def test_start_with_teeth_overlapping():
     assert "start" not in kinds(messages(dict(EXAMPLE, l_x=50e-6)))
     # a start kick dq0 that cancels the offset (x1 = -l_x) starts the teeth clear
     assert "start" not in kinds(messages(dict(EXAMPLE, dq0=[-80e-6, 0, 0, 0, 0, 0, 0])))
+
+
+def test_start_overlap_made_by_a_spacing_error():
+    """Eq. 11 with the tooth's spacing error e_j: the plausible spline (l_x 50 um, every |dn_j|
+    at t0 within c = 60 um; teeth 8 and 21 nearest, +-49.75 um) with e_21 = -15 um overlaps
+    tooth 21 by about 4.75 um, the tooth and overlap of the oracle's dn_j at the core's start
+    state; e_21 = +15 um moves that tooth away from its flank: no overlap."""
+    fields = dict(PLAUSIBLE, spacing_error=[0.0] * 20 + [-15e-6])
+    assert messages(PLAUSIBLE) == []
+    case = ps.load_case(fields)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ps.SplineWarning)
+        model = ps.load(case)
+    dn = np.abs(oracle.mesh(case["t0"], model.start_state(), case)["dn"])
+    j, c = int(np.argmax(dn)), model.info()["c_bulk"]
+    assert j + 1 == 21 and dn[j] - c == pytest.approx(4.75e-6, rel=0.01)
+    assert closed_forms(case)["overlap"] == pytest.approx(dn[j] - c, rel=1e-9)
+    msg = one(messages(fields), "start")
+    for number in ("starts tooth 21 overlapping", f"backlash c = {c:.3E} m", f"by {dn[j] - c:.3E} m"):
+        assert number in msg, (number, msg)
+    assert messages(dict(PLAUSIBLE, spacing_error=[0.0] * 20 + [15e-6])) == []
 
 
 def test_tooth_load_of_a_torque_in_n_mm():

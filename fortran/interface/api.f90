@@ -22,6 +22,7 @@ module spline_api
        kterm_names, model_warnings
   use spline_stiffness, only: external_tooth_stiffness, internal_tooth_stiffness
   use spline_dynamics, only: accelerations, start_state
+  use spline_mesh, only: start_warning
   use spline_run, only: run_case, run_results, tooth_quantities, output_times
   use spline_quantities, only: quantity_t, nstats, stat_q, ntooth_q, tooth_q, state_q, nout_q, &
        output_q, nload, load_q, nload_tooth, load_tooth_q, nextreme, extreme_q
@@ -171,7 +172,7 @@ contains
     model = transfer(m, model)
     sizes = [m%z, m%n_out, run_sections(m), lyapunov_count(m), &
          merge(m%n_slices, 0, m%n_slices > 1)]       ! realisations > 1: one copy's
-    warn = model_warnings(m)
+    warn = model_warnings(m, start_warning(m))
   end subroutine load_model
 
   !> The case field nearest to a misspelt name (blank if none is near): the suggestion of the

@@ -24,6 +24,7 @@ program spline_dyn
        c_file_kind
   use spline_model, only: model_t, model_from_case, model_warnings, nstate, nkterms, kterm_names
   use spline_run, only: run_case, run_results
+  use spline_mesh, only: start_warning
   use spline_quantities, only: nstats, stat_q, state_q, ntooth_q, tooth_q, nout_q, output_q, nload, &
        load_q, nload_tooth, load_tooth_q, il_load_sharing, il_free_mean, il_back_teeth, &
        il_impacts_rev, il_closing_speed, il_tf_max, il_tf_max_tooth, il_tf_max_t, il_sigma_root, &
@@ -198,7 +199,7 @@ program spline_dyn
   ! right-hand side, the temporary file is removed, and the exit status is 130.
   sigint0 = c_sigint_watch()
 
-  call print_warnings(model_warnings(m))
+  call print_warnings(model_warnings(m, start_warning(m)))
   nt = m%n_out*m%realisations    ! realisations = K: K copies of n_out outputs, one after another
   allocate(t(nt), y(nstate, nt), tooth(nt, m%z, ntooth_q), tm(nt))
   call system_clock(c0, rate)

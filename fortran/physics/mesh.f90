@@ -3,7 +3,7 @@
 !> (Eqs. 1, 3-7, 12-13) and the energy-consistent mesh forces on the bodies (Eqs. 19-22, corrected).
 module spline_mesh
   use spline_kinds, only: wp, max_teeth
-  use spline_errors, only: err_ok, err_solver, err_thermal
+  use spline_errors, only: err_ok, err_solver, err_thermal, itoa, num
   use spline_model, only: model_t, thermal_oneway, thermal_coupled
   use spline_geometry, only: tooth_angles, tooth1_angle, pitch_step, profile_shift, contact_radius, &
        active_profile
@@ -12,6 +12,7 @@ module spline_mesh
   private
   public :: mesh_eval, mesh_forces, mesh_outputs, mesh_switch_functions, coupling_stats_t, tooth_approach
   public :: eq11_gradient, eq16_mode, eq16_root_mode, eq16_root_directions, slice_offset
+  public :: start_warning
 
   integer, parameter :: max_coupling_iter = 60
   real(wp), parameter :: coupling_tol = 1.0e-14_wp   !< relative step tolerance on T_f
@@ -155,6 +156,30 @@ contains
     if (present(cphi_out)) cphi_out = cp(1:m%z)
     if (present(mtilt)) mtilt = [mx, my]
   end subroutine mesh_eval
+
+  !> start = 'rest' (plus dq0) with a tooth overlapping beyond its backlash at t0: the largest
+  !> |dn_j| - c of Eq. 11 (face centre, with the tooth's spacing error e_j) over the teeth in
+  !> the start state; one of spline_model::model_warnings (its argument start).
+  function start_warning(m) result(text)
+    type(model_t), intent(in) :: m
+    character(len=:), allocatable :: text
+    real(wp) :: sp(m%z), cp(m%z), dn(m%z), ddn(m%z)
+    integer :: j
+    text = ''
+    if (m%start_equilibrium) return
+    call tooth_angles(m%z, m%omega, m%t0, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
+    call eq11(m%dq0(1) + m%l_x - m%dq0(3), m%dq0(2) + m%l_y - m%dq0(4), 0.0_wp, 0.0_wp, m%dq0(6), &
+         0.0_wp, 0.0_wp, m%spacing_error(1:m%z), sp, cp, dn, ddn)
+    dn = abs(dn)
+    j = maxloc(dn, 1)
+    if (dn(j) <= m%c_bulk) return
+    text = 'case '//trim(m%name)//': start = ''rest'' with l_x = '// &
+         num(m%l_x, readable=.true.)//', l_y = '//num(m%l_y, readable=.true.)// &
+         ' m starts tooth '//itoa(j)//' overlapping its backlash c = '// &
+         num(m%c_bulk, readable=.true.)//' m by '//num(dn(j) - m%c_bulk, readable=.true.)// &
+         ' m (Eq. 11 at t0): an impact made by the start, not the drive; '// &
+         'start = ''equilibrium''? Run as given'//new_line('a')
+  end function start_warning
 
   !> Eq. 11 and its total time derivative (phi_j' = omega) for one tooth at the face centre, the
   !> one place they are written (right-hand side, switch functions, outputs, loads): the tooth's

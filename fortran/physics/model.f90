@@ -9,7 +9,7 @@ module spline_model
   use spline_case, only: case_t, case_validate, case_run_times, namelen, option_index, thermal_values, &
        method_values, nonlinear_values, start_values, fidelity_values, section_values, nripple, &
        lyapunov_method_values, goal_values
-  use spline_geometry, only: iso4156_radii, pitch_rotation, tooth_angles
+  use spline_geometry, only: iso4156_radii, pitch_rotation
   use spline_stiffness, only: spline_mesh_stiffness_fillet
   use spline_thermal, only: backlash_coefficient, thermal_backlash
   use spline_accuracy, only: accuracy_settings, stats_transient_rtol
@@ -317,9 +317,11 @@ contains
   !> geometry (Eq. 18), supports that take most of the offset, a shaft wound up beyond
   !> windup_limit, a start at rest with teeth overlapping, a tooth deflected beyond
   !> deflection_limit of the module. The executable prints them to stderr, Python raises
-  !> pyspline.SplineWarning (api_load_file's and api_load_fields' warn).
-  function model_warnings(m) result(text)
+  !> pyspline.SplineWarning (api_load_file's and api_load_fields' warn). start: the start
+  !> warning, spline_mesh::start_warning(m) (Eq. 11 lives in spline_mesh, which uses this module).
+  function model_warnings(m, start) result(text)
     type(model_t), intent(in) :: m
+    character(len=*), intent(in) :: start
     character(len=:), allocatable :: text
     text = ''
     if (.not. m%k_m_computed .and. m%k_m_nofillet > 0.0_wp) then
@@ -330,7 +332,7 @@ contains
              'unit slip (N/mm for N/m)? Run as given'//new_line('a')
       end if
     end if
-    text = text//support_warning(m)//windup_warning(m)//start_warning(m)//load_warning(m)// &
+    text = text//support_warning(m)//windup_warning(m)//start//load_warning(m)// &
          separation_warning(m)
   end function model_warnings
 
@@ -415,27 +417,6 @@ contains
            tname//' = '//num(t, readable=.true.)//' N m'
     end subroutine shaft
   end function windup_warning
-
-  !> start = 'rest' (plus dq0) with a tooth overlapping beyond its backlash at t0: the largest
-  !> |Delta n_j| - c of Eq. 11 over the teeth (face centre) in the start state.
-  function start_warning(m) result(text)
-    type(model_t), intent(in) :: m
-    character(len=:), allocatable :: text
-    real(wp) :: sp(m%z), cp(m%z), dn(m%z)
-    integer :: j
-    text = ''
-    if (m%start_equilibrium) return
-    call tooth_angles(m%z, m%omega, m%t0, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
-    dn = abs((m%dq0(1) + m%l_x - m%dq0(3))*sp - (m%dq0(2) + m%l_y - m%dq0(4))*cp + m%dq0(6))
-    j = maxloc(dn, 1)
-    if (dn(j) <= m%c_bulk) return
-    text = 'case '//trim(m%name)//': start = ''rest'' with l_x = '// &
-         num(m%l_x, readable=.true.)//', l_y = '//num(m%l_y, readable=.true.)// &
-         ' m starts tooth '//itoa(j)//' overlapping its backlash c = '// &
-         num(m%c_bulk, readable=.true.)//' m by '//num(dn(j) - m%c_bulk, readable=.true.)// &
-         ' m (Eq. 11 at t0): an impact made by the start, not the drive; '// &
-         'start = ''equilibrium''? Run as given'//new_line('a')
-  end function start_warning
 
   !> The static tooth load T / (Z r_b) of the larger torque, all teeth sharing it, deflects a
   !> tooth by that load over the geometry's Eq. 18 stiffness (whatever k_m the case gives):
