@@ -333,10 +333,8 @@ class _Branch:
                 y = _map_only(prob.model(p), prob.t0, prob.t1(p, self.n), y)[0]
         except (SolverError, CaseError):
             return None
-        res = self.correct(np.r_[y[prob.free] / prob.d0[prob.free], pred[-1]], a["tau"],
-                           a["tau"] @ pred)
-        pt = None if res is None or specials.far(res[0], pred, sigma) else self.point(res, a)
-        return None if pt is None else dict(pt, sigma=sigma)
+        start = np.r_[y[prob.free] / prob.d0[prob.free], pred[-1]]
+        return specials.point_at(self, a, sigma, start)
 
 
 def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=None, *,

@@ -57,12 +57,13 @@ def far(u, pred, ds) -> bool:
     return bool(np.linalg.norm(u - pred) > ds)
 
 
-def _at(br, a, sigma):
-    """The branch point at arclength sigma from point a (along a's tangent); None when the
-    corrector fails or lands further than sigma from its predictor (another branch)."""
+def point_at(br, a, sigma, start=None):
+    """The branch point at arclength sigma from point a (along a's tangent), the corrector
+    started from `start` (default the predictor); None when the corrector fails or lands
+    further than sigma from its predictor (another branch)."""
     tau = a["tau"]
     pred = a["u"] + sigma * tau
-    res = br.correct(pred, tau, tau @ pred)
+    res = br.correct(pred if start is None else start, tau, tau @ pred)
     pt = None if res is None or far(res[0], pred, sigma) else br.point(res, a)
     return None if pt is None else dict(pt, sigma=sigma)
 
@@ -84,7 +85,7 @@ def graze(br, a, b, sigma_b, iters=8):
     lo, hi, last, past, beyond = 0.0, sigma_b, a, b, b
     for _ in range(iters):
         s = (lo + hi) / 2
-        pt = _at(br, a, s) or br.restart(a, s)
+        pt = point_at(br, a, s) or br.restart(a, s)
         if pt is None and b is None:
             hi = s
             continue
@@ -186,10 +187,10 @@ def _secant(br, a, b, sigma_b, kind, iters=12):
         s = hi - fhi * (hi - lo) / (fhi - flo)
         if not lo < s < hi:
             s = (lo + hi) / 2
-        pt = _at(br, a, s)
+        pt = point_at(br, a, s)
         if pt is None and s != (lo + hi) / 2:     # the secant's point failed: the middle
             s = (lo + hi) / 2
-            pt = _at(br, a, s)
+            pt = point_at(br, a, s)
         if pt is None:
             break
         f = pt["tests"][kind]
