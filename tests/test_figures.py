@@ -425,6 +425,9 @@ def test_paper_dynamics_figure_shows_the_run(monkeypatch, tmp_path):
             ticks = [v for v in ax.get_xticks() if 1 <= v <= res.F.shape[1]]
             assert len(ticks) <= 10 and all(v == int(v) for v in ticks)
         assert f"at t = {res.t[k]:.4f} s (largest load)" in _words(f, ["legend"])
+        # the aligned drive's lateral forces balance: the note says so, not round-off digits
+        assert abs(res.Fx[k].sum()) <= 1e-9 * np.abs(res.Fx[k]).sum()
+        assert fx.get_title().startswith("sum of F_jx at that instant: 0 to round-off (sum of")
         assert d.get_ylabel() == "relative displacement D_2 (line of action) [mm]"
         assert _inside(d, res.t, res.D2 * 1e3) and _inside(tm, res.t, res.Tm)
         assert tm.get_ylabel() == "meshing torque T_m [N m]" and tm.get_xlabel() == "time t [s]"

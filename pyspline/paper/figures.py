@@ -42,7 +42,11 @@ def _tooth_bars(ax_f, ax_fx, res):
         ax.xaxis.set_major_locator(MaxNLocator(nbins=9, integer=True))   # 16 numbers crowd
         ax.axhline(0, color="k", lw=0.5)
     ax_f.legend(fontsize=7, loc="lower right")
-    ax_fx.set_title(f"sum of F_jx at that instant: {eng(res.Fx[k].sum(), 3)} N", fontsize=8)
+    total, scale = res.Fx[k].sum(), np.abs(res.Fx[k]).sum()
+    # a balanced sum is round-off of the teeth's forces: say so, not its digits
+    said = (f"0 to round-off (sum of |F_jx| {eng(scale, 3)} N)" if abs(total) <= 1e-9 * scale
+            else f"{eng(total, 3)} N")
+    ax_fx.set_title(f"sum of F_jx at that instant: {said}", fontsize=8)
 
 
 def dynamics_figure(res, path, title):
