@@ -114,6 +114,18 @@ def _checked(base, field, start, stop, n, *, tol, max_points, max_corrector, mon
         except CaseError as exc:
             raise CaseError(f"continuation in {label}: {arg} = {value:g} is not a valid value "
                             f"of {label}: {exc}") from None
+    h = prob.h * max(abs(start), prob.pscale)       # evaluate's difference step at start
+    why = []
+    for p in (start + h, start - h):
+        try:
+            prob.model(p)
+            break
+        except CaseError as exc:
+            why.append(str(exc))
+    else:
+        raise CaseError(f"case {base.name}: field {label} cannot be continued: its valid values "
+                        f"are isolated (none within {h:.3g} of start = {start:g}: {why[0]}); "
+                        "continuation follows a field that varies continuously")
     return prob, label, start, stop, tol
 
 
