@@ -105,6 +105,22 @@ def merged(pieces, label, scale):
     return keep
 
 
+def _distinct(ds, label, scale):
+    """The branches of `ds` (_concat's) without those every point of which lies on another
+    (merged: a seed's branch traced from another seed too, or a doubled branch another
+    seed's continuation traced), renumbered; and the indices of the seeds kept."""
+    nb = ds.branch.values
+    every = np.unique(nb)
+    keep = sorted(every[merged([ds.isel(point=nb == b) for b in every], label, scale)])
+    ds = ds.isel(point=np.isin(nb, keep), special=np.isin(ds.special_branch.values, keep))
+    ds["branch"] = ("point", np.searchsorted(keep, ds.branch.values))
+    ds["special_branch"] = ("special", np.searchsorted(keep, ds.special_branch.values))
+    kept = np.unique(ds.seed.values)
+    ds["seed"] = ("point", np.searchsorted(kept, ds.seed.values))
+    ds["special_seed"] = ("special", np.searchsorted(kept, ds.special_seed.values))
+    return ds, kept
+
+
 def _join(down, up, label):
     """One branch from a seed's two halves: `down` (seed to start) reversed, then `up` (seed to
     stop) without its first point (the seed again). Doubled branches keep their own numbers."""
@@ -229,8 +245,9 @@ def _branches(case, field, start, stop, points, max_n, progress, command, sweep_
                     try:
                         with warnings.catch_warnings(record=True):
                             warnings.simplefilter("always", SplineWarning)
-                            halves.append(continuation(case, field, p, end, n=orb.n,
-                                                       guess=orb.y0, progress=progress, **cont))
+                            halves.append(continuation(
+                                case, field, p, end, n=orb.n, guess=orb.y0, progress=progress,
+                                band=(start, stop), **cont))
                     except OrbitError as exc:   # no time left for its orbit at the seed
                         if not out_of_time():
                             raise
@@ -251,11 +268,10 @@ def _branches(case, field, start, stop, points, max_n, progress, command, sweep_
         raise SplineError(f"branches: no periodic attractor found by the follow sweeps over "
                           f"{field} = {start:g}..{stop:g} (stretches without a period: "
                           f"{_spans(no_period) or 'none'})")
-    keep = merged(pieces, field, scale)
-    ds = _concat([pieces[i] for i in keep])
+    ds, kept = _distinct(_concat(pieces), field, scale)
     if no_period:       # plots.frequency_response shades them
         ds["no_period_range"] = (("stretch", "end"), np.sort([[a, b] for _, a, b in no_period]))
-    ds.attrs.update(start=start, stop=stop, seeds="; ".join(seeds[i] for i in keep),
+    ds.attrs.update(start=start, stop=stop, seeds="; ".join(seeds[i] for i in kept),
                     no_period=_spans(no_period), status="; ".join(status) or "complete",
                     n_points=ds.sizes["point"], n_branches=int(ds.branch.max()) + 1,
                     command=command or f"pyspline.branches({case.name!r}, {field!r}, "

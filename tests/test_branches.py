@@ -66,6 +66,22 @@ def test_pieces_of_the_same_branch_are_merged(every_branch):
     assert sorted(merged([off, ds], "speed_rpm", s)) == [0, 1]
 
 
+def test_a_branch_traced_twice_goes(every_branch):
+    """Two seeds' pieces (the S-curve, and points 30-70 of it as another seed's): one branch
+    is left, the first seed's; a piece off the branch stays, renumbered."""
+    from pyspline.diagram import _concat, _distinct
+    from test_orbits import scale_of
+    ds, s = every_branch[0], scale_of(DRIVE)
+    mid = ds.isel(point=slice(30, 70))
+    out, kept = _distinct(_concat([ds, mid]), "speed_rpm", s)
+    assert list(kept) == [0] and (out.branch == 0).all() and out.sizes["point"] == ds.sizes["point"]
+    off = mid.copy(deep=True)
+    off["y0"] = off.y0 + 0.05 * np.ptp(ds.y0.values, axis=0)
+    out, kept = _distinct(_concat([mid, off, ds]), "speed_rpm", s)
+    assert list(kept) == [1, 2] and sorted(set(out.branch.values)) == [0, 1]
+    assert set(out.seed.values) == {0, 1}
+
+
 def test_a_stretch_without_a_period_is_shaded(every_branch):
     """Sweep points whose sections give no period (n = 0: chaotic, quasi-periodic or not
     settled) form their own stretch, none is split from its neighbours' periods; the figure

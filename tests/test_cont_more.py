@@ -68,6 +68,47 @@ def test_period_two_seed_from_the_sections(monkeypatch):
     assert ds.attrs["status"] == "complete" and ds.attrs["no_period"] == ""
     assert (ds.n == 2).all() and ds.stable.all()
     assert float(ds.speed_rpm[0]) == 1646 and float(ds.speed_rpm[-1]) == pytest.approx(1650, rel=1e-12)
+    # no point past stop (a corrector that converged there is put onto it)
+    assert (ds.speed_rpm >= 1646).all() and (ds.speed_rpm <= 1650).all(), ds.speed_rpm.values
+
+
+def test_branches_through_a_period_doubling():
+    """DOUBLING over 1617-1626 r/min (rtol 1e-8, steps up to 0.5): the follow sweeps' runs have
+    not settled (no period), the seed in the middle is the stable period-1 orbit; its branch
+    doubles (a multiplier at -1) and the doubled branch is followed over the whole band, not
+    only the seed's half (1621.5-1626): from the doubling down, unstable, to its fold (a
+    multiplier of P^2 at +1) below the seed, and back up, stable, to stop. Its points are
+    period-2 orbits (P^2(y) = y, P(y) away from y); two branches, none past the band."""
+    from pyspline.orbits import _period_map, map_and_monodromy
+    from test_orbits import scale_of
+    case = DOUBLING.replace(rtol=1e-8, atol=1e-10)
+    T = 60 / 1650
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds, _ = pyspline.branches(case, "speed_rpm", 1617, 1626, points=3, max_n=2,
+                                  progress=False, ds_max=0.5, max_angle=0.3,
+                                  sweep_case=case.replace(t_end=20 * T, t_transient=10 * T,
+                                                          section="shaft"))
+    assert ds.attrs["status"] == "complete" and ds.attrs["n_branches"] == 2
+    p, b, n = ds.speed_rpm.values, ds.branch.values, ds.n.values
+    assert ((p >= 1617) & (p <= 1626)).all()
+    assert (n[b == 0] == 1).all() and (n[b == 1] == 2).all()
+    kind, sp = ds.special_type.values, ds.special_speed_rpm.values
+    mu = ds.special_mu_real.values + 1j * ds.special_mu_imag.values
+    pd, fold = np.flatnonzero(kind == "period_doubling"), np.flatnonzero(kind == "fold")
+    assert len(pd) == 1 and ds.special_branch[pd[0]] == 0 and abs(mu[pd[0]] + 1) < 1e-3
+    assert len(fold) == 1 and ds.special_branch[fold[0]] == 1 and abs(mu[fold[0]] - 1) < 1e-2
+    two, st = p[b == 1], ds.stable.values[b == 1].astype(bool)
+    assert two[0] == pytest.approx(sp[pd[0]], abs=0.1) and two[-1] == pytest.approx(1626)
+    assert sp[fold[0]] < 1621.5 and two.min() == pytest.approx(sp[fold[0]], abs=0.5)
+    turn = np.argmin(two)
+    assert not st[:turn - 1].any() and st[turn + 2:].all()
+    y, s = ds.y0.values[b == 1][-1], scale_of(case)
+    c = case.replace(speed_rpm=1626.0)
+    y2, _, free = map_and_monodromy(c, 0.0, 2 * 60 / 1626, y)
+    y1 = _period_map(c.model, 0.0, 60 / 1626, y[:, None])[0][:, 0]
+    assert np.abs((y2 - y)[free] / s[free]).max() < 1e-5
+    assert np.abs((y1 - y)[free] / s[free]).max() > 0.1
 
 
 def test_cli_all_and_fold_keep_what_they_have(tmp_path):
