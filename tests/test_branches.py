@@ -165,6 +165,41 @@ def test_fold_curve_grazing_below_the_upper_fold(fold_curves):
     assert np.isnan(g[4]).all()
 
 
+def test_fold_pair_closes_at_a_cusp():
+    """Near the cusp (docs: between a = 0.08 and 0.085) over 2575-2600 r/min: the fold pair
+    narrows as a falls (0.0875, 0.085) and is gone at 0.08. At a cusp the width closes as
+    (a - a_c)^(3/2): its 2/3 power, linear in a through the two pairs, reaches zero between
+    0.08 and 0.085. Follow sweeps at the middle of the 0.085 pair and 8 r/min either side say
+    two orbits there and one outside; at 0.08, at the same speeds, the up and the down chains
+    end on the same orbit (T_m peak-to-peak to 0.5 %): no hysteresis past the cusp."""
+    fc = pyspline.fold_curve(DRIVE.replace(rtol=1e-7, atol=1e-9), "speed_rpm", 2575, 2600,
+                             "ripple_amp(1)", [0.0875, 0.085, 0.08], progress=False,
+                             ds_max=0.5, max_angle=0.3, narrow=False)
+    assert (fc.status == "complete").all(), fc.status.values
+    f = fc.fold.values
+    assert np.isfinite(f[:2, :2]).all() and np.isnan(f[2]).all(), f
+    width = f[:2, 1] - f[:2, 0]
+    assert width[0] > width[1] > 0, width
+    a = fc.value2.values
+    w23 = width ** (2 / 3)
+    cusp = a[1] - w23[1] * (a[0] - a[1]) / (w23[0] - w23[1])
+    assert a[2] < cusp < a[1], (cusp, width)
+    lo, hi = f[1, :2]
+    speeds = [lo - 8, (lo + hi) / 2, hi + 8]
+    pp = {}
+    for amp in (0.085, 0.08):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", pyspline.SplineWarning)
+            sw = pyspline.sweep(SETTLED.replace(ripple_amp=[amp, 0, 0, 0], n_out=2001),
+                                speed_rpm=speeds, follow="both", progress=False,
+                                spectrum=False)
+        assert (sw.error == "").all()
+        pp[amp] = (sw.Tm_max - sw.Tm_min).values
+        assert list(coexistence(sw)) == ([False, True, False] if amp == 0.085 else
+                                         [False] * 3), (amp, pp[amp])
+    assert (np.abs(pp[0.08][0] - pp[0.08][1]) < 5e-3 * pp[0.08].max(0)).all(), pp[0.08]
+
+
 def test_bad_input_is_a_case_error(monkeypatch):
     """A CaseError naming the argument before anything runs (no sweep, no continuation),
     continuation's keywords handed on included."""
