@@ -99,6 +99,17 @@ def test_a_stretch_without_a_period_is_shaded(every_branch):
     assert len(spans) == 1
     assert any(t.get_text().startswith("no periodic attractor") and "chaotic" in t.get_text()
                for t in ax.get_legend().get_texts())
+    # told apart (branches' no_period_chaotic): chaotic darker, each said once
+    ds["no_period_range"] = (("stretch", "end"), [[2250.0, 2260.0], [2260.0, 2280.0],
+                                                  [2400.0, 2410.0]])
+    ds["no_period_chaotic"] = ("stretch", [0, 1, 1])
+    ax = frequency_response(ds, sweep=every_branch[1]).axes[0]
+    grey = {pt.get_x(): pt.get_facecolor()[0] for pt in ax.patches if pt.get_x() in
+            (2250.0, 2260.0, 2400.0)}
+    assert grey[2260.0] == grey[2400.0] < grey[2250.0]
+    texts = [t.get_text() for t in ax.get_legend().get_texts() if "attractor" in t.get_text()]
+    assert len(texts) == 2 and "not chaotic" in texts[0] and "chaotic (largest Lyapunov" in \
+        texts[1]
 
 
 def test_branches_folds_where_the_follow_sweeps_jump(every_branch, follow_sweeps):

@@ -22,8 +22,11 @@ def test_chaotic_drive_seeds_no_branch(monkeypatch):
     """chaos_z24 (a vibro-impact drive with a Lyapunov exponent near 900 1/s,
     tests/test_chaos.py) swept up and down over 5900-6100 r/min: no run's sections give a
     period, Newton from its final state finds no stable period-1 orbit, so the whole band is
-    one stretch without a period each way, named in the error, and no continuation runs
-    (runs of 5 revolutions after 2: the follow chains carry the motion on)."""
+    one stretch without a period each way, named in the error as chaotic (a run of the same
+    length from its middle point's final state has a largest Lyapunov exponent of 300 1/s or
+    more, as tests/test_chaos.py measures over 200 revolutions, beyond its estimate's spread),
+    and no continuation runs (runs of 5 revolutions after 2: the follow chains carry the
+    motion on)."""
     case = pyspline.load_case(CASES / "chaos_z24.nml", lyapunov=False, t_transient=0.02,
                               t_end=0.07, n_out=201)
     tried = []
@@ -36,10 +39,34 @@ def test_chaotic_drive_seeds_no_branch(monkeypatch):
         warnings.simplefilter("ignore", pyspline.SplineWarning)
         with pytest.raises(pyspline.SplineError, match=r"no periodic attractor found by the "
                            r"follow sweeps over speed_rpm = 5900..6100 \(stretches without a "
-                           r"period: up 5900..6100; down 6100..5900\)"):
+                           r"period: up 5900..6100 \(chaotic: .*\); down 6100..5900 "
+                           r"\(chaotic: .*\)\)") as err:
             pyspline.branches(case, "speed_rpm", 5900, 6100, points=3, max_n=1,
                               progress=False)
     assert tried == [1, 1]      # one seed tried per stretch, at its middle
+    said = re.findall(r"largest Lyapunov exponent (\S+) 1/s \(spread ([\d.e+-]+)\)",
+                      str(err.value))
+    assert len(said) == 2 and all(300 < float(lam) and float(sp) < float(lam) for lam, sp in said)
+
+
+def test_unsettled_periodic_drive_is_not_chaos():
+    """DOUBLING over 1646-1650 r/min, whose attractor is the stable period-2 orbit (its
+    sections give period 2 after 40 revolutions, test_period_two_seed_from_the_sections),
+    swept with runs of 5 revolutions after 5 and max_n = 1: the sections give no period
+    (not settled) and Newton finds no stable period-1 orbit, so nothing is seeded; each
+    stretch is said to have no period within 5 revolutions and not to be chaotic: the largest
+    Lyapunov exponent of its run is negative."""
+    T = 60 / 1650
+    short = DOUBLING.replace(t_end=10 * T, t_transient=5 * T, n_out=201, section="shaft")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        with pytest.raises(pyspline.SplineError, match=r"no periodic attractor") as err:
+            pyspline.branches(DOUBLING, "speed_rpm", 1646, 1650, points=3, max_n=1,
+                              progress=False, sweep_case=short)
+    said = re.findall(r"(up|down) \S+ \(no period found within 5 revolutions, not chaotic: "
+                      r"largest Lyapunov exponent (\S+) 1/s", str(err.value))
+    assert [d for d, _ in said] == ["up", "down"] and "(chaotic:" not in str(err.value), err.value
+    assert all(float(lam) < 0 for _, lam in said), said
 
 
 def test_period_two_seed_from_the_sections(monkeypatch):
