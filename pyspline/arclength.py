@@ -109,24 +109,21 @@ def _checked(base, field, start, stop, n, *, tol, max_points, max_corrector, mon
         raise CaseError(f"case {base.name}: monodromy = {monodromy!r}: 'exact' (variational "
                         "equations) or 'fd' (central differences of the map)")
     prob = _Problem(base, name, index, n, start, stop, float(base["t0"]), monodromy)
-    for arg, value in (("stop", stop), ("start", start)):
+    try:
+        ends = sorted(map(float, (start, stop) if band is None else band))
+    except (TypeError, ValueError):
+        ends = []
+    if len(ends) != 2 or not np.isfinite(ends).all() or ends[0] > min(start, stop) \
+            or ends[1] < max(start, stop):
+        raise CaseError(f"continuation in {label}: band = {band!r}: two values holding start "
+                        f"= {start:g} and stop = {stop:g}")
+    for arg, value in (("stop", stop), ("start", start), ("band", ends[0]), ("band", ends[1])):
         try:
             prob.model(value)
         except CaseError as exc:
             raise CaseError(f"continuation in {label}: {arg} = {value:g} is not a valid value "
                             f"of {label}: {exc}") from None
-    band = sorted((start, stop)) if band is None else band
-    if (np.shape(band) != (2,) or not np.isfinite(np.asarray(band, float)).all()
-            or min(band) > min(start, stop) or max(band) < max(start, stop)):
-        raise CaseError(f"continuation in {label}: band = {band!r}: two values holding start "
-                        f"= {start:g} and stop = {stop:g}")
-    for value in band:
-        try:
-            prob.model(float(value))
-        except CaseError as exc:
-            raise CaseError(f"continuation in {label}: band = {band!r}: {value:g} is not a "
-                            f"valid value of {label}: {exc}") from None
-    prob.band = tuple((float(v) - start) / prob.pscale for v in sorted(band))
+    prob.band = tuple((v - start) / prob.pscale for v in ends)
     h = prob.h * max(abs(start), prob.pscale)       # evaluate's difference step at start
     why = []
     for p in (start + h, start - h):

@@ -240,6 +240,7 @@ def test_bad_range_and_follow():
     (dict(n=0), r"n = 0: the shaft revolutions"),
     (dict(band=(30.5, 31.0)), r"band = \(30.5, 31.0\): two values holding start = 30 and stop"),
     (dict(band=(30.0,)), r"band = \(30.0,\): two values holding"),
+    (dict(band=("a", 31.0)), r"band = \('a', 31.0\): two values holding"),
 ])
 def test_bad_arguments_name_themselves(kwargs, match):
     """Each bad argument: a CaseError naming it and why, before anything runs."""
