@@ -93,10 +93,11 @@ def check_arguments(case, label, start, stop, n, tol, **positive):
 
 
 def _checked(base, field, start, stop, n, *, tol, max_points, max_corrector, monodromy,
-             switch=True, detect=True, **positive):
+             switch=True, detect=True, band=None, **positive):
     """continuation's arguments checked (CaseError naming the one that is bad; start and stop
-    valid values of the field, with the forcing periodic over n revolutions): (its _Problem,
-    the field's label, start, stop, tol)."""
+    valid values of the field, with the forcing periodic over n revolutions; band valid
+    values holding them): (its _Problem, the field's label, start, stop, tol); prob.band:
+    the range of the doubled branches in q."""
     name, index = parse_field(base, field)
     label = field_label(name, index)
     start, stop, tol = check_arguments(base, label, start, stop, n, tol, **positive)
@@ -108,17 +109,39 @@ def _checked(base, field, start, stop, n, *, tol, max_points, max_corrector, mon
         raise CaseError(f"case {base.name}: monodromy = {monodromy!r}: 'exact' (variational "
                         "equations) or 'fd' (central differences of the map)")
     prob = _Problem(base, name, index, n, start, stop, float(base["t0"]), monodromy)
-    for arg, value in (("stop", stop), ("start", start)):
+    try:
+        ends = sorted(map(float, (start, stop) if band is None else band))
+    except (TypeError, ValueError):
+        ends = []
+    if len(ends) != 2 or not np.isfinite(ends).all() or ends[0] > min(start, stop) \
+            or ends[1] < max(start, stop):
+        raise CaseError(f"continuation in {label}: band = {band!r}: two values holding start "
+                        f"= {start:g} and stop = {stop:g}")
+    for arg, value in (("stop", stop), ("start", start), ("band", ends[0]), ("band", ends[1])):
         try:
             prob.model(value)
         except CaseError as exc:
             raise CaseError(f"continuation in {label}: {arg} = {value:g} is not a valid value "
                             f"of {label}: {exc}") from None
+    prob.band = tuple((v - start) / prob.pscale for v in ends)
+    h = prob.h * max(abs(start), prob.pscale)       # evaluate's difference step at start
+    why = []
+    for p in (start + h, start - h):
+        try:
+            prob.model(p)
+            break
+        except CaseError as exc:
+            why.append(str(exc))
+    else:
+        raise CaseError(f"case {base.name}: field {label} cannot be continued: its valid values "
+                        f"are isolated (none within {h:.3g} of start = {start:g}: {why[0]}); "
+                        "continuation follows a field that varies continuously")
     return prob, label, start, stop, tol
 
 
 #: continuation's arguments that branches and fold_curve set themselves (not in their **cont)
-_OWN = ("case", "field", "start", "stop", "n", "guess", "progress", "command", "max_seconds")
+_OWN = ("case", "field", "start", "stop", "n", "guess", "progress", "command", "max_seconds",
+        "band")
 
 
 def check_handed_on(case, field, start, stop, n, cont: dict) -> None:
@@ -342,7 +365,7 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
                  max_points: int = 200, tol: float | None = None, max_corrector: int = 6,
                  margin: float = 1e-4, switch: bool = True, detect: bool = True,
                  monodromy: str = "exact", progress: bool = True, command: str | None = None,
-                 max_seconds: float = CALL_SECONDS):
+                 max_seconds: float = CALL_SECONDS, band=None):
     """Pseudo-arclength continuation of the period-n orbit of `case` in `field` from `start`
     to `stop`, through stable and unstable parts; returns an xarray.Dataset.
 
@@ -366,7 +389,9 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     tol : the corrector's scaled residual max |P^n(y) - y| (default 100 rtol).
     margin : stable means every |mu| < 1 - margin.
     switch : at a period doubling continue the doubled branch (n -> 2n) from it along the
-        critical eigenvector.
+        critical eigenvector, over `band`.
+    band : (a, b) holding start and stop: the range of the field over which doubled branches
+        are followed (default start..stop; branches gives each seed's halves the whole band).
     detect : report folds, period doublings, Neimark-Sacker points, grazings and non-smooth
         folds (grazings are located while following either way).
     monodromy : 'exact' (variational equations, one run per corrector iteration) or 'fd'
@@ -395,7 +420,7 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     prob, label, start, stop, tol = _checked(
         base, field, start, stop, n, tol=tol, ds=ds, ds_min=ds_min, ds_max=ds_max,
         max_angle=max_angle, margin=margin, max_points=max_points, max_corrector=max_corrector,
-        monodromy=monodromy)
+        monodromy=monodromy, band=band)
     t0 = prob.t0
     c0 = prob.case_at(start)
     with sundials_said("the continuation's map runs") as said, \
@@ -412,9 +437,10 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
             while todo and sum(len(b) for b in branches) < max_points:
                 nb, u_start, tau0, y_fixed = todo.pop(0)
                 br = _Branch(prob, nb, y_fixed, tol, max_corrector)
-                pts, why = _follow(br, u_start, tau0, (stop - start) / prob.pscale, ds, ds_min,
-                                   ds_max, max_angle, max_points - sum(len(b) for b in branches),
-                                   len(branches), bar)
+                q_end = (stop - start) / prob.pscale
+                pts, why = _follow(br, u_start, tau0, q_end, sorted((0.0, q_end)) if tau0 is None
+                                   else prob.band, ds, ds_min, ds_max, max_angle,
+                                   max_points - sum(len(b) for b in branches), len(branches), bar)
                 _use(prob, monodromy, base["method"])
                 if why != "complete" and status == "complete":
                     status = why
@@ -450,9 +476,10 @@ def _doubled_start(sp, nb, y_fixed):
     return (2 * nb, sp["u"], tau, y_fixed)
 
 
-def _follow(br, u0, tau0, q_end, ds, ds_min, ds_max, max_angle, max_points, ibranch, bar):
+def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_points, ibranch,
+            bar):
     """The points of one branch from u0 and what ended it: predictor-corrector until q leaves
-    [0, q_end] (the last point put on its end: 'complete'), max_points, or a step that fails
+    bounds (the last point put on its end: 'complete'), max_points, or a step that fails
     below ds_min with every fallback (the other monodromy, then the other integrator): a
     sentence saying where and why. A converged point further from its predictor than the step
     itself, or whose contact sequence changed with no grazing located between (specials.graze),
@@ -478,7 +505,7 @@ def _follow(br, u0, tau0, q_end, ds, ds_min, ds_max, max_angle, max_points, ibra
             return [], "complete"
         pts = [new]
     bar.update(1)
-    lo, hi = min(0.0, q_end), max(0.0, q_end)
+    lo, hi = bounds
     fallbacks = _fallbacks(prob)
     primary, on_fallback = (prob.how, prob.case["method"]), 0
     while len(pts) < max_points:
@@ -497,6 +524,9 @@ def _follow(br, u0, tau0, q_end, ds, ds_min, ds_max, max_angle, max_points, ibra
                 res = br.correct(pred, e_q, end)
         else:
             res = br.correct(pred, a["tau"], a["tau"] @ pred)
+            if res is not None and not lo - 1e-12 <= res[0][-1] <= hi + 1e-12:
+                end = hi if res[0][-1] > hi else lo     # converged past the end: onto it
+                res = _onto(br, res[0], pred, ds, end)
         if res is not None and end is None and specials.far(res[0], pred, ds):
             br.last_hist, br.last_error = res[6], (
                 f"the corrector went {np.linalg.norm(res[0] - pred):.3g} from a predictor "
@@ -515,6 +545,8 @@ def _follow(br, u0, tau0, q_end, ds, ds_min, ds_max, max_angle, max_points, ibra
                 new["grazing"] = loc[-1]
         if new is None:
             crossed = specials.diagnose(br, a, pred, step) if step > 0 else None
+            # none past the end (those crossings are not the branch's: it ends before them)
+            crossed = [c for c in crossed or () if lo - 1e-12 <= c["u"][-1] <= hi + 1e-12]
             if crossed:
                 pts += crossed
                 bar.update(len(crossed))
@@ -549,6 +581,14 @@ def _follow(br, u0, tau0, q_end, ds, ds_min, ds_max, max_angle, max_points, ibra
         grow = 1.5 if it <= 2 else (0.6 if it >= 4 else 1.0)
         ds = max(ds_min, min(ds_max, ds * grow, ds * max_angle / max(angle, 1e-12)))
     return pts, f"max_points = {max_points} reached at {prob.name} = {pts[-1]['p']:.6g}"
+
+
+def _onto(br, u, pred, ds, end):
+    """The corrector from u (a point converged past the field's end, pred its predictor)
+    with the field fixed at the end: the branch's last point, or None when it fails or lands
+    further than the step from the predictor."""
+    res = br.correct(u, np.eye(len(u))[-1], end)
+    return None if res is None or specials.far(res[0], pred, ds) else res
 
 
 def _fallbacks(prob):

@@ -24,7 +24,41 @@ def _stretches(period):
 
 
 def _spans(stretches):
-    return "; ".join(f"{d} {a:g}..{b:g}" for d, a, b in stretches)
+    return "; ".join(f"{d} {a:g}..{b:g}" + (f" ({what})" if what else "")
+                     for d, a, b, what in stretches)
+
+
+def _without_period(case, final, n, max_n):
+    """What a stretch that seeded nothing is: its sections' period n beyond max_n, or, when
+    they gave none (n = 0), chaotic or not, by the largest Lyapunov exponent (Benettin) of a
+    run as long as the sweep's sampled window continued from its middle point's final state
+    (y, t), with renormalisations at least every quarter revolution:
+    'chaotic: ...' when positive beyond the spread of its running estimate
+    (analysis.is_chaotic), else 'no period found within N revolutions, not chaotic: ...'
+    (a run not settled, or quasi-periodic)."""
+    from .analysis import is_chaotic, largest_lyapunov_fit
+    from .follow import continued
+    from .orbits import _wall
+    from .result import run
+    if n > max_n:
+        return f"period {n} > max_n = {max_n}"
+    omega = case.model.info()["omega"]
+    c = continued(case.replace(         # the sweep's window, no transient (it ran before)
+        lyapunov=True, lyapunov_interval=min(case["lyapunov_interval"], 0.25), t_transient=0.0,
+        transient_revolutions=0.0, t_end=case["t_end"] - case["t_transient"]), *final, omega)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SplineWarning)
+            res = run(c.model, max_seconds=_wall(c.model, np.inf))
+        ly = res.lyapunov
+        fit = largest_lyapunov_fit(ly["t"], ly["log_growth"], t0=float(res.t[0]))
+    except (SplineError, ValueError) as exc:
+        return f"no period found, chaos not told (its Lyapunov run: {exc})"
+    lam = f"largest Lyapunov exponent {fit.lam:.3g} 1/s (spread {fit.spread:.2g})"
+    if is_chaotic(fit.lam, fit.spread):
+        return f"chaotic: {lam}"
+    revs = (res.t[-1] - res.t[0]) * omega / (2 * np.pi)
+    return f"no period found within {revs:.0f} revolutions, not chaotic: {lam}"
 
 
 def _cut(sw):
@@ -103,6 +137,22 @@ def merged(pieces, label, scale):
                        zip(pieces[i][label].values, pieces[i].y0.values)) for j in keep):
             keep.append(i)
     return keep
+
+
+def _distinct(ds, label, scale):
+    """The branches of `ds` (_concat's) without those every point of which lies on another
+    (merged: a seed's branch traced from another seed too, or a doubled branch another
+    seed's continuation traced), renumbered; and the indices of the seeds kept."""
+    nb = ds.branch.values
+    every = np.unique(nb)
+    keep = sorted(every[merged([ds.isel(point=nb == b) for b in every], label, scale)])
+    ds = ds.isel(point=np.isin(nb, keep), special=np.isin(ds.special_branch.values, keep))
+    ds["branch"] = ("point", np.searchsorted(keep, ds.branch.values))
+    ds["special_branch"] = ("special", np.searchsorted(keep, ds.special_branch.values))
+    kept = np.unique(ds.seed.values)
+    ds["seed"] = ("point", np.searchsorted(kept, ds.seed.values))
+    ds["special_seed"] = ("special", np.searchsorted(kept, ds.special_seed.values))
+    return ds, kept
 
 
 def _join(down, up, label):
@@ -197,7 +247,8 @@ def _branches(case, field, start, stop, points, max_n, progress, command, sweep_
     finals = {}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SplineWarning)   # unsettled runs near the folds
-        sw = sweep(sweep_case if sweep_case is not None else case, progress=progress,
+        sweep_case = case if sweep_case is None else sweep_case
+        sw = sweep(sweep_case, progress=progress,
                    follow="both", spectrum=False, finals=finals, **{name: values})
     scale = _scale(load(case))
     pieces, seeds, no_period, status, skipped = [], [], [], [], []
@@ -218,7 +269,9 @@ def _branches(case, field, start, stop, points, max_n, progress, command, sweep_
                     skipped.append(f"{d} {field} = {p:g}")
                     continue
                 if orb is None:
-                    no_period.append((d, values[idx[i]], values[idx[j]]))
+                    no_period.append((d, values[idx[i]], values[idx[j]], "" if finals[d][k] is
+                                      None else _without_period(sweep_case.replace(
+                                          **{name: p}), finals[d][k], n, max_n)))
                     continue
                 if any(_on_branch(x, field, p, orb.y0, scale) for x in pieces):
                     continue
@@ -229,8 +282,9 @@ def _branches(case, field, start, stop, points, max_n, progress, command, sweep_
                     try:
                         with warnings.catch_warnings(record=True):
                             warnings.simplefilter("always", SplineWarning)
-                            halves.append(continuation(case, field, p, end, n=orb.n,
-                                                       guess=orb.y0, progress=progress, **cont))
+                            halves.append(continuation(
+                                case, field, p, end, n=orb.n, guess=orb.y0, progress=progress,
+                                band=(start, stop), **cont))
                     except OrbitError as exc:   # no time left for its orbit at the seed
                         if not out_of_time():
                             raise
@@ -251,11 +305,14 @@ def _branches(case, field, start, stop, points, max_n, progress, command, sweep_
         raise SplineError(f"branches: no periodic attractor found by the follow sweeps over "
                           f"{field} = {start:g}..{stop:g} (stretches without a period: "
                           f"{_spans(no_period) or 'none'})")
-    keep = merged(pieces, field, scale)
-    ds = _concat([pieces[i] for i in keep])
+    ds, kept = _distinct(_concat(pieces), field, scale)
     if no_period:       # plots.frequency_response shades them
-        ds["no_period_range"] = (("stretch", "end"), np.sort([[a, b] for _, a, b in no_period]))
-    ds.attrs.update(start=start, stop=stop, seeds="; ".join(seeds[i] for i in keep),
+        ds["no_period_range"] = (("stretch", "end"),
+                                 np.sort([[a, b] for _, a, b, _ in no_period]))
+        ds["no_period_chaotic"] = ("stretch", [  # 1 chaotic, 0 not, -1 not told
+            1 if w.startswith("chaotic") else 0 if "not chaotic" in w or w.startswith("period")
+            else -1 for *_, w in no_period])
+    ds.attrs.update(start=start, stop=stop, seeds="; ".join(seeds[i] for i in kept),
                     no_period=_spans(no_period), status="; ".join(status) or "complete",
                     n_points=ds.sizes["point"], n_branches=int(ds.branch.max()) + 1,
                     command=command or f"pyspline.branches({case.name!r}, {field!r}, "

@@ -66,6 +66,22 @@ def test_pieces_of_the_same_branch_are_merged(every_branch):
     assert sorted(merged([off, ds], "speed_rpm", s)) == [0, 1]
 
 
+def test_a_branch_traced_twice_goes(every_branch):
+    """Two seeds' pieces (the S-curve, and points 30-70 of it as another seed's): one branch
+    is left, the first seed's; a piece off the branch stays, renumbered."""
+    from pyspline.diagram import _concat, _distinct
+    from test_orbits import scale_of
+    ds, s = every_branch[0], scale_of(DRIVE)
+    mid = ds.isel(point=slice(30, 70))
+    out, kept = _distinct(_concat([ds, mid]), "speed_rpm", s)
+    assert list(kept) == [0] and (out.branch == 0).all() and out.sizes["point"] == ds.sizes["point"]
+    off = mid.copy(deep=True)
+    off["y0"] = off.y0 + 0.05 * np.ptp(ds.y0.values, axis=0)
+    out, kept = _distinct(_concat([mid, off, ds]), "speed_rpm", s)
+    assert list(kept) == [1, 2] and sorted(set(out.branch.values)) == [0, 1]
+    assert set(out.seed.values) == {0, 1}
+
+
 def test_a_stretch_without_a_period_is_shaded(every_branch):
     """Sweep points whose sections give no period (n = 0: chaotic, quasi-periodic or not
     settled) form their own stretch, none is split from its neighbours' periods; the figure
@@ -83,6 +99,17 @@ def test_a_stretch_without_a_period_is_shaded(every_branch):
     assert len(spans) == 1
     assert any(t.get_text().startswith("no periodic attractor") and "chaotic" in t.get_text()
                for t in ax.get_legend().get_texts())
+    # told apart (branches' no_period_chaotic): chaotic darker, each said once
+    ds["no_period_range"] = (("stretch", "end"), [[2250.0, 2260.0], [2260.0, 2280.0],
+                                                  [2400.0, 2410.0]])
+    ds["no_period_chaotic"] = ("stretch", [0, 1, 1])
+    ax = frequency_response(ds, sweep=every_branch[1]).axes[0]
+    grey = {pt.get_x(): pt.get_facecolor()[0] for pt in ax.patches if pt.get_x() in
+            (2250.0, 2260.0, 2400.0)}
+    assert grey[2260.0] == grey[2400.0] < grey[2250.0]
+    texts = [t.get_text() for t in ax.get_legend().get_texts() if "attractor" in t.get_text()]
+    assert len(texts) == 2 and "not chaotic" in texts[0] and "chaotic (largest Lyapunov" in \
+        texts[1]
 
 
 def test_branches_folds_where_the_follow_sweeps_jump(every_branch, follow_sweeps):
@@ -147,6 +174,41 @@ def test_fold_curve_grazing_below_the_upper_fold(fold_curves):
         rest = g[k][1:][np.isfinite(g[k][1:])]
         assert ((rest > f[k, 0] - 5) & (rest < f[k, 1] + 5)).all(), (AMPS[k], g[k], f[k])
     assert np.isnan(g[4]).all()
+
+
+def test_fold_pair_closes_at_a_cusp():
+    """Near the cusp (docs: between a = 0.08 and 0.085) over 2575-2600 r/min: the fold pair
+    narrows as a falls (0.0875, 0.085) and is gone at 0.08. At a cusp the width closes as
+    (a - a_c)^(3/2): its 2/3 power, linear in a through the two pairs, reaches zero between
+    0.08 and 0.085. Follow sweeps at the middle of the 0.085 pair and 8 r/min either side say
+    two orbits there and one outside; at 0.08, at the same speeds, the up and the down chains
+    end on the same orbit (T_m peak-to-peak to 0.5 %): no hysteresis past the cusp."""
+    fc = pyspline.fold_curve(DRIVE.replace(rtol=1e-7, atol=1e-9), "speed_rpm", 2575, 2600,
+                             "ripple_amp(1)", [0.0875, 0.085, 0.08], progress=False,
+                             ds_max=0.5, max_angle=0.3, narrow=False)
+    assert (fc.status == "complete").all(), fc.status.values
+    f = fc.fold.values
+    assert np.isfinite(f[:2, :2]).all() and np.isnan(f[2]).all(), f
+    width = f[:2, 1] - f[:2, 0]
+    assert width[0] > width[1] > 0, width
+    a = fc.value2.values
+    w23 = width ** (2 / 3)
+    cusp = a[1] - w23[1] * (a[0] - a[1]) / (w23[0] - w23[1])
+    assert a[2] < cusp < a[1], (cusp, width)
+    lo, hi = f[1, :2]
+    speeds = [lo - 8, (lo + hi) / 2, hi + 8]
+    pp = {}
+    for amp in (0.085, 0.08):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", pyspline.SplineWarning)
+            sw = pyspline.sweep(SETTLED.replace(ripple_amp=[amp, 0, 0, 0], n_out=2001),
+                                speed_rpm=speeds, follow="both", progress=False,
+                                spectrum=False)
+        assert (sw.error == "").all()
+        pp[amp] = (sw.Tm_max - sw.Tm_min).values
+        assert list(coexistence(sw)) == ([False, True, False] if amp == 0.085 else
+                                         [False] * 3), (amp, pp[amp])
+    assert (np.abs(pp[0.08][0] - pp[0.08][1]) < 5e-3 * pp[0.08].max(0)).all(), pp[0.08]
 
 
 def test_bad_input_is_a_case_error(monkeypatch):

@@ -22,8 +22,11 @@ def test_chaotic_drive_seeds_no_branch(monkeypatch):
     """chaos_z24 (a vibro-impact drive with a Lyapunov exponent near 900 1/s,
     tests/test_chaos.py) swept up and down over 5900-6100 r/min: no run's sections give a
     period, Newton from its final state finds no stable period-1 orbit, so the whole band is
-    one stretch without a period each way, named in the error, and no continuation runs
-    (runs of 5 revolutions after 2: the follow chains carry the motion on)."""
+    one stretch without a period each way, named in the error as chaotic (a run of the same
+    length from its middle point's final state has a largest Lyapunov exponent of 300 1/s or
+    more, as tests/test_chaos.py measures over 200 revolutions, beyond its estimate's spread),
+    and no continuation runs (runs of 5 revolutions after 2: the follow chains carry the
+    motion on)."""
     case = pyspline.load_case(CASES / "chaos_z24.nml", lyapunov=False, t_transient=0.02,
                               t_end=0.07, n_out=201)
     tried = []
@@ -36,10 +39,34 @@ def test_chaotic_drive_seeds_no_branch(monkeypatch):
         warnings.simplefilter("ignore", pyspline.SplineWarning)
         with pytest.raises(pyspline.SplineError, match=r"no periodic attractor found by the "
                            r"follow sweeps over speed_rpm = 5900..6100 \(stretches without a "
-                           r"period: up 5900..6100; down 6100..5900\)"):
+                           r"period: up 5900..6100 \(chaotic: .*\); down 6100..5900 "
+                           r"\(chaotic: .*\)\)") as err:
             pyspline.branches(case, "speed_rpm", 5900, 6100, points=3, max_n=1,
                               progress=False)
     assert tried == [1, 1]      # one seed tried per stretch, at its middle
+    said = re.findall(r"largest Lyapunov exponent (\S+) 1/s \(spread ([\d.e+-]+)\)",
+                      str(err.value))
+    assert len(said) == 2 and all(300 < float(lam) and float(sp) < float(lam) for lam, sp in said)
+
+
+def test_unsettled_periodic_drive_is_not_chaos():
+    """DOUBLING over 1646-1650 r/min, whose attractor is the stable period-2 orbit (its
+    sections give period 2 after 40 revolutions, test_period_two_seed_from_the_sections),
+    swept with runs of 5 revolutions after 5 and max_n = 1: the sections give no period
+    (not settled) and Newton finds no stable period-1 orbit, so nothing is seeded; each
+    stretch is said to have no period within 5 revolutions and not to be chaotic: the largest
+    Lyapunov exponent of its run is negative."""
+    T = 60 / 1650
+    short = DOUBLING.replace(t_end=10 * T, t_transient=5 * T, n_out=201, section="shaft")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        with pytest.raises(pyspline.SplineError, match=r"no periodic attractor") as err:
+            pyspline.branches(DOUBLING, "speed_rpm", 1646, 1650, points=3, max_n=1,
+                              progress=False, sweep_case=short)
+    said = re.findall(r"(up|down) \S+ \(no period found within 5 revolutions, not chaotic: "
+                      r"largest Lyapunov exponent (\S+) 1/s", str(err.value))
+    assert [d for d, _ in said] == ["up", "down"] and "(chaotic:" not in str(err.value), err.value
+    assert all(float(lam) < 0 for _, lam in said), said
 
 
 def test_period_two_seed_from_the_sections(monkeypatch):
@@ -68,6 +95,47 @@ def test_period_two_seed_from_the_sections(monkeypatch):
     assert ds.attrs["status"] == "complete" and ds.attrs["no_period"] == ""
     assert (ds.n == 2).all() and ds.stable.all()
     assert float(ds.speed_rpm[0]) == 1646 and float(ds.speed_rpm[-1]) == pytest.approx(1650, rel=1e-12)
+    # no point past stop (a corrector that converged there is put onto it)
+    assert (ds.speed_rpm >= 1646).all() and (ds.speed_rpm <= 1650).all(), ds.speed_rpm.values
+
+
+def test_branches_through_a_period_doubling():
+    """DOUBLING over 1617-1626 r/min (rtol 1e-8, steps up to 0.5): the follow sweeps' runs have
+    not settled (no period), the seed in the middle is the stable period-1 orbit; its branch
+    doubles (a multiplier at -1) and the doubled branch is followed over the whole band, not
+    only the seed's half (1621.5-1626): from the doubling down, unstable, to its fold (a
+    multiplier of P^2 at +1) below the seed, and back up, stable, to stop. Its points are
+    period-2 orbits (P^2(y) = y, P(y) away from y); two branches, none past the band."""
+    from pyspline.orbits import _period_map, map_and_monodromy
+    from test_orbits import scale_of
+    case = DOUBLING.replace(rtol=1e-8, atol=1e-10)
+    T = 60 / 1650
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds, _ = pyspline.branches(case, "speed_rpm", 1617, 1626, points=3, max_n=2,
+                                  progress=False, ds_max=0.5, max_angle=0.3,
+                                  sweep_case=case.replace(t_end=20 * T, t_transient=10 * T,
+                                                          section="shaft"))
+    assert ds.attrs["status"] == "complete" and ds.attrs["n_branches"] == 2
+    p, b, n = ds.speed_rpm.values, ds.branch.values, ds.n.values
+    assert ((p >= 1617) & (p <= 1626)).all()
+    assert (n[b == 0] == 1).all() and (n[b == 1] == 2).all()
+    kind, sp = ds.special_type.values, ds.special_speed_rpm.values
+    mu = ds.special_mu_real.values + 1j * ds.special_mu_imag.values
+    pd, fold = np.flatnonzero(kind == "period_doubling"), np.flatnonzero(kind == "fold")
+    assert len(pd) == 1 and ds.special_branch[pd[0]] == 0 and abs(mu[pd[0]] + 1) < 1e-3
+    assert len(fold) == 1 and ds.special_branch[fold[0]] == 1 and abs(mu[fold[0]] - 1) < 1e-2
+    two, st = p[b == 1], ds.stable.values[b == 1].astype(bool)
+    assert two[0] == pytest.approx(sp[pd[0]], abs=0.1) and two[-1] == pytest.approx(1626)
+    assert sp[fold[0]] < 1621.5 and two.min() == pytest.approx(sp[fold[0]], abs=0.5)
+    turn = np.argmin(two)
+    assert not st[:turn - 1].any() and st[turn + 2:].all()
+    y, s = ds.y0.values[b == 1][-1], scale_of(case)
+    c = case.replace(speed_rpm=1626.0)
+    y2, _, free = map_and_monodromy(c, 0.0, 2 * 60 / 1626, y)
+    y1 = _period_map(c.model, 0.0, 60 / 1626, y[:, None])[0][:, 0]
+    assert np.abs((y2 - y)[free] / s[free]).max() < 1e-5
+    assert np.abs((y1 - y)[free] / s[free]).max() > 0.1
 
 
 def test_cli_all_and_fold_keep_what_they_have(tmp_path):

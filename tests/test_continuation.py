@@ -238,6 +238,9 @@ def test_bad_range_and_follow():
     (dict(tol=np.nan), r"tol = nan: must be finite"),
     (dict(n="1"), r"n = '1': the shaft revolutions of the period must be a whole number"),
     (dict(n=0), r"n = 0: the shaft revolutions"),
+    (dict(band=(30.5, 31.0)), r"band = \(30.5, 31.0\): two values holding start = 30 and stop"),
+    (dict(band=(30.0,)), r"band = \(30.0,\): two values holding"),
+    (dict(band=("a", 31.0)), r"band = \('a', 31.0\): two values holding"),
 ])
 def test_bad_arguments_name_themselves(kwargs, match):
     """Each bad argument: a CaseError naming it and why, before anything runs."""
@@ -250,7 +253,9 @@ def test_bad_arguments_name_themselves(kwargs, match):
 def test_field_values_outside_their_range():
     """A stop outside the field's valid range names the stop (not a difference step's value);
     a speed of 0 has no forcing period; a ripple order that does not repeat in one revolution
-    is refused at the stop as at the start; periodic_orbit refuses tol = nan."""
+    is refused at the stop as at the start, and one whose valid values are whole numbers (1 to
+    2) cannot be continued (no valid value within the difference step); periodic_orbit refuses
+    tol = nan."""
     with pytest.raises(pyspline.CaseError, match=r"stop = 0 is not a valid value of speed_rpm: "
                        r".*speed_rpm = 0.0: the shaft does not turn"):
         pyspline.continuation(RESONANCE, "speed_rpm", 2300, 0.0, progress=False)
@@ -260,6 +265,10 @@ def test_field_values_outside_their_range():
     with pytest.raises(pyspline.CaseError, match=r"stop = 1.5 is not a valid value of "
                        r"ripple_order\(1\): .*ripple_order = 1.5 .* does not repeat within n = 1"):
         pyspline.continuation(RESONANCE, "ripple_order(1)", 1.0, 1.5, progress=False)
+    with pytest.raises(pyspline.CaseError, match=r"field ripple_order\(1\) cannot be continued: "
+                       r"its valid values are isolated \(none within 3.16e-05 of start = 1: "
+                       r".*does not repeat within n = 1"):
+        pyspline.continuation(RESONANCE, "ripple_order(1)", 1.0, 2.0, progress=False)
     with pytest.raises(pyspline.CaseError, match=r"tol = nan: the scaled residual to reach"):
         pyspline.periodic_orbit(RESONANCE, tol=float("nan"))
 

@@ -88,12 +88,21 @@ def frequency_response(branch, measure: str = "Tm_pp", sweep=None, path=None,
                     ls="", marker=mk, ms=6, mfc="none", mec=colour, mew=1.2, zorder=4)
             handles.append(Line2D([], [], ls="", marker=mk, ms=6, mfc="none", mec=colour,
                                   mew=1.2, label=label))
-    for k, (a, b) in enumerate(branch["no_period_range"].values if "no_period_range" in
-                               branch else []):      # pyspline.branches: no seed there
-        ax.axvspan(a / fx, b / fx, color="0.85", zorder=0)
-        if not k:
-            handles.append(Patch(color="0.85", label="no periodic attractor (n <= max_n): "
-                                 "chaotic, quasi-periodic or not settled"))
+    ranges = branch["no_period_range"].values if "no_period_range" in branch else []
+    chaotic = branch["no_period_chaotic"].values if "no_period_chaotic" in branch else \
+        [-1] * len(ranges)                # pyspline.branches: no seed there; -1: not told
+    said = {1: ("0.7", "no periodic attractor: chaotic (largest Lyapunov exponent > 0)"),
+            0: ("0.85", "no periodic attractor (n <= max_n): not settled, quasi-periodic or a "
+                "longer period; not chaotic"),
+            -1: ("0.85", "no periodic attractor (n <= max_n): chaotic, quasi-periodic or not "
+                 "settled")}
+    shown = set()
+    for (a, b), kind in zip(ranges, map(int, chaotic)):
+        colour, label = said[kind]
+        ax.axvspan(a / fx, b / fx, color=colour, zorder=0)
+        if kind not in shown:
+            shown.add(kind)
+            handles.append(Patch(color=colour, label=label))
     ax.set_xlabel(ps.label(branch, field, factor_unit=ux))
     ax.set_ylabel(f"{name} [{uy}]" if uy else name)
     ax.grid(alpha=0.3, lw=0.5)
