@@ -7,9 +7,7 @@ import warnings
 
 import numpy as np
 import pytest
-from matplotlib.axes import Axes
 from matplotlib.colors import TwoSlopeNorm
-from matplotlib.text import Text
 
 import pyspline
 from pyspline import analysis, dataset
@@ -18,7 +16,8 @@ from pyspline.plots import eng
 from pyspline.plots import run as pr
 from pyspline.plots import sweeps as sw
 
-from conftest import CASES, PAPER_SHAFTS  # noqa: E402
+from conftest import CASES  # noqa: E402
+from figtools import _cut_off, _inside, _points, _words  # noqa: E402
 
 xr = pytest.importorskip("xarray")
 
@@ -42,55 +41,6 @@ def _var(dims, values, name):
 
 def _coord(name, values):
     return (name, np.asarray(values, float), dataset._field_attrs(name))
-
-
-def _texts(fig) -> dict:
-    """The words a reader sees on a figure or one of its axes, by place: 'labels' (axis labels,
-    titles, colour bar labels), 'legend' (entries and titles), 'notes' (texts on the axes and
-    on the figure)."""
-    out = {"labels": [], "legend": [], "notes": []}
-    if isinstance(fig, Axes):
-        fig, axes = fig.figure, [fig]
-    else:
-        axes = fig.axes
-    for ax in axes:
-        out["labels"] += [ax.xaxis.label, ax.yaxis.label, ax.title]
-        out["notes"] += ax.texts
-        if ax.get_legend():
-            out["legend"] += [*ax.get_legend().get_texts(), ax.get_legend().get_title()]
-    if axes == fig.axes:
-        for leg in fig.legends:
-            out["legend"] += [*leg.get_texts(), leg.get_title()]
-        out["labels"] += [t for t in (fig._suptitle, fig._supylabel) if t is not None]
-        out["notes"] += fig.texts
-    return {k: [t for t in v if t.get_visible() and t.get_text()] for k, v in out.items()}
-
-
-def _words(fig, where=("labels", "legend", "notes")) -> str:
-    return " | ".join(t.get_text() for k in where for t in _texts(fig)[k])
-
-
-def _cut_off(fig) -> list:
-    """The labels, titles, legend entries and notes that reach past the figure's edge."""
-    fig.draw_without_rendering()
-    r = fig._get_renderer()
-    w, h = fig.bbox.width, fig.bbox.height
-    return [t.get_text() for ts in _texts(fig).values() for t in ts
-            if not (lambda b: b.x0 >= -1 and b.y0 >= -1 and b.x1 <= w + 1 and b.y1 <= h + 1)(
-                t.get_window_extent(r))]
-
-
-def _points(ax) -> np.ndarray:
-    """The (x, y) of every marker of the axes' scatter collections."""
-    offs = [c.get_offsets() for c in ax.collections if hasattr(c, "get_offsets")
-            and len(c.get_offsets())]
-    return np.vstack(offs) if offs else np.empty((0, 2))
-
-
-def _inside(ax, x, y):
-    (x0, x1), (y0, y1) = sorted(ax.get_xlim()), sorted(ax.get_ylim())
-    x, y = np.asarray(x, float), np.asarray(y, float)
-    return bool((x0 <= x.min()) & (x.max() <= x1) & (y0 <= y.min()) & (y.max() <= y1))
 
 
 # --------------------------------------------------------------------------- sweeps
@@ -398,40 +348,3 @@ def test_sweep_figures_show_the_sweep(tiny_sweep, tmp_path, monkeypatch, capsys)
     assert wf.get_xlabel() == "frequency [Hz]" and wf.get_ylabel() == "shaft speed [r/min]"
     assert "16x" in _words(wf, ["notes"])          # the tooth pass of the Z = 16 case
     assert _cut_off(figs["bifurcation.png"]) == []        # the sweep's own titles
-
-
-# --------------------------------------------------------------------------- the paper's
-
-@PAPER_SHAFTS
-def test_paper_dynamics_figure_shows_the_run(monkeypatch, tmp_path):
-    """Fig. 4's page of a 0.2 s run of paper_ideal: the Poincare panel's points and its count of
-    distinct ones, one bar per tooth at the instant of the largest load, the time panels."""
-    from pyspline import paper
-    from pyspline.paper import figures as pf
-    res = pyspline.simulate(pyspline.load_case(CASES / "paper_ideal.nml", t_end=0.2))
-    close, figs = pf.plt.close, []
-    monkeypatch.setattr(pf.plt, "close", figs.append)       # keep the figure to read it
-    pf.dynamics_figure(res, tmp_path / "fig4.png", "Ideal spline pair (paper Fig. 4)")
-    (fig,) = figs
-    try:
-        d, phase, poinc, f, fx, tm = fig.axes
-        p, nd = paper.poincare(res), paper.poincare_count(res)
-        (pts,) = poinc.get_lines()
-        assert len(pts.get_xdata()) == len(p) > 5 and _inside(poinc, p[:, 0] * 1e3, p[:, 1])
-        assert f"{nd} distinct point" in poinc.get_title().replace("\n", " ")
-        k = int(np.argmax(np.abs(res.Tm)))
-        for ax, q in ((f, res.F), (fx, res.Fx)):
-            assert [b.get_height() for b in ax.patches] == q[k].tolist()    # one bar a tooth
-            ticks = [v for v in ax.get_xticks() if 1 <= v <= res.F.shape[1]]
-            assert len(ticks) <= 10 and all(v == int(v) for v in ticks)
-        assert f"at t = {res.t[k]:.4f} s (largest load)" in _words(f, ["legend"])
-        # the aligned drive's lateral forces balance: the note says so, not round-off digits
-        assert abs(res.Fx[k].sum()) <= 1e-9 * np.abs(res.Fx[k]).sum()
-        assert fx.get_title().startswith("sum of F_jx at that instant: 0 to round-off (sum of")
-        assert d.get_ylabel() == "relative displacement D_2 (line of action) [mm]"
-        assert _inside(d, res.t, res.D2 * 1e3) and _inside(tm, res.t, res.Tm)
-        assert tm.get_ylabel() == "meshing torque T_m [N m]" and tm.get_xlabel() == "time t [s]"
-        assert (phase.get_xlabel(), phase.get_ylabel()) == ("D_2 [mm]", "dD_2/dt [m/s]")
-        assert _cut_off(fig) == []
-    finally:
-        close(fig)
