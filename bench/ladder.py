@@ -16,7 +16,7 @@ from pathlib import Path
 from pyspline import SplineError, load_case, simulate
 from pyspline.core import THERMAL_LEVELS as THERMAL, level_name
 from pyspline.paper import cases_dir
-from speed import _errors, _write_csv
+from speed import _errors, _write_csv, decade_axis
 
 #: thermal levels that report what a case's own level reports (auto chooses among these)
 ELIGIBLE = {"none": ("none",), "bulk": ("none", "bulk"), "oneway": ("oneway",),
@@ -123,6 +123,7 @@ def _plot(rows, names, path=None):
                              3.8, 9), fontsize=9)
         ax.set_xlabel("core time [s]", fontsize=8)
         ax.set_ylabel("error vs the case's level", fontsize=8)
+        decade_axis(ax.xaxis)
         ax.tick_params(labelsize=7)
     for ax in list(axes.flat)[len(names):]:
         ax.axis("off")

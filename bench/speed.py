@@ -275,6 +275,16 @@ def _write_csv(path, rows):
         w.writerows(rows)
 
 
+def decade_axis(axis):
+    """A log axis with a labelled decade and no minor tick labels (2x10^-2, 3x10^-2 ... crowd
+    one another): limits at least a decade apart around the data's."""
+    from matplotlib.ticker import NullFormatter
+    lo, hi = sorted(axis.get_view_interval())
+    if hi < 10 * lo:
+        axis.set_view_interval(np.sqrt(lo * hi) / 3.2, np.sqrt(lo * hi) * 3.2, ignore=True)
+    axis.set_minor_formatter(NullFormatter())
+
+
 def _plot_wp(rows, notes, path=None):
     """Error against wall time per method and case, one panel per case; one legend for all
     (a method keeps its colour); failed runs are named in their panel's title, not drawn."""
@@ -292,9 +302,14 @@ def _plot_wp(rows, notes, path=None):
             style = "-" if "CVODE" in method else ("--" if "fortran" in method else ":")
             ax.plot([r["time_s"] for r in ok], [max(r["err_Tm"], r["err_F"]) for r in ok],
                     style, marker="o", ms=3, label=method, color=colours[i % len(colours)])
-        bad = [f"{r['method']} at rtol {r['rtol']:g}" for r in sub if r["status"] != "ok"]
+        bad = {}
+        for r in sub:
+            if r["status"] != "ok":
+                bad.setdefault(r["method"], []).append(f"{r['rtol']:g}")
+        bad = [f"{m} at rtol {', '.join(rt)}" for m, rt in bad.items()]
         ax.set_xscale("log")
         ax.set_yscale("log")
+        decade_axis(ax.xaxis)
         ax.set_xlabel("wall time of a run [s]")
         ax.set_ylabel("max relative error of T_m and F_j")
         ax.set_title(ps.wrap(f"{name}; failed, not drawn: {', '.join(bad)}" if bad else name,

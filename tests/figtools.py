@@ -92,3 +92,20 @@ def _shown(axis, v) -> bool:
 def _visible_ticks(axis) -> list:
     """The tick values an axis shows (within its limits)."""
     return [v for v in axis.get_majorticklocs() if _shown(axis, v)]
+
+
+def _crowded(fig) -> list:
+    """The tick labels (major and minor) of an axis that overlap one another or the axis'
+    label, as pairs of texts."""
+    r = _renderer(fig)
+    out = []
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            texts = [t for tick in axis.get_major_ticks() + axis.get_minor_ticks()
+                     if _shown(axis, tick.get_loc())
+                     for t in (tick.label1, tick.label2) if t.get_visible() and t.get_text()]
+            texts += [axis.label] if axis.label.get_visible() and axis.label.get_text() else []
+            boxes = [(t.get_text(), t.get_window_extent(r)) for t in texts]
+            out += [(a, b) for i, (a, box) in enumerate(boxes) for b, other in boxes[i + 1:]
+                    if box.overlaps(other)]
+    return out

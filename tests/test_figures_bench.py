@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from conftest import ROOT  # noqa: E402
-from figtools import _covered, _cut_off, _inside, _markers, _renderer, _words  # noqa: E402
+from figtools import _covered, _crowded, _cut_off, _inside, _markers, _renderer, _words  # noqa: E402
 
 sys.path.insert(0, str(ROOT / "bench"))
 import speed  # noqa: E402  (bench/ is not installed)
@@ -25,15 +25,16 @@ def _texts_inside_axes(ax) -> list:
 
 
 def test_work_precision_one_colour_a_method_and_failures_named():
-    """22 methods (more than one colour cycle of tab20), two rtols each, one failed run: every
-    method its own colour, one legend for the page, over no marker; the failed run in its
-    panel's title, not drawn."""
+    """22 methods (more than one colour cycle of tab20), two rtols each, the last failing at
+    both: every method its own colour, one legend for the page, over no marker; the failed
+    runs in the panel's title, not drawn."""
     methods = [f"method {i}" for i in range(22)]
     rows = [dict(case="paper_lx1e-4", method=m, rtol=rt, status="ok", time_s=1e-3 * (i + 1) / rt
                  ** 0.1, err_Tm=rt * (i + 1), err_F=rt) for i, m in enumerate(methods)
             for rt in (1e-3, 1e-5)]
-    rows[-1].update(status="FAILED: budget", time_s=float("nan"), err_Tm=float("nan"),
-                    err_F=float("nan"))
+    for r in rows[-2:]:                                    # the last method fails at both
+        r.update(status="FAILED: budget", time_s=float("nan"), err_Tm=float("nan"),
+                 err_F=float("nan"))
     fig = speed._plot_wp(rows, ["paper_lx1e-4: reference agrees with DOP853 to 1e-9"])
     (ax,) = fig.axes
     lines = ax.get_lines()
@@ -42,13 +43,13 @@ def test_work_precision_one_colour_a_method_and_failures_named():
     ok = [r for r in rows if r["status"] == "ok"]
     assert sum(len(ln.get_xdata()) for ln in lines) == len(ok)              # failures not drawn
     assert _inside(ax, [r["time_s"] for r in ok], [max(r["err_Tm"], r["err_F"]) for r in ok])
-    assert "failed, not drawn: method 21 at rtol 1e-05" in ax.get_title().replace("\n", " ")
+    assert "failed, not drawn: method 21 at rtol 0.001, 1e-05" in ax.get_title().replace("\n", " ")
     assert ax.get_xlabel() == "wall time of a run [s]" and ax.get_legend() is None
     (legend,) = fig.legends
     assert [t.get_text() for t in legend.get_texts()] == methods
     assert _covered(ax, legend) == []
     assert "reference agrees with DOP853" in fig._suptitle.get_text()
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == []
 
 
 def test_stability_map_one_colour_scale_and_failures_marked():
@@ -72,19 +73,20 @@ def test_stability_map_one_colour_scale_and_failures_marked():
     assert x.get_text() == "X" and x.get_position() == (1, 1)
     assert "1 of 6 runs failed" in a.get_title() and "0 of 6 runs failed" in b.get_title()
     assert bar.get_ylabel() == "log10 of the wall time of a run [s]"
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == []
 
 
 def test_ladder_holds_every_level_and_marks_auto_by_tolerance():
-    """One case: levels from exact (drawn at the 1e-16 floor) to an error of 10, a failed level,
-    auto's two picks at the dearest level: every marker inside the limits, the picks told
-    apart by marker (no annotation past the panel), the failure in the title."""
+    """One case: levels from exact (drawn at the 1e-16 floor) to an error of 10, costs within
+    one decade, a failed level, auto's two picks at the dearest level: every marker inside the
+    limits, the picks told apart by marker (no annotation past the panel), the failure in the
+    title, the time axis' labels apart."""
     import ladder
     rows = [dict(case="paper_T100", level=f"{d}-DOF {th}", dof=d, thermal=th, own=own,
                  eligible=True, status="ok", cost_s=c, error=e)
             for d, th, own, c, e in ((7, "coupled", True, 0.1, 0.0), (3, "coupled", False, 0.02,
-                                     10.0), (7, "oneway", False, 0.01, 1e-3),
-                                     (3, "oneway", False, 0.005, 0.5))]
+                                     10.0), (7, "oneway", False, 0.05, 1e-3),
+                                     (3, "oneway", False, 0.03, 0.5))]
     rows.append(dict(rows[1], level="3-DOF bulk", thermal="bulk", status="FAILED: x",
                      cost_s=float("nan"), error=float("nan")))
     rows += [dict(rows[0], level=f"auto {tol:g}", own=False, tol=tol) for tol in ladder.TOLS]
@@ -99,7 +101,7 @@ def test_ladder_holds_every_level_and_marks_auto_by_tolerance():
     legend = _words(fig, ["legend"])
     assert "fidelity = auto, tol 0.01" in legend and "fidelity = auto, tol 0.001" in legend
     assert _texts_inside_axes(ax) == [] and _covered(ax, fig.legends[0]) == []
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == []
 
 
 def test_anatomy_shares_and_costs_inside_their_axes():
@@ -122,7 +124,7 @@ def test_anatomy_shares_and_costs_inside_their_axes():
     assert _inside(a2, xy[:, 0], xy[:, 1]) and a2.get_ylabel() == "ns per call"
     assert [t.get_text() for t in a2.get_xticklabels()] == [r["case"] for r in rows]
     assert _covered(a1) == [] and _covered(a2) == []
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == []
 
 
 def test_bifurcation_accuracy_holds_every_rtol():
@@ -142,4 +144,4 @@ def test_bifurcation_accuracy_holds_every_rtol():
     assert [t.get_text() for t in ax.texts] == [f"{rt:g}" for rt in rtols]
     assert _texts_inside_axes(ax) == [] and _covered(ax) == []
     assert "the sweep at each rtol against rtol" in ax.get_title().replace("\n", " ")
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == []
