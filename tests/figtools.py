@@ -109,3 +109,13 @@ def _crowded(fig) -> list:
             out += [(a, b) for i, (a, box) in enumerate(boxes) for b, other in boxes[i + 1:]
                     if box.overlaps(other)]
     return out
+
+
+def _legend_over_words(fig) -> list:
+    """The legends (the axes' and the figure's) that overlap a title, an axis label or the
+    figure's title, as (legend's first entry, the text)."""
+    r = _renderer(fig)
+    legends = [ax.get_legend() for ax in fig.axes if ax.get_legend()] + list(fig.legends)
+    words = _texts(fig)["labels"]
+    return [(leg.get_texts()[0].get_text(), t.get_text()) for leg in legends for t in words
+            if leg.get_window_extent(r).overlaps(t.get_window_extent(r))]

@@ -17,7 +17,8 @@ from pyspline.plots import run as pr
 from pyspline.plots import sweeps as sw
 
 from conftest import CASES  # noqa: E402
-from figtools import _cut_off, _inside, _points, _words  # noqa: E402
+from figtools import (_covered, _cut_off, _inside, _legend_over_words, _points,  # noqa: E402
+                      _words)
 
 xr = pytest.importorskip("xarray")
 
@@ -71,6 +72,25 @@ def test_bifurcation_shows_every_section_point_by_period(line):
     assert "not periodic (1)" in legend and "period 3" not in legend
     assert "1 of 5 runs without a result" in _words(fig, ["notes"])    # the failed point
     assert _cut_off(fig) == []
+
+
+def test_bifurcation_legend_covers_no_point():
+    """A sweep whose section points fill the panel (40 speeds, 25 levels each, not periodic
+    but the last): the legend stands beside them."""
+    speed = np.linspace(1000.0, 5000.0, 40)
+    y = np.tile(np.linspace(-900e-6, -700e-6, 25), (40, 1))
+    per = np.r_[np.zeros(39), 1.0]
+    ds = xr.Dataset({"section_D2": _var(("speed_rpm", "section_point"), y, "section_D2"),
+                     "period": _var("speed_rpm", per, "period")},
+                    coords={"speed_rpm": _coord("speed_rpm", speed)})
+    fig = sw.bifurcation(ds, "speed_rpm")
+    ax = fig.axes[0]
+    assert len(_points(ax)) == y.size and _inside(ax, *_points(ax).T)
+    (legend,) = fig.legends or [ax.get_legend()]
+    assert _covered(ax, legend) == []
+    assert _words(fig, ["legend"]).split(" | ") == ["not periodic (39)", "period 1 (1)",
+                                                     "runs by period"]
+    assert _cut_off(fig) == [] and _legend_over_words(fig) == []
 
 
 def test_lyapunov_shades_chaos_and_gives_horizons_beyond_the_spread(line):

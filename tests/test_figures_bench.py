@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from conftest import ROOT  # noqa: E402
-from figtools import _covered, _crowded, _cut_off, _inside, _markers, _renderer, _words  # noqa: E402
+from figtools import (_covered, _crowded, _cut_off, _inside, _legend_over_words,
+                     _markers, _renderer, _words)  # noqa: E402
 
 sys.path.insert(0, str(ROOT / "bench"))
 import speed  # noqa: E402  (bench/ is not installed)
@@ -49,7 +50,7 @@ def test_work_precision_one_colour_a_method_and_failures_named():
     assert [t.get_text() for t in legend.get_texts()] == methods
     assert _covered(ax, legend) == []
     assert "reference agrees with DOP853" in fig._suptitle.get_text()
-    assert _cut_off(fig) == [] and _crowded(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 def test_stability_map_one_colour_scale_and_failures_marked():
@@ -68,12 +69,13 @@ def test_stability_map_one_colour_scale_and_failures_marked():
         assert im.norm.vmin == logt.min() and im.norm.vmax == logt.max()    # shared
         assert ax.get_xlabel() == "mesh stiffness k_m [N/m]"
     grid = a.get_images()[0].get_array()
-    assert np.ma.getmaskarray(grid)[1, 1] and grid[0, 1] == pytest.approx(np.log10(rows[2]["time_s"]))
+    assert np.ma.getmaskarray(grid)[1, 1]                          # the failed cell: no colour
+    assert grid[0, 1] == pytest.approx(np.log10(rows[2]["time_s"]))
     (x,) = a.texts
     assert x.get_text() == "X" and x.get_position() == (1, 1)
     assert "1 of 6 runs failed" in a.get_title() and "0 of 6 runs failed" in b.get_title()
     assert bar.get_ylabel() == "log10 of the wall time of a run [s]"
-    assert _cut_off(fig) == [] and _crowded(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 def test_ladder_holds_every_level_and_marks_auto_by_tolerance():
@@ -101,7 +103,7 @@ def test_ladder_holds_every_level_and_marks_auto_by_tolerance():
     legend = _words(fig, ["legend"])
     assert "fidelity = auto, tol 0.01" in legend and "fidelity = auto, tol 0.001" in legend
     assert _texts_inside_axes(ax) == [] and _covered(ax, fig.legends[0]) == []
-    assert _cut_off(fig) == [] and _crowded(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 def test_anatomy_shares_and_costs_inside_their_axes():
@@ -124,7 +126,7 @@ def test_anatomy_shares_and_costs_inside_their_axes():
     assert _inside(a2, xy[:, 0], xy[:, 1]) and a2.get_ylabel() == "ns per call"
     assert [t.get_text() for t in a2.get_xticklabels()] == [r["case"] for r in rows]
     assert _covered(a1) == [] and _covered(a2) == []
-    assert _cut_off(fig) == [] and _crowded(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 def test_bifurcation_accuracy_holds_every_rtol():
@@ -144,4 +146,4 @@ def test_bifurcation_accuracy_holds_every_rtol():
     assert [t.get_text() for t in ax.texts] == [f"{rt:g}" for rt in rtols]
     assert _texts_inside_axes(ax) == [] and _covered(ax) == []
     assert "the sweep at each rtol against rtol" in ax.get_title().replace("\n", " ")
-    assert _cut_off(fig) == [] and _crowded(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []

@@ -12,7 +12,8 @@ from pyspline import paper
 from pyspline.paper import figures as pf
 
 from conftest import CASES, PAPER_SHAFTS  # noqa: E402
-from figtools import _covered, _crowded, _cut_off, _inside, _visible_ticks, _words  # noqa: E402
+from figtools import (_covered, _crowded, _cut_off, _inside, _legend_over_words,
+                     _visible_ticks, _words)  # noqa: E402
 
 pytestmark = PAPER_SHAFTS
 T_END = 0.2       # [s]: ten revolutions past paper.SETTLE, the largest load at 0.076 s
@@ -72,7 +73,7 @@ def test_fig4_dynamics_shows_the_run(results):
     assert _inside(d, res.t, res.D2 * 1e3) and _inside(tm, res.t, res.Tm)
     assert tm.get_ylabel() == "meshing torque T_m [N m]" and tm.get_xlabel() == "time t [s]"
     assert (phase.get_xlabel(), phase.get_ylabel()) == ("D_2 [mm]", "dD_2/dt [m/s]")
-    assert _cut_off(fig) == [] and _crowded(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 def test_figs5_6_misalignment_one_row_per_case(results):
@@ -96,7 +97,7 @@ def test_figs5_6_misalignment_one_row_per_case(results):
         k = int(np.argmax(np.abs(res.Tm)))
         assert fx.get_title() == (f"sum of F_jx at that instant: "
                                   f"{pyspline.plots.eng(res.Fx[k].sum(), 3)} N")
-    assert _cut_off(fig) == [] and _crowded(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 def test_figs7_8_bulk_temperature(results):
@@ -110,7 +111,7 @@ def test_figs7_8_bulk_temperature(results):
         assert _inside(tm, res.t, res.Tm) and _inside(kv, res.t, res.kv)
         assert tm.get_ylabel() == "meshing torque T_m [N m]"
         assert kv.get_ylabel() == "dynamic load coefficient k_v [-]"
-    assert _cut_off(fig) == [] and _crowded(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 def test_figs9_10_flash_temperature_over_misalignment(results):
@@ -136,4 +137,4 @@ def test_figs9_10_flash_temperature_over_misalignment(results):
     assert curve.get_xdata().tolist() == lx and _inside(trend, lx, curve.get_ydata())
     assert trend.get_xlabel() == "misalignment l_x [mm]"
     assert "f_m = " in fig._suptitle.get_text()
-    assert _cut_off(fig) == [] and _crowded(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
