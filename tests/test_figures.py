@@ -75,11 +75,11 @@ def test_bifurcation_shows_every_section_point_by_period(line):
 
 
 def test_bifurcation_legend_covers_no_point():
-    """A sweep whose section points fill the panel (40 speeds, 25 levels each, not periodic
+    """A sweep whose section points fill the panel (20 speeds, 12 levels each, not periodic
     but the last): the legend stands beside them."""
-    speed = np.linspace(1000.0, 5000.0, 40)
-    y = np.tile(np.linspace(-900e-6, -700e-6, 25), (40, 1))
-    per = np.r_[np.zeros(39), 1.0]
+    speed = np.linspace(1000.0, 5000.0, 20)
+    y = np.tile(np.linspace(-900e-6, -700e-6, 12), (20, 1))
+    per = np.r_[np.zeros(19), 1.0]
     ds = xr.Dataset({"section_D2": _var(("speed_rpm", "section_point"), y, "section_D2"),
                      "period": _var("speed_rpm", per, "period")},
                     coords={"speed_rpm": _coord("speed_rpm", speed)})
@@ -88,7 +88,7 @@ def test_bifurcation_legend_covers_no_point():
     assert len(_points(ax)) == y.size and _inside(ax, *_points(ax).T)
     (legend,) = fig.legends or [ax.get_legend()]
     assert _covered(ax, legend) == []
-    assert _words(fig, ["legend"]).split(" | ") == ["not periodic (39)", "period 1 (1)",
+    assert _words(fig, ["legend"]).split(" | ") == ["not periodic (19)", "period 1 (1)",
                                                      "runs by period"]
     assert _cut_off(fig) == [] and _legend_over_words(fig) == []
 
