@@ -1,8 +1,9 @@
 """What each figure of pyspline.plots shows, on small hand-built datasets (with the names and
 units a sweep gives them, pyspline.dataset's) and one tiny sweep: axis labels with their units,
 limits that hold the data, as many markers and curves as the data has points and branches, the
-legends' and notes' words (a failed point, chaos, points left out), and every label, title,
-legend and note inside the figure (none cut off at its edge)."""
+legends' and notes' words (a failed point, chaos, points left out), every label, title,
+legend, note and tick label inside the figure (none cut off at its edge), tick labels apart and
+no legend over a title, label or the data it explains."""
 import warnings
 
 import numpy as np
@@ -17,8 +18,8 @@ from pyspline.plots import run as pr
 from pyspline.plots import sweeps as sw
 
 from conftest import CASES  # noqa: E402
-from figtools import (_covered, _cut_off, _inside, _legend_over_words, _points,  # noqa: E402
-                      _words)
+from figtools import (_covered, _crowded, _cut_off, _inside, _legend_over_words,  # noqa: E402
+                      _points, _words)
 
 xr = pytest.importorskip("xarray")
 
@@ -71,7 +72,7 @@ def test_bifurcation_shows_every_section_point_by_period(line):
     assert "period 1 (2)" in legend and "period 2 (1)" in legend
     assert "not periodic (1)" in legend and "period 3" not in legend
     assert "1 of 5 runs without a result" in _words(fig, ["notes"])    # the failed point
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 def test_bifurcation_legend_covers_no_point():
@@ -90,7 +91,7 @@ def test_bifurcation_legend_covers_no_point():
     assert _covered(ax, legend) == []
     assert _words(fig, ["legend"]).split(" | ") == ["not periodic (19)", "period 1 (1)",
                                                      "runs by period"]
-    assert _cut_off(fig) == [] and _legend_over_words(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 def test_lyapunov_shades_chaos_and_gives_horizons_beyond_the_spread(line):
@@ -107,7 +108,7 @@ def test_lyapunov_shades_chaos_and_gives_horizons_beyond_the_spread(line):
     assert h.get_xdata().tolist() == [3000.0] and h.get_ydata().tolist() == [1 / 8.0]
     assert ax2.get_yscale() == "log" and ax2.get_ylabel().endswith("[s]")
     assert "lambda > 0: chaotic" in _words(fig, ["legend"])
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 def test_lyapunov_without_chaos_has_no_horizon_axis(line):
@@ -147,7 +148,7 @@ def test_bifurcation_grid_one_panel_per_value(grid):
     assert "5 of 5 runs without a result" in _words(panels[2], ["notes"])   # not just empty
     assert panels[-1].get_xlabel() == "shaft speed [r/min]"
     assert _words(fig, ["legend"]).split(" | ") == ["period 1", "period 2", "not periodic"]
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
     two = sw.bifurcation_grid(grid, "speed_rpm", "t_d", max_panels=2)
     assert "(2 of 3 values of t_d)" in two._suptitle.get_text()
     assert [ax.get_title() for ax in two.axes if ax.axison] == ["t_d = 20 N m", "t_d = 60 N m"]
@@ -166,7 +167,7 @@ def test_param_map_of_periods_and_of_an_exponent(grid):
     assert "hatched: no result" in cb.get_ylabel()
     assert ax.get_xlabel() == "shaft speed [r/min]" and ax.get_ylabel().endswith("[N m]")
     assert _inside(ax, SPEED, [20.0, 60.0])
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
     fig = sw.param_map(grid, "lyapunov", "speed_rpm", "t_d")
     ax, cb = fig.axes
@@ -176,7 +177,7 @@ def test_param_map_of_periods_and_of_an_exponent(grid):
     assert mesh.norm.vmin == np.nanmin(lam) and mesh.norm.vmax == np.nanmax(lam)
     assert mesh.get_array().mask.sum() == np.isnan(lam).sum()
     assert cb.get_ylabel() == "largest Lyapunov exponent [1/s] (hatched: no result)"
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 def test_param_map_places_text_values_and_says_no_hatching_without_gaps(grid):
@@ -212,7 +213,7 @@ def test_bifurcation_follow_overlays_both_directions(follow):
     assert ax.get_xlabel() == "shaft speed [r/min]" and ax.get_ylabel().endswith("[µm]")
     assert _words(fig, ["legend"]).split(" | ") == ["follow up", "follow down",
                                                      "each run from the one before"]
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 @pytest.fixture(scope="module")
@@ -258,7 +259,7 @@ def test_frequency_response_draws_stability_specials_and_gaps(branch):
         assert words in legend
     assert "period-2 orbits, stable" not in legend
     assert ax.get_xlabel() == "shaft speed [r/min]" and ax.get_ylabel() == "T_m peak-to-peak [N m]"
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 def test_fold_plane_shades_the_band_between_the_folds():
@@ -289,7 +290,7 @@ def test_fold_plane_shades_the_band_between_the_folds():
     for words in ("between the folds: two stable orbits coexist", "lower fold (mu = +1)",
                   "first grazing", "the other grazings", "two orbits", "one orbit"):
         assert words in legend
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 # --------------------------------------------------------------------------- one run
@@ -324,7 +325,7 @@ def test_scene_shows_a_run_with_its_start_transient_left_out():
     assert ax_s.get_xlabel() == "frequency [Hz]" and ax_s.get_xlim()[1] == pytest.approx(
         2.5 * z * rpm / 60)                           # up to 2.5 Z shaft orders
     assert _words(ax_s, ["legend"]) == "shaft orders 1x, 2x | tooth pass 16x, 32x"
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 # --------------------------------------------------------------------------- a sweep
