@@ -185,11 +185,12 @@ def anatomy(out, quick=False, cases=CASES):
     return rows
 
 
-def _plot(rows, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 3.8))
+def _plot(rows, path=None):
+    """The shares of one run's wall time per case; the RHS call against the flop floor."""
+    from matplotlib.figure import Figure
+    from pyspline.plots import style as ps
+    fig = Figure(figsize=(11, 4.2), layout="constrained")
+    a1, a2 = fig.subplots(1, 2)
     names = [r["case"] for r in rows]
     left = [0.0] * len(rows)
     for key, color in (("share_rhs", "tab:blue"), ("share_jacobian", "tab:orange"),
@@ -202,16 +203,16 @@ def _plot(rows, path):
     a1.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=5)
     a1.set_title("where a run's time goes", fontsize=10)
     x = range(len(rows))
-    a2.bar([i - 0.2 for i in x], [r["rhs_ns"] for r in rows], 0.4, label="RHS call")
-    a2.bar([i + 0.2 for i in x], [r["floor_ns"] for r in rows], 0.4, label="flop floor")
+    # markers, not bars: a bar's length on a log axis starts at an arbitrary bottom
+    a2.plot(x, [r["rhs_ns"] for r in rows], "o", ms=8, label="RHS call")
+    a2.plot(x, [r["floor_ns"] for r in rows], "s", ms=8, label="flop floor")
     a2.set_xticks(list(x), names, fontsize=8)
+    a2.set_xlim(-0.5, len(rows) - 0.5)
     a2.set_ylabel("ns per call")
     a2.set_yscale("log")
     a2.set_title("RHS against the flop-count floor", fontsize=10)
     a2.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    return ps.finish(fig, path)
 
 
 def format_rows(rows) -> list[str]:

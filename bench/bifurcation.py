@@ -172,11 +172,11 @@ def accuracy(out: Path, n: int) -> list[dict]:
     return rows
 
 
-def _plot_accuracy(rows, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6, 4), constrained_layout=True)
+def _plot_accuracy(rows, path=None):
+    from matplotlib.figure import Figure
+    from pyspline.plots import style as ps
+    fig = Figure(figsize=(6, 4.3), layout="constrained")
+    ax = fig.subplots()
     x = [r["steps_per_point"] for r in rows]       # the cost without the host's noise
     y = [r["section_error_of_range"] for r in rows]
     ax.loglog(x, y, "o-", label="every period as at the reference")
@@ -184,18 +184,18 @@ def _plot_accuracy(rows, path):
     ax.loglog([x[k] for k in odd], [y[k] for k in odd], "o", color="C3",
               label="periods differ from the reference")
     for r, xi, yi in zip(rows, x, y):
-        ax.annotate(f"{r['rtol']:g}", (xi, yi), textcoords="offset points", xytext=(5, -11),
+        ax.annotate(f"{r['rtol']:g}", (xi, yi), textcoords="offset points", xytext=(5, 4),
                     fontsize=8)
     ax.axhline(1e-3, color="0.6", lw=0.8, ls="--", label="1/1000 of the range")
-    ax.set_ylim(top=1e-2)
-    ax.legend(fontsize=8, loc="upper right")
+    ax.set_ylim(top=max(1e-2, 3 * max(y)))      # room above each point for its rtol
+    ax.legend(fontsize=8)
     ax.set_xlabel("CVODE steps per point (wall times: bifurcation_accuracy.csv)")
     ax.set_ylabel("largest section error / range of D2")
-    ax.set_title(f"paper_lx1e-4 bifurcation diagram ({int(rows[0]['points'])} points): the "
-                 f"sweep at each rtol against rtol {REFERENCE_RTOL:g}", fontsize=9)
-    ax.set_xlim(right=max(x) * 1.15)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    ax.set_title(ps.wrap(f"paper_lx1e-4 bifurcation diagram ({int(rows[0]['points'])} points): "
+                         f"the sweep at each rtol against rtol {REFERENCE_RTOL:g}", 5.6, 9),
+                 fontsize=9)
+    ax.set_xlim(right=max(x) * 1.3)
+    return ps.finish(fig, path)
 
 
 def main(args) -> int:

@@ -16,7 +16,7 @@ from pathlib import Path
 from pyspline import SplineError, load_case, simulate
 from pyspline.core import THERMAL_LEVELS as THERMAL, level_name
 from pyspline.paper import cases_dir
-from speed import _errors, _write_csv
+from speed import _errors, _write_csv, decade_axis
 
 #: thermal levels that report what a case's own level reports (auto chooses among these)
 ELIGIBLE = {"none": ("none",), "bulk": ("none", "bulk"), "oneway": ("oneway",),
@@ -87,23 +87,27 @@ def ladder(out, quick=False, progress=True, cases=None):
     return rows
 
 
-def _plot(rows, names, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+AUTO_MARKERS = dict(zip(TOLS, ("x", "+")))   # fidelity = auto's pick at each tolerance
+
+
+def _plot(rows, names, path=None):
+    """Error against core time of every level, one panel per case; auto's picks marked by
+    tolerance (AUTO_MARKERS); errors below 1e-16 at 1e-16."""
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
+    from pyspline.plots import style as ps
     ncol = 3
     nrow = -(-len(names) // ncol)
-    fig, axes = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 3.4 * nrow), squeeze=False)
+    fig = Figure(figsize=(4.2 * ncol, 3.4 * nrow + 0.8), layout="constrained")
+    axes = fig.subplots(nrow, ncol, squeeze=False)
     colors = dict(zip(THERMAL, ("tab:blue", "tab:green", "tab:orange", "tab:red")))
     floor = 1e-16
+    top = 3 * max([1.0] + [r["error"] for r in rows if r["status"] == "ok"])
     for ax, name in zip(axes.flat, names):
         for r in (r for r in rows if r["case"] == name and r["status"] == "ok"):
             err = max(r["error"], floor)
             if r["level"].startswith("auto"):
-                ax.plot(r["cost_s"], err, "kx", ms=10, mew=2)
-                ax.annotate(f"auto {r['tol']:g}", (r["cost_s"], err), fontsize=7,
-                            xytext=(5, -11 if r["tol"] == TOLS[0] else 4),
-                            textcoords="offset points")
+                ax.plot(r["cost_s"], err, AUTO_MARKERS[r["tol"]], color="k", ms=10, mew=2)
                 continue
             marker = "^" if r["dof"] == 3 else "o"
             face = colors[r["thermal"]] if r["eligible"] else "none"
@@ -113,27 +117,28 @@ def _plot(rows, names, path):
             ax.axhline(tol, color="0.6", ls="--", lw=0.8)
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_ylim(floor / 3, 3)
-        ax.set_title(name, fontsize=9)
+        ax.set_ylim(floor / 3, top)
+        bad = [r["level"] for r in rows if r["case"] == name and r["status"] != "ok"]
+        ax.set_title(ps.wrap(f"{name}; failed, not drawn: {', '.join(bad)}" if bad else name,
+                             3.8, 9), fontsize=9)
         ax.set_xlabel("core time [s]", fontsize=8)
         ax.set_ylabel("error vs the case's level", fontsize=8)
+        decade_axis(ax.xaxis)
         ax.tick_params(labelsize=7)
     for ax in list(axes.flat)[len(names):]:
         ax.axis("off")
-    handles = [plt.Line2D([], [], marker="o", ls="none", mfc=c, mec=c, label=t)
+    handles = [Line2D([], [], marker="o", ls="none", mfc=c, mec=c, label=t)
                for t, c in colors.items()]
-    handles += [plt.Line2D([], [], marker="^", ls="none", mfc="k", mec="k", label="3 DOF"),
-                plt.Line2D([], [], marker="o", ls="none", mfc="k", mec="k", label="7 DOF"),
-                plt.Line2D([], [], marker="o", ls="none", mfc="none", mec="k",
-                           label="not eligible"),
-                plt.Line2D([], [], marker="x", ls="none", color="k", label="fidelity = auto")]
-    fig.legend(handles=handles, loc="lower center", ncol=8, fontsize=8)
-    fig.suptitle("Fidelity ladder: cost against error of each model level (large marker: the "
-                 "case's own level; dashed: tolerances; errors below 1e-16 drawn at 1e-16)",
-                 fontsize=9)
-    fig.tight_layout(rect=(0, 0.05, 1, 0.96))
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    handles += [Line2D([], [], marker="^", ls="none", mfc="k", mec="k", label="3 DOF"),
+                Line2D([], [], marker="o", ls="none", mfc="k", mec="k", label="7 DOF"),
+                Line2D([], [], marker="o", ls="none", mfc="none", mec="k", label="not eligible")]
+    handles += [Line2D([], [], marker=m, ls="none", color="k", mew=2,
+                       label=f"fidelity = auto, tol {tol:g}") for tol, m in AUTO_MARKERS.items()]
+    fig.legend(handles=handles, loc="outside lower center", ncol=5, fontsize=8)
+    fig.suptitle(ps.wrap("Fidelity ladder: cost against error of each model level (large "
+                         "marker: the case's own level; dashed: tolerances; errors below 1e-16 "
+                         "drawn at 1e-16)", 4.2 * ncol - 0.5, 9), fontsize=9)
+    return ps.finish(fig, path)
 
 
 def format_rows(rows) -> list[str]:

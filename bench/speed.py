@@ -240,7 +240,7 @@ def work_precision(out, quick=False, progress=True, cases=None):
             rows.append(row)
     _write_csv(out / "work_precision.csv", rows)
     _write_csv(out / "speed_ratios.csv", speed_ratios(rows))
-    _plot_wp(rows, out / "work_precision.png", notes)
+    _plot_wp(rows, notes, out / "work_precision.png")
     return rows, notes
 
 
@@ -275,36 +275,52 @@ def _write_csv(path, rows):
         w.writerows(rows)
 
 
-def _plot_wp(rows, path, notes):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+def decade_axis(axis):
+    """A log axis with a labelled decade and no minor tick labels (2x10^-2, 3x10^-2 ... crowd
+    one another): limits at least a decade apart around the data's."""
+    from matplotlib.ticker import NullFormatter
+    lo, hi = sorted(axis.get_view_interval())
+    if hi < 10 * lo:
+        axis.set_view_interval(np.sqrt(lo * hi) / 3.2, np.sqrt(lo * hi) * 3.2, ignore=True)
+    axis.set_minor_formatter(NullFormatter())
+
+
+def _plot_wp(rows, notes, path=None):
+    """Error against wall time per method and case, one panel per case; one legend for all
+    (a method keeps its colour); failed runs are named in their panel's title, not drawn."""
+    from matplotlib import colormaps
+    from matplotlib.figure import Figure
+    from pyspline.plots import style as ps
     cases = list(dict.fromkeys(r["case"] for r in rows))
-    fig, axs = plt.subplots(1, len(cases), figsize=(8 * len(cases), 6.5), squeeze=False)
-    for ax, name in zip(axs[0], cases):
+    methods = list(dict.fromkeys(r["method"] for r in rows))
+    colours = colormaps["tab20"].colors + colormaps["tab20b"].colors   # 40, none twice
+    fig = Figure(figsize=(8 * len(cases), 8.5), layout="constrained")
+    for ax, name in zip(fig.subplots(1, len(cases), squeeze=False)[0], cases):
         sub = [r for r in rows if r["case"] == name]
-        for i, method in enumerate(dict.fromkeys(r["method"] for r in sub)):
-            pts = [r for r in sub if r["method"] == method]
-            ok = [r for r in pts if r["status"] == "ok"]
+        for i, method in enumerate(methods):
+            ok = [r for r in sub if r["method"] == method and r["status"] == "ok"]
             style = "-" if "CVODE" in method else ("--" if "fortran" in method else ":")
-            line, = ax.plot([r["time_s"] for r in ok],
-                            [max(r["err_Tm"], r["err_F"]) for r in ok],
-                            style, marker="o", ms=3, label=method, color=plt.cm.tab20(i % 20))
-            bad = [r for r in pts if r["status"] != "ok"]
-            if bad:   # failures drawn at error 1 (top edge), in the method's colour
-                ax.plot([1e-3 * (1 + j) for j in range(len(bad))], [1.0] * len(bad), "x",
-                        color=line.get_color(), ms=8)
+            ax.plot([r["time_s"] for r in ok], [max(r["err_Tm"], r["err_F"]) for r in ok],
+                    style, marker="o", ms=3, label=method, color=colours[i % len(colours)])
+        bad = {}
+        for r in sub:
+            if r["status"] != "ok":
+                bad.setdefault(r["method"], []).append(f"{r['rtol']:g}")
+        bad = [f"{m} at rtol {', '.join(rt)}" for m, rt in bad.items()]
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlabel("CPU time (wall clock, median) [s]")
+        decade_axis(ax.xaxis)
+        ax.set_xlabel("wall time of a run [s]")
         ax.set_ylabel("max relative error of T_m and F_j")
-        ax.set_title(name + " (x at error 1: failed runs)", fontsize=10)
+        ax.set_title(ps.wrap(f"{name}; failed, not drawn: {', '.join(bad)}" if bad else name,
+                             7.5, 10), fontsize=10)
         ax.grid(True, which="both", lw=0.3)
-        ax.legend(fontsize=6, ncol=2)
-    fig.suptitle("Work-precision: " + " | ".join(notes), fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    fig.legend(*fig.axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=4,
+               fontsize=7)
+    fig.suptitle("\n".join(ps.wrap(n, 8 * len(cases) - 0.5, 8)
+                           for n in ["Work-precision against a reference run:", *notes]),
+                 fontsize=8)
+    return ps.finish(fig, path)
 
 
 def stability_map(out, quick=False, progress=True):
@@ -354,29 +370,34 @@ def stability_map(out, quick=False, progress=True):
     return rows
 
 
-def _plot_stability(rows, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+def _plot_stability(rows, path=None):
+    """log10 of each run's wall time per method and k_m, one panel per damping, on one colour
+    scale; X: a failed run."""
+    from matplotlib.colors import Normalize
+    from matplotlib.figure import Figure
+    from pyspline.plots import style as ps
     dampings = list(dict.fromkeys(r["damping"] for r in rows))
     methods = list(dict.fromkeys(r["method"] for r in rows))
     kms = sorted({r["k_m"] for r in rows})
-    fig, axs = plt.subplots(1, len(dampings), figsize=(7.5 * len(dampings), 5), squeeze=False)
-    for ax, d in zip(axs[0], dampings):
+    logt = [np.log10(r["time_s"]) for r in rows if r["status"] == "ok"]
+    norm = Normalize(min(logt, default=0.0), max(logt, default=1.0))
+    fig = Figure(figsize=(7.5 * len(dampings) + 1, 5), layout="constrained")
+    axs = fig.subplots(1, len(dampings), squeeze=False, sharey=True)[0]
+    for ax, d in zip(axs, dampings):
         grid = np.full((len(methods), len(kms)), np.nan)
+        failed = [r for r in rows if r["damping"] == d and r["status"] != "ok"]
         for r in rows:
             if r["damping"] == d and r["status"] == "ok":
                 grid[methods.index(r["method"]), kms.index(r["k_m"])] = np.log10(r["time_s"])
-        im = ax.imshow(grid, aspect="auto", cmap="viridis", origin="upper")
-        for r in rows:
-            if r["damping"] == d and r["status"] != "ok":
-                ax.text(kms.index(r["k_m"]), methods.index(r["method"]), "X", ha="center",
-                        va="center", color="red", fontsize=11, fontweight="bold")
-        ax.set_xticks(range(len(kms)), [f"{k:.0e}" for k in kms], rotation=60, fontsize=7)
+        im = ax.imshow(grid, aspect="auto", cmap="viridis", origin="upper", norm=norm)
+        for r in failed:
+            ax.text(kms.index(r["k_m"]), methods.index(r["method"]), "X", ha="center",
+                    va="center", color="red", fontsize=11, fontweight="bold")
+        ax.set_xticks(range(len(kms)), [f"{k:.0e}" for k in kms], fontsize=7,
+                      rotation=60 if len(kms) > 6 else 0)
         ax.set_yticks(range(len(methods)), methods, fontsize=7)
         ax.set_xlabel("mesh stiffness k_m [N/m]")
-        ax.set_title(f"c_m {d}: log10(time [s]); X = failed", fontsize=9)
-        fig.colorbar(im, ax=ax)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+        ax.set_title(f"c_m {d}: {len(failed)} of {len(kms) * len(methods)} runs failed (X)",
+                     fontsize=9)
+    fig.colorbar(im, ax=axs, label="log10 of the wall time of a run [s]")
+    return ps.finish(fig, path)

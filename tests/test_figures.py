@@ -1,15 +1,14 @@
 """What each figure of pyspline.plots shows, on small hand-built datasets (with the names and
 units a sweep gives them, pyspline.dataset's) and one tiny sweep: axis labels with their units,
 limits that hold the data, as many markers and curves as the data has points and branches, the
-legends' and notes' words (a failed point, chaos, points left out), and every label, title,
-legend and note inside the figure (none cut off at its edge)."""
+legends' and notes' words (a failed point, chaos, points left out), every label, title,
+legend, note and tick label inside the figure (none cut off at its edge), tick labels apart and
+no legend over a title, label or the data it explains."""
 import warnings
 
 import numpy as np
 import pytest
-from matplotlib.axes import Axes
 from matplotlib.colors import TwoSlopeNorm
-from matplotlib.text import Text
 
 import pyspline
 from pyspline import analysis, dataset
@@ -18,7 +17,9 @@ from pyspline.plots import eng
 from pyspline.plots import run as pr
 from pyspline.plots import sweeps as sw
 
-from conftest import CASES, PAPER_SHAFTS  # noqa: E402
+from conftest import CASES  # noqa: E402
+from figtools import (_covered, _crowded, _cut_off, _inside, _legend_over_words,  # noqa: E402
+                      _points, _words)
 
 xr = pytest.importorskip("xarray")
 
@@ -42,55 +43,6 @@ def _var(dims, values, name):
 
 def _coord(name, values):
     return (name, np.asarray(values, float), dataset._field_attrs(name))
-
-
-def _texts(fig) -> dict:
-    """The words a reader sees on a figure or one of its axes, by place: 'labels' (axis labels,
-    titles, colour bar labels), 'legend' (entries and titles), 'notes' (texts on the axes and
-    on the figure)."""
-    out = {"labels": [], "legend": [], "notes": []}
-    if isinstance(fig, Axes):
-        fig, axes = fig.figure, [fig]
-    else:
-        axes = fig.axes
-    for ax in axes:
-        out["labels"] += [ax.xaxis.label, ax.yaxis.label, ax.title]
-        out["notes"] += ax.texts
-        if ax.get_legend():
-            out["legend"] += [*ax.get_legend().get_texts(), ax.get_legend().get_title()]
-    if axes == fig.axes:
-        for leg in fig.legends:
-            out["legend"] += [*leg.get_texts(), leg.get_title()]
-        out["labels"] += [t for t in (fig._suptitle, fig._supylabel) if t is not None]
-        out["notes"] += fig.texts
-    return {k: [t for t in v if t.get_visible() and t.get_text()] for k, v in out.items()}
-
-
-def _words(fig, where=("labels", "legend", "notes")) -> str:
-    return " | ".join(t.get_text() for k in where for t in _texts(fig)[k])
-
-
-def _cut_off(fig) -> list:
-    """The labels, titles, legend entries and notes that reach past the figure's edge."""
-    fig.draw_without_rendering()
-    r = fig._get_renderer()
-    w, h = fig.bbox.width, fig.bbox.height
-    return [t.get_text() for ts in _texts(fig).values() for t in ts
-            if not (lambda b: b.x0 >= -1 and b.y0 >= -1 and b.x1 <= w + 1 and b.y1 <= h + 1)(
-                t.get_window_extent(r))]
-
-
-def _points(ax) -> np.ndarray:
-    """The (x, y) of every marker of the axes' scatter collections."""
-    offs = [c.get_offsets() for c in ax.collections if hasattr(c, "get_offsets")
-            and len(c.get_offsets())]
-    return np.vstack(offs) if offs else np.empty((0, 2))
-
-
-def _inside(ax, x, y):
-    (x0, x1), (y0, y1) = sorted(ax.get_xlim()), sorted(ax.get_ylim())
-    x, y = np.asarray(x, float), np.asarray(y, float)
-    return bool((x0 <= x.min()) & (x.max() <= x1) & (y0 <= y.min()) & (y.max() <= y1))
 
 
 # --------------------------------------------------------------------------- sweeps
@@ -120,7 +72,26 @@ def test_bifurcation_shows_every_section_point_by_period(line):
     assert "period 1 (2)" in legend and "period 2 (1)" in legend
     assert "not periodic (1)" in legend and "period 3" not in legend
     assert "1 of 5 runs without a result" in _words(fig, ["notes"])    # the failed point
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
+
+
+def test_bifurcation_legend_covers_no_point():
+    """A sweep whose section points fill the panel (20 speeds, 12 levels each, not periodic
+    but the last): the legend stands beside them."""
+    speed = np.linspace(1000.0, 5000.0, 20)
+    y = np.tile(np.linspace(-900e-6, -700e-6, 12), (20, 1))
+    per = np.r_[np.zeros(19), 1.0]
+    ds = xr.Dataset({"section_D2": _var(("speed_rpm", "section_point"), y, "section_D2"),
+                     "period": _var("speed_rpm", per, "period")},
+                    coords={"speed_rpm": _coord("speed_rpm", speed)})
+    fig = sw.bifurcation(ds, "speed_rpm")
+    ax = fig.axes[0]
+    assert len(_points(ax)) == y.size and _inside(ax, *_points(ax).T)
+    (legend,) = fig.legends or [ax.get_legend()]
+    assert _covered(ax, legend) == []
+    assert _words(fig, ["legend"]).split(" | ") == ["not periodic (19)", "period 1 (1)",
+                                                     "runs by period"]
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 def test_lyapunov_shades_chaos_and_gives_horizons_beyond_the_spread(line):
@@ -137,7 +108,7 @@ def test_lyapunov_shades_chaos_and_gives_horizons_beyond_the_spread(line):
     assert h.get_xdata().tolist() == [3000.0] and h.get_ydata().tolist() == [1 / 8.0]
     assert ax2.get_yscale() == "log" and ax2.get_ylabel().endswith("[s]")
     assert "lambda > 0: chaotic" in _words(fig, ["legend"])
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 def test_lyapunov_without_chaos_has_no_horizon_axis(line):
@@ -177,7 +148,7 @@ def test_bifurcation_grid_one_panel_per_value(grid):
     assert "5 of 5 runs without a result" in _words(panels[2], ["notes"])   # not just empty
     assert panels[-1].get_xlabel() == "shaft speed [r/min]"
     assert _words(fig, ["legend"]).split(" | ") == ["period 1", "period 2", "not periodic"]
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
     two = sw.bifurcation_grid(grid, "speed_rpm", "t_d", max_panels=2)
     assert "(2 of 3 values of t_d)" in two._suptitle.get_text()
     assert [ax.get_title() for ax in two.axes if ax.axison] == ["t_d = 20 N m", "t_d = 60 N m"]
@@ -196,7 +167,7 @@ def test_param_map_of_periods_and_of_an_exponent(grid):
     assert "hatched: no result" in cb.get_ylabel()
     assert ax.get_xlabel() == "shaft speed [r/min]" and ax.get_ylabel().endswith("[N m]")
     assert _inside(ax, SPEED, [20.0, 60.0])
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
     fig = sw.param_map(grid, "lyapunov", "speed_rpm", "t_d")
     ax, cb = fig.axes
@@ -206,7 +177,7 @@ def test_param_map_of_periods_and_of_an_exponent(grid):
     assert mesh.norm.vmin == np.nanmin(lam) and mesh.norm.vmax == np.nanmax(lam)
     assert mesh.get_array().mask.sum() == np.isnan(lam).sum()
     assert cb.get_ylabel() == "largest Lyapunov exponent [1/s] (hatched: no result)"
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 def test_param_map_places_text_values_and_says_no_hatching_without_gaps(grid):
@@ -242,7 +213,7 @@ def test_bifurcation_follow_overlays_both_directions(follow):
     assert ax.get_xlabel() == "shaft speed [r/min]" and ax.get_ylabel().endswith("[µm]")
     assert _words(fig, ["legend"]).split(" | ") == ["follow up", "follow down",
                                                      "each run from the one before"]
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 @pytest.fixture(scope="module")
@@ -288,7 +259,7 @@ def test_frequency_response_draws_stability_specials_and_gaps(branch):
         assert words in legend
     assert "period-2 orbits, stable" not in legend
     assert ax.get_xlabel() == "shaft speed [r/min]" and ax.get_ylabel() == "T_m peak-to-peak [N m]"
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 def test_fold_plane_shades_the_band_between_the_folds():
@@ -319,7 +290,7 @@ def test_fold_plane_shades_the_band_between_the_folds():
     for words in ("between the folds: two stable orbits coexist", "lower fold (mu = +1)",
                   "first grazing", "the other grazings", "two orbits", "one orbit"):
         assert words in legend
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 # --------------------------------------------------------------------------- one run
@@ -354,7 +325,7 @@ def test_scene_shows_a_run_with_its_start_transient_left_out():
     assert ax_s.get_xlabel() == "frequency [Hz]" and ax_s.get_xlim()[1] == pytest.approx(
         2.5 * z * rpm / 60)                           # up to 2.5 Z shaft orders
     assert _words(ax_s, ["legend"]) == "shaft orders 1x, 2x | tooth pass 16x, 32x"
-    assert _cut_off(fig) == []
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 # --------------------------------------------------------------------------- a sweep
@@ -398,40 +369,3 @@ def test_sweep_figures_show_the_sweep(tiny_sweep, tmp_path, monkeypatch, capsys)
     assert wf.get_xlabel() == "frequency [Hz]" and wf.get_ylabel() == "shaft speed [r/min]"
     assert "16x" in _words(wf, ["notes"])          # the tooth pass of the Z = 16 case
     assert _cut_off(figs["bifurcation.png"]) == []        # the sweep's own titles
-
-
-# --------------------------------------------------------------------------- the paper's
-
-@PAPER_SHAFTS
-def test_paper_dynamics_figure_shows_the_run(monkeypatch, tmp_path):
-    """Fig. 4's page of a 0.2 s run of paper_ideal: the Poincare panel's points and its count of
-    distinct ones, one bar per tooth at the instant of the largest load, the time panels."""
-    from pyspline import paper
-    from pyspline.paper import figures as pf
-    res = pyspline.simulate(pyspline.load_case(CASES / "paper_ideal.nml", t_end=0.2))
-    close, figs = pf.plt.close, []
-    monkeypatch.setattr(pf.plt, "close", figs.append)       # keep the figure to read it
-    pf.dynamics_figure(res, tmp_path / "fig4.png", "Ideal spline pair (paper Fig. 4)")
-    (fig,) = figs
-    try:
-        d, phase, poinc, f, fx, tm = fig.axes
-        p, nd = paper.poincare(res), paper.poincare_count(res)
-        (pts,) = poinc.get_lines()
-        assert len(pts.get_xdata()) == len(p) > 5 and _inside(poinc, p[:, 0] * 1e3, p[:, 1])
-        assert f"{nd} distinct point" in poinc.get_title().replace("\n", " ")
-        k = int(np.argmax(np.abs(res.Tm)))
-        for ax, q in ((f, res.F), (fx, res.Fx)):
-            assert [b.get_height() for b in ax.patches] == q[k].tolist()    # one bar a tooth
-            ticks = [v for v in ax.get_xticks() if 1 <= v <= res.F.shape[1]]
-            assert len(ticks) <= 10 and all(v == int(v) for v in ticks)
-        assert f"at t = {res.t[k]:.4f} s (largest load)" in _words(f, ["legend"])
-        # the aligned drive's lateral forces balance: the note says so, not round-off digits
-        assert abs(res.Fx[k].sum()) <= 1e-9 * np.abs(res.Fx[k]).sum()
-        assert fx.get_title().startswith("sum of F_jx at that instant: 0 to round-off (sum of")
-        assert d.get_ylabel() == "relative displacement D_2 (line of action) [mm]"
-        assert _inside(d, res.t, res.D2 * 1e3) and _inside(tm, res.t, res.Tm)
-        assert tm.get_ylabel() == "meshing torque T_m [N m]" and tm.get_xlabel() == "time t [s]"
-        assert (phase.get_xlabel(), phase.get_ylabel()) == ("D_2 [mm]", "dD_2/dt [m/s]")
-        assert _cut_off(fig) == []
-    finally:
-        close(fig)

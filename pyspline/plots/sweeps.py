@@ -70,8 +70,9 @@ def bifurcation(ds, param: str, coord: str = "section_D2", period: str = "period
     handles = _bifurcation_points(ax, p / px, y / factor, per)
     ax.set_xlabel(ps.label(ds, param, factor_unit=ux))
     ax.set_ylabel(ps.wrap(ps.label(ds, coord, factor_unit=unit), 4.5))
-    ax.legend(handles=handles, fontsize=8, loc="best", title="runs by period",
-              title_fontsize=8, framealpha=0.9)
+    # beside the panel: a sweep's points can fill it (no 'best' place covers none)
+    fig.legend(handles=handles, fontsize=8, loc="outside lower center", ncols=len(handles),
+               title="runs by period", title_fontsize=8)
     ax.set_title(ps.wrap(title or f"bifurcation diagram: {long} vs {ps.long_name(ds, param)}",
                          8.5, 12))
     return ps.finish(fig, path)
