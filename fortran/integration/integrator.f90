@@ -226,6 +226,8 @@ contains
     integer(c_int), intent(out) :: flag
     character(len=*), intent(out) :: stage
     type(c_ptr) :: ud
+    integer :: tbl, ios
+    character(len=16) :: envv
     ud = udata
     cv%erk = .true.
     cv%roots = nroot > 0
@@ -248,7 +250,10 @@ contains
     end if
     if (flag == 0) then
       stage = 'setting the solver options'
-      flag = FERKStepSetTableNum(cv%mem, ARKODE_DORMAND_PRINCE_7_4_5)
+      tbl = ARKODE_DORMAND_PRINCE_7_4_5     ! TEMPORARY experiment hook
+      call get_environment_variable('SPLINE_ERK_TABLE', envv, status=ios)
+      if (ios == 0) read(envv, *) tbl
+      flag = FERKStepSetTableNum(cv%mem, int(tbl, c_int))
     end if
     if (flag == 0) flag = FERKStepSetMaxNumSteps(cv%mem, int(m%max_steps, c_long))
     ! a contact switch inside a step (roots off) is a kink the order-5 error model does not
