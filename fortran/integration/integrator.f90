@@ -226,8 +226,6 @@ contains
     integer(c_int), intent(out) :: flag
     character(len=*), intent(out) :: stage
     type(c_ptr) :: ud
-    integer :: tbl, ios
-    character(len=16) :: envv
     ud = udata
     cv%erk = .true.
     cv%roots = nroot > 0
@@ -250,10 +248,7 @@ contains
     end if
     if (flag == 0) then
       stage = 'setting the solver options'
-      tbl = ARKODE_DORMAND_PRINCE_7_4_5     ! TEMPORARY experiment hook
-      call get_environment_variable('SPLINE_ERK_TABLE', envv, status=ios)
-      if (ios == 0) read(envv, *) tbl
-      flag = FERKStepSetTableNum(cv%mem, int(tbl, c_int))
+      flag = FERKStepSetTableNum(cv%mem, ARKODE_DORMAND_PRINCE_7_4_5)
     end if
     if (flag == 0) flag = FERKStepSetMaxNumSteps(cv%mem, int(m%max_steps, c_long))
     ! a contact switch inside a step (roots off) is a kink the order-5 error model does not

@@ -166,18 +166,6 @@ contains
     m%rtol_transient = m%rtol; m%atol_transient = m%atol
     if (m%goal_statistics) then
       m%rtol_transient = stats_transient_rtol; m%atol_transient = 1.0e-2_wp*stats_transient_rtol
-      block   ! TEMPORARY experiment hook
-        character(len=32) :: envv
-        integer :: ios
-        call get_environment_variable('SPLINE_STATS_RTOL', envv, status=ios)
-        if (ios == 0) then
-          read(envv, *) m%rtol; m%atol = 1.0e-2_wp*m%rtol
-        end if
-        call get_environment_variable('SPLINE_STATS_TRT', envv, status=ios)
-        if (ios == 0) then
-          read(envv, *) m%rtol_transient; m%atol_transient = 1.0e-2_wp*m%rtol_transient
-        end if
-      end block
     end if
     m%method_bdf = merge(1, 0, k == 1)
     m%erk = k == 3
