@@ -107,12 +107,12 @@ def test_section_instants_of_one_run_and_of_copies():
 def test_statistics_transient_runs_at_its_own_tolerances():
     """goal = 'statistics' runs the transient (no outputs) at rtol 1e-1, atol 1e-3 and the window
     at 1e-2, 1e-4 (docs/accuracy.md): one run's window and realisations = 2's copies start from
-    the state, to the bit, of an ERK run (Cash-Karp) without roots at the transient's tolerances, not at the
+    the state, to the bit, of an ERK run (Dormand-Prince) without roots at the transient's tolerances, not at the
     window's (chaos_z24's 0.3 s engagement: the two differ by far more than round-off). No
     sections: their instants stop the integrator, and the transient has none."""
     def transient_end(rtol):
-        return simulate(chaos(goal="trajectory", method="erk", erk_table="cash_karp",
-                              roots=False, rtol=rtol, atol=1e-2 * rtol, t_transient=0.0, t_end=0.3, n_out=1,
+        return simulate(chaos(goal="trajectory", method="erk", roots=False, rtol=rtol,
+                              atol=1e-2 * rtol, t_transient=0.0, t_end=0.3, n_out=1,
                               section="none")).y[-1]
     loose, tight = transient_end(1e-1), transient_end(1e-2)
     assert np.abs(loose - tight).max() > 1e-6 * np.abs(tight).max()
