@@ -64,7 +64,7 @@ module spline_case_type
     !> it was measured (docs/performance.md, "Impacting scenes, and how the defaults were
     !> chosen"), with located contact switches.
     character(len=optlen) :: method = 'auto', jacobian = 'dq', nonlinear = 'auto'
-    !> ERKStep's Butcher table (method = 'erk'; goal = 'statistics' picks 'cash_karp')
+    !> ERKStep's Butcher table (method = 'erk'; goal = 'statistics' runs its window on 'cash_karp')
     character(len=optlen) :: erk_table = 'dormand_prince'
     logical  :: roots = .true., stald = .false., linear_tail = .true.
     real(wp) :: rtol = 1.0e-8_wp, atol = 1.0e-10_wp

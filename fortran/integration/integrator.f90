@@ -481,8 +481,8 @@ contains
   !> ERKStep also takes Cash-Karp's table (cash_karp) or Dormand-Prince's. Only from
   !> Dormand-Prince to Cash-Karp or to itself: both are of order 5(4) (the step controller's
   !> orders stay), Cash-Karp's 6 stages fit the 7 vectors ERKStep allocated for Dormand-Prince's
-  !> at its first step, and its first right-hand side is evaluated anew (its last stage is not at
-  !> the step's end, so nothing of the step before is reused).
+  !> at its first step, and its first stage is f at the step's start either way (Dormand-Prince's
+  !> last stage, or evaluated anew); the other way a stage vector would be missing.
   integer(c_int) function integrator_tolerances(cv, rtol, atol, cash_karp) result(flag)
     type(integrator_t), intent(inout) :: cv
     real(wp), intent(in) :: rtol, atol
