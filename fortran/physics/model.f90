@@ -58,7 +58,8 @@ module spline_model
     real(wp) :: t_bulk, f_m, u_flash, eta_hertz
     integer  :: method_bdf = 1              !< 1 = BDF, 0 = Adams (CVODE)
     logical  :: erk = .false.               !< ARKODE ERKStep instead of CVODE (spline_integrator)
-    logical  :: cash_karp = .false.         !< ERKStep's table: Cash-Karp, else Dormand-Prince (a loose transient: Dormand-Prince)
+    !> ERKStep's table: Cash-Karp, else Dormand-Prince (a loose transient: Dormand-Prince)
+    logical  :: cash_karp = .false.
     logical  :: newton = .true.             !< Newton + dense solver, else fixed-point iteration
     logical  :: roots = .false.
     logical  :: stald = .false.
