@@ -92,9 +92,10 @@ def rms(res):
 
 
 def test_statistics_goal_reads_a_tight_runs_statistics():
-    """chaos_z24, 20 revolutions after its engagement: goal = 'statistics' (ERK without roots at
-    rtol 1e-2) against the case's own settings (Adams with roots at rtol 1e-7), T_m RMS, free
-    teeth and impacts per revolution within 3 standard errors (batch means) of each other."""
+    """chaos_z24, 20 revolutions after its engagement: goal = 'statistics' (ERK's Cash-Karp
+    table without roots at rtol 1e-2) against the case's own settings (Adams with roots at rtol
+    1e-7), T_m RMS, free teeth and impacts per revolution within 3 standard errors (batch means)
+    of each other."""
     case = pyspline.load_case(CASES / "chaos_z24.nml", t_end=0.5, n_out=3201, lyapunov=False)
     tight, fast = pyspline.simulate(case), pyspline.simulate(case.replace(goal="statistics"))
     assert fast.stats["rtol_used"] == 1e-2 and fast.stats["roots_found"] == 0
@@ -104,7 +105,7 @@ def test_statistics_goal_reads_a_tight_runs_statistics():
                       (lambda r: r.loads["impacts_per_rev"], "impacts_per_rev_se")):
         spread = np.hypot(tight.loads[se], fast.loads[se])
         assert abs(value(fast) - value(tight)) <= 3 * spread, se
-    assert "goal statistics: ERK without root finding at rtol 1e-02" in _summary(fast)
+    assert "goal statistics: ERK (Cash-Karp) without root finding at rtol 1e-02" in _summary(fast)
 
 
 def test_executable_gives_the_accuracy_run_of_python(exe, tmp_path):

@@ -28,6 +28,7 @@ pytestmark = [PAPER_SHAFTS, PAPER_SUPPORTS, DEMONSTRATION_SCENES]   # expected w
     (dict(c0=math.inf), ["c0", "finite"]),
     (dict(thermal="hot"), ["thermal", "none, bulk, oneway or coupled"]),
     (dict(method="rk4"), ["method", "bdf, adams, erk or auto"]),
+    (dict(erk_table="verner"), ["field erk_table", "dormand_prince or cash_karp"]),
     (dict(z=16.5), ["z", "whole number"]),
     (dict(dq0=[0.0, 1.0]), ["dq0", "7 numbers"]),
     (dict(speed_rpm=-100.0), ["speed_rpm"]),

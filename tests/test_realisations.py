@@ -107,7 +107,7 @@ def test_section_instants_of_one_run_and_of_copies():
 def test_statistics_transient_runs_at_its_own_tolerances():
     """goal = 'statistics' runs the transient (no outputs) at rtol 1e-1, atol 1e-3 and the window
     at 1e-2, 1e-4 (docs/accuracy.md): one run's window and realisations = 2's copies start from
-    the state, to the bit, of an ERK run without roots at the transient's tolerances, not at the
+    the state, to the bit, of an ERK run (Dormand-Prince) without roots at the transient's tolerances, not at the
     window's (chaos_z24's 0.3 s engagement: the two differ by far more than round-off). No
     sections: their instants stop the integrator, and the transient has none."""
     def transient_end(rtol):

@@ -15,7 +15,7 @@ module spline_case
   use spline_case_type, only: case_t, case_field, case_field_meta, case_name_of, option_index, &
        case_output_bytes, case_run_times, namelen, nripple, ndof_case, nfields, max_case_bytes, &
        max_output_bytes, thermal_values, method_values, nonlinear_values, start_values, fidelity_values, section_values, &
-       lyapunov_method_values, goal_values
+       lyapunov_method_values, goal_values, erk_table_values
   use spline_case_text, only: case_suggest, shown
   use spline_case_parse, only: case_parse, case_write_text
   use spline_case_check, only: case_validate
@@ -26,7 +26,7 @@ module spline_case
   public :: case_run_times, c_file_kind   ! c_file_kind: also spline-dyn's output checks
   public :: namelen, nripple, ndof_case, thermal_values, method_values, nonlinear_values, start_values, &
        fidelity_values, section_values, option_index, nfields, max_case_bytes, max_output_bytes, &
-       lyapunov_method_values, goal_values
+       lyapunov_method_values, goal_values, erk_table_values
 
   interface   ! fortran/interface/fileinfo.c
     integer(c_int) function c_file_kind(path, size, errbuf, errlen) bind(C, name='spline_file_kind')

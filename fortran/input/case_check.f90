@@ -9,7 +9,7 @@ module spline_case_check
   use spline_case_type, only: case_t, fields, nfields, field_index, ndof_case, nripple, &
        option_index, case_output_bytes, case_run_times, max_output_bytes, thermal_values, method_values, &
        nonlinear_values, start_values, fidelity_values, jacobian_values, section_values, &
-       lyapunov_method_values, goal_values
+       lyapunov_method_values, goal_values, erk_table_values
   use spline_case_text, only: size_text
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
@@ -204,6 +204,7 @@ contains
     if (.not. one_of(section_values, c%section, 'section')) return
     if (.not. one_of(lyapunov_method_values, c%lyapunov_method, 'lyapunov_method')) return
     if (.not. one_of(goal_values, c%goal, 'goal')) return
+    if (.not. one_of(erk_table_values, c%erk_table, 'erk_table')) return
     if (option_index(goal_values, c%goal) == 2 .and. c%accuracy > 0.0_wp) then
       call fail('accuracy', '= '//num(c%accuracy)//' is the error of the trajectory''s tooth '// &
            'forces; goal = ''statistics'' reads statistics, whose error is their standard error: '// &

@@ -10,7 +10,7 @@ module spline_case_type
        case_name_of, option_index, case_output_bytes, case_run_times
   public :: namelen, optlen, nripple, ndof_case, max_case_bytes, max_output_bytes
   public :: thermal_values, method_values, nonlinear_values, start_values, fidelity_values, &
-       jacobian_values, section_values, lyapunov_method_values, goal_values
+       jacobian_values, section_values, lyapunov_method_values, goal_values, erk_table_values
 
   integer, parameter :: namelen = 128
   integer, parameter :: nripple = 4         !< torque-ripple orders a case can give
@@ -36,6 +36,8 @@ module spline_case_type
        'none', 'shaft', 'tooth']
   character(len=optlen), parameter :: goal_values(2) = [character(len=optlen) :: &
        'trajectory', 'statistics']
+  character(len=optlen), parameter :: erk_table_values(2) = [character(len=optlen) :: &
+       'dormand_prince', 'cash_karp']
   character(len=optlen), parameter :: lyapunov_method_values(2) = [character(len=optlen) :: &
        'copy', 'tangent']
 
@@ -62,6 +64,8 @@ module spline_case_type
     !> it was measured (docs/performance.md, "Impacting scenes, and how the defaults were
     !> chosen"), with located contact switches.
     character(len=optlen) :: method = 'auto', jacobian = 'dq', nonlinear = 'auto'
+    !> ERKStep's Butcher table (method = 'erk'; goal = 'statistics' runs its window on 'cash_karp')
+    character(len=optlen) :: erk_table = 'dormand_prince'
     logical  :: roots = .true., stald = .false., linear_tail = .true.
     real(wp) :: rtol = 1.0e-8_wp, atol = 1.0e-10_wp
     integer  :: max_steps = 100000, max_total_steps = 20000000
@@ -116,7 +120,7 @@ module spline_case_type
     real(wp) :: lo = 0.0_wp, hi = 0.0_wp
     character(len=80) :: note = ''
   end type field_t
-  integer, parameter :: nfields = 90
+  integer, parameter :: nfields = 91
   real(wp), parameter :: inf_ = huge(1.0_wp)
   type(field_t), parameter :: fields(nfields) = [ &
        field_t('name', 'c', namelen, '', 'case name, used in messages (default: the file name)'), &
@@ -189,6 +193,8 @@ module spline_case_type
        field_t('method', 'c', optlen, '', 'auto | adams | bdf (CVODE) | erk (ARKODE, order 5)'), &
        field_t('jacobian', 'c', optlen, '', 'dq: dense difference-quotient Jacobian'), &
        field_t('nonlinear', 'c', optlen, '', 'auto (adams: fixedpoint, bdf: newton) | newton | fixedpoint'), &
+       field_t('erk_table', 'c', optlen, '', 'erk: dormand_prince (5(4), 7 stages) | cash_karp '// &
+               '(5(4), 6 stages)'), &
        field_t('roots', 'l', 1, '', 'locate the contact switches by root finding'), &
        field_t('stald', 'l', 1, '', 'BDF stability-limit detection'), &
        field_t('linear_tail', 'l', 1, '', 'closed-form tail once full contact is proven to last'), &

@@ -11,7 +11,8 @@
 !> message handler's user data is that run's log, never a module variable.
 !>
 !> ERKStep (method = 'erk') is an explicit one-step Runge-Kutta pair (Dormand-Prince 5(4), 7
-!> stages, ARKODE_DORMAND_PRINCE_7_4_5) for the scaled system of Eq. 25. Chosen by measurement over Fehlberg's 13-stage 7(8) pair
+!> stages, ARKODE_DORMAND_PRINCE_7_4_5; Cash-Karp 5(4), 6 stages, with erk_table = 'cash_karp'
+!> and goal = 'statistics', docs/accuracy.md) for the scaled system of Eq. 25. Chosen by measurement over Fehlberg's 13-stage 7(8) pair
 !> (with switches located, at the defaults): physical_z24 F error 1.6e-5 with 68 700 RHS calls
 !> at rtol 1e-8 against 4.7e-5 with 117 700; paper_lx1e-4 2.4e-9 with 7 500 against 8.9e-8 with
 !> 7 200. The impacts bound the steps there, not the order. A contact switch (root finding) restarts it for
@@ -23,7 +24,8 @@
 module spline_integrator
   use, intrinsic :: iso_c_binding
   use fcvode_mod
-  use farkode_mod, only: ARK_NORMAL, ARK_ROOT_RETURN, ARK_TSTOP_RETURN, ARKODE_DORMAND_PRINCE_7_4_5
+  use farkode_mod, only: ARK_NORMAL, ARK_ROOT_RETURN, ARK_TSTOP_RETURN, ARKODE_DORMAND_PRINCE_7_4_5, &
+       ARKODE_CASH_KARP_6_4_5
   use farkode_erkstep_mod
   use fsundials_context_mod
   use fsundials_nvector_mod
@@ -72,6 +74,9 @@ module spline_integrator
     type(SUNNonlinearSolver), pointer :: nls => null()
     !> ERKStep: the step that crossed the last located switch, to restart with after it
     real(c_double) :: h_cross = 0.0_c_double
+    !> ERKStep's table set to Dormand-Prince's by integrator_tolerances (its 7 stage vectors,
+    !> freed as 7 whatever the table at the end)
+    logical :: dormand_prince = .false.
     !> the run in messages: 'the run' (spline_solver) or 'the variational run'
     character(len=24) :: run = 'the run'
     integer(8) :: max_steps = 0, max_total_steps = 0   !< the case's work bounds
@@ -248,7 +253,8 @@ contains
     end if
     if (flag == 0) then
       stage = 'setting the solver options'
-      flag = FERKStepSetTableNum(cv%mem, ARKODE_DORMAND_PRINCE_7_4_5)
+      flag = FERKStepSetTableNum(cv%mem, merge(ARKODE_CASH_KARP_6_4_5, ARKODE_DORMAND_PRINCE_7_4_5, &
+           m%cash_karp))
     end if
     if (flag == 0) flag = FERKStepSetMaxNumSteps(cv%mem, int(m%max_steps, c_long))
     ! a contact switch inside a step (roots off) is a kink the order-5 error model does not
@@ -471,12 +477,21 @@ contains
     if (flag == 0) flag = FCVodeReInit(mem, tau, sv)
   end function cvode_restart
 
-  !> New tolerances from the next step on (the step size and the integrator's history kept).
-  integer(c_int) function integrator_tolerances(cv, rtol, atol) result(flag)
+  !> New tolerances from the next step on (the step size and the integrator's history kept);
+  !> ERKStep also takes Cash-Karp's table (cash_karp) or Dormand-Prince's. Only from
+  !> Dormand-Prince to Cash-Karp or to itself: both are of order 5(4) (the step controller's
+  !> orders stay), Cash-Karp's 6 stages fit the 7 vectors ERKStep allocated for Dormand-Prince's
+  !> at its first step, and its first stage is f at the step's start either way (Dormand-Prince's
+  !> last stage, or evaluated anew); the other way a stage vector would be missing.
+  integer(c_int) function integrator_tolerances(cv, rtol, atol, cash_karp) result(flag)
     type(integrator_t), intent(inout) :: cv
     real(wp), intent(in) :: rtol, atol
+    logical, intent(in) :: cash_karp
     if (cv%erk) then
       flag = FERKStepSStolerances(cv%mem, real(rtol, c_double), real(atol, c_double))
+      if (flag == 0) flag = FERKStepSetTableNum(cv%mem, merge(ARKODE_CASH_KARP_6_4_5, &
+           ARKODE_DORMAND_PRINCE_7_4_5, cash_karp))
+      cv%dormand_prince = cv%dormand_prince .or. .not. cash_karp
     else
       flag = FCVodeSStolerances(cv%mem, real(rtol, c_double), real(atol, c_double))
     end if
@@ -642,6 +657,9 @@ contains
     integer(c_int) :: flag
     if (c_associated(cv%mem)) then
       if (cv%erk) then
+        ! ERKStepFree frees as many stage vectors as the table has: Dormand-Prince's 7 if it
+        ! ever ran (integrator_tolerances switches from it to Cash-Karp's 6)
+        if (cv%dormand_prince) flag = FERKStepSetTableNum(cv%mem, ARKODE_DORMAND_PRINCE_7_4_5)
         call FERKStepFree(cv%mem)
       else
         call FCVodeFree(cv%mem)

@@ -8,7 +8,7 @@ module spline_model
   use spline_errors, only: err_ok, err_case, err_thermal, itoa, ftoa, num
   use spline_case, only: case_t, case_validate, case_run_times, namelen, option_index, thermal_values, &
        method_values, nonlinear_values, start_values, fidelity_values, section_values, nripple, &
-       lyapunov_method_values, goal_values
+       lyapunov_method_values, goal_values, erk_table_values
   use spline_geometry, only: iso4156_radii, pitch_rotation
   use spline_stiffness, only: spline_mesh_stiffness_fillet
   use spline_thermal, only: backlash_coefficient, thermal_backlash
@@ -58,6 +58,8 @@ module spline_model
     real(wp) :: t_bulk, f_m, u_flash, eta_hertz
     integer  :: method_bdf = 1              !< 1 = BDF, 0 = Adams (CVODE)
     logical  :: erk = .false.               !< ARKODE ERKStep instead of CVODE (spline_integrator)
+    !> ERKStep's table: Cash-Karp, else Dormand-Prince (a loose transient: Dormand-Prince)
+    logical  :: cash_karp = .false.
     logical  :: newton = .true.             !< Newton + dense solver, else fixed-point iteration
     logical  :: roots = .false.
     logical  :: stald = .false.
@@ -169,6 +171,7 @@ contains
     end if
     m%method_bdf = merge(1, 0, k == 1)
     m%erk = k == 3
+    m%cash_karp = m%goal_statistics .or. option_index(erk_table_values, c%erk_table) == 2
     select case (option_index(nonlinear_values, c%nonlinear))
     case (1)
       m%newton = .true.
