@@ -109,12 +109,18 @@ def _checked(base, field, start, stop, n, *, tol, max_points, max_corrector, mon
                         "equations) or 'fd' (central differences of the map)")
     prob = _Problem(base, name, index, n, start, stop, float(base["t0"]), monodromy)
     for arg, value in (("stop", stop), ("start", start)):
-        try:
-            prob.model(value)
-        except CaseError as exc:
-            raise CaseError(f"continuation in {label}: {arg} = {value:g} is not a valid value "
-                            f"of {label}: {exc}") from None
+        valid_value(prob.model, value, label, f"continuation in {label}: {arg} = ")
     return prob, label, start, stop, tol
+
+
+def valid_value(load_at, value: float, label: str, prefix: str):
+    """load_at(value): the model of a case with a field (its `label`) at value, checked by
+    loading it; CaseError '{prefix}{value} is not a valid value of {label}: why' where it fails
+    (continuation's start and stop, fold_curve's values of its second field)."""
+    try:
+        return load_at(value)
+    except CaseError as exc:
+        raise CaseError(f"{prefix}{value:g} is not a valid value of {label}: {exc}") from None
 
 
 #: continuation's arguments that branches and fold_curve set themselves (not in their **cont)
