@@ -333,12 +333,11 @@ contains
     finite = all(fin == 0.0_wp)
   end subroutine mesh_outputs
 
-  !> Eq. 16: contact state of a tooth pair, +1 drive flank (dn > c), -1 back flank (dn < -c), 0 free.
+  !> Eq. 16: contact state of a tooth pair, +1 drive flank (dn > c), -1 back flank (dn < -c), 0 free:
+  !> eq16_mode of its switch functions (dn - c > 0 exactly when dn > c).
   pure integer function contact_state(dn, c)
     real(wp), intent(in) :: dn, c
-    contact_state = 0
-    if (dn > c) contact_state = 1
-    if (dn < -c) contact_state = -1
+    contact_state = eq16_mode(dn - c, dn + c)
   end function contact_state
 
   !> Eqs. 15-17: tooth force in contact state mode (+-1): k_m (dn -+ c) + c_m d(dn)/dt.
