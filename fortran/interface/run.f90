@@ -314,8 +314,9 @@ contains
     if (stats(ist_closed) > 0.0_wp) then
       text = text//'case '//trim(m%name)//': the one-way flash temperature closes the backlash '// &
            '(Eq. 2: c0 - kappa (T_M + T_f) <= 0) in '//itoa(nint(stats(ist_closed)))//' tooth '// &
-           'samples, first at t = '//ftoa(stats(ist_closed_t), '(es12.5)')//' s: the one-way result is not '// &
-           'physical there (thermal = ''coupled'' stops at the interference)'//new_line('a')
+           'samples, first at t = '//ftoa(stats(ist_closed_t), '(es12.5)')//' s: the one-way '// &
+           'result is not physical there (thermal = ''coupled'' stops at the interference)'// &
+           new_line('a')
     end if
   end function run_warnings
 

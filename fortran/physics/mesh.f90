@@ -333,8 +333,8 @@ contains
     finite = all(fin == 0.0_wp)
   end subroutine mesh_outputs
 
-  !> Eq. 16: contact state of a tooth pair, +1 drive flank (dn > c), -1 back flank (dn < -c), 0 free:
-  !> eq16_mode of its switch functions (dn - c > 0 exactly when dn > c).
+  !> Eq. 16: contact state of a tooth pair, +1 drive flank (dn > c), -1 back flank (dn < -c),
+  !> 0 free: eq16_mode of its switch functions (dn - c > 0 exactly when dn > c).
   pure integer function contact_state(dn, c)
     real(wp), intent(in) :: dn, c
     contact_state = eq16_mode(dn - c, dn + c)
