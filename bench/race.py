@@ -31,7 +31,7 @@ means over revolutions, as the core's Tm_rms_se; 3, as tests/test_stderr.py: the
 four z-scores of runs that differ only by chance passes 2 about half the time). That test on a
 single run missed the level at every rtol 30-60 % of the time (the batch means of 50
 revolutions understate the spread), so a rung passed or missed by chance. Each timing round of
-this scene now runs another realisation (the start perturbed, PERTURB; trajectories part
+this scene runs another realisation (the start perturbed, PERTURB; trajectories part
 within milliseconds, so realisations are independent samples of the statistics), the
 reference too, and a setting is at the statistics level when the mean of each statistic over
 its realisations lies within 3 standard errors of the reference's (Welch's t, the standard

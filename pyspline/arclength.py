@@ -118,11 +118,7 @@ def _checked(base, field, start, stop, n, *, tol, max_points, max_corrector, mon
         raise CaseError(f"continuation in {label}: band = {band!r}: two values holding start "
                         f"= {start:g} and stop = {stop:g}")
     for arg, value in (("stop", stop), ("start", start), ("band", ends[0]), ("band", ends[1])):
-        try:
-            prob.model(value)
-        except CaseError as exc:
-            raise CaseError(f"continuation in {label}: {arg} = {value:g} is not a valid value "
-                            f"of {label}: {exc}") from None
+        valid_value(prob.model, value, label, f"continuation in {label}: {arg} = ")
     prob.band = tuple((v - start) / prob.pscale for v in ends)
     h = prob.h * max(abs(start), prob.pscale)       # evaluate's difference step at start
     why = []
@@ -137,6 +133,16 @@ def _checked(base, field, start, stop, n, *, tol, max_points, max_corrector, mon
                         f"are isolated (none within {h:.3g} of start = {start:g}: {why[0]}); "
                         "continuation follows a field that varies continuously")
     return prob, label, start, stop, tol
+
+
+def valid_value(load_at, value: float, label: str, prefix: str):
+    """load_at(value): the model of a case with a field (its `label`) at value, checked by
+    loading it; CaseError '{prefix}{value} is not a valid value of {label}: why' where it fails
+    (continuation's start and stop, fold_curve's values of its second field)."""
+    try:
+        return load_at(value)
+    except CaseError as exc:
+        raise CaseError(f"{prefix}{value:g} is not a valid value of {label}: {exc}") from None
 
 
 #: continuation's arguments that branches and fold_curve set themselves (not in their **cont)

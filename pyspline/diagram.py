@@ -9,7 +9,8 @@ import warnings
 
 import numpy as np
 
-from .arclength import check_handed_on, continuation, field_label, parse_field
+from .arclength import (check_handed_on, continuation, field_label, parse_field, set_field,
+                        valid_value)
 from .errors import CaseError, SplineError, SplineWarning
 from .follow import repeat_revolutions
 from .orbits import CALL_SECONDS, OrbitError, out_of_time, time_bound
@@ -433,7 +434,6 @@ def _values(case, name2, index2, what, values, least):
     """values of the second field (field2: name2, element index2) as a 1-d float array, each
     a valid value of it in `case`; CaseError naming `what` otherwise or when fewer than
     `least`."""
-    from .arclength import set_field
     from .core import load
     label = field_label(name2, index2)
     try:
@@ -444,10 +444,7 @@ def _values(case, name2, index2, what, values, least):
         raise CaseError(f"{what} = {values!r}: finite values of {label}"
                         + (", at least one" if least else ""))
     for x in v:
-        try:
-            load(set_field(case, name2, index2, x))
-        except CaseError as exc:
-            raise CaseError(f"{what}: {x:g} is not a valid value of {label}: {exc}") from None
+        valid_value(lambda p: load(set_field(case, name2, index2, p)), x, label, f"{what}: ")
     return v
 
 
@@ -455,7 +452,6 @@ def _fold_values(case, field, start, stop, name2, index2, values2, n, narrow, pr
     """fold_curve's continuations, one per value of the second field, each within its share
     of the time left."""
     import xarray as xr
-    from .arclength import set_field
     from .orbits import time_left
     folds, grazes, bands, status, prev, pairs = [], [], [], [], None, []
     for i, v in enumerate(values2):
@@ -509,7 +505,6 @@ def _fold_values(case, field, start, stop, name2, index2, values2, n, narrow, pr
 def _check(out, case, field, start, stop, name2, index2, check, points, progress):
     """The follow sweeps' verdicts at the values `check` of the second field into `out`
     (-1 where the time bound had passed before the sweep)."""
-    from .arclength import set_field
     from .sweeps import sweep
     pts = np.linspace(min(start, stop), max(start, stop), points)
     verdict = []

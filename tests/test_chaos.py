@@ -64,8 +64,8 @@ def test_benettin_copy_carries_no_solver_noise():
     """A drive that settles (physical_z24 at 4000 r/min, 5 N m: k_v within 1 +- 2 %) has no
     positive exponent, whatever Benettin's separation: the perturbed copy is integrated beside
     the reference as one system, with the same steps, so their difference carries no
-    independent solver error. (Integrated separately, as before session 6, d0 = 1e-8 at rtol
-    1e-8 gave +58 1/s here: the separation measured the solver's noise.)"""
+    independent solver error. (Integrated as two separate runs, d0 = 1e-8 at rtol 1e-8 gave
+    +58 1/s here: the separation measured the solver's noise.)"""
     case = pyspline.load_case(CASES / "physical_z24.nml", speed_rpm=4000.0, t_d=5.0, t_l=5.0,
                               t_transient=0.3, t_end=0.8, n_out=2001, lyapunov=True)
     res = pyspline.simulate(case)

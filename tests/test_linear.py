@@ -1,4 +1,4 @@
-"""The linear tail (fortran/integration/linear.f90, docs/model.md section 14): once every tooth is proven to
+"""The linear tail (fortran/integration/linear.f90, docs/running.md section 4): once every tooth is proven to
 stay in contact on one flank, the rest of a run is the closed-form solution of the affine,
 time-invariant full-contact system."""
 import numpy as np

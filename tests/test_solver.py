@@ -144,14 +144,15 @@ GRAZING = pyspline.load_case(CASES / "paper_ideal.nml", rtol=1e-8, atol=1e-10, r
 @pytest.mark.parametrize("method", ["adams", "bdf"])
 def test_period_run_through_a_grazing_cluster_of_switches(method):
     """The state run over one forcing period from GRAZING_Y0 (what orbits._trajectory runs for
-    a branch point) failed with CV_ILL_INPUT "tout too far back" at the case's rtol, with Adams
-    and BDF: a free tooth's switch function at round-off level (exactly 0 at a restart) was
-    located crossing back the way that changes nothing, restart after restart at one instant,
-    each cutting the first step tenfold, until the step fell below round-off of t and CVODE
-    'reached' the next output without a state there (BDF's period map 'succeeded' that way,
-    6 % of the state off its orbit). Now only the crossings that change a contact state are
-    located: the run succeeds, its end state is the period map's to the continuation's
-    tolerance (100 rtol on the scaled states of Eq. 25), and CVODE says nothing."""
+    a branch point) passes a free tooth whose switch function is at round-off level (exactly 0
+    at a restart). Located crossing back the way that changes nothing, it would restart CVODE
+    at one instant, each restart cutting the first step tenfold, until the step fell below
+    round-off of t and CVODE 'reached' the next output without a state there (CV_ILL_INPUT
+    "tout too far back" with Adams and BDF; BDF's period map 'succeeded' that way, 6 % of the
+    state off its orbit). Only the crossings that change a contact state are located
+    (spline_mesh::eq16_root_directions): the run succeeds, its end state is the period map's
+    to the continuation's tolerance (100 rtol on the scaled states of Eq. 25), and CVODE says
+    nothing."""
     from pyspline.orbits import _period_map
     from test_orbits import scale_of
     case = GRAZING.replace(method=method)

@@ -48,7 +48,7 @@ contains
   end function itoa
 
   !> A real as text in the format f, without blanks, for messages (e.g. '(es10.3)', '(f0.2)').
-  function ftoa(x, f) result(s)
+  pure function ftoa(x, f) result(s)
     real(wp), intent(in) :: x
     character(len=*), intent(in) :: f
     character(len=:), allocatable :: s

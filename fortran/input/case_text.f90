@@ -3,7 +3,7 @@
 !> (the field name nearest to a misspelt one). No state: each routine works on its arguments.
 module spline_case_text
   use spline_kinds, only: wp
-  use spline_errors, only: itoa
+  use spline_errors, only: itoa, ftoa
   use spline_case_type, only: fields, nfields
   implicit none
   private
@@ -298,7 +298,6 @@ contains
   pure function size_text(bytes) result(s)
     real(wp), intent(in) :: bytes
     character(len=:), allocatable :: s
-    character(len=24) :: buf
     character(len=2), parameter :: units(5) = ['B ', 'kB', 'MB', 'GB', 'TB']
     real(wp) :: v
     integer :: k
@@ -306,8 +305,7 @@ contains
     do while (v >= 1000.0_wp .and. k < 5)
       v = v/1000.0_wp; k = k + 1
     end do
-    write(buf, '(f0.1)') v
-    s = trim(buf)//' '//trim(units(k))
+    s = ftoa(v, '(f0.1)')//' '//trim(units(k))
   end function size_text
 
 end module spline_case_text

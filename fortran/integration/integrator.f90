@@ -267,7 +267,7 @@ contains
     ! Dormand-Prince (F error, degree 3 / degree 4, at rtol 1e-3, 1e-4, 1e-5: paper_lx1e-4 with
     ! 6401 outputs 0.67, 1.05, 1.00 for 45, 42, 33 % fewer right-hand sides; physical_z24 with
     ! roots 1.23, 1.81, 1.02 for 50, 46, 45 % fewer); tighter it is not (at 1e-6 to 1e-8 3.0, 3.3,
-    ! 4.5 and 1.6, 2.0, 1.6 times the error): docs/model.md section 8
+    ! 4.5 and 1.6, 2.0, 1.6 times the error): docs/running.md section 2
     if (flag == 0) flag = FERKStepSetInterpolantDegree(cv%mem, merge(3_c_int, 4_c_int, &
          m%rtol >= cubic_rtol))
     if (flag == 0 .and. nroot > 0) then

@@ -1,4 +1,4 @@
-!> The linear tail (docs/model.md section 14). With every tooth pair in contact on the same flank,
+!> The linear tail (docs/running.md section 4). With every tooth pair in contact on the same flank,
 !> the mesh of Eqs. 15-17 and 19-22 is a linear, isotropic spring: for Z >= 3,
 !> sum_j sin^2(phi_j) = sum_j cos^2(phi_j) = Z/2 and sum_j sin(phi_j) cos(phi_j) = 0 (Eqs. 8-9),
 !> whatever the shaft angle. Without torque ripple, unbalance, the coupled flash temperature

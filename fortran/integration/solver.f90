@@ -214,6 +214,7 @@ contains
       real(c_double) :: tau_out, tau_to, tret(1)
       integer(c_int) :: flag
       integer(8) :: done_k
+      integer :: c
       going = .false.
       tau_out = tout(k)*m%w_ref
       done_k = integrator_steps_done(cv)
@@ -225,7 +226,7 @@ contains
           ! only the crossings that change a contact state are switches (CVODE): the
           ! directions follow the contact states, set again only when these changed (the
           ! start, a switch, a resynchronisation; CVODE keeps them across restarts)
-          dirs = root_directions(ctx)
+          dirs = [(eq16_root_directions(ctx%modes(:, c)), c = 1, ctx%ncopy)]
           if (any(dirs /= dirs_set)) then
             flag = integrator_root_directions(cv, dirs)
             if (flag /= 0) then
@@ -428,26 +429,6 @@ contains
       end if
     end do
   end subroutine sync_modes
-
-  !> The directions of the root functions (copy after copy) whose crossings change the contact
-  !> states ctx%modes (spline_mesh::eq16_root_directions). Without them a crossing the other
-  !> way, at round-off level on a grazing tooth (g exactly 0 at the restart, then +-1e-20 m),
-  !> was located, changed no state and restarted CVODE, whose search found it again within its
-  !> root tolerance: restarts without end at one instant, each cutting the first step tenfold,
-  !> until the step fell below round-off (the Z16 drive of tests/test_cont_drives.py, ripple
-  !> 0.13 at 2488.47 r/min: CV_ILL_INPUT, "tout too far back").
-  pure function root_directions(ctx) result(dirs)
-    type(solver_ctx_t), intent(in) :: ctx
-    integer :: dirs(ctx%nrc*ctx%ncopy)
-    integer :: j, c, nc
-    nc = ctx%m%z*ctx%m%n_slices
-    do c = 1, ctx%ncopy
-      do j = 1, nc
-        dirs((c - 1)*ctx%nrc + 2*j - 1:(c - 1)*ctx%nrc + 2*j) = &
-             eq16_root_directions(ctx%modes(j, c))
-      end do
-    end do
-  end function root_directions
 
   !> A located root of g_{2j-1} = dn_j - c_j (rising: drive flank engages, falling: it opens)
   !> or of g_{2j} = dn_j + c_j (falling: back flank engages, rising: it opens).

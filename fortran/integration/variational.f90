@@ -25,7 +25,7 @@ module spline_variational
   use spline_geometry, only: tooth_angles
   use spline_dynamics, only: rhs_scaled, rhs_jacobian, to_scaled, from_scaled, integrated_states
   use spline_mesh, only: mesh_switch_functions, eq11_gradient, eq16_mode, eq16_root_mode, &
-       eq16_root_directions, slice_offset
+       eq16_root_directions, tooth_approach, slice_approach
   use spline_integrator, only: integrator_t, lib_log_t, integrator_open, cvode_create, &
        integrator_advance, integrator_root_info, integrator_root_directions, integrator_restart, &
        integrator_fail_text, integrator_warnings, integrator_free
@@ -95,7 +95,7 @@ contains
     real(c_double) :: tau, tau1, tret(1)
     integer(c_int) :: flag, nroot
     integer(c_int), allocatable :: rootsfound(:)
-    integer :: n, k, nsw, j
+    integer :: n, k, nsw
     logical :: salt
     character(len=48) :: stage
     salt = .true.
@@ -135,7 +135,7 @@ contains
     do while (flag == 0 .and. tau < tau1)
       ! only the crossings that change a contact state are switches (as in spline_solver)
       stage = 'setting the directions of the contact switches'
-      flag = integrator_root_directions(cv, [(eq16_root_directions(ctx%modes(j)), j = 1, ctx%nc)])
+      flag = integrator_root_directions(cv, eq16_root_directions(ctx%modes))
       if (flag /= 0) exit
       ! max_steps and max_total_steps over the run (its one output interval), across restarts
       stage = 'integrating'
@@ -230,7 +230,7 @@ contains
     integer, intent(in) :: k, new
     real(c_double), intent(inout) :: v(:)
     real(wp) :: ys(nstate), y(nstate), fm(nstate), fp(nstate), hy(nstate), ht, den, sp(max_teeth)
-    real(wp) :: cp(max_teeth), ex, ey, zs, dfi(nstate), hphi, u(ndof)
+    real(wp) :: cp(max_teeth), ex, ey, dn, ddn, dns, dfi(nstate), hphi, u(ndof)
     integer :: mode_new(size(ctx%modes)), j, is, ns, n, c, ie
     associate(m => ctx%m)
       n = ctx%n
@@ -241,13 +241,16 @@ contains
       ys(ctx%idx(1:n)) = v(1:n)
       call from_scaled(m, ys, y)
       call tooth_angles(m%z, m%omega, tau/m%w_ref, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
-      zs = slice_offset(m, is)
       ex = y(1) + m%l_x - y(3)
       ey = y(2) + m%l_y - y(4)
       hy = 0.0_wp
       call eq11_gradient(sp(j), cp(j), u)
       hy(1:ndof) = m%l_ref*u
-      ht = m%omega*(ex*cp(j) + ey*sp(j) + zs*(m%gamma_y*cp(j) - m%gamma_x*sp(j)))/m%w_ref
+      ! h_tau: the contact's approach rate at rest (Eq. 11's rate with the velocities 0)
+      call tooth_approach(ex, ey, 0.0_wp, 0.0_wp, y(6), 0.0_wp, m%omega, m%spacing_error(j), &
+           sp(j), cp(j), dn, ddn)
+      call slice_approach(m, is, sp(j), cp(j), dn, ddn, dns, ht)
+      ht = ht/m%w_ref
       mode_new = ctx%modes
       mode_new(k) = new
       call rhs_scaled(m, tau, ys, fm, ie, ctx%cb_msg, ctx%modes(1:ctx%nc))

@@ -5,7 +5,7 @@
 !> thermal levels that have it, Eqs. 1-7) at every output time, and the checks of the result.
 module spline_run
   use spline_kinds, only: wp
-  use spline_errors, only: err_ok, err_solver, itoa, num
+  use spline_errors, only: err_ok, err_solver, itoa, ftoa, num
   use spline_model, only: model_t, nstate, ndof, thermal_oneway, thermal_coupled, set_thermal_level
   use spline_dynamics, only: start_state
   use spline_mesh, only: mesh_eval, mesh_outputs
@@ -272,16 +272,14 @@ contains
       character(len=*), intent(in) :: what, which
       integer, intent(in) :: k
       real(wp), intent(in), optional :: tk
-      character(len=40) :: buf
       real(wp) :: tt
       if (ierr /= err_ok) return
       tt = 0.0_wp
       if (k > 0) tt = t(k)
       if (present(tk)) tt = tk
-      write(buf, '(es12.5)') tt
       ierr = err_solver
       errmsg = 'case '//trim(m%name)//': the run produced a non-finite value (NaN or Inf): '// &
-           what//which//' at t = '//trim(adjustl(buf))//' s; the model left its range there '// &
+           what//which//' at t = '//ftoa(tt, '(es12.5)')//' s; the model left its range there '// &
            '(e.g. a runaway state)'
     end subroutine bad
   end subroutine result_checks
@@ -312,14 +310,13 @@ contains
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: stats(nstats)
     character(len=:), allocatable :: text
-    character(len=32) :: buf
     text = restart_warning(m, stats)//accuracy_warning(m, stats)
     if (stats(ist_closed) > 0.0_wp) then
-      write(buf, '(es12.5)') stats(ist_closed_t)
       text = text//'case '//trim(m%name)//': the one-way flash temperature closes the backlash '// &
            '(Eq. 2: c0 - kappa (T_M + T_f) <= 0) in '//itoa(nint(stats(ist_closed)))//' tooth '// &
-           'samples, first at t = '//trim(adjustl(buf))//' s: the one-way result is not '// &
-           'physical there (thermal = ''coupled'' stops at the interference)'//new_line('a')
+           'samples, first at t = '//ftoa(stats(ist_closed_t), '(es12.5)')//' s: the one-way '// &
+           'result is not physical there (thermal = ''coupled'' stops at the interference)'// &
+           new_line('a')
     end if
   end function run_warnings
 
@@ -359,12 +356,10 @@ contains
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: stats(nstats)
     character(len=:), allocatable :: text
-    character(len=16) :: buf
     text = ''
     if (m%erk .or. .not. m%roots .or. m%rtol <= restart_rtol .or. stats(ist_roots_found) < 1) &
          return
-    write(buf, '(es10.3)') m%rtol
-    text = 'case '//trim(m%name)//': rtol = '//trim(adjustl(buf))//' with method = '''// &
+    text = 'case '//trim(m%name)//': rtol = '//ftoa(m%rtol, '(es10.3)')//' with method = '''// &
          trim(merge('bdf  ', 'adams', m%method_bdf == 1))//''' and '// &
          itoa(nint(stats(ist_roots_found)))//' contact switches located: CVODE restarts at '// &
          'order 1 after each, and above rtol 1e-3 that can falsify the impacts (chaos_z24 '// &

@@ -11,7 +11,7 @@ module spline_mesh
   implicit none
   private
   public :: mesh_eval, mesh_forces, mesh_outputs, mesh_switch_functions, coupling_stats_t, tooth_approach
-  public :: eq11_gradient, eq16_mode, eq16_root_mode, eq16_root_directions, slice_offset
+  public :: eq11_gradient, eq16_mode, eq16_root_mode, eq16_root_directions, slice_approach
   public :: start_warning
 
   integer, parameter :: max_coupling_iter = 60
@@ -81,8 +81,7 @@ contains
         fj = 0.0_wp
         do is = 1, ns
           zs = slice_z(m, is)
-          dns = dnj + zs*(m%gamma_y*sp(j) + m%gamma_x*cp(j))
-          ddns = ddnj + m%omega*zs*(m%gamma_y*cp(j) - m%gamma_x*sp(j))
+          call eq11_sliced(m, zs, sp(j), cp(j), dnj, ddnj, dns, ddns)
           if (present(mode)) then
             mj = mode((j - 1)*ns + is)
           else
@@ -334,12 +333,11 @@ contains
     finite = all(fin == 0.0_wp)
   end subroutine mesh_outputs
 
-  !> Eq. 16: contact state of a tooth pair, +1 drive flank (dn > c), -1 back flank (dn < -c), 0 free.
+  !> Eq. 16: contact state of a tooth pair, +1 drive flank (dn > c), -1 back flank (dn < -c),
+  !> 0 free: eq16_mode of its switch functions (dn - c > 0 exactly when dn > c).
   pure integer function contact_state(dn, c)
     real(wp), intent(in) :: dn, c
-    contact_state = 0
-    if (dn > c) contact_state = 1
-    if (dn < -c) contact_state = -1
+    contact_state = eq16_mode(dn - c, dn + c)
   end function contact_state
 
   !> Eqs. 15-17: tooth force in contact state mode (+-1): k_m (dn -+ c) + c_m d(dn)/dt.
@@ -449,7 +447,7 @@ contains
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(7)
     real(wp), intent(out) :: g(2*m%z*m%n_slices)
-    real(wp) :: sp(max_teeth), cp(max_teeth), ex, ey, dnj, ddnj, dns
+    real(wp) :: sp(max_teeth), cp(max_teeth), ex, ey, dnj, ddnj, dns, ddns
     integer :: j, is, k, ns
     call tooth_angles(m%z, m%omega, t, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
     ex = q(1) + m%l_x - q(3)
@@ -463,7 +461,7 @@ contains
         g(2*j) = dnj + m%c_bulk
       else
         do is = 1, ns
-          dns = dnj + slice_z(m, is)*(m%gamma_y*sp(j) + m%gamma_x*cp(j))
+          call eq11_sliced(m, slice_z(m, is), sp(j), cp(j), dnj, ddnj, dns, ddns)
           k = (j - 1)*ns + is
           g(2*k - 1) = dns - m%c_bulk
           g(2*k) = dns + m%c_bulk
@@ -472,15 +470,29 @@ contains
     end do
   end subroutine mesh_switch_functions
 
-  !> The axial position of slice is of the n_s of the face, from its mid-plane (docs/model.md
-  !> section 11): z_s = b ((s - 1/2) / n_s - 1/2). For other modules; this one calls slice_z,
-  !> inlined (tooth_approach says why).
-  elemental real(wp) function slice_offset(m, is) result(zs)
+  !> Eq. 11 and its rate for slice is of the n_s of the face of tooth j (docs/model.md section
+  !> 11), from the tooth's at the face centre (dn, ddn: eq11's): the angular misalignment
+  !> (gamma_x, gamma_y) of spline 1 moves the slice at axial position z_s by
+  !> z_s (gamma_y sin phi_j + gamma_x cos phi_j) along the line of action. For other modules;
+  !> this one calls eq11_sliced and slice_z, inlined (tooth_approach says why).
+  elemental subroutine slice_approach(m, is, sp, cp, dn, ddn, dns, ddns)
     type(model_t), intent(in) :: m
     integer, intent(in) :: is
-    zs = slice_z(m, is)
-  end function slice_offset
+    real(wp), intent(in) :: sp, cp, dn, ddn
+    real(wp), intent(out) :: dns, ddns
+    call eq11_sliced(m, slice_z(m, is), sp, cp, dn, ddn, dns, ddns)
+  end subroutine slice_approach
 
+  elemental subroutine eq11_sliced(m, zs, sp, cp, dn, ddn, dns, ddns)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: zs, sp, cp, dn, ddn
+    real(wp), intent(out) :: dns, ddns
+    dns = dn + zs*(m%gamma_y*sp + m%gamma_x*cp)
+    ddns = ddn + m%omega*zs*(m%gamma_y*cp - m%gamma_x*sp)
+  end subroutine eq11_sliced
+
+  !> The axial position of slice is of the n_s of the face, from its mid-plane:
+  !> z_s = b ((s - 1/2) / n_s - 1/2).
   elemental real(wp) function slice_z(m, is) result(zs)
     type(model_t), intent(in) :: m
     integer, intent(in) :: is
@@ -509,24 +521,32 @@ contains
     if (root_back == 1) new = 0
   end function eq16_root_mode
 
-  !> The crossing directions of a contact's switch functions (g_drive, g_back) that change its
-  !> contact state mode by eq16_root_mode, as SUNDIALS' root directions (+1 rising, -1 falling,
-  !> 0 either): free (0), g_drive rising and g_back falling; on the drive flank (+1), g_drive
-  !> falling, g_back either; on the back flank (-1), g_back rising, g_drive either. The other
-  !> way (a free tooth's g_drive falling, say) leaves the state as it is: at round-off level on a
-  !> grazing tooth such a crossing, located, changed nothing but cost a restart, and restarts
-  !> there chained without end (spline_solver::root_directions).
-  pure function eq16_root_directions(mode) result(dirs)
-    integer, intent(in) :: mode
-    integer :: dirs(2)
-    select case (mode)
-    case (1)
-      dirs = [-1, 0]
-    case (-1)
-      dirs = [0, 1]
-    case default
-      dirs = [1, -1]
-    end select
+  !> The crossing directions of the switch functions (g_drive, g_back) of each contact that
+  !> change its contact state modes(j) by eq16_root_mode, as SUNDIALS' root directions (+1
+  !> rising, -1 falling, 0 either), in the root functions' order (dirs(2j-1:2j) for contact j):
+  !> free (0), g_drive rising and g_back falling; on the drive flank (+1), g_drive falling,
+  !> g_back either; on the back flank (-1), g_back rising, g_drive either. The other way (a free
+  !> tooth's g_drive falling, say) leaves the state as it is. Without these directions such a
+  !> crossing, at round-off level on a grazing tooth (g exactly 0 at the restart, then +-1e-20
+  !> m), was located, changed no state and restarted CVODE, whose search found it again within
+  !> its root tolerance: restarts without end at one instant, each cutting the first step
+  !> tenfold, until the step fell below round-off (the Z16 drive of tests/test_cont_drives.py,
+  !> ripple 0.13 at 2488.47 r/min: CV_ILL_INPUT, "tout too far back"). The state run (each of
+  !> its copies) and the variational run set them from their contact states.
+  pure function eq16_root_directions(modes) result(dirs)
+    integer, intent(in) :: modes(:)
+    integer :: dirs(2*size(modes))
+    integer :: j
+    do j = 1, size(modes)
+      select case (modes(j))
+      case (1)
+        dirs(2*j - 1:2*j) = [-1, 0]
+      case (-1)
+        dirs(2*j - 1:2*j) = [0, 1]
+      case default
+        dirs(2*j - 1:2*j) = [1, -1]
+      end select
+    end do
   end function eq16_root_directions
 
 end module spline_mesh

@@ -459,7 +459,7 @@ contains
 
   !> The integrator of a case, as its position in method_values (1 bdf, 2 adams, 3 erk): the
   !> case's, or for method = 'auto' the one that won on the shipped scenes at their own settings
-  !> (docs/model.md section 14, "Integrators"). With the stiff mesh of Eq. 18 (k_m = 0): ERK from
+  !> (docs/running.md section 2). With the stiff mesh of Eq. 18 (k_m = 0): ERK from
   !> rest (the teeth take up the backlash with hundreds of impacts, and a one-step method
   !> restarts at each for nothing); BDF from equilibrium in one face slice (slices switch one by
   !> one, and each switch restarts BDF at order 1). Adams with a given (calibrated) k_m, and from

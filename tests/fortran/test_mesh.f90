@@ -197,11 +197,12 @@ program test_mesh
 
   ! the root directions the runs locate are exactly the crossings that change the contact state
   block
-    integer :: mode, fn, dir, r(2), dirs(2)
+    integer :: mode, fn, dir, r(2), dirs(2), every(6)
     logical :: agree
     agree = .true.
+    every = eq16_root_directions([-1, 0, 1])    ! three contacts: two root functions each
     do mode = -1, 1
-      dirs = eq16_root_directions(mode)
+      dirs = every(2*mode + 3:2*mode + 4)
       do fn = 1, 2                        ! g_drive, g_back
         do dir = -1, 1, 2                 ! falling, rising
           r = 0
