@@ -20,13 +20,13 @@ import warnings
 import numpy as np
 
 from .case import Case, defaults, load_case
-from .core import STATE_QUANTITIES, load, sundials_said
+from .core import load, sundials_said
+from .dataset import continuation_dataset
 from .errors import CaseError, SolverError, SplineWarning
 from .orbits import (CALL_SECONDS, OrbitError, _period_map, _scale, _trajectory, fd_monodromy,
                      forcing_periods, map_and_monodromy, out_of_time, periodic_orbit, time_bound)
 from . import specials
 from .specials import SPECIAL_TYPES, contact_measures, locate, multipliers, smooth, tests
-from .summary import _version
 
 __all__ = ["continuation", "SPECIAL_TYPES"]
 
@@ -634,76 +634,3 @@ def _where(br, u, ds, where):
         f"arclength step down to {ds:.3g}: scaled residual {hist[-1]:.3g} (wanted "
         f"{br.tol:.3g}), history {', '.join(f'{v:.2g}' for v in hist)}"
         + (f" (last failure: {br.last_error})" if getattr(br, "last_error", "") else ""))
-
-
-# --------------------------------------------------------------------------- the dataset
-
-_POINT_VARS = {"Tm_pp": ("T_m peak-to-peak over the period", "N m"),
-               "F_max": ("largest tooth load over the period", "N"),
-               "D2_pp": ("D2 peak-to-peak over the period", "m"),
-               "closest_approach": ("closest approach to a contact boundary: smallest |dn_j| - "
-                                    "c_j of the teeth whose contact does not change", "m"),
-               "switches": ("contact changes of all teeth over the period", "1"),
-               "residual": ("corrector residual max |P^n(y) - y| (scaled, Eq. 25)", "1"),
-               "iterations": ("corrector iterations", "1")}
-
-
-def continuation_dataset(case, prob, label, branches, found, margin, k, attrs):
-    """The branches and special points as an xarray.Dataset (docs/continuation.md)."""
-    import xarray as xr
-    from .dataset import _field_attrs
-    pts = [(ib, p) for ib, b in enumerate(branches) for p in b]
-    npt, nsp = len(pts), len(found)
-    mu = np.full((npt, k), np.nan, complex)
-    for i, (_, p) in enumerate(pts):
-        mu[i, :len(p["mu"])] = p["mu"]
-    fa = _field_attrs(prob.name)
-    state = [str(s) for s in STATE_QUANTITIES]
-
-    def col(key, rows):
-        return np.array([r["contact"][key] if key in ("closest_approach", "switches")
-                         else r[key] for r in rows], dtype=float)
-    rows = [p for _, p in pts]
-    data = {label: (("point",), col("p", rows), fa),
-            "branch": (("point",), np.array([ib for ib, _ in pts], int),
-                       {"long_name": "branch number (0: from start; later: doubled branches)"}),
-            "n": (("point",), np.array([p["n"] for p in rows], int),
-                  {"long_name": "shaft revolutions of the orbit's period"}),
-            "y0": (("point", "state"), np.array([p["y"] for p in rows]).reshape(npt, 14),
-                   {"long_name": "section state at t0 (SI: m, rad; m/s, rad/s)"}),
-            "mu_real": (("point", "multiplier"), mu.real, {"long_name": "Floquet multiplier, real part"}),
-            "mu_imag": (("point", "multiplier"), mu.imag, {"long_name": "Floquet multiplier, imaginary part"}),
-            "mu_abs": (("point", "multiplier"), np.abs(mu), {"long_name": "Floquet multiplier, modulus"}),
-            "stable": (("point",), np.array([bool(np.all(np.abs(p["mu"]) < 1 - margin))
-                                            for p in rows], np.int8),
-                       {"long_name": f"1: every |mu| < 1 - {margin:g}"})}
-    for key, (long, unit) in _POINT_VARS.items():
-        data[key] = (("point",), col(key, rows), {"long_name": long, "units": unit})
-    crit = np.array([s["critical"] for s in found], complex).reshape(nsp)
-    data.update({
-        "special_type": (("special",), np.array([s["type"] for s in found], dtype=object
-                                                ).astype(str) if nsp else np.zeros(0, "<U1"),
-                         {"long_name": "special point: " + "; ".join(
-                             f"{t}: {d}" for t, d in SPECIAL_TYPES.items())}),
-        f"special_{label}": (("special",), col("p", found), fa),
-        "special_branch": (("special",), np.array([s["branch"] for s in found], int)),
-        "special_n": (("special",), np.array([s["n"] for s in found], int)),
-        "special_mu_real": (("special",), crit.real, {"long_name": "critical multiplier, real part"}),
-        "special_mu_imag": (("special",), crit.imag, {"long_name": "critical multiplier, imaginary part"}),
-        "special_smooth": (("special",), np.array([smooth(s) for s in found], np.int8),
-                           {"long_name": "1: the critical multiplier is at +1, -1 or on the unit "
-                                         "circle (within 0.01); 0: it jumped across (a "
-                                         "non-smooth bifurcation, e.g. at a grazing)"}),
-        "special_y0": (("special", "state"), np.array([s["y"] for s in found]).reshape(nsp, 14),
-                       {"long_name": "section state at t0 (SI)"}),
-    })
-    for key in ("Tm_pp", "F_max", "D2_pp", "closest_approach"):
-        long, unit = _POINT_VARS[key]
-        data[f"special_{key}"] = (("special",), np.array([s[key] for s in found], float),
-                                  {"long_name": long, "units": unit})
-    ds = xr.Dataset(data, coords={"state": state})
-    ds.attrs.update(case=case.text(), field=label, field_name=prob.name,
-                    pyspline_version=_version(), n_points=npt, n_special=nsp,
-                    n_branches=len(branches), **attrs)
-    return ds
-
