@@ -56,6 +56,11 @@ measure() {
   rm -rf --one-file-system "$copy" && mkdir -p "$copy"
   tar -C "$copy" -xf "$pristine"
   cp /etc/resolv.conf "$copy/etc/resolv.conf"
+  # the host's local CA certificates (those of its HTTPS egress), which a new machine has too
+  if compgen -G "/usr/local/share/ca-certificates/*.crt" >/dev/null; then
+    cp /usr/local/share/ca-certificates/*.crt "$copy/usr/local/share/ca-certificates/"
+    chroot "$copy" update-ca-certificates >/dev/null 2>&1
+  fi
   git clone -q --no-local "$repo" "$copy/root/pyspline" && git -C "$copy/root/pyspline" checkout -q "$commit"
   cat >"$copy/root/measure.sh" <<'EOF'
 cd /root/pyspline
