@@ -121,7 +121,8 @@ if [ "$prefix" = system ]; then
     step "apt-get install Debian's SUNDIALS" apt_install libsundials-dev libsundials-fortran-dev
   fi
 else
-  setup_args=("-Csetup-args=-Dsundials_prefix=$prefix")
+  # the long form: Debian 12's pip 23.0.1 has no -C
+  setup_args=("--config-settings=setup-args=-Dsundials_prefix=$prefix")
 fi
 if [ $tests = 1 ]; then
   # ROSS 2.3 needs plotly < 6
