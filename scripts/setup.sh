@@ -19,10 +19,15 @@ cd "$(dirname "$0")/.."
 tests=0; [ "${1:-}" = "--tests" ] && tests=1
 SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
 log="$(mktemp -t pyspline-setup.XXXXXX.log)"
-step() {   # step "what" command...: one line, the command's output in $log
-  local what="$1" t0=$SECONDS; shift
+cpu() {   # $cpu: CPU seconds (user + sys) of the processes this script has waited for
+  times >"$log.cpu"
+  cpu=$(awk 'NR == 2 {gsub(/[ms]/, " "); printf "%.0f", $1 * 60 + $2 + $3 * 60 + $4}' "$log.cpu")
+}
+step() {   # step "what" command...: one line with its wall and CPU seconds, the output in $log
+  local what="$1" t0=$SECONDS cpu0; shift
+  cpu; cpu0=$cpu
   printf 'setup: %s ... ' "$what"
-  if "$@" >>"$log" 2>&1; then echo "done ($((SECONDS - t0)) s)"
+  if "$@" >>"$log" 2>&1; then cpu; echo "done ($((SECONDS - t0)) s, $((cpu - cpu0)) s of CPU)"
   else echo "FAILED (the last lines of $log:)"; tail -20 "$log" >&2; return 1; fi
 }
 apt_install() {
@@ -130,4 +135,4 @@ if [ $tests = 1 ]; then
     ross-rotordynamics "plotly<6" numba numbalsoda dask-jobqueue
 fi
 step "pip install . (pyspline)" pip_install --no-build-isolation "${setup_args[@]}" .
-rm -f "$log"
+rm -f "$log" "$log.cpu"
