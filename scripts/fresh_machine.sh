@@ -42,7 +42,8 @@ Suites: bookworm-security
 Components: main
 Signed-By: /usr/share/keyrings/debian-archive-keyring.gpg
 EOF
-  rm -rf "$root"/var/lib/apt/lists/* "$root"/var/cache/apt/archives/*.deb "$root"/var/cache/apt/*.bin
+  rm -rf "$root"/var/lib/apt/lists/* "$root"/var/cache/apt/archives/*.deb \
+    "$root"/var/cache/apt/*.bin
   mkdir -p "$root/var/lib/apt/lists/partial"
   tar -C "$root" -cf "$pristine" . && rm -rf --one-file-system "$root"
 }
@@ -54,14 +55,15 @@ measure() {
   [ -n "$line" ] || { echo "no command $n in README.md at $commit" >&2; return 1; }
   if grep -q " $copy/" /proc/mounts; then echo "$copy has mounts: not removing it" >&2; return 1; fi
   rm -rf --one-file-system "$copy" && mkdir -p "$copy"
-  tar -C "$copy" -xf "$pristine"
+  tar -C "$copy" -xf "$pristine" || return 1
   cp /etc/resolv.conf "$copy/etc/resolv.conf"
   # the host's local CA certificates (those of its HTTPS egress), which a new machine has too
   if compgen -G "/usr/local/share/ca-certificates/*.crt" >/dev/null; then
     cp /usr/local/share/ca-certificates/*.crt "$copy/usr/local/share/ca-certificates/"
     chroot "$copy" update-ca-certificates >/dev/null 2>&1
   fi
-  git clone -q --no-local "$repo" "$copy/root/pyspline" && git -C "$copy/root/pyspline" checkout -q "$commit"
+  git clone -q --no-local "$repo" "$copy/root/pyspline" || return 1
+  git -C "$copy/root/pyspline" checkout -q "$commit" || return 1
   cat >"$copy/root/measure.sh" <<'EOF'
 cd /root/pyspline
 line="$1"; parts=(); total=0
@@ -95,7 +97,12 @@ EOF
 
 [ -f "$pristine" ] || make_pristine
 case "$which" in
-  1|2) measure "$which" ;;
-  both) rc=0; measure 1 || rc=1; measure 2 || rc=1; exit $rc ;;
+  1|2) runs=("$which") ;;
+  both) runs=(1 2) ;;
   *) echo "usage: bash scripts/fresh_machine.sh [1|2|both] [COMMIT]" >&2; exit 2 ;;
 esac
+rc=0
+for n in "${runs[@]}"; do measure "$n" || rc=1; done
+echo "== summary: per step and in all (load average: 1, 5, 15 min)"
+for n in "${runs[@]}"; do grep -h '^==\|^setup:\|^measure:' "$dir/run$n.log"; done
+exit $rc
