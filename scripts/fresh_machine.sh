@@ -77,9 +77,9 @@ for part in "${parts[@]}"; do
   total=$((total + SECONDS - t0))
   echo "measure: load after: $(cut -d' ' -f1-3 /proc/loadavg)"
 done
-echo "measure: total $total s wall: ${parts[*]}"
+echo "measure: total $total s wall: $1"
 EOF
-  echo "== fresh Debian 12 root, commit ${commit:0:7}, command $n: $line"
+  echo "== fresh Debian 12 root, commit ${commit:0:7}, command $n: $line" | tee "$dir/run$n.log"
   unshare --mount --propagation private bash -c '
     set -e; c="$1"
     mount -t proc proc "$c/proc"; mount -t sysfs -o ro sysfs "$c/sys"
@@ -92,7 +92,7 @@ EOF
     ln -s /proc/self/fd "$c/dev/fd"
     exec chroot "$c" /usr/bin/env -i HOME=/root LANG=C.UTF-8 TERM=dumb \
       PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
-      bash /root/measure.sh "$2"' _ "$copy" "$line" 2>&1 | tee "$dir/run$n.log"
+      bash /root/measure.sh "$2"' _ "$copy" "$line" 2>&1 | tee -a "$dir/run$n.log"
 }
 
 [ -f "$pristine" ] || make_pristine
