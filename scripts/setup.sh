@@ -19,10 +19,15 @@ cd "$(dirname "$0")/.."
 tests=0; [ "${1:-}" = "--tests" ] && tests=1
 SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
 log="$(mktemp -t pyspline-setup.XXXXXX.log)"
-step() {   # step "what" command...: one line, the command's output in $log
-  local what="$1" t0=$SECONDS; shift
+cpu() {   # $cpu: CPU seconds (user + sys) of the processes this script has waited for
+  times >"$log.cpu"
+  cpu=$(awk 'NR == 2 {gsub(/[ms]/, " "); printf "%.0f", $1 * 60 + $2 + $3 * 60 + $4}' "$log.cpu")
+}
+step() {   # step "what" command...: one line with its wall and CPU seconds, the output in $log
+  local what="$1" t0=$SECONDS cpu0; shift
+  cpu; cpu0=$cpu
   printf 'setup: %s ... ' "$what"
-  if "$@" >>"$log" 2>&1; then echo "done ($((SECONDS - t0)) s)"
+  if "$@" >>"$log" 2>&1; then cpu; echo "done ($((SECONDS - t0)) s, $((cpu - cpu0)) s of CPU)"
   else echo "FAILED (the last lines of $log:)"; tail -20 "$log" >&2; return 1; fi
 }
 apt_install() {
@@ -31,11 +36,30 @@ apt_install() {
 # Byte-compiling every module pip installs is most of its CPU time (43 of 56 s); without it the
 # first import compiles what it uses (6 s for `pyspline reproduce`) and keeps it, unless
 # PYTHONDONTWRITEBYTECODE is set: then every process would compile its imports anew.
-nocompile=(); [ -z "${PYTHONDONTWRITEBYTECODE:-}" ] && nocompile=(--no-compile)
-pip_install() { python3 -m pip install -q --disable-pip-version-check "${nocompile[@]}" "$@"; }
+pip_opts=(); [ -z "${PYTHONDONTWRITEBYTECODE:-}" ] && pip_opts=(--no-compile)
+# Debian's own python3 refuses pip outside a venv (PEP 668, "externally-managed-environment"):
+# the README's commands need pyspline and pytest on PATH afterwards, so outside a venv they go
+# into /usr/local (root; ~/.local otherwise), with pip's --break-system-packages. In a venv
+# (activated before setup.sh) or another Python (pyenv, conda) they go where pip puts them.
+managed() {
+  python3 -c 'import os, sys, sysconfig
+sys.exit(sys.prefix != sys.base_prefix
+         or not os.path.exists(os.path.join(sysconfig.get_path("stdlib"), "EXTERNALLY-MANAGED")))'
+}
+if managed; then
+  pip_opts+=(--break-system-packages)
+  echo "setup: $(command -v python3) is externally managed (PEP 668): pip installs outside a venv" \
+    "into $([ "$(id -u)" -eq 0 ] && echo /usr/local || echo "~/.local") (activate a venv first to avoid it)"
+fi
+pip_install() { python3 -m pip install -q --disable-pip-version-check "${pip_opts[@]}" "$@"; }
 
 need=(); update=0
 pkgs=(gfortran cmake liblapack-dev libblas-dev)
+# the headers of Debian's python3 for the extension (a new Debian has none), xz for SUNDIALS' source
+python3 -c 'import os, sys, sysconfig
+sys.exit(not os.path.exists(os.path.join(sysconfig.get_path("include"), "Python.h")))' \
+  || pkgs+=(python3-dev)
+[ "${PYSPLINE_SUNDIALS:-}" = system ] || pkgs+=(xz-utils)
 [ $tests = 1 ] && pkgs+=(libsundials-cvode6 libsundials-arkode5)
 for pkg in "${pkgs[@]}"; do dpkg -s "$pkg" >/dev/null 2>&1 || need+=("$pkg"); done
 
@@ -46,6 +70,10 @@ add_deb_src() {   # Debian's source package needs a deb-src entry for the binari
   sed -n 's/^Types: deb$/Types: deb-src/p; /^URIs:/p; /^Suites:/p; /^Components:/p; /^Signed-By:/p' \
     /etc/apt/sources.list.d/debian.sources 2>/dev/null | head -5 \
     | $SUDO tee /etc/apt/sources.list.d/pyspline-deb-src.sources >/dev/null
+  [ -s /etc/apt/sources.list.d/pyspline-deb-src.sources ] && return 0
+  $SUDO rm -f /etc/apt/sources.list.d/pyspline-deb-src.sources   # one-line format (debootstrap's)
+  sed -n 's/^deb \(.*\)/deb-src \1/p' /etc/apt/sources.list 2>/dev/null \
+    | $SUDO tee /etc/apt/sources.list.d/pyspline-deb-src.list >/dev/null
 }
 sundials_version() {   # the installed libsundials-dev's, else the archive's
   dpkg-query -W -f='${Version}' libsundials-dev 2>/dev/null \
@@ -98,7 +126,8 @@ if [ "$prefix" = system ]; then
     step "apt-get install Debian's SUNDIALS" apt_install libsundials-dev libsundials-fortran-dev
   fi
 else
-  setup_args=("-Csetup-args=-Dsundials_prefix=$prefix")
+  # the long form: Debian 12's pip 23.0.1 has no -C
+  setup_args=("--config-settings=setup-args=-Dsundials_prefix=$prefix")
 fi
 if [ $tests = 1 ]; then
   # ROSS 2.3 needs plotly < 6
@@ -106,4 +135,4 @@ if [ $tests = 1 ]; then
     ross-rotordynamics "plotly<6" numba numbalsoda dask-jobqueue
 fi
 step "pip install . (pyspline)" pip_install --no-build-isolation "${setup_args[@]}" .
-rm -f "$log"
+rm -f "$log" "$log.cpu"
