@@ -125,10 +125,10 @@ SHARED_ACROSS_MODULES = {"every_branch": "z16_band", "s_curve": "z16_band",
 def pytest_collection_modifyitems(items):
     """With `--dist loadgroup` (pyproject.toml), every xdist worker computes a shared result
     only if a test that uses it is sent to it: the tests that share one go to one worker as a
-    group. A test that uses a module- or class-scoped fixture of its module joins its module's
-    group, one that uses a fixture of SHARED_ACROSS_MODULES that group; a module may name its
-    own group (pytestmark = pytest.mark.xdist_group(...)). The other tests are handed out one
-    by one to the worker that is free, so both finish together."""
+    group. A test that uses a fixture of its module that is not function-scoped joins its
+    module's group, one that uses a fixture of SHARED_ACROSS_MODULES that group; a module may
+    name its own group (pytestmark = pytest.mark.xdist_group(...)). The other tests are handed
+    out one by one to the worker that is free, so both finish together."""
     for item in items:
         if item.get_closest_marker("xdist_group"):
             continue
@@ -136,7 +136,8 @@ def pytest_collection_modifyitems(items):
         defs = item._fixtureinfo.name2fixturedefs
         group = next((SHARED_ACROSS_MODULES[n] for n in item.fixturenames
                       if n in SHARED_ACROSS_MODULES), None)
-        if group is None and any(d[-1].scope != "function" and d[-1].baseid == module
+        if group is None and any(d[-1].scope != "function"
+                                 and d[-1].baseid.split("::")[0] == module
                                  for d in defs.values()):
             group = Path(module).stem
         if group:
