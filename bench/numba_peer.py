@@ -59,7 +59,7 @@ if str(ROOT / "tests") not in sys.path:
 import oracle  # noqa: E402
 
 __all__ = ["Setup", "make_rhs", "solve", "rhs_eval", "load_case", "DEFAULTS", "lsoda_sig",
-           "COMPILE_SECONDS"]
+           "COMPILE_SECONDS", "compile_all"]
 
 # numbalsoda's RHS signature: void f(double t, double *u, double *du, double *data)
 lsoda_sig = types.void(types.double, types.CPointer(types.double),
@@ -496,6 +496,14 @@ def _compiled(kind="fast"):
                              fastmath=fast)(_rhs_fast_py if fast else _rhs_py)
         COMPILE_SECONDS.append(time.perf_counter() - t0)
     return _CFUNC[kind]
+
+
+def compile_all():
+    """Compiles both right-hand sides and the forces into numba's cache (bench/__pycache__), so
+    that later processes load them (`scripts/setup.sh --tests` runs it once: each test worker
+    would otherwise compile them, about 6 s of CPU)."""
+    _compiled("fast"), _compiled("general")
+    Setup(load_case({"k_m": 2.3e5})).forces(np.zeros(2), np.zeros((2, 14)))
 
 
 def _refs(p, scaled):

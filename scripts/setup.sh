@@ -4,7 +4,8 @@
 # packages, then pyspline itself (the f2py extension and the spline-dyn executable).
 # `--tests` adds what only the tests use: pytest, pytest-xdist, hypothesis, f90nml, the
 # cross-checks and peers (ROSS, numba, numbalsoda, dask-jobqueue) and Debian's CVODE and ARKODE
-# runtime libraries (tests/test_build.py: the optimised build gives Debian's numbers bit for bit).
+# runtime libraries (tests/test_build.py: the optimised build gives Debian's numbers bit for bit),
+# and compiles the numba peer's right-hand sides into numba's cache (bench/__pycache__).
 # One line per step; each step's output goes to $log, whose tail is printed if a step fails.
 #
 # Why build CVODE and ARKODE: Debian 12's SUNDIALS 6.4.1 libraries are compiled without
@@ -135,4 +136,10 @@ if [ $tests = 1 ]; then
     ross-rotordynamics "plotly<6" numba numbalsoda dask-jobqueue
 fi
 step "pip install . (pyspline)" pip_install --no-build-isolation "${setup_args[@]}" .
+if [ $tests = 1 ]; then
+  # numba compiles the peer's right-hand sides (bench/numba_peer.py) into its cache next to them,
+  # bench/__pycache__, once here, where each test worker would compile them (6 s of CPU each)
+  step "numba: the peer's compiled RHS" python3 -c \
+    'import sys; sys.path.insert(0, "bench"); import numba_peer; numba_peer.compile_all()'
+fi
 rm -f "$log" "$log.cpu"

@@ -112,3 +112,33 @@ def pytest_runtest_makereport(item, call):
     if rep.passed and any(r in text for r in SUNDIALS_RAW):
         rep.outcome = "failed"
         rep.longrepr = f"SUNDIALS' own text on stdout or stderr:\n{text[:2000]}"
+
+
+#: fixtures whose result is computed once per process for tests in more than one module
+#: (functools.cache in tests/test_cont_drives.py: the Z16 S-curve, its follow sweeps), and the
+#: xdist group of the tests that use them
+SHARED_ACROSS_MODULES = {"every_branch": "z16_band", "s_curve": "z16_band",
+                         "follow_sweeps": "z16_band"}
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(items):
+    """With `--dist loadgroup` (pyproject.toml), every xdist worker computes a shared result
+    only if a test that uses it is sent to it: the tests that share one go to one worker as a
+    group. A test that uses a fixture of its module that is not function-scoped joins its
+    module's group, one that uses a fixture of SHARED_ACROSS_MODULES that group; a module may
+    name its own group (pytestmark = pytest.mark.xdist_group(...)). The other tests are handed
+    out one by one to the worker that is free, so both finish together."""
+    for item in items:
+        if item.get_closest_marker("xdist_group"):
+            continue
+        module = item.nodeid.split("::")[0]
+        defs = item._fixtureinfo.name2fixturedefs
+        group = next((SHARED_ACROSS_MODULES[n] for n in item.fixturenames
+                      if n in SHARED_ACROSS_MODULES), None)
+        if group is None and any(d[-1].scope != "function"
+                                 and d[-1].baseid.split("::")[0] == module
+                                 for d in defs.values()):
+            group = Path(module).stem
+        if group:
+            item.add_marker(pytest.mark.xdist_group(group))

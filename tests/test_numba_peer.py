@@ -21,6 +21,10 @@ from conftest import random_states  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "bench"))
 import numba_peer  # noqa: E402
 
+#: one xdist worker runs them all: numba's import, the RHS loaded from its cache and numbalsoda's
+#: drivers compiled once (tests/conftest.py)
+pytestmark = pytest.mark.xdist_group("numba_peer")
+
 BASE = dict(k_m=2.3e5, m_1=2.0, m_2=2.0)      # conftest.PAPER, over the core's defaults
 CASES = {
     "aligned": dict(BASE),
