@@ -139,6 +139,7 @@ build_sundials() {
     -DBUILD_STATIC_LIBS=OFF -DEXAMPLES_ENABLE_C=OFF -DEXAMPLES_ENABLE_F2003=OFF \
     -DEXAMPLES_INSTALL=OFF -DCMAKE_INSTALL_PREFIX="$prefix" \
     -DCMAKE_INSTALL_RPATH="$prefix/lib" -DCMAKE_INSTALL_LIBDIR=lib \
+    -DCMAKE_PROJECT_INCLUDE="$PWD/scripts/sundials.cmake" \
     && cmake --build "$work/build" -j 2 && cmake --install "$work/build" || return 1
 }
 if [ -n "$work" ]; then
