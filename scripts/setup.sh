@@ -20,17 +20,38 @@ cd "$(dirname "$0")/.."
 tests=0; [ "${1:-}" = "--tests" ] && tests=1
 SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
 log="$(mktemp -t pyspline-setup.XXXXXX.log)"
-cpu() {   # $cpu: CPU seconds (user + sys) of the processes this script has waited for
-  times >"$log.cpu"
-  cpu=$(awk 'NR == 2 {gsub(/[ms]/, " "); printf "%.0f", $1 * 60 + $2 + $3 * 60 + $4}' "$log.cpu")
-}
 step() {   # step "what" command...: one line with its wall and CPU seconds, the output in $log
-  local what="$1" t0=$SECONDS cpu0; shift
-  cpu; cpu0=$cpu
+  local what="$1" t0=$SECONDS; shift
   printf 'setup: %s ... ' "$what"
-  if "$@" >>"$log" 2>&1; then cpu; echo "done ($((SECONDS - t0)) s, $((cpu - cpu0)) s of CPU)"
+  if ("$@" >>"$log" 2>&1; rc=$?; times >"$log.cpu"; exit $rc); then
+    echo "done ($((SECONDS - t0)) s, $(cpu_of "$log.cpu") s of CPU)"
   else echo "FAILED (the last lines of $log:)"; tail -20 "$log" >&2; return 1; fi
 }
+cpu_of() {   # the CPU seconds (user + sys of the processes waited for) in the output of `times`
+  awk 'NR == 2 {gsub(/[ms]/, " "); printf "%.0f", $1 * 60 + $2 + $3 * 60 + $4}' "$1"
+}
+# background "what" name command...: starts a step in the background, its output in $log.name;
+# finish name: waits for it, then its line as step's (its wall time counted from its start)
+declare -A bg_pid bg_t0 bg_what
+background() {
+  local name="$2"; bg_what[$name]="$1"; bg_t0[$name]=$SECONDS; shift 2
+  ("$@" >"$log.$name" 2>&1; rc=$?; times >"$log.$name.cpu"; exit $rc) &
+  bg_pid[$name]=$!
+}
+finish() {
+  local name="$1"
+  [ -n "${bg_pid[$name]:-}" ] || return 0
+  printf 'setup: %s ... ' "${bg_what[$name]}"
+  if wait "${bg_pid[$name]}"; then
+    echo "done ($((SECONDS - bg_t0[$name])) s, $(cpu_of "$log.$name.cpu") s of CPU, in the background)"
+    cat "$log.$name" >>"$log"; rm -f "$log.$name" "$log.$name.cpu"; unset "bg_pid[$name]"
+  else
+    echo "FAILED (the last lines of $log.$name:)"; tail -20 "$log.$name" >&2; unset "bg_pid[$name]"
+    return 1
+  fi
+}
+# a failed step stops the script once the steps still in the background have ended
+trap wait EXIT
 apt_install() {
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "$@"
 }
@@ -53,6 +74,11 @@ if managed; then
     "into $([ "$(id -u)" -eq 0 ] && echo /usr/local || echo "~/.local") (activate a venv first to avoid it)"
 fi
 pip_install() { python3 -m pip install -q --disable-pip-version-check "${pip_opts[@]}" "$@"; }
+# The Python packages need nothing from apt: pip fetches and installs them while apt installs the
+# toolchain and SUNDIALS builds (network and disk against CPU). ninja is meson's.
+background "pip: build tools and pyspline's packages" pip pip_install "numpy>=2.0" meson \
+  meson-python ninja matplotlib scipy tqdm xarray "h5netcdf[h5py]" distributed
+echo "setup: pip: build tools and pyspline's packages ... in the background"
 
 need=(); update=0
 pkgs=(gfortran cmake liblapack-dev libblas-dev)
@@ -85,6 +111,7 @@ version="$(sundials_version || true)"
 if [ "$prefix" != system ] && { [ -z "$version" ] || ! built "${prefix:-$cache/sundials-$version-O3-arkode}"; }; then
   add_deb_src || true
   update=1   # the package lists, with the deb-src entry
+  dpkg -s ninja-build >/dev/null 2>&1 || need+=(ninja-build)   # SUNDIALS' build (pip's is later)
 fi
 updated=0
 apt_update() { [ $updated = 1 ] || step "apt-get update" $SUDO apt-get update -qq; updated=1; }
@@ -92,13 +119,18 @@ if [ $update = 1 ] || [ ${#need[@]} -gt 0 ]; then
   apt_update
   version="$(sundials_version)"
 fi
-if [ ${#need[@]} -gt 0 ]; then step "apt-get install ${need[*]}" apt_install "${need[@]}"; fi
 [ -z "$prefix" ] && prefix="$cache/sundials-$version-O3-arkode"
+# SUNDIALS' source is fetched while apt installs the toolchain, then built (`build_sundials`)
+work=""
+if [ "$prefix" != system ] && ! built "$prefix"; then
+  work="$(mktemp -d)"
+  background "apt-get source sundials=$version" source \
+    sh -c 'cd "$1" && apt-get source --download-only -qq "sundials=$2"' _ "$work" "$version"
+fi
+if [ ${#need[@]} -gt 0 ]; then step "apt-get install ${need[*]}" apt_install "${need[@]}"; fi
 
 build_sundials() {
-  local work src
-  work="$(mktemp -d)"
-  (cd "$work" && apt-get source --download-only -qq "sundials=$version") || return 1
+  local src
   tar -xf "$work"/sundials_*.orig.tar.* -C "$work" || return 1
   src="$(ls -d "$work"/sundials-*/ | head -1)"
   cmake -S "$src" -B "$work/build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
@@ -109,16 +141,14 @@ build_sundials() {
     -DEXAMPLES_INSTALL=OFF -DCMAKE_INSTALL_PREFIX="$prefix" \
     -DCMAKE_INSTALL_RPATH="$prefix/lib" -DCMAKE_INSTALL_LIBDIR=lib \
     && cmake --build "$work/build" -j 2 && cmake --install "$work/build" || return 1
-  rm -rf "$work"
 }
-# ninja for SUNDIALS' cmake build and for meson
-step "pip: build tools and pyspline's packages" pip_install "numpy>=2.0" meson meson-python \
-  ninja matplotlib scipy tqdm xarray "h5netcdf[h5py]" distributed
-if [ "$prefix" != system ] && ! built "$prefix"; then
-  if ! step "building optimised CVODE and ARKODE $version into $prefix" build_sundials; then
+if [ -n "$work" ]; then
+  if ! finish source \
+      || ! step "building optimised CVODE and ARKODE $version into $prefix" build_sundials; then
     echo "setup: WARNING: could not build CVODE and ARKODE; using Debian's unoptimised SUNDIALS (same numbers, ~2.4x slower)" >&2
     prefix=system
   fi
+  rm -rf "$work"
 fi
 setup_args=()
 if [ "$prefix" = system ]; then
@@ -130,6 +160,7 @@ else
   # the long form: Debian 12's pip 23.0.1 has no -C
   setup_args=("--config-settings=setup-args=-Dsundials_prefix=$prefix")
 fi
+finish pip
 if [ $tests = 1 ]; then
   # ROSS 2.3 needs plotly < 6
   step "pip: test packages" pip_install pytest pytest-xdist hypothesis f90nml \
@@ -142,4 +173,4 @@ if [ $tests = 1 ]; then
   step "numba: the peer's compiled RHS" python3 -c \
     'import sys; sys.path.insert(0, "bench"); import numba_peer; numba_peer.compile_all()'
 fi
-rm -f "$log" "$log.cpu"
+rm -f "$log" "$log".*
