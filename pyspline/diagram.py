@@ -26,23 +26,23 @@ def _stretches(period):
 
 def _spans(stretches):
     return "; ".join(f"{d} {a:g}..{b:g}" + (f" ({what})" if what else "")
-                     for d, a, b, what in stretches)
+                     for d, a, b, what, _ in stretches)
 
 
 def _without_period(case, final, n, max_n):
-    """What a stretch that seeded nothing is: its sections' period n beyond max_n, or, when
-    they gave none (n = 0), chaotic or not, by the largest Lyapunov exponent (Benettin) of a
-    run as long as the sweep's sampled window continued from its middle point's final state
-    (y, t), with renormalisations at least every quarter revolution:
-    'chaotic: ...' when positive beyond the spread of its running estimate
-    (analysis.is_chaotic), else 'no period found within N revolutions, not chaotic: ...'
-    (a run not settled, or quasi-periodic)."""
+    """What a stretch that seeded nothing is, as (text, kind; kind 1 chaotic, 0 not, -1 not
+    told): its sections' period n beyond max_n (0), or, when they gave none (n = 0), chaotic or
+    not, by the largest Lyapunov exponent (Benettin) of a run as long as the sweep's sampled
+    window continued from its middle point's final state (y, t), with renormalisations at
+    least every quarter revolution: 'chaotic: ...' (1) when positive beyond the spread of its
+    running estimate (analysis.is_chaotic), else 'no period found within N revolutions, not
+    chaotic: ...' (0: a run not settled, or quasi-periodic); -1 when its run failed."""
     from .analysis import is_chaotic, largest_lyapunov_fit
     from .follow import continued
     from .orbits import _wall
     from .result import run
     if n > max_n:
-        return f"period {n} > max_n = {max_n}"
+        return f"period {n} > max_n = {max_n}", 0
     omega = case.model.info()["omega"]
     c = continued(case.replace(         # the sweep's window, no transient (it ran before)
         lyapunov=True, lyapunov_interval=min(case["lyapunov_interval"], 0.25), t_transient=0.0,
@@ -54,12 +54,12 @@ def _without_period(case, final, n, max_n):
         ly = res.lyapunov
         fit = largest_lyapunov_fit(ly["t"], ly["log_growth"], t0=float(res.t[0]))
     except (SplineError, ValueError) as exc:
-        return f"no period found, chaos not told (its Lyapunov run: {exc})"
+        return f"no period found, chaos not told (its Lyapunov run: {exc})", -1
     lam = f"largest Lyapunov exponent {fit.lam:.3g} 1/s (spread {fit.spread:.2g})"
     if is_chaotic(fit.lam, fit.spread):
-        return f"chaotic: {lam}"
+        return f"chaotic: {lam}", 1
     revs = (res.t[-1] - res.t[0]) * omega / (2 * np.pi)
-    return f"no period found within {revs:.0f} revolutions, not chaotic: {lam}"
+    return f"no period found within {revs:.0f} revolutions, not chaotic: {lam}", 0
 
 
 def _cut(sw):
@@ -270,9 +270,9 @@ def _branches(case, field, start, stop, points, max_n, progress, command, sweep_
                     skipped.append(f"{d} {field} = {p:g}")
                     continue
                 if orb is None:
-                    no_period.append((d, values[idx[i]], values[idx[j]], "" if finals[d][k] is
-                                      None else _without_period(sweep_case.replace(
-                                          **{name: p}), finals[d][k], n, max_n)))
+                    no_period.append((d, values[idx[i]], values[idx[j]], *(
+                        ("", -1) if finals[d][k] is None else _without_period(
+                            sweep_case.replace(**{name: p}), finals[d][k], n, max_n))))
                     continue
                 if any(_on_branch(x, field, p, orb.y0, scale) for x in pieces):
                     continue
@@ -309,10 +309,8 @@ def _branches(case, field, start, stop, points, max_n, progress, command, sweep_
     ds, kept = _distinct(_concat(pieces), field, scale)
     if no_period:       # plots.frequency_response shades them
         ds["no_period_range"] = (("stretch", "end"),
-                                 np.sort([[a, b] for _, a, b, _ in no_period]))
-        ds["no_period_chaotic"] = ("stretch", [  # 1 chaotic, 0 not, -1 not told
-            1 if w.startswith("chaotic") else 0 if "not chaotic" in w or w.startswith("period")
-            else -1 for *_, w in no_period])
+                                 np.sort([[a, b] for _, a, b, *_ in no_period]))
+        ds["no_period_chaotic"] = ("stretch", [kind for *_, kind in no_period])  # _without_period
     ds.attrs.update(start=start, stop=stop, seeds="; ".join(seeds[i] for i in kept),
                     no_period=_spans(no_period), status="; ".join(status) or "complete",
                     n_points=ds.sizes["point"], n_branches=int(ds.branch.max()) + 1,
