@@ -512,6 +512,9 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
         pts = [new]
     bar.update(1)
     lo, hi = bounds
+
+    def inside(q):                    # q within the bounds, to round-off
+        return lo - 1e-12 <= q <= hi + 1e-12
     fallbacks = _fallbacks(prob)
     primary, on_fallback = (prob.how, prob.case["method"]), 0
     while len(pts) < max_points:
@@ -521,7 +524,7 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
         step = ds
         pred = a["u"] + ds * a["tau"]
         end = None
-        if not lo - 1e-12 <= pred[-1] <= hi + 1e-12:
+        if not inside(pred[-1]):
             end = hi if pred[-1] > hi else lo
             res = None
             if abs(a["tau"][-1]) > 1e-3:      # the last step: onto the end, the field fixed
@@ -530,7 +533,7 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
                 res = br.correct(pred, e_q, end)
         else:
             res = br.correct(pred, a["tau"], a["tau"] @ pred)
-            if res is not None and not lo - 1e-12 <= res[0][-1] <= hi + 1e-12:
+            if res is not None and not inside(res[0][-1]):
                 end = hi if res[0][-1] > hi else lo     # converged past the end: onto it
                 res = _onto(br, res[0], pred, ds, end)
         if res is not None and end is None and specials.far(res[0], pred, ds):
@@ -552,7 +555,7 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
         if new is None:
             crossed = specials.diagnose(br, a, pred, step) if step > 0 else None
             # none past the end (those crossings are not the branch's: it ends before them)
-            crossed = [c for c in crossed or () if lo - 1e-12 <= c["u"][-1] <= hi + 1e-12]
+            crossed = [c for c in crossed or () if inside(c["u"][-1])]
             if crossed:
                 pts += crossed
                 bar.update(len(crossed))
