@@ -30,11 +30,13 @@ step() {   # step "what" command...: one line with its wall and CPU seconds, the
 cpu_of() {   # the CPU seconds (user + sys of the processes waited for) in the output of `times`
   awk 'NR == 2 {gsub(/[ms]/, " "); printf "%.0f", $1 * 60 + $2 + $3 * 60 + $4}' "$1"
 }
-# background "what" name command...: starts a step in the background, its output in $log.name;
-# finish name: waits for it, then its line as step's (its wall time counted from its start)
+# background "what" name command...: starts a step in the background (a line saying so), its
+# output in $log.name; finish name: waits for it, then its line as step's (its wall time counted
+# from its start)
 declare -A bg_pid bg_t0 bg_what
 background() {
   local name="$2"; bg_what[$name]="$1"; bg_t0[$name]=$SECONDS; shift 2
+  echo "setup: ${bg_what[$name]} ... in the background"
   ("$@" >"$log.$name" 2>&1; rc=$?; times >"$log.$name.cpu"; exit $rc) &
   bg_pid[$name]=$!
 }
@@ -78,7 +80,6 @@ pip_install() { python3 -m pip install -q --disable-pip-version-check "${pip_opt
 # toolchain and SUNDIALS builds (network and disk against CPU). ninja is meson's.
 background "pip: build tools and pyspline's packages" pip pip_install "numpy>=2.0" meson \
   meson-python ninja matplotlib scipy tqdm xarray "h5netcdf[h5py]" distributed
-echo "setup: pip: build tools and pyspline's packages ... in the background"
 
 need=(); update=0
 pkgs=(gfortran cmake liblapack-dev libblas-dev)
