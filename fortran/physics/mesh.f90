@@ -483,6 +483,8 @@ contains
     call eq11_sliced(m, slice_z(m, is), sp, cp, dn, ddn, dns, ddns)
   end subroutine slice_approach
 
+  !> Eq. 11 and its rate at axial position zs of the face (slice_approach's, given z_s): the
+  !> one place the slice term is written (mesh_eval, mesh_switch_functions, slice_approach).
   elemental subroutine eq11_sliced(m, zs, sp, cp, dn, ddn, dns, ddns)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: zs, sp, cp, dn, ddn
