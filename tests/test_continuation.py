@@ -442,7 +442,7 @@ def test_frequency_response_figure(doubling_branch):
                             progress=False, spectrum=False)
     fig = frequency_response(ds, "Tm_pp", sweep=sw)
     ax = fig.axes[0]
-    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
     for want in ("period-1 orbits, stable", "period-1 orbits, unstable", "period-2 orbits, stable",
                  "period-2 orbits, unstable", "period doubling (mu = -1) (1)", "fold (mu = +1) (1)"):
         assert want in labels, labels
