@@ -100,6 +100,19 @@ def test_bifurcation_accuracy_quick(tmp_path):
     assert len(list(csv.DictReader(open(tmp_path / "bifurcation_accuracy.csv")))) == len(rows)
 
 
+def test_bifurcation_figure_only(tmp_path, capsys):
+    """--figure: the diagram alone (docs/bifurcation.png's command), no timing table."""
+    import argparse
+
+    import bifurcation
+    args = argparse.Namespace(out=str(tmp_path), accuracy=False, figure=True, points=3,
+                              blocks=None, repeats=None, rtol=None, quick=False)
+    assert bifurcation.main(args) == 0
+    assert (tmp_path / "bifurcation.png").stat().st_size > 10_000
+    assert not (tmp_path / "bifurcation.csv").exists()
+    assert "periods: {" in capsys.readouterr().out
+
+
 def test_bifurcation_scaling_labels():
     """--scaling pairs each 2-worker executor with the same executor on one worker."""
     import bifurcation
@@ -120,7 +133,7 @@ def test_bifurcation_repeats_quick(tmp_path, exe, monkeypatch):
     import bifurcation
     monkeypatch.setenv("SPLINE_DYN", exe)
     args = argparse.Namespace(out=str(tmp_path), accuracy=False, points=4, blocks=2, repeats=2,
-                              rtol=1e-6, quick=True, scaling=False, host=True)
+                              rtol=1e-6, quick=True, scaling=False, host=True, figure=False)
     assert bifurcation.main(args) == 0
     table = list(csv.DictReader(open(tmp_path / "bifurcation.csv")))
     host = table[-2:]
