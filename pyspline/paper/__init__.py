@@ -419,7 +419,10 @@ def calibrate(directory=None, quick=False, targets=None, bracket=(5e4, 5e6), pro
     log = []
 
     def d2(logk):
-        v = float(CAL_KM.extract(simulate(base.replace(k_m=float(np.exp(logk))))))
+        with warnings.catch_warnings():     # a trial value of the search, not one to judge
+            warnings.filterwarnings("ignore", message=r"case .*: field k_m = .* times below",
+                                    category=SplineWarning)
+            v = float(CAL_KM.extract(simulate(base.replace(k_m=float(np.exp(logk))))))
         log.append((float(np.exp(logk)), v))
         return v - targets["D2max"]
 
