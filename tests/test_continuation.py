@@ -14,8 +14,10 @@ import pytest
 
 import pyspline
 import pyspline.cli
-from conftest import CASES, jacobian
+from conftest import CASES, PAPER_SHAFTS, jacobian
 from test_orbits import A_RIPPLE, linear_scene, scale_of
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
 # a drive whose ripple reaches the mesh: the paper's aligned drive at dof 3 with shafts of
 # k_t = 1000 N m/rad (the paper's 7.9 filter the ripple out); its mesh mode near 45 Hz
