@@ -1,6 +1,6 @@
 """A bifurcation diagram of paper_lx1e-4 over l_x (issue 11's benchmark), measured side by side
 in one run: `python bench/run.py bifurcation [--points N] [--rtol R] [--repeats R] [--blocks K]
-[--scaling] [--host] [--accuracy] [--quick]`.
+[--scaling] [--host] [--accuracy] [--figure] [--quick]`.
 
 Each point: 20 shaft revolutions of transient, then 100 revolutions sampled (exact shaft
 sections, 8 outputs per revolution for the load statistics). The same sweep runs serially, on 2
@@ -43,6 +43,10 @@ largest error of a section point (D2 at whole revolutions) as a fraction of the 
 of D2, the points whose period differs, the largest relative error of the RMS of T_m, the
 steps per point and the wall time (bifurcation_accuracy.csv; the figure charts the error against
 the steps, which unlike the wall time do not depend on the host's load).
+
+With --figure only the diagram is drawn (bifurcation.png; no timing, no table), its sweep on 2
+threads: `OPENBLAS_NUM_THREADS=1 python bench/run.py bifurcation --figure --out docs` makes
+docs/bifurcation.png (14 s of CPU; 41 s wall on 2 cores under a load of 8).
 """
 from __future__ import annotations
 
@@ -210,6 +214,10 @@ def main(args) -> int:
     repeats = max(1, args.repeats or 1)
     case = bench_case(args.rtol)
     l_x = np.linspace(0.0, 3e-4, n)
+    if args.figure:
+        with cf.ThreadPoolExecutor(2) as pool:
+            draw(pyspline.sweep(case, executor=pool, progress=False, l_x=l_x), out)
+        return 0
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
                             text=True, cwd=Path(__file__).parent).stdout.strip()
     print(f"commit {commit}, {os.cpu_count()} cores; {n} points of paper_lx1e-4 over l_x, "
@@ -306,12 +314,16 @@ def main(args) -> int:
         for label, message in first_error.items():
             print(f"  first error on {label}: {message}")
     _write_csv(out / "bifurcation.csv", rows)
+    print(f"wrote {out}/bifurcation.csv")
     if ds is not None:              # the figure of the serial sweep (one block only)
-        from pyspline import plots
-        plots.bifurcation(ds, "l_x", path=out / "bifurcation.png")
-        periods = ds["period"].values
-        print(f"periods: {dict(zip(*np.unique(periods[np.isfinite(periods)], return_counts=True)))}")
-        print(f"wrote {out}/bifurcation.csv and bifurcation.png")
-    else:
-        print(f"wrote {out}/bifurcation.csv")
+        draw(ds, out)
     return 0
+
+
+def draw(ds, out: Path) -> None:
+    """The diagram of the sweep `ds` into out/bifurcation.png, its periods counted."""
+    from pyspline import plots
+    plots.bifurcation(ds, "l_x", path=out / "bifurcation.png")
+    periods = ds["period"].values
+    print(f"periods: {dict(zip(*np.unique(periods[np.isfinite(periods)], return_counts=True)))}")
+    print(f"wrote {out}/bifurcation.png")

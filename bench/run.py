@@ -104,6 +104,8 @@ def main(argv=None) -> int:
                    "speed-up, from runs of the standalone executable one and two at a time")
     p.add_argument("--accuracy", action="store_true", help="bifurcation: the diagram's section "
                    "error, periods, steps and wall time over rtol (every 10th point)")
+    p.add_argument("--figure", action="store_true", help="bifurcation: the diagram only "
+                   "(bifurcation.png, its sweep on 2 threads; no timing)")
     from speed import PYSPLINE_VARIANTS
     p.add_argument("--variants", nargs="+", choices=PYSPLINE_VARIANTS, help="race: only these "
                    "of pyspline's setting families (default: all; the accuracy and goal settings "

@@ -50,7 +50,9 @@ def same(a, b):
 
 
 def test_scenes_in_threads_equal_serial_runs():
-    serial = {name: outcome(c) for name, c in SCENES.items()}
+    with pytest.warns(pyspline.SplineWarning, match=r"case runaway: start = 'rest' with l_x = "
+                      r"1\.000E-04, .* overlapping its backlash"):   # its hot, closed backlash
+        serial = {name: outcome(c) for name, c in SCENES.items()}
     assert serial["runaway"][0] == "ThermalInterferenceError"
     assert "tooth" in serial["runaway"][1]
     assert serial["T100 coupled"][4]["coupling_iterations"] > 0       # the coupled level ran

@@ -8,10 +8,14 @@ import numpy as np
 import pytest
 
 import pyspline
-from conftest import CASES, ROOT
+from conftest import CASES, DEMONSTRATION_SCENES, PAPER_SHAFTS, ROOT
 
 sys.path.insert(0, str(ROOT / "bench"))
 import speed as bench  # noqa: E402  (bench/ is not installed)
+
+pytestmark = [PAPER_SHAFTS, DEMONSTRATION_SCENES]   # expected warnings (conftest)
+#: what a sweep of the paper drive over l_x says of its points past the 0.2 mm backlash
+PAST_BACKLASH = r"case paper_lx1e-4: start = 'rest' with l_x = .* overlapping its backlash"
 
 
 def test_budget_failure_is_reported_not_dropped():
@@ -21,7 +25,8 @@ def test_budget_failure_is_reported_not_dropped():
 
 
 def test_stability_quick(tmp_path):
-    rows = bench.stability_map(tmp_path, quick=True, progress=False)
+    with pytest.warns(pyspline.SplineWarning, match=r"field k_m = 1\.000E\+05 N/m is .* times below"):
+        rows = bench.stability_map(tmp_path, quick=True, progress=False)   # k_m from 1e5 on purpose
     assert (tmp_path / "stability.png").stat().st_size > 10_000
     table = list(csv.DictReader(open(tmp_path / "stability.csv")))
     methods = {r["method"] for r in table}
@@ -91,13 +96,28 @@ def test_bifurcation_accuracy_quick(tmp_path):
     """The diagram's accuracy chart: every rtol a row, the section error falls as rtol tightens,
     and at the case's rtol every period is the reference's."""
     import bifurcation
-    rows = bifurcation.accuracy(tmp_path, 30)                       # l_x[::10]: 3 points
+    with pytest.warns(pyspline.SplineWarning, match=PAST_BACKLASH):
+        rows = bifurcation.accuracy(tmp_path, 30)                   # l_x[::10]: 3 points
     assert [r["rtol"] for r in rows] == sorted(bifurcation.ACCURACY_RTOLS)     # tightest first
     err = {r["rtol"]: r["section_error_of_range"] for r in rows}
     assert err[1e-10] < err[1e-8] < err[1e-6] < 1e-3
     assert next(r for r in rows if r["rtol"] == 1e-9)["period_differs"] == 0
     assert (tmp_path / "bifurcation_accuracy.png").stat().st_size > 10_000
     assert len(list(csv.DictReader(open(tmp_path / "bifurcation_accuracy.csv")))) == len(rows)
+
+
+def test_bifurcation_figure_only(tmp_path, capsys):
+    """--figure: the diagram alone (docs/bifurcation.png's command), no timing table."""
+    import argparse
+
+    import bifurcation
+    args = argparse.Namespace(out=str(tmp_path), accuracy=False, figure=True, points=3,
+                              blocks=None, repeats=None, rtol=None, quick=False)
+    with pytest.warns(pyspline.SplineWarning, match=PAST_BACKLASH):
+        assert bifurcation.main(args) == 0
+    assert (tmp_path / "bifurcation.png").stat().st_size > 10_000
+    assert not (tmp_path / "bifurcation.csv").exists()
+    assert "periods: {" in capsys.readouterr().out
 
 
 def test_bifurcation_scaling_labels():
@@ -120,8 +140,9 @@ def test_bifurcation_repeats_quick(tmp_path, exe, monkeypatch):
     import bifurcation
     monkeypatch.setenv("SPLINE_DYN", exe)
     args = argparse.Namespace(out=str(tmp_path), accuracy=False, points=4, blocks=2, repeats=2,
-                              rtol=1e-6, quick=True, scaling=False, host=True)
-    assert bifurcation.main(args) == 0
+                              rtol=1e-6, quick=True, scaling=False, host=True, figure=False)
+    with pytest.warns(pyspline.SplineWarning, match=PAST_BACKLASH):
+        assert bifurcation.main(args) == 0
     table = list(csv.DictReader(open(tmp_path / "bifurcation.csv")))
     host = table[-2:]
     assert [r["executor"] for r in host] == list(bifurcation.HOST)

@@ -98,7 +98,7 @@ def test_a_stretch_without_a_period_is_shaded(every_branch):
     spans = [pt for pt in ax.patches if pt.get_x() == 2250.0 and pt.get_width() == 30.0]
     assert len(spans) == 1
     assert any(t.get_text().startswith("no periodic attractor") and "chaotic" in t.get_text()
-               for t in ax.get_legend().get_texts())
+               for t in ax.figure.legends[0].get_texts())
     # told apart (branches' no_period_chaotic): chaotic darker, each said once
     ds["no_period_range"] = (("stretch", "end"), [[2250.0, 2260.0], [2260.0, 2280.0],
                                                   [2400.0, 2410.0]])
@@ -107,7 +107,7 @@ def test_a_stretch_without_a_period_is_shaded(every_branch):
     grey = {pt.get_x(): pt.get_facecolor()[0] for pt in ax.patches if pt.get_x() in
             (2250.0, 2260.0, 2400.0)}
     assert grey[2260.0] == grey[2400.0] < grey[2250.0]
-    texts = [t.get_text() for t in ax.get_legend().get_texts() if "attractor" in t.get_text()]
+    texts = [t.get_text() for t in ax.figure.legends[0].get_texts() if "attractor" in t.get_text()]
     assert len(texts) == 2 and "not chaotic" in texts[0] and "chaotic (largest Lyapunov" in \
         texts[1]
 

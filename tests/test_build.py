@@ -9,7 +9,9 @@ import pytest
 import pyspline
 from pyspline._build_info import SUNDIALS_LIBDIR
 from pyspline.core import cvode_library
-from conftest import CASES
+from conftest import CASES, PAPER_SHAFTS
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
 DEBIAN_LIBDIR = "/usr/lib/x86_64-linux-gnu"
 

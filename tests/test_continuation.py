@@ -14,8 +14,10 @@ import pytest
 
 import pyspline
 import pyspline.cli
-from conftest import CASES, jacobian
+from conftest import CASES, PAPER_SHAFTS, jacobian
 from test_orbits import A_RIPPLE, linear_scene, scale_of
+
+pytestmark = PAPER_SHAFTS   # expected warnings (conftest)
 
 # a drive whose ripple reaches the mesh: the paper's aligned drive at dof 3 with shafts of
 # k_t = 1000 N m/rad (the paper's 7.9 filter the ripple out); its mesh mode near 45 Hz
@@ -442,7 +444,7 @@ def test_frequency_response_figure(doubling_branch):
                             progress=False, spectrum=False)
     fig = frequency_response(ds, "Tm_pp", sweep=sw)
     ax = fig.axes[0]
-    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
     for want in ("period-1 orbits, stable", "period-1 orbits, unstable", "period-2 orbits, stable",
                  "period-2 orbits, unstable", "period doubling (mu = -1) (1)", "fold (mu = +1) (1)"):
         assert want in labels, labels

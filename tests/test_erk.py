@@ -7,7 +7,10 @@ import pytest
 
 import oracle
 import pyspline
-from conftest import CASES, PAPER, assert_executable_matches_python
+from conftest import (CASES, DEMONSTRATION_SCENES, PAPER, PAPER_SHAFTS, PAPER_SUPPORTS,
+                      assert_executable_matches_python)
+
+pytestmark = [PAPER_SHAFTS, PAPER_SUPPORTS, DEMONSTRATION_SCENES]   # expected warnings (conftest)
 
 SHIPPED = sorted(p.stem for p in CASES.glob("*.nml") if p.stem != "template")
 

@@ -22,9 +22,12 @@ def forced_response(A, B, omega):
 
 
 def run_on_the_orbit(case, y_eq, yp):
-    """Simulate from y_eq + y_p(0) (start = rest plus offsets): no transient is excited."""
+    """Simulate from y_eq + y_p(0) (start = rest plus offsets): no transient is excited. A
+    start in the loaded mesh overlaps the teeth by its static deflection, which the model says
+    (it cannot tell a loaded start from an impact)."""
     y0 = y_eq + yp(np.array([0.0]))[0]
-    res = pyspline.simulate(case.replace(start="rest", dq0=list(y0[:7]), dv0=list(y0[7:])))
+    with pytest.warns(pyspline.SplineWarning, match=r"start = 'rest' .* overlapping its backlash"):
+        res = pyspline.simulate(case.replace(start="rest", dq0=list(y0[:7]), dv0=list(y0[7:])))
     return res, res.y - y_eq, yp(res.t)
 
 

@@ -213,6 +213,8 @@ def test_bifurcation_follow_overlays_both_directions(follow):
     assert ax.get_xlabel() == "shaft speed [r/min]" and ax.get_ylabel().endswith("[µm]")
     assert _words(fig, ["legend"]).split(" | ") == ["follow up", "follow down",
                                                      "each run from the one before"]
+    (legend,) = fig.legends                                  # beside the panel, over no point
+    assert _covered(ax, legend) == []
     assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
@@ -259,6 +261,8 @@ def test_frequency_response_draws_stability_specials_and_gaps(branch):
         assert words in legend
     assert "period-2 orbits, stable" not in legend
     assert ax.get_xlabel() == "shaft speed [r/min]" and ax.get_ylabel() == "T_m peak-to-peak [N m]"
+    (legend,) = fig.legends              # beside the panel: over no line, mark or shaded stretch
+    assert _covered(ax, legend, lines=True) == []
     assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 

@@ -7,7 +7,9 @@ import pytest
 import pyspline
 from scipy.linalg import expm
 
-from conftest import CASES, jacobian
+from conftest import CASES, DEMONSTRATION_SCENES, PAPER_SHAFTS, jacobian
+
+pytestmark = [PAPER_SHAFTS, DEMONSTRATION_SCENES]   # expected warnings (conftest)
 
 # the paper's aligned drive in full contact, lateral supports damped (every mode decays): a
 # linear, time-invariant system forced by the torque ripple T_d a sin(n omega t)

@@ -1,5 +1,6 @@
 """The main job: reproduce (quick), Poincare point counting, calibration."""
 import json
+import warnings
 
 import numpy as np
 import pytest
@@ -65,6 +66,19 @@ def test_reproduce_quick_writes_every_figure_and_row(tmp_path):
         assert row["status"] == "ok" or row["why"], row     # every miss says why
 
 
+def test_a_miss_quotes_its_runs_static_share():
+    """The paper_ideal force row's reason quotes the run's static share T_d/(Z r_b) (the loads'
+    F_static), so it follows the case: twice the paper's T_d, twice the number."""
+    key = "paper_ideal/tooth force F_j at the largest load (mean over teeth)"
+    assert set(paper.WHY) <= {f"{r.case}/{r.quantity}" for r in paper.ROWS}   # every reason has its row
+    base = pyspline.load_case(CASES / "paper_ideal.nml").replace(t_end=0.005, n_out=33)
+    said = [paper.why(key, pyspline.simulate(c)) for c in (base, base.replace(t_d=2 * base["t_d"]))]
+    share = base["t_d"] / (base["z"] * base.model.info()["r_b"])
+    assert f"{share:.4g}" == "138.5"                                     # the paper's drive
+    assert [s.split(";")[0] for s in said] == [f"the static share T_d/(Z r_b) is {f:.4g} N"
+                                               for f in (share, 2 * share)]
+
+
 def test_calibration_recovers_known_parameters(tmp_path):
     """Simulate with known k_m and f_m, then fit them back from the two calibration rows."""
     truth = {"k_m": 3.1e5, "f_m": 0.37}
@@ -72,7 +86,9 @@ def test_calibration_recovers_known_parameters(tmp_path):
     for row, key in ((paper.CAL_KM, "D2max"), (paper.CAL_FM, "Tfmax")):
         case = paper.load_paper_case(row.case, CASES, quick=True).replace(**truth)
         targets[key] = float(row.extract(pyspline.simulate(case)))
-    fit = paper.calibrate(CASES, quick=True, targets=targets, progress=False)
+    with warnings.catch_warnings():     # the search's trial k_m are not the user's: no warning
+        warnings.filterwarnings("error", message=".*k_m", category=pyspline.SplineWarning)
+        fit = paper.calibrate(CASES, quick=True, targets=targets, progress=False)
     assert fit["k_m"] == pytest.approx(truth["k_m"], rel=1e-6)
     assert fit["f_m"] == pytest.approx(truth["f_m"], rel=1e-6)
 

@@ -41,7 +41,7 @@ def test_computed_k_m_counts_the_fillet_by_default():
 
 
 def test_linear_in_face_width():
-    k1, k2 = spline_terms(b=0.03), spline_terms(b=0.045)
+    k1, k2 = spline_terms(b=0.03, k_m=0.0), spline_terms(b=0.045, k_m=0.0)   # no case k_m to judge
     for n in ("k_h", "k_b1", "k_s1", "k_a1", "k_f1", "k_b2", "k_s2", "k_a2", "k_f2", "k_m"):
         np.testing.assert_allclose(k2[n] / k1[n], 1.5, rtol=1e-13, err_msg=n)
 

@@ -138,7 +138,9 @@ def test_bad_thermal_fields(fields, words, err):
 
 def test_flash_closing_the_backlash_is_an_error():
     """Runaway: with huge friction the flash temperature closes the backlash during the run."""
-    with pytest.raises(pyspline.ThermalInterferenceError) as exc:
+    with pytest.raises(pyspline.ThermalInterferenceError) as exc, \
+            pytest.warns(pyspline.SplineWarning, match=r"case runaway: start = 'rest' .* "
+                         r"overlapping its backlash c = 4\.209E-06 m"):   # 3000 degC closes it
         pyspline.simulate(dict(HOT, name="runaway", thermal="coupled", t_bulk=3000.0, f_m=1e5))
     msg = str(exc.value)
     assert "case runaway" in msg and "tooth" in msg and "t =" in msg

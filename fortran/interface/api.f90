@@ -190,16 +190,27 @@ contains
   end function api_model_size
 
   !> The model_t in the bytes of a loaded model; ierr = err_case if they are not one.
-  subroutine unpack(model, m, ierr, errmsg)
+  !> max_seconds (optional, > 0): the call's wall-time bound over all its runs, from now
+  !> (m%max_seconds, m%wall_start; spline_integrator::integrator_open); 0: none.
+  subroutine unpack(model, m, ierr, errmsg, max_seconds)
     integer(c_int), intent(in) :: model(:)
     type(model_t), intent(out) :: m
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
+    real(c_double), intent(in), optional :: max_seconds
     ierr = err_ok
     errmsg = ''
     if (size(model) == api_model_size()) then
       m = transfer(model, m)
-      if (m%magic == model_magic) return
+      if (m%magic == model_magic) then
+        if (present(max_seconds)) then
+          if (max_seconds > 0.0_c_double) then
+            m%max_seconds = max_seconds
+            call system_clock(m%wall_start)
+          end if
+        end if
+        return
+      end if
     end if
     ierr = err_case
     errmsg = 'not a loaded case of this build of pyspline (load the case again)'
@@ -241,11 +252,7 @@ contains
     integer :: ie, nw
     stats = 0; sec_t = 0; sec_y = 0; lyap_t = 0; lyap_g = 0   ! t, y, tooth, tm: below
     face = 0; tilt = 0; nqw = nq; consts = 0; loads = 0; tload = 0; ext = 0; warnings = ''
-    call unpack(model, m, ie, errmsg)
-    if (max_seconds > 0.0_c_double) then
-      m%max_seconds = max_seconds
-      call system_clock(m%wall_start)
-    end if
+    call unpack(model, m, ie, errmsg, max_seconds)
     if (ie == err_ok .and. (m%z /= z .or. m%n_out /= nt .or. nq /= ntooth_q .or. ns /= nstats &
          .or. nsec /= run_sections(m) .or. (m%realisations > 1 .and. &
          (copy < 1 .or. copy > m%realisations)) .or. nlyap /= lyapunov_count(m) .or. &
@@ -375,11 +382,7 @@ contains
     type(model_t) :: m
     integer :: ie
     y = 0
-    call unpack(model, m, ie, errmsg)
-    if (max_seconds > 0.0_c_double) then
-      m%max_seconds = max_seconds
-      call system_clock(m%wall_start)
-    end if
+    call unpack(model, m, ie, errmsg, max_seconds)
     if (ie == err_ok .and. transient == 1) then
       call transient_state(m, y, ie, errmsg, interruptible=.true.)
     else if (ie == err_ok) then

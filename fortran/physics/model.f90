@@ -116,7 +116,8 @@ module spline_model
     real(wp) :: spacing_error(max_teeth) = 0.0_wp
     logical  :: spacing = .false.
     !> not a case field: a call's wall-time bound [s] over all its runs (0: none) and the
-    !> system_clock count it counts from (api_simulate sets them; spline_integrator::integrator_open)
+    !> system_clock count it counts from (spline_api's unpack sets them for api_simulate and
+    !> api_start_state; spline_integrator::integrator_open)
     real(wp) :: max_seconds = 0.0_wp
     integer(8) :: wall_start = 0
   end type model_t

@@ -106,7 +106,9 @@ def frequency_response(branch, measure: str = "Tm_pp", sweep=None, path=None,
     ax.set_xlabel(ps.label(branch, field, factor_unit=ux))
     ax.set_ylabel(f"{name} [{uy}]" if uy else name)
     ax.grid(alpha=0.3, lw=0.5)
-    ax.legend(handles=handles, fontsize=8, loc="best", framealpha=0.9)
+    # below the panel: a dense diagram fills it (no 'best' place covers none), in two columns
+    fig.legend(handles, [ps.wrap(h.get_label(), 4.0, 8) for h in handles], fontsize=8,
+               loc="outside lower center", ncols=2, frameon=False)
     ax.set_title(title or f"frequency response: {name} of the periodic orbits vs {field}")
     return ps.finish(fig, path)
 
@@ -135,8 +137,8 @@ def bifurcation_follow(ds, param: str, coord: str = "section_D2", path=None,
     ax.set_xlabel(ps.label(ds, param, factor_unit=ux))
     ax.set_ylabel(f"{coord} [{uy}]")
     ax.grid(alpha=0.3, lw=0.5)
-    ax.legend(handles=handles, fontsize=8, loc="best", title="each run from the one before",
-              title_fontsize=8)
+    fig.legend(handles=handles, fontsize=8, loc="outside lower center", ncols=len(handles),
+               title="each run from the one before", title_fontsize=8)
     ax.set_title(ps.wrap(title or f"bifurcation diagram: {ps.long_name(ds, coord)} vs {param}, "
                          "both directions", 8.5, 12))
     return ps.finish(fig, path)
