@@ -89,6 +89,35 @@ def test_roots_located_with_erk(z24):
     assert f_error(on, ref) < 1e-4 and f_error(on, ref) < 0.1 * f_error(off, ref)
 
 
+
+def test_every_switch_of_a_cluster_is_located_with_erk():
+    """The aligned Z16 drive of tests/test_cont_drives.py on its contact-loss orbit at 2480
+    r/min: four times a period its 16 teeth switch together (1e-11 apart on the scaled time).
+    ERK's root finding reports them a few at a time on its interpolant while the state it lands
+    on has crossed more; those must switch too (spline_solver::settle_roots), or their teeth
+    stay in the wrong contact state, the orbit's symmetry breaks and the map jumps (so
+    continuing this drive with ERK stalled at 2356.01 r/min). ERK's orbit is Adams' with its
+    64 switches, and ERK's map from it moved by 1e-9 to 1e-3 (scaled) along each state is its
+    linearisation by the exact monodromy (the variational run) to 1e-5: the lost teeth left
+    an orbit of 57 switches and 225 of 364 such runs off by up to 68."""
+    from test_cont_drives import DRIVE
+    from test_orbits import scale_of
+    from pyspline.orbits import _period_map, map_and_monodromy
+    case = DRIVE.replace(speed_rpm=2480.0)
+    erk, adams = (pyspline.periodic_orbit(case.replace(method=m)) for m in ("erk", "adams"))
+    assert erk.trajectory.stats["roots_found"] == adams.trajectory.stats["roots_found"] == 64
+    d = scale_of(case)
+    assert np.abs((erk.y0 - adams.y0) / d).max() < 1e-5
+    model = pyspline.load(case.replace(method="erk"))
+    t1 = erk.t0 + erk.period
+    M = map_and_monodromy(model, erk.t0, t1, erk.y0)[1]
+    moves = [(i, s * a) for i in range(14) for a in 10.0 ** np.arange(-9.0, -2.0) for s in (1, -1)]
+    ys = np.array([erk.y0] + [erk.y0 + np.eye(14)[i] * a * d for i, a in moves]).T
+    y1 = _period_map(model, erk.t0, t1, ys)[0]
+    lin = np.array([M[:, i] * a for i, a in moves]).T
+    off = np.abs((y1[:, 1:] - y1[:, :1]) / d[:, None] - lin).max(axis=0)
+    assert off.max() < 1e-5, (off > 1e-5).sum()
+
 def test_outputs_cost_no_rhs_at_loose_rtol(z24):
     """ERKStep's dense output: the cubic Hermite interpolant at rtol >= 1e-5 needs no
     right-hand side (the steps do not depend on the outputs after the first, which sets the

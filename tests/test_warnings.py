@@ -198,15 +198,18 @@ def test_tooth_load_of_a_torque_in_n_mm():
 
 def test_benettin_separation_below_the_default_where_switches_are_not_located():
     """A given lyapunov_d0 below the default 1e4 rtol (within [1e-8, 1e-3]) warns with the copy
-    that does not locate its own switches (roots off, or ERK); with CVODE and roots, the
-    tangent, or the default d0 it does not. tests/test_chaos.py shows what it reads there."""
+    that does not locate its own switches (roots off, with any method); with roots (CVODE or
+    ERK), the tangent, or the default d0 it does not. tests/test_chaos.py shows what it reads
+    there."""
     fields = dict(PLAUSIBLE, lyapunov=True, lyapunov_d0=1e-8, rtol=1e-8, atol=1e-10)
     default = min(1e-3, max(1e-8, 1e4 * fields["rtol"]))
-    for extra, why in ((dict(roots=False), "roots = .false."), (dict(method="erk"), "method = 'erk'")):
-        msg = one(messages(dict(fields, **extra)), "separation")
-        for number in ("lyapunov_d0 = 1.000E-08", f"default separation {default:.3E}", why):
+    for method in ("adams", "erk"):
+        msg = one(messages(dict(fields, roots=False, method=method)), "separation")
+        for number in ("lyapunov_d0 = 1.000E-08", f"default separation {default:.3E}",
+                       "roots = .false."):
             assert number in msg, (number, msg)
-    for quiet in (dict(roots=True, method="adams"), dict(roots=False, lyapunov_method="tangent"),
+    for quiet in (dict(roots=True, method="adams"), dict(roots=True, method="erk"),
+                  dict(roots=False, lyapunov_method="tangent"),
                   dict(roots=False, lyapunov_d0=0.0), dict(roots=False, lyapunov_d0=default),
                   dict(roots=False, lyapunov=False)):
         assert messages(dict(fields, **quiet)) == [], quiet

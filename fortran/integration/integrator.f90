@@ -439,9 +439,12 @@ contains
   !> remainder, which its growth limit took several steps to recover).
   !> floored (default .true.): CVODE's first step at least cvode_restart_floor (|tau| + |h|).
   !> The variational run passes .false.: with the floor there the ERK S-curve continuation's
-  !> corrector failed near 2355.58 r/min (tests/test_cont_drives.py::test_erk_traces_the_s_curve;
-  !> why not analysed); the state run (and the period map on it) needs it, without it BDF's map
-  !> through the Z16 drive's grazing cluster closed 6.6 % off the orbit (tests/test_solver.py).
+  !> corrector failed near 2355.58 r/min (tests/test_cont_drives.py::test_erk_traces_the_s_curve)
+  !> while ERK's state run lost switches in the teeth's clusters (spline_solver::settle_roots);
+  !> with them kept it completes with the floor too (2200-2500 and 2330-2470 r/min, the same
+  !> folds), which was not adopted; the state run (and the period map on it) needs it, without it
+  !> BDF's map through the Z16 drive's grazing cluster closed 6.6 % off the orbit
+  !> (tests/test_solver.py).
   integer(c_int) function integrator_restart(cv, tau, stats, floored) result(flag)
     type(integrator_t), intent(inout) :: cv
     real(c_double), intent(in) :: tau

@@ -442,29 +442,40 @@ contains
   !> Root functions for the contact switches of Eq. 16: g_{2k-1} = dn_k - c_k, g_{2k} = dn_k + c_k
   !> for every contact k (a tooth, or slice s of tooth j: k = (j - 1) n_s + s), with the backlash
   !> at the bulk temperature, which decides the contact state; dn_k includes the tooth's spacing
-  !> error e_j (|dn_j + e_j| = c_j, docs/model.md section 11).
-  pure subroutine mesh_switch_functions(m, t, q, g)
+  !> error e_j (|dn_j + e_j| = c_j, docs/model.md section 11). With the velocities v (optional),
+  !> dg their rates dg/dt (both d(dn_k)/dt, Eq. 11's rate).
+  pure subroutine mesh_switch_functions(m, t, q, g, v, dg)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: t, q(7)
     real(wp), intent(out) :: g(2*m%z*m%n_slices)
-    real(wp) :: sp(max_teeth), cp(max_teeth), ex, ey, dnj, ddnj, dns, ddns
+    real(wp), intent(in), optional :: v(7)
+    real(wp), intent(out), optional :: dg(2*m%z*m%n_slices)
+    real(wp) :: sp(max_teeth), cp(max_teeth), ex, ey, dnj, ddnj, dns, ddns, vv(7), w
     integer :: j, is, k, ns
     call tooth_angles(m%z, m%omega, t, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
     ex = q(1) + m%l_x - q(3)
     ey = q(2) + m%l_y - q(4)
     ns = m%n_slices
+    vv = 0.0_wp
+    w = 0.0_wp                                    ! the rate only with v
+    if (present(v)) then
+      vv = v
+      w = m%omega
+    end if
     do j = 1, m%z
-      call eq11(ex, ey, 0.0_wp, 0.0_wp, q(6), 0.0_wp, 0.0_wp, m%spacing_error(j), sp(j), cp(j), &
-           dnj, ddnj)                             ! Eq. 11 (its rate unused)
+      call eq11(ex, ey, vv(1) - vv(3), vv(2) - vv(4), q(6), vv(6), w, m%spacing_error(j), &
+           sp(j), cp(j), dnj, ddnj)              ! Eq. 11 and its rate
       if (ns == 1) then
         g(2*j - 1) = dnj - m%c_bulk
         g(2*j) = dnj + m%c_bulk
+        if (present(dg)) dg(2*j - 1:2*j) = ddnj
       else
         do is = 1, ns
           call eq11_sliced(m, slice_z(m, is), sp(j), cp(j), dnj, ddnj, dns, ddns)
           k = (j - 1)*ns + is
           g(2*k - 1) = dns - m%c_bulk
           g(2*k) = dns + m%c_bulk
+          if (present(dg)) dg(2*k - 1:2*k) = ddns
         end do
       end if
     end do

@@ -14,6 +14,7 @@ program test_mesh
   type(model_t) :: md, ms
   real(wp) :: q(7), v(7), fx, fy, tm, fx2, fy2, tm2, c, km, z, d, vel, fj, t, tz, th, scale, h
   real(wp) :: ex, ey, dn(1000), f(1000), g(2000), want_fx, want_fy, gx, gy, gd, gx2
+  real(wp) :: dg(2000), gp(2000), gm(2000)
   real(wp) :: phi, s, co, dnj, ddn, delta, sumf
   integer :: ierr, j, k, n_pos, n_neg, modes_k(1000)
   character(len=256) :: msg
@@ -107,6 +108,14 @@ program test_mesh
   call mesh_switch_functions(ms, t, q, g)
   call check_true('switch functions g = dn_j -/+ c', all(abs(g(1:2*md%z:2) - (dn(1:md%z) - c)) &
        <= 4*eps*c) .and. all(abs(g(2:2*md%z:2) - (dn(1:md%z) + c)) <= 4*eps*c))
+  ! their rates dg/dt with the velocities v: central differences along the motion (q + v dt
+  ! at t + dt; the teeth turn with omega)
+  h = 1.0e-7_wp
+  call mesh_switch_functions(ms, t, q, g, v, dg)
+  call mesh_switch_functions(ms, t + h, q + h*v, gp)
+  call mesh_switch_functions(ms, t - h, q - h*v, gm)
+  call check_true('switch functions: their rates dg/dt', all(abs(dg(1:2*md%z) - &
+       (gp(1:2*md%z) - gm(1:2*md%z))/(2*h)) <= 1.0e-7_wp*maxval(abs(dg(1:2*md%z)))))
 
   ! ---- the forces are the gradient of the mesh potential V = k_m/2 sum delta_j^2 (section 4):
   !      F_x1 = -dV/dx1, F_y1 = -dV/dy1, -F_x1 = -dV/dx2, T_m = r_b dV/dD2 (v = 0; central
