@@ -219,3 +219,36 @@ def test_realisations_transient_within_the_bound():
     assert "the run took longer than its wall-time bound" in str(sw.error.values[0])
     assert str(sw.error.values[1]) == "the wall-time bound of the test, max_seconds = 1 s, " \
         "was reached before this run"
+
+
+def test_cli_band(tmp_path):
+    """`pyspline continue --band LO HI` is continuation's band: from 1623 to 1626 r/min on the
+    doubling scene (the doubling at 1623.61) with --band 1621 1626 the doubled branch goes down
+    past --start to 1621 (without it, it stops at 1623); the command says so. A band that is
+    not two finite values LO < HI holding --start and --stop, or given with --all, is a
+    CaseError naming --band, exit 2, before anything runs."""
+    import xarray as xr
+    from test_continuation import cli
+    path = tmp_path / "doubling.nml"
+    path.write_text(DOUBLING.replace(rtol=1e-8, atol=1e-10, speed_rpm=1623.0, n_out=201,
+                                         t_end=0.2, t_transient=0.1).text())
+    args = ("continue", path, "--field", "speed_rpm", "--start", "1623", "--stop", "1626",
+            "--quiet")
+    for band, why in ((("1626", "1621"), "two finite values LO < HI"),
+                      (("1621", "1621"), "two finite values LO < HI"),
+                      (("nan", "1626"), "two finite values LO < HI"),
+                      (("1624", "1630"), "does not hold --start 1623"),
+                      (("1620", "1625"), "does not hold --stop 1626")):
+        run = cli(tmp_path, *args, "--band", *band, "--out", "bad")
+        assert run.returncode == 2 and f"--band {float(band[0]):g} {float(band[1]):g}: " \
+            f"{why}" in run.stderr, run.stderr
+    run = cli(tmp_path, *args, "--band", "1621", "1626", "--all", "--out", "bad")
+    assert run.returncode == 2 and "--band: " in run.stderr, run.stderr
+    assert not (tmp_path / "bad").exists()
+    run = cli(tmp_path, *args, "--band", "1621", "1626", "--out", "out")
+    assert run.returncode == 0, run.stderr
+    ds = xr.open_dataset(tmp_path / "out" / "continuation.nc", engine="h5netcdf")
+    p, b = ds.speed_rpm.values, ds.branch.values
+    assert "--band 1621 1626" in ds.attrs["command"]
+    assert (ds.n.values[b == 1] == 2).all() and p[b == 1].min() == pytest.approx(1621, abs=1e-9)
+    assert p[b == 0].min() == 1623 and p.max() == pytest.approx(1626, abs=1e-9)
