@@ -250,31 +250,6 @@ def test_variational_run_is_bounded_by_max_total_steps(impacting):
         pyspline.orbits.map_and_monodromy(case, orbit.t0, orbit.t0 + orbit.period, orbit.y0)
 
 
-def test_variational_run_on_the_cases_integrator(impacting):
-    """The variational run is on the case's own integrator, as the state run and the map are:
-    with method = 'erk' ARKODE's ERKStep (its bound names ARKODE's steps, Adams' CVODE's), so
-    the exact map's end state is ERK's (within 1e-8 scaled of ERK's period map and closer to it
-    than Adams' by half: measured 2.1e-9 at rtol 1e-7, Adams' 6.5e-9; when the variational run
-    was CVODE Adams for every method, the two were Adams' bit for bit); its M agrees with central
-    differences of ERK's map (measured 3.4e-6, Adams' 1.3e-4, against entries up to 4.8)."""
-    from pyspline.orbits import _period_map, _scale, fd_monodromy, map_and_monodromy
-    orbit, model = impacting
-    t0, t1 = orbit.t0, orbit.t0 + orbit.period
-    erk, adams = (model.case.replace(method=m) for m in ("erk", "adams"))
-    for case, name in ((erk, "ARKODE"), (adams, "CVODE")):
-        with pytest.raises(pyspline.SolverError, match=f"variational run took max_total_steps "
-                           f"= 200 {name} steps"):
-            map_and_monodromy(case.replace(max_total_steps=200), t0, t1, orbit.y0)
-    y1, M, free = map_and_monodromy(erk, t0, t1, orbit.y0)
-    ya = map_and_monodromy(adams, t0, t1, orbit.y0)[0]
-    ym = _period_map(erk.model, t0, t1, orbit.y0[:, None])[0][:, 0]
-    s = _scale(erk.model)[free]
-    off, off_adams = (np.abs((y - ym)[free] / s).max() for y in (y1, ya))
-    assert off < 1e-8 and off < off_adams / 2, (off, off_adams)
-    _, Mf, _ = fd_monodromy(erk.model, t0, t1, orbit.y0, h=1e-5)
-    assert np.abs(Mf - M).max() < 1e-3, np.abs(Mf - M).max()
-
-
 def test_coupled_thermal_level_is_not_covered():
     case, y_eq, _, _ = linear_scene(2.0)
     with pytest.raises(pyspline.CaseError, match="thermal = 'coupled'.*variational equations.*fd"):

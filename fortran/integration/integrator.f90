@@ -46,7 +46,7 @@ module spline_integrator
   implicit none
   private
   public :: integrator_t, lib_log_t, integrator_open, cvode_create, erk_create, integrator_advance, &
-       integrator_root_info, integrator_root_directions, integrator_land_on_root, landed_root, &
+       integrator_root_info, integrator_root_directions, integrator_land_on_root, &
        integrator_restart, integrator_steps_done, integrator_last_step, integrator_fail_text, &
        integrator_tolerances, &
        integrator_warnings, add_counters, integrator_free
@@ -392,19 +392,6 @@ contains
     if (flag == ARK_TSTOP_RETURN) flag = 0
     if (flag == 0) flag = root_init(cv, cv%nroot, cv%groots)
   end function integrator_land_on_root
-
-  !> After integrator_land_on_root: a located root (direction root, 0: none) whose function g,
-  !> in the landed state, has reached or crossed zero in its direction (root g >= 0), else 0.
-  !> The root was found on the interpolant of the crossing step; the landed state, of the
-  !> method's order, may not have crossed yet (by 1e-15 of its scale): that switch waits until
-  !> it does. A function exactly zero there counts as crossed: root finding leaves out a
-  !> function that is zero at its start, and would miss that switch.
-  elemental integer(c_int) function landed_root(root, g) result(crossed)
-    integer(c_int), intent(in) :: root
-    real(wp), intent(in) :: g
-    crossed = 0
-    if (root*g >= 0.0_wp) crossed = root
-  end function landed_root
 
   !> Locate only the crossings of root function i in direction dirs(i) (+1 rising, -1 falling,
   !> 0 either) from the next call on. CVODE only: ERKStep's landing on a root

@@ -22,7 +22,7 @@ module spline_solver
        erk_create, integrator_advance, integrator_root_info, integrator_root_directions, &
        integrator_land_on_root, integrator_restart, integrator_steps_done, integrator_last_step, &
        integrator_fail_text, integrator_warnings, add_counters, integrator_free, &
-       integrator_tolerances, landed_root
+       integrator_tolerances
   use spline_quantities, only: nstats => nsolver_stats, ist_roots_found, &
        ist_last_step, ist_mode_resyncs, ist_coupling_residual, ist_coupling_iterations, &
        ist_linear_tail_t
@@ -450,10 +450,12 @@ contains
   end subroutine apply_roots
 
   !> ERKStep landed on located roots (integrator_land_on_root): a root whose switch function has
-  !> reached or crossed zero in the landed state v, in its direction (landed_root), switches its
-  !> tooth as apply_roots does; a tooth whose function has not crossed yet keeps its state
-  !> until it does (a contact switched early adds its damping force c_m d(dn)/dt at once, at
-  !> the impact speed).
+  !> reached or crossed zero in the landed state v, in its direction, switches its tooth as
+  !> apply_roots does. The root was found on the interpolant of the crossing step; the landed
+  !> state, of the method's order, may not have crossed yet (by 1e-15 of c): that tooth keeps its
+  !> state until it does (a contact switched early adds its damping force c_m d(dn)/dt at once,
+  !> at the impact speed). A switch function exactly zero there counts as crossed: root finding
+  !> leaves out a function that is zero at its start, and would miss that switch.
   subroutine settle_roots(ctx, rootsfound, tau, v, nroots)
     type(solver_ctx_t), intent(inout) :: ctx
     integer(c_int), intent(in) :: rootsfound(:)
@@ -461,13 +463,15 @@ contains
     integer, intent(inout) :: nroots
     real(wp) :: y(nstate), g(2*ctx%m%z*ctx%m%n_slices)
     integer(c_int) :: crossed(size(rootsfound))
-    integer :: c, o
+    integer :: c, o, i
     crossed = 0
     do c = 1, ctx%ncopy
       o = (c - 1)*ctx%nrc
       call from_scaled(ctx%m, copy_state(ctx, v, c), y)
       call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), g)
-      crossed(o + 1:o + ctx%nrc) = landed_root(rootsfound(o + 1:o + ctx%nrc), g(1:ctx%nrc))
+      do i = 1, ctx%nrc
+        if (rootsfound(o + i)*g(i) >= 0.0_wp) crossed(o + i) = rootsfound(o + i)
+      end do
     end do
     call apply_roots(ctx, crossed, nroots)
   end subroutine settle_roots

@@ -7,10 +7,9 @@
 !> and the contact states only: spline_dynamics' closed form (rhs_jacobian) from Eqs.
 !> 11, 15-17 and 19-24. Everything is in the scaled states and time of Eq. 25. The thermal level
 !> coupled (the tooth force depends on itself through the flash temperature) is not covered.
-!> The run is on the state run's integrator (the case's method: CVODE Adams or BDF with its
-!> solver, or ARKODE's ERKStep), made and driven through the integrator layer
-!> (spline_integrator) as the state run's is: same set-up, work bounds, messages, landing on a
-!> located switch (ERKStep) and restart after it. Reentrant: the run's state sits in a context and an
+!> The run is CVODE's (the case's method and solver) made and driven through the integrator
+!> layer (spline_integrator), as the state run's is: same set-up, work bounds, messages and
+!> restart after a located switch. Reentrant: the run's state sits in a context and an
 !> integrator_t local to tangent_flow, the context handed to CVODE as user data.
 module spline_variational
   use, intrinsic :: iso_c_binding
@@ -28,9 +27,8 @@ module spline_variational
   use spline_mesh, only: mesh_switch_functions, eq11_gradient, eq16_mode, eq16_root_mode, &
        eq16_root_directions, tooth_approach, slice_approach
   use spline_integrator, only: integrator_t, lib_log_t, integrator_open, cvode_create, &
-       erk_create, integrator_advance, integrator_root_info, integrator_root_directions, &
-       integrator_land_on_root, landed_root, integrator_restart, integrator_fail_text, &
-       integrator_warnings, integrator_free
+       integrator_advance, integrator_root_info, integrator_root_directions, integrator_restart, &
+       integrator_fail_text, integrator_warnings, integrator_free
   implicit none
   private
   public :: tangent_flow, variational_check
@@ -72,8 +70,8 @@ contains
   !> (scaled integrated states, ctx order: integrated_states) beside it: the variational
   !> equations of the run with root-located contact switches (always, whatever the case's
   !> roots), the saltation matrix applied to phi at each switch (unless saltation = .false.,
-  !> kept to show it matters). The integrator (CVODE's method and (non)linear solver, or
-  !> ERKStep) and tolerances are the case's; the tangents are in its error control. y1: the SI state at t1; phi: the tangents there.
+  !> kept to show it matters). CVODE's method, (non)linear solver and tolerances are the case's;
+  !> the tangents are in its error control. y1: the SI state at t1; phi: the tangents there.
   !> nswitch (optional): the switches located. ierr: err_case (variational_check), err_solver,
   !> err_interrupted; errmsg says why. On success errmsg holds SUNDIALS' warnings, counted in
   !> msgs (optional: across a caller's runs), as spline_solver::integrate's; max_seconds
@@ -132,13 +130,8 @@ contains
     ! Newton: the exact block-diagonal Jacobian (tan_jac_cb) in a band of half-width n - 1; its
     ! LU costs (1 + ntan) n^3 instead of ((1 + ntan) n)^3 at every restart (a rattling drive
     ! restarts thousands of times a revolution)
-    if (flag == 0 .and. m%erk) then
-      call erk_create(m, tau, nroot, c_funloc(tan_rhs_cb), c_funloc(tan_roots_cb), c_loc(ctx), &
-           cv, flag, stage)
-    else if (flag == 0) then
-      call cvode_create(m, tau, nroot, c_funloc(tan_rhs_cb), c_funloc(tan_roots_cb), &
-           c_funloc(tan_jac_cb), n - 1, c_loc(ctx), cv, flag, stage)
-    end if
+    if (flag == 0) call cvode_create(m, tau, nroot, c_funloc(tan_rhs_cb), c_funloc(tan_roots_cb), &
+         c_funloc(tan_jac_cb), n - 1, c_loc(ctx), cv, flag, stage)
     do while (flag == 0 .and. tau < tau1)
       ! only the crossings that change a contact state are switches (as in spline_solver)
       stage = 'setting the directions of the contact switches'
@@ -153,12 +146,6 @@ contains
         stage = 'reading the roots found'
         flag = integrator_root_info(cv, rootsfound)
         if (flag /= 0) exit
-        ! ERKStep: onto the switch by its own step, then the roots crossed there (as the state
-        ! run's spline_solver::settle_roots); CVODE: nothing to do
-        stage = 'stepping onto a contact switch'
-        flag = integrator_land_on_root(cv, tau)
-        if (flag /= 0) exit
-        if (cv%erk) rootsfound = landed_root(rootsfound, switch_values(ctx, tau, yr))
         call switch(rootsfound)
         if (ctx%cb_ierr /= err_ok) then
           flag = -1
@@ -225,22 +212,13 @@ contains
   subroutine sync_modes(ctx, tau, v)
     type(tan_ctx_t), intent(inout) :: ctx
     real(c_double), intent(in) :: tau, v(:)
-    real(wp) :: g(2*ctx%nc)
-    g = switch_values(ctx, tau, v)
-    ctx%modes = eq16_mode(g(1::2), g(2::2))
-  end subroutine sync_modes
-
-  !> The switch functions of Eq. 16 (spline_mesh::mesh_switch_functions) at tau, the integrated
-  !> states v(1:n) (scaled).
-  function switch_values(ctx, tau, v) result(g)
-    type(tan_ctx_t), intent(in) :: ctx
-    real(c_double), intent(in) :: tau, v(:)
-    real(wp) :: g(2*ctx%nc), ys(nstate), y(nstate)
+    real(wp) :: y(nstate), g(2*ctx%nc), ys(nstate)
     ys = ctx%ys_full
     ys(ctx%idx(1:ctx%n)) = v(1:ctx%n)
     call from_scaled(ctx%m, ys, y)
     call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), g)
-  end function switch_values
+    ctx%modes = eq16_mode(g(1::2), g(2::2))
+  end subroutine sync_modes
 
   !> Phi <- S Phi at the switch of contact k (tooth j, slice s) to state new, at tau:
   !> S = I + (f+ - f-) h_y^T / (h_y f- + h_tau), h = dn_k -+ c (Eq. 11, scaled states), f-, f+
@@ -291,7 +269,7 @@ contains
     end associate
   end subroutine apply_saltation
 
-  !> The right-hand side (CVODE's or ERKStep's): Eq. 25 on the integrated states (frozen contact states), and
+  !> CVODE's right-hand side: Eq. 25 on the integrated states (frozen contact states), and
   !> J Phi for the tangents.
   integer(c_int) function tan_rhs_cb(tau, sv_y, sv_f, udata) result(ret) bind(C)
     real(c_double), value :: tau
@@ -362,9 +340,13 @@ contains
     type(c_ptr), value :: udata
     type(tan_ctx_t), pointer :: ctx
     real(c_double), pointer :: ys(:)
+    real(wp) :: y(nstate), yf(nstate)
     call c_f_pointer(udata, ctx)
     ys => FN_VGetArrayPointer(sv_y)
-    gout(1:2*ctx%nc) = switch_values(ctx, tau, ys)
+    yf = ctx%ys_full
+    yf(ctx%idx(1:ctx%n)) = ys(1:ctx%n)
+    call from_scaled(ctx%m, yf, y)
+    call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), gout(1:2*ctx%nc))
     ret = 0
   end function tan_roots_cb
 
