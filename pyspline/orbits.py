@@ -119,6 +119,20 @@ def _period_map(model, t0: float, t1: float, ys: np.ndarray, max_seconds: float 
     return y1, mask.astype(bool)
 
 
+def section_points(model, t0: float, n: int, y) -> np.ndarray:
+    """The section points of the period-n orbit through y (14,), SI, at t0: (m, 14), y and its
+    images under the core's map over the r revolutions after which the forcing repeats
+    (follow.repeat_revolutions), m = n / r of them. A period-n orbit is the same orbit from any
+    of them (a period-2 orbit of a forcing of one revolution: y and P(y))."""
+    from .follow import repeat_revolutions
+    r = repeat_revolutions(model.case)
+    t1 = t0 + 2 * np.pi * r / model.info()["omega"]
+    out = [np.asarray(y, float)]
+    for _ in range(n // r - 1):
+        out.append(_period_map(model, t0, t1, out[-1][:, None])[0][:, 0])
+    return np.array(out)
+
+
 def _scale(model) -> np.ndarray:
     """The scales of Eq. 25 per state: l_ref for displacements, l_ref w_ref for velocities."""
     info = model.info()

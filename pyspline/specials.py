@@ -224,6 +224,14 @@ def special(pt, kind):
                 closest_approach=pt["contact"]["closest_approach"])
 
 
+def same_point(u, v, tol) -> bool:
+    """Two points of the continuation's scaled unknowns u = (z, q) are one: within sqrt(tol)
+    of each other in every component (tol the corrector's residual: a converged point is off
+    by about tol, and near a fold, where M - I is singular along the branch, by about its
+    square root)."""
+    return bool(np.abs(np.asarray(u) - np.asarray(v)).max() <= np.sqrt(tol))
+
+
 def smooth(sp) -> bool:
     """The critical multiplier at +1, -1 or on the unit circle within 0.01 (a grazing: True,
     no multiplier is watched; a non-smooth fold: False, its multipliers jump)."""

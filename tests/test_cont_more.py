@@ -99,7 +99,25 @@ def test_period_two_seed_from_the_sections(monkeypatch):
     assert (ds.speed_rpm >= 1646).all() and (ds.speed_rpm <= 1650).all(), ds.speed_rpm.values
 
 
-def test_branches_through_a_period_doubling():
+#: the doubling scene at rtol 1e-8 (the band's branches and the tests on them)
+DOUBLING8 = DOUBLING.replace(rtol=1e-8, atol=1e-10)
+
+
+@pytest.fixture(scope="module")
+def doubling_band():
+    """pyspline.branches of DOUBLING8 over 1617-1626 r/min (steps up to 0.5, follow sweeps of
+    runs of 20 revolutions at 3 speeds), once per process."""
+    T = 60 / 1650
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds, _ = pyspline.branches(DOUBLING8, "speed_rpm", 1617, 1626, points=3, max_n=2,
+                                  progress=False, ds_max=0.5, max_angle=0.3,
+                                  sweep_case=DOUBLING8.replace(t_end=20 * T, t_transient=10 * T,
+                                                               section="shaft"))
+    return ds
+
+
+def test_branches_through_a_period_doubling(doubling_band):
     """DOUBLING over 1617-1626 r/min (rtol 1e-8, steps up to 0.5): the follow sweeps' runs have
     not settled (no period), the seed in the middle is the stable period-1 orbit; its branch
     doubles (a multiplier at -1) and the doubled branch is followed over the whole band, not
@@ -108,14 +126,7 @@ def test_branches_through_a_period_doubling():
     period-2 orbits (P^2(y) = y, P(y) away from y); two branches, none past the band."""
     from pyspline.orbits import _period_map, map_and_monodromy
     from test_orbits import scale_of
-    case = DOUBLING.replace(rtol=1e-8, atol=1e-10)
-    T = 60 / 1650
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", pyspline.SplineWarning)
-        ds, _ = pyspline.branches(case, "speed_rpm", 1617, 1626, points=3, max_n=2,
-                                  progress=False, ds_max=0.5, max_angle=0.3,
-                                  sweep_case=case.replace(t_end=20 * T, t_transient=10 * T,
-                                                          section="shaft"))
+    case, ds = DOUBLING8, doubling_band
     assert ds.attrs["status"] == "complete" and ds.attrs["n_branches"] == 2
     p, b, n = ds.speed_rpm.values, ds.branch.values, ds.n.values
     assert ((p >= 1617) & (p <= 1626)).all()
@@ -136,6 +147,43 @@ def test_branches_through_a_period_doubling():
     y1 = _period_map(c.model, 0.0, 60 / 1626, y[:, None])[0][:, 0]
     assert np.abs((y2 - y)[free] / s[free]).max() < 1e-5
     assert np.abs((y1 - y)[free] / s[free]).max() > 0.1
+
+
+def _other_phase(ds, near):
+    """The doubled branch's (branch 1's) stable point nearest `near` r/min: (p, y, P(y), the
+    branch), P the map over one revolution."""
+    from pyspline.orbits import section_points
+    two = ds.isel(point=ds.branch.values == 1)
+    k = np.argmin(np.abs(two.speed_rpm.values - near) + 100 * ~two.stable.values.astype(bool))
+    p, y = float(two.speed_rpm[k]), two.y0.values[k]
+    y_a, y_b = section_points(DOUBLING8.replace(speed_rpm=p).model, 0.0, 2, y)
+    assert np.array_equal(y_a, y)
+    return p, y, y_b, two
+
+
+def test_period_two_seed_at_its_other_section_point(doubling_band):
+    """A period-2 orbit has two section points, y and P(y): at the doubled branch's stable
+    point nearest 1625 r/min, P(y) lies on the branch only through its section points (a seed
+    there is the same orbit: branches does not continue it; y alone is a scaled distance of
+    0.1 or more from it), and a copy of the whole doubled branch at its other section points
+    is merged into it (diagram._distinct with the branches' phases: one seed kept, two
+    without them). Tolerance: sqrt(tol), tol the corrector's 100 rtol (specials.same_point)."""
+    from pyspline.diagram import _concat, _distinct, _on_branch, _phases
+    from pyspline.orbits import section_points
+    from test_orbits import scale_of
+    s, tol = scale_of(DOUBLING8), 100 * DOUBLING8["rtol"]
+    p, y, y_b, two = _other_phase(doubling_band, 1625)
+    assert np.abs((y_b - y) / s).max() > 0.1
+    assert _on_branch(two, "speed_rpm", p, y, s, tol)
+    assert not _on_branch(two, "speed_rpm", p, y_b, s, tol)
+    at = section_points(DOUBLING8.replace(speed_rpm=p).model, 0.0, 2, y_b)
+    assert any(_on_branch(two, "speed_rpm", p, x, s, tol) for x in at)
+    copy = two.copy(deep=True)
+    copy["y0"] = (("point", "state"), _phases(DOUBLING8, "speed_rpm", two)[0])
+    both = _concat([two, copy])
+    assert list(_distinct(both, "speed_rpm", s, tol, lambda piece: _phases(
+        DOUBLING8, "speed_rpm", piece))[1]) == [0]
+    assert list(_distinct(both, "speed_rpm", s, tol)[1]) == [0, 1]
 
 
 def test_cli_all_and_fold_keep_what_they_have(tmp_path):
