@@ -186,6 +186,28 @@ def test_period_two_seed_at_its_other_section_point(doubling_band):
     assert list(_distinct(both, "speed_rpm", s, tol)[1]) == [0, 1]
 
 
+def test_a_fold_located_twice_is_reported_once(doubling_band):
+    """The period-2 orbit at 1625 r/min continued down from its other section point P(y) (band
+    1615-1630): its branch runs stable down to the fold at 1618.409 r/min, back up unstable to
+    the doubling, through it onto the other section point's half of the same orbit, down to
+    the same fold again and back up: two turns at 1618.41, one fold reported (located twice,
+    1e-6 r/min apart, once at each section point: specials.once), its multiplier at +1."""
+    p, _, y_b, _ = _other_phase(doubling_band, 1625)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds = pyspline.continuation(DOUBLING8, "speed_rpm", p, 1615, n=2, guess=y_b,
+                                   band=(1615, 1630), progress=False, ds_max=0.5, max_angle=0.3)
+    assert ds.attrs["status"] == "complete"
+    q = ds.speed_rpm.values[ds.branch.values == 0]
+    turns = q[1:-1][(np.diff(q)[:-1] < 0) & (np.diff(q)[1:] > 0)]
+    assert len(turns) == 2 and np.abs(turns - 1618.41).max() < 0.05, turns
+    kind = ds.special_type.values
+    fold = np.flatnonzero(kind == "fold")
+    assert len(fold) == 1, ds.special_speed_rpm.values[fold]
+    assert ds.special_speed_rpm[fold[0]] == pytest.approx(1618.409, abs=1e-3)
+    assert abs(complex(ds.special_mu_real[fold[0]], ds.special_mu_imag[fold[0]]) - 1) < 1e-2
+
+
 def test_cli_all_and_fold_keep_what_they_have(tmp_path):
     """`pyspline continue --all` and `--fold` whose continuations stop short (--max-points 3, steps of
     0.23 r/min)
