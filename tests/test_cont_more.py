@@ -49,6 +49,38 @@ def test_chaotic_drive_seeds_no_branch(monkeypatch):
     assert len(said) == 2 and all(300 < float(lam) and float(sp) < float(lam) for lam, sp in said)
 
 
+def test_chaotic_stretch_in_a_branches_dataset():
+    """chaos_z24 (runs of 5 revolutions after 2) followed in its mesh damping zeta_m over
+    0.01-0.1 at 4 values: up, the run at 0.01 (the case's own, chaotic) gives no period and
+    its T_m peak-to-peak jumps from 58 to 4.7 N m at the next value, so it is a stretch of its
+    own; Newton from its final state finds no stable period-1 orbit, and its Lyapunov run says
+    chaotic (a largest exponent of 300 1/s or more, beyond its spread); the damped stretch
+    above seeds the stable period-1 orbit at 0.07 (continued 2 points: max_points). The
+    Dataset holds the stretch (no_period_range, no_period_chaotic = 1) and the figure shades
+    it as chaotic."""
+    import matplotlib
+    matplotlib.use("Agg")
+    from pyspline.plots import frequency_response
+    case = pyspline.load_case(CASES / "chaos_z24.nml", lyapunov=False, t_transient=0.02,
+                              t_end=0.07, n_out=201)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds, sw = pyspline.branches(case, "zeta_m", 0.01, 0.1, points=4, max_n=1,
+                                   progress=False, max_points=2)
+    assert sw.period.sel(direction="up").values[0] == 0
+    assert ds.no_period_range.values.tolist() == [[0.01, 0.01]]
+    assert ds.no_period_chaotic.values.tolist() == [1]
+    lam, spread = map(float, re.fullmatch(r"up 0.01..0.01 \(chaotic: largest Lyapunov exponent "
+                                          r"(\S+) 1/s \(spread (\S+)\)\)",
+                                          ds.attrs["no_period"]).groups())
+    assert lam > 300 and spread < lam
+    assert ds.attrs["seeds"] == "0.07 up n=1" and (ds.n == 1).all() and ds.stable.all()
+    assert "max_points = 2 reached" in ds.attrs["status"]
+    ax = frequency_response(ds, sweep=sw).axes[0]
+    assert any(t.get_text().startswith("no periodic attractor: chaotic") for t in
+               ax.get_legend().get_texts())
+
+
 def test_unsettled_periodic_drive_is_not_chaos():
     """DOUBLING over 1646-1650 r/min, whose attractor is the stable period-2 orbit (its
     sections give period 2 after 40 revolutions, test_period_two_seed_from_the_sections),
