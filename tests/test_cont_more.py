@@ -240,6 +240,24 @@ def test_a_fold_located_twice_is_reported_once(doubling_band):
     assert abs(complex(ds.special_mu_real[fold[0]], ds.special_mu_imag[fold[0]]) - 1) < 1e-2
 
 
+def test_grazing_just_past_stop(doubling_band):
+    """The stable period-2 orbit near 1619.3 r/min continued up to 1620.085 r/min, its grazing
+    (1620.092, tests above) just past stop: the branch ends on stop, complete, with no grazing
+    reported and no point past stop. (The filter that drops diagnosed crossings past an end is
+    not reached here, nor by any run tried: the diagnosis bisects the step onto the end, so
+    its points lie within the band. Stops 0.01-0.06 r/min past the grazing fail: docs,
+    Limits.)"""
+    p, y, _, _ = _other_phase(doubling_band, 1619.3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds = pyspline.continuation(DOUBLING8, "speed_rpm", p, 1620.085, n=2, guess=y,
+                                   progress=False, ds_max=0.5, max_angle=0.3)
+    q = ds.speed_rpm.values
+    assert ds.attrs["status"] == "complete" and q[-1] == pytest.approx(1620.085, abs=1e-9)
+    assert (q <= 1620.085 + 1e-9).all() and ds.attrs["diagnosed_grazings"] == 0, q
+    assert "grazing" not in ds.special_type.values and (ds.switches == ds.switches[0]).all()
+
+
 def test_cli_all_and_fold_keep_what_they_have(tmp_path):
     """`pyspline continue --all` and `--fold` whose continuations stop short (--max-points 3, steps of
     0.23 r/min)
