@@ -12,8 +12,7 @@ import numpy as np
 from .arclength import (check_handed_on, continuation, field_label, parse_field, set_field,
                         valid_value)
 from .errors import CaseError, SplineError, SplineWarning
-from .follow import repeat_revolutions
-from .orbits import CALL_SECONDS, OrbitError, out_of_time, time_bound
+from .orbits import CALL_SECONDS, OrbitError, out_of_time, repeat_revolutions, time_bound
 
 
 def _stretches(period):
