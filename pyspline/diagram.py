@@ -11,8 +11,9 @@ import numpy as np
 
 from .arclength import (check_handed_on, continuation, field_label, parse_field, set_field,
                         valid_value)
-from .errors import CaseError, SplineError, SplineWarning
-from .orbits import CALL_SECONDS, OrbitError, out_of_time, repeat_revolutions, time_bound
+from .errors import CaseError, SolverError, SplineError, SplineWarning
+from .orbits import (CALL_SECONDS, OrbitError, out_of_time, repeat_revolutions,
+                     section_points, time_bound)
 
 
 def _stretches(period):
@@ -146,16 +147,29 @@ def merged(pieces, label, scale, tol, phases=None):
 
 def _phases(case, name, piece):
     """The states of a period-n piece's points at each of their other section points
-    (orbits.section_points): one (points, 14) array per section point after the first."""
-    from .orbits import section_points
+    (section_points): one (points, 14) array per section point after the first; none when a
+    map run fails (or the time bound has passed: the branches so far are returned as they
+    are)."""
     n = int(piece.n.values[0])
     if n == 1:
         return []
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", SplineWarning)      # the case's notes, said before
-        ys = np.array([section_points(case.replace(**{name: float(p)}).model, case["t0"], n, y)
-                       for p, y in zip(piece[name].values, piece.y0.values)])
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SplineWarning)      # the case's notes, said before
+            ys = np.array([section_points(case.replace(**{name: float(p)}).model, case["t0"],
+                                          n, y)
+                           for p, y in zip(piece[name].values, piece.y0.values)])
+    except SolverError:
+        return []
     return list(ys.transpose(1, 0, 2)[1:])
+
+
+def _section_points(orb):
+    """The seed orbit's section points (section_points); its own alone when a map run fails."""
+    try:
+        return section_points(orb.case.model, orb.t0, orb.n, orb.y0)
+    except SolverError:
+        return orb.y0[None]
 
 
 def _distinct(ds, label, scale, tol, phases=None):
@@ -253,7 +267,7 @@ def branches(case, field: str, start: float, stop: float, points: int = 31, *,
 def _branches(case, field, start, stop, points, max_n, progress, command, sweep_case, cont):
     """branches within its time bound."""
     from .core import load
-    from .orbits import _scale, section_points
+    from .orbits import _scale
     from .sweeps import sweep
     name, index = parse_field(case, field)
     if index is not None:
@@ -296,8 +310,8 @@ def _branches(case, field, start, stop, points, max_n, progress, command, sweep_
                         ("", -1) if finals[d][k] is None else _without_period(
                             sweep_case.replace(**{name: p}), finals[d][k], n, max_n))))
                     continue
-                at = section_points(orb.case.model, orb.t0, orb.n, orb.y0)
-                if any(_on_branch(x, field, p, y, scale, tol) for x in pieces for y in at):
+                if any(_on_branch(x, field, p, y, scale, tol) for x in pieces
+                       for y in _section_points(orb)):
                     continue        # the same orbit, at any of its section points
                 halves = []
                 for end in (start, stop):
