@@ -24,7 +24,8 @@ from .core import load, sundials_said
 from .dataset import continuation_dataset
 from .errors import CaseError, SolverError, SplineWarning
 from .orbits import (CALL_SECONDS, OrbitError, _period_map, _scale, _trajectory, fd_monodromy,
-                     forcing_periods, map_and_monodromy, out_of_time, periodic_orbit, time_bound)
+                     forcing_periods, map_and_monodromy, out_of_time, periodic_orbit,
+                     section_points, time_bound)
 from . import specials
 from .specials import SPECIAL_TYPES, contact_measures, locate, multipliers, smooth, tests
 
@@ -232,6 +233,16 @@ class _Problem:
         y = np.array(y_fixed, float)
         y[self.free] = u[:-1] * self.d0[self.free]
         return y
+
+    def sections(self, pt):
+        """The scaled unknowns u of the branch point pt (a record of _Branch.point) at each of
+        its orbit's section points (orbits.section_points), its own first; its own alone
+        when a map run fails (or the time bound has passed)."""
+        try:
+            ys = section_points(self.model(pt["p"]), self.t0, pt["n"], pt["y"])
+        except SolverError:
+            ys = pt["y"][None]
+        return np.c_[ys[:, self.free] / self.d0[self.free], np.full(len(ys), pt["u"][-1])]
 
     def evaluate(self, y_fixed, u, n):
         """At u = (z, q): F (k,), J = [M - I, dF/dq] (k, k+1), M (k, k), the state y (14,)."""
@@ -460,6 +471,7 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
                             todo.append(_doubled_start(sp, nb, y_fixed))
         finally:
             bar.close()
+        found = specials.once(found, prob.sections, tol)    # a point located twice, once
     wall = time.perf_counter() - wall0
     if status != "complete":
         warnings.warn(f"{status}: the branch so far is returned ({sum(map(len, branches))} "

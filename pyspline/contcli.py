@@ -25,6 +25,8 @@ Writes into --out DIR:
 Prints one line per special point. Exit status: README's (CaseError 2, SolverError 3); 1 when
 the branch could not be followed to --stop (the points so far are written, with where and why
 it stopped: attrs['status'] and the last line on stderr) or no orbit was found at --start.
+With --band LO HI the doubled branches that period doublings start are followed over LO..HI
+(holding --start and --stop; default --start..--stop), e.g. down past --start to their fold.
 
 With --all: every periodic branch of the band (pyspline.branches): a follow sweep of --sweep N
 points (default 31; runs of the case's t_end: let it settle them, e.g. --fix t_end=1
@@ -56,11 +58,17 @@ def cmd_continue(args, fixed, exit_code) -> int:
         if args.sweep and index is not None:
             raise CaseError(f"--sweep: a follow sweep runs whole fields; {args.field} is "
                             "one element of an array field")
+        band = _band(args)
         if args.all or args.fold:
+            if band is not None:
+                raise CaseError("--band: the range of continue's doubled branches; --all and "
+                                "--fold set it themselves (each seed's halves, the whole band)")
             return _other(args, case, name, index, command, out)
+        if band is not None:
+            command += f" --band {band[0]:g} {band[1]:g}"
         ds = continuation(case, args.field, args.start, args.stop, n=args.n, ds=args.ds,
                           max_points=args.max_points, tol=args.tol, progress=not args.quiet,
-                          command=command, max_seconds=args.max_seconds)
+                          command=command, max_seconds=args.max_seconds, band=band)
         sw = None
         if args.sweep:
             from .sweeps import sweep
@@ -97,6 +105,21 @@ def cmd_continue(args, fixed, exit_code) -> int:
         print(f"stopped: {ds.attrs['status']}", file=sys.stderr)
         return 1
     return 0
+
+
+def _band(args):
+    """--band LO HI as (lo, hi), or None; CaseError naming it unless finite with lo < hi and
+    holding --start and --stop."""
+    if args.band is None:
+        return None
+    lo, hi = args.band
+    if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+        raise CaseError(f"--band {lo:g} {hi:g}: two finite values LO < HI")
+    for arg, v in (("--start", args.start), ("--stop", args.stop)):
+        if not lo <= v <= hi:
+            raise CaseError(f"--band {lo:g} {hi:g}: does not hold {arg} {v:g} (the band "
+                            "holds the branch from --start to --stop)")
+    return lo, hi
 
 
 def _values(text: str, what: str):
@@ -173,6 +196,9 @@ def add_continue(sub, fixed, exit_code) -> None:
     r.add_argument("--ds", type=float, default=0.05, help="first arclength step (default 0.05)")
     r.add_argument("--max-points", type=int, default=200, help="most branch points (200)")
     r.add_argument("--tol", type=float, help="corrector residual, scaled (default 100 rtol)")
+    r.add_argument("--band", nargs=2, type=float, metavar=("LO", "HI"),
+                   help="the field's range over which doubled branches (period doublings) are "
+                   "followed, holding --start and --stop (default --start..--stop)")
     r.add_argument("--measure", choices=("Tm_pp", "F_max", "D2_pp"), default="Tm_pp",
                    help="response measure of the figure (default Tm_pp)")
     r.add_argument("--sweep", type=int, default=0, metavar="N",

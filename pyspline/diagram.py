@@ -11,9 +11,9 @@ import numpy as np
 
 from .arclength import (check_handed_on, continuation, field_label, parse_field, set_field,
                         valid_value)
-from .errors import CaseError, SplineError, SplineWarning
-from .follow import repeat_revolutions
-from .orbits import CALL_SECONDS, OrbitError, out_of_time, time_bound
+from .errors import CaseError, SolverError, SplineError, SplineWarning
+from .orbits import (CALL_SECONDS, OrbitError, out_of_time, repeat_revolutions,
+                     section_points, time_bound)
 
 
 def _stretches(period):
@@ -110,12 +110,13 @@ def _seed(case, final, n, max_n):
     return None
 
 
-def _on_branch(ds, label, p, y, scale):
+def _on_branch(ds, label, p, y, scale, tol):
     """Whether (p, y) lies on a branch of `ds`: within a tenth of a chord (the sagitta at the
-    continuation's max_angle is about 2 % of it) of the segment between two consecutive
-    points of the branch, in the continuation's scaled unknowns (the states by Eq. 25, the
-    field by a tenth of its magnitude): the nearest point of the segment, so that a point at
-    a fold, beyond the field values sampled on either side of it, is found too."""
+    continuation's max_angle is about 2 % of it), and at least sqrt(tol) (specials.same_point),
+    of the segment between two consecutive points of the branch, in the continuation's scaled
+    unknowns (the states by Eq. 25, the field by a tenth of its magnitude): the nearest point
+    of the segment, so that a point at a fold, beyond the field values sampled on either side
+    of it, is found too."""
     pscale = 0.1 * max(abs(p), np.abs(ds[label].values).max())
     x = np.r_[p / pscale, np.asarray(y) / scale]
     for b in np.unique(ds.branch.values):
@@ -124,29 +125,62 @@ def _on_branch(ds, label, p, y, scale):
         d, r = np.diff(X, axis=0), x - X[:-1]
         w = np.clip((r * d).sum(1) / np.maximum((d * d).sum(1), 1e-300), 0, 1)
         dist = np.abs(r - w[:, None] * d).max(1)
-        if (dist <= 0.1 * np.abs(d).max(1) + 1e-6 * np.abs(x).max()).any():
+        if (dist <= np.maximum(0.1 * np.abs(d).max(1), np.sqrt(tol))).any():
             return True
     return False
 
 
-def merged(pieces, label, scale):
+def merged(pieces, label, scale, tol, phases=None):
     """The indices of the pieces to keep, largest first: a piece every point of which lies on
-    a kept one (_on_branch) is the same branch and goes."""
+    a kept one (_on_branch), at its own section points or, for a period-n piece, all at the
+    k-th of them (phases(piece): the states there, one (points, 14) array per k), is the same
+    branch and goes."""
     keep = []
     for i in sorted(range(len(pieces)), key=lambda i: -pieces[i].sizes["point"]):
-        if not any(all(_on_branch(pieces[j], label, p, y, scale) for p, y in
-                       zip(pieces[i][label].values, pieces[i].y0.values)) for j in keep):
+        ps = pieces[i][label].values
+        ways = [pieces[i].y0.values] + (list(phases(pieces[i])) if phases and keep else [])
+        if not any(all(_on_branch(pieces[j], label, p, y, scale, tol) for p, y in zip(ps, ys))
+                   for ys in ways for j in keep):
             keep.append(i)
     return keep
 
 
-def _distinct(ds, label, scale):
+def _phases(case, name, piece):
+    """The states of a period-n piece's points at each of their other section points
+    (section_points): one (points, 14) array per section point after the first; none when a
+    map run fails (or the time bound has passed: the branches so far are returned as they
+    are)."""
+    n = int(piece.n.values[0])
+    if n == 1:
+        return []
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SplineWarning)      # the case's notes, said before
+            ys = np.array([section_points(case.replace(**{name: float(p)}).model, case["t0"],
+                                          n, y)
+                           for p, y in zip(piece[name].values, piece.y0.values)])
+    except SolverError:
+        return []
+    return list(ys.transpose(1, 0, 2)[1:])
+
+
+def _section_points(orb):
+    """The seed orbit's section points (section_points); its own alone when a map run fails."""
+    try:
+        return section_points(orb.case.model, orb.t0, orb.n, orb.y0)
+    except SolverError:
+        return orb.y0[None]
+
+
+def _distinct(ds, label, scale, tol, phases=None):
     """The branches of `ds` (_concat's) without those every point of which lies on another
-    (merged: a seed's branch traced from another seed too, or a doubled branch another
-    seed's continuation traced), renumbered; and the indices of the seeds kept."""
+    (merged: a seed's branch traced from another seed too, at the same or another section
+    point of a period-n orbit, or a doubled branch another seed's continuation traced),
+    renumbered; and the indices of the seeds kept."""
     nb = ds.branch.values
     every = np.unique(nb)
-    keep = sorted(every[merged([ds.isel(point=nb == b) for b in every], label, scale)])
+    keep = sorted(every[merged([ds.isel(point=nb == b) for b in every], label, scale, tol,
+                               phases)])
     ds = ds.isel(point=np.isin(nb, keep), special=np.isin(ds.special_branch.values, keep))
     ds["branch"] = ("point", np.searchsorted(keep, ds.branch.values))
     ds["special_branch"] = ("special", np.searchsorted(keep, ds.special_branch.values))
@@ -210,8 +244,9 @@ def branches(case, field: str, start: float, stop: float, points: int = 31, *,
     section phase, seeds `periodic_orbit` (period n, or when the sections gave none, the first
     n <= max_n on which Newton converges to a stable orbit) and a continuation from there to
     start and to stop (`cont`: continuation's keywords). A seed whose orbit lies on a branch
-    already traced (same orbit at the same value) is not continued again; a branch whose every
-    point lies on another is dropped. Stretches without a stable periodic orbit of n <= max_n
+    already traced (same orbit at the same value, at any of its n section points) is not
+    continued again; a branch whose every point lies on another (at the same section point, or
+    every point at its k-th) is dropped. Stretches without a stable periodic orbit of n <= max_n
     (chaotic or quasi-periodic, or not settled) seed nothing; listed in attrs['no_period'].
 
     max_seconds : the wall time of the whole call (orbits.CALL_SECONDS; math.inf: none), shared
@@ -252,6 +287,7 @@ def _branches(case, field, start, stop, points, max_n, progress, command, sweep_
         sw = sweep(sweep_case, progress=progress,
                    follow="both", spectrum=False, finals=finals, **{name: values})
     scale = _scale(load(case))
+    tol = cont.get("tol") or 100 * case["rtol"]         # continuation's corrector's
     pieces, seeds, no_period, status, skipped = [], [], [], [], []
     if (cut := _cut(sw)).any():
         status.append(f"{out_of_time()} was reached in the follow sweeps ({cut.sum()} of "
@@ -274,8 +310,9 @@ def _branches(case, field, start, stop, points, max_n, progress, command, sweep_
                         ("", -1) if finals[d][k] is None else _without_period(
                             sweep_case.replace(**{name: p}), finals[d][k], n, max_n))))
                     continue
-                if any(_on_branch(x, field, p, orb.y0, scale) for x in pieces):
-                    continue
+                if any(_on_branch(x, field, p, y, scale, tol) for x in pieces
+                       for y in _section_points(orb)):
+                    continue        # the same orbit, at any of its section points
                 halves = []
                 for end in (start, stop):
                     if p == end:
@@ -306,7 +343,8 @@ def _branches(case, field, start, stop, points, max_n, progress, command, sweep_
         raise SplineError(f"branches: no periodic attractor found by the follow sweeps over "
                           f"{field} = {start:g}..{stop:g} (stretches without a period: "
                           f"{_spans(no_period) or 'none'})")
-    ds, kept = _distinct(_concat(pieces), field, scale)
+    ds, kept = _distinct(_concat(pieces), field, scale, tol,
+                         lambda piece: _phases(case, name, piece))
     if no_period:       # plots.frequency_response shades them
         ds["no_period_range"] = (("stretch", "end"),
                                  np.sort([[a, b] for _, a, b, *_ in no_period]))

@@ -11,25 +11,15 @@ is serial: an executor runs one chain per direction ('both': up and down at once
 from __future__ import annotations
 
 import warnings
-from fractions import Fraction
-from math import inf, lcm
+from math import inf
 
 import numpy as np
 
 from .errors import SolverError, SplineWarning
+from .orbits import repeat_revolutions
 from .summary import failed_summary, summarise
 
 DIRECTIONS = ("up", "down", "both")
-
-
-def repeat_revolutions(case) -> int:
-    """The shaft revolutions after which the case's forcing repeats (ripple orders n_k of
-    non-zero amplitude: the lcm of their denominators, up to 1000; 1 otherwise)."""
-    m = 1
-    for order, amp in zip(case["ripple_order"], case["ripple_amp"]):
-        if amp:
-            m = lcm(m, Fraction(order).limit_denominator(1000).denominator)
-    return m
 
 
 def continued(case, y, t_prev: float, omega_prev: float):

@@ -16,6 +16,7 @@ import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from fractions import Fraction
+from math import lcm
 
 import numpy as np
 
@@ -119,6 +120,19 @@ def _period_map(model, t0: float, t1: float, ys: np.ndarray, max_seconds: float 
     return y1, mask.astype(bool)
 
 
+def section_points(model, t0: float, n: int, y) -> np.ndarray:
+    """The section points of the period-n orbit through y (14,), SI, at t0: (m, 14), y and its
+    images under the core's map over the r revolutions after which the forcing repeats
+    (repeat_revolutions), m = n / r of them. A period-n orbit is the same orbit from any of them
+    (a period-2 orbit of a forcing of one revolution: y and P(y))."""
+    r = repeat_revolutions(model.case)
+    t1 = t0 + 2 * np.pi * r / model.info()["omega"]
+    out = [np.asarray(y, float)]
+    for _ in range(n // r - 1):
+        out.append(_period_map(model, t0, t1, out[-1][:, None])[0][:, 0])
+    return np.array(out)
+
+
 def _scale(model) -> np.ndarray:
     """The scales of Eq. 25 per state: l_ref for displacements, l_ref w_ref for velocities."""
     info = model.info()
@@ -177,6 +191,16 @@ def fd_monodromy(model, t0: float, t1: float, y: np.ndarray, h: float | None = N
     yd, _ = _period_map(model, t0, t1, cols)
     z1 = yd[idx] / scale[idx, None]
     return y1[:, 0], (z1[:, 0::2] - z1[:, 1::2]) / (2 * steps), free
+
+
+def repeat_revolutions(case) -> int:
+    """The shaft revolutions after which the case's forcing repeats (ripple orders n_k of
+    non-zero amplitude: the lcm of their denominators, up to 1000; 1 otherwise)."""
+    m = 1
+    for order, amp in zip(case["ripple_order"], case["ripple_amp"]):
+        if amp:
+            m = lcm(m, Fraction(order).limit_denominator(1000).denominator)
+    return m
 
 
 def forcing_periods(case: Case, n: int) -> None:

@@ -224,6 +224,28 @@ def special(pt, kind):
                 closest_approach=pt["contact"]["closest_approach"])
 
 
+def same_point(u, v, tol) -> bool:
+    """Two points of the continuation's scaled unknowns u = (z, q) are one: within sqrt(tol)
+    of each other in every component (tol the corrector's residual: a converged point is off
+    by about tol, and near a fold, where M - I is singular along the branch, by about its
+    square root)."""
+    return bool(np.abs(np.asarray(u) - np.asarray(v)).max() <= np.sqrt(tol))
+
+
+def once(sps, sections, tol):
+    """The special points without repeats: one of the kind and branch of a point kept before
+    and the same point (same_point) as it at any of that point's section points (sections(sp):
+    its u at each of its orbit's n / r section points; a period-2 branch continued through
+    its doubling comes back at the other one) was located twice and goes."""
+    kept = []
+    for sp in sps:
+        if not any(k["type"] == sp["type"] and k["branch"] == sp["branch"]
+                   and same_point(k["u"][-1:], sp["u"][-1:], tol)
+                   and any(same_point(u, sp["u"], tol) for u in sections(k)) for k in kept):
+            kept.append(sp)
+    return kept
+
+
 def smooth(sp) -> bool:
     """The critical multiplier at +1, -1 or on the unit circle within 0.01 (a grazing: True,
     no multiplier is watched; a non-smooth fold: False, its multipliers jump)."""

@@ -49,6 +49,38 @@ def test_chaotic_drive_seeds_no_branch(monkeypatch):
     assert len(said) == 2 and all(300 < float(lam) and float(sp) < float(lam) for lam, sp in said)
 
 
+def test_chaotic_stretch_in_a_branches_dataset():
+    """chaos_z24 (runs of 5 revolutions after 2) followed in its mesh damping zeta_m over
+    0.01-0.1 at 4 values: up, the run at 0.01 (the case's own, chaotic) gives no period and
+    its T_m peak-to-peak jumps from 58 to 4.7 N m at the next value, so it is a stretch of its
+    own; Newton from its final state finds no stable period-1 orbit, and its Lyapunov run says
+    chaotic (a largest exponent of 300 1/s or more, beyond its spread); the damped stretch
+    above seeds the stable period-1 orbit at 0.07 (continued 2 points: max_points). The
+    Dataset holds the stretch (no_period_range, no_period_chaotic = 1) and the figure shades
+    it as chaotic."""
+    import matplotlib
+    matplotlib.use("Agg")
+    from pyspline.plots import frequency_response
+    case = pyspline.load_case(CASES / "chaos_z24.nml", lyapunov=False, t_transient=0.02,
+                              t_end=0.07, n_out=201)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds, sw = pyspline.branches(case, "zeta_m", 0.01, 0.1, points=4, max_n=1,
+                                   progress=False, max_points=2)
+    assert sw.period.sel(direction="up").values[0] == 0
+    assert ds.no_period_range.values.tolist() == [[0.01, 0.01]]
+    assert ds.no_period_chaotic.values.tolist() == [1]
+    lam, spread = map(float, re.fullmatch(r"up 0.01..0.01 \(chaotic: largest Lyapunov exponent "
+                                          r"(\S+) 1/s \(spread (\S+)\)\)",
+                                          ds.attrs["no_period"]).groups())
+    assert lam > 300 and spread < lam
+    assert ds.attrs["seeds"] == "0.07 up n=1" and (ds.n == 1).all() and ds.stable.all()
+    assert "max_points = 2 reached" in ds.attrs["status"]
+    ax = frequency_response(ds, sweep=sw).axes[0]
+    assert any(t.get_text().startswith("no periodic attractor: chaotic") for t in
+               ax.get_legend().get_texts())
+
+
 def test_unsettled_periodic_drive_is_not_chaos():
     """DOUBLING over 1646-1650 r/min, whose attractor is the stable period-2 orbit (its
     sections give period 2 after 40 revolutions, test_period_two_seed_from_the_sections),
@@ -99,7 +131,25 @@ def test_period_two_seed_from_the_sections(monkeypatch):
     assert (ds.speed_rpm >= 1646).all() and (ds.speed_rpm <= 1650).all(), ds.speed_rpm.values
 
 
-def test_branches_through_a_period_doubling():
+#: the doubling scene at rtol 1e-8 (the band's branches and the tests on them)
+DOUBLING8 = DOUBLING.replace(rtol=1e-8, atol=1e-10)
+
+
+@pytest.fixture(scope="module")
+def doubling_band():
+    """pyspline.branches of DOUBLING8 over 1617-1626 r/min (steps up to 0.5, follow sweeps of
+    runs of 20 revolutions at 3 speeds), once per process."""
+    T = 60 / 1650
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds, _ = pyspline.branches(DOUBLING8, "speed_rpm", 1617, 1626, points=3, max_n=2,
+                                  progress=False, ds_max=0.5, max_angle=0.3,
+                                  sweep_case=DOUBLING8.replace(t_end=20 * T, t_transient=10 * T,
+                                                               section="shaft"))
+    return ds
+
+
+def test_branches_through_a_period_doubling(doubling_band):
     """DOUBLING over 1617-1626 r/min (rtol 1e-8, steps up to 0.5): the follow sweeps' runs have
     not settled (no period), the seed in the middle is the stable period-1 orbit; its branch
     doubles (a multiplier at -1) and the doubled branch is followed over the whole band, not
@@ -108,14 +158,7 @@ def test_branches_through_a_period_doubling():
     period-2 orbits (P^2(y) = y, P(y) away from y); two branches, none past the band."""
     from pyspline.orbits import _period_map, map_and_monodromy
     from test_orbits import scale_of
-    case = DOUBLING.replace(rtol=1e-8, atol=1e-10)
-    T = 60 / 1650
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", pyspline.SplineWarning)
-        ds, _ = pyspline.branches(case, "speed_rpm", 1617, 1626, points=3, max_n=2,
-                                  progress=False, ds_max=0.5, max_angle=0.3,
-                                  sweep_case=case.replace(t_end=20 * T, t_transient=10 * T,
-                                                          section="shaft"))
+    case, ds = DOUBLING8, doubling_band
     assert ds.attrs["status"] == "complete" and ds.attrs["n_branches"] == 2
     p, b, n = ds.speed_rpm.values, ds.branch.values, ds.n.values
     assert ((p >= 1617) & (p <= 1626)).all()
@@ -136,6 +179,83 @@ def test_branches_through_a_period_doubling():
     y1 = _period_map(c.model, 0.0, 60 / 1626, y[:, None])[0][:, 0]
     assert np.abs((y2 - y)[free] / s[free]).max() < 1e-5
     assert np.abs((y1 - y)[free] / s[free]).max() > 0.1
+
+
+def _other_phase(ds, near):
+    """The doubled branch's (branch 1's) stable point nearest `near` r/min: (p, y, P(y), the
+    branch), P the map over one revolution."""
+    from pyspline.orbits import section_points
+    two = ds.isel(point=ds.branch.values == 1)
+    k = np.argmin(np.abs(two.speed_rpm.values - near) + 100 * ~two.stable.values.astype(bool))
+    p, y = float(two.speed_rpm[k]), two.y0.values[k]
+    y_a, y_b = section_points(DOUBLING8.replace(speed_rpm=p).model, 0.0, 2, y)
+    assert np.array_equal(y_a, y)
+    return p, y, y_b, two
+
+
+def test_period_two_seed_at_its_other_section_point(doubling_band):
+    """A period-2 orbit has two section points, y and P(y): at the doubled branch's stable
+    point nearest 1625 r/min, P(y) lies on the branch only through its section points (a seed
+    there is the same orbit: branches does not continue it; y alone is a scaled distance of
+    0.1 or more from it), and a copy of the whole doubled branch at its other section points
+    is merged into it (diagram._distinct with the branches' phases: one seed kept, two
+    without them). Tolerance: sqrt(tol), tol the corrector's 100 rtol (specials.same_point)."""
+    from pyspline.diagram import _concat, _distinct, _on_branch, _phases
+    from pyspline.orbits import section_points
+    from test_orbits import scale_of
+    s, tol = scale_of(DOUBLING8), 100 * DOUBLING8["rtol"]
+    p, y, y_b, two = _other_phase(doubling_band, 1625)
+    assert np.abs((y_b - y) / s).max() > 0.1
+    assert _on_branch(two, "speed_rpm", p, y, s, tol)
+    assert not _on_branch(two, "speed_rpm", p, y_b, s, tol)
+    at = section_points(DOUBLING8.replace(speed_rpm=p).model, 0.0, 2, y_b)
+    assert any(_on_branch(two, "speed_rpm", p, x, s, tol) for x in at)
+    copy = two.copy(deep=True)
+    copy["y0"] = (("point", "state"), _phases(DOUBLING8, "speed_rpm", two)[0])
+    both = _concat([two, copy])
+    assert list(_distinct(both, "speed_rpm", s, tol, lambda piece: _phases(
+        DOUBLING8, "speed_rpm", piece))[1]) == [0]
+    assert list(_distinct(both, "speed_rpm", s, tol)[1]) == [0, 1]
+
+
+def test_a_fold_located_twice_is_reported_once(doubling_band):
+    """The period-2 orbit at 1625 r/min continued down from its other section point P(y) (band
+    1615-1630): its branch runs stable down to the fold at 1618.409 r/min, back up unstable to
+    the doubling, through it onto the other section point's half of the same orbit, down to
+    the same fold again and back up: two turns at 1618.41, one fold reported (located twice,
+    1e-6 r/min apart, once at each section point: specials.once), its multiplier at +1."""
+    p, _, y_b, _ = _other_phase(doubling_band, 1625)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds = pyspline.continuation(DOUBLING8, "speed_rpm", p, 1615, n=2, guess=y_b,
+                                   band=(1615, 1630), progress=False, ds_max=0.5, max_angle=0.3)
+    assert ds.attrs["status"] == "complete"
+    q = ds.speed_rpm.values[ds.branch.values == 0]
+    turns = q[1:-1][(np.diff(q)[:-1] < 0) & (np.diff(q)[1:] > 0)]
+    assert len(turns) == 2 and np.abs(turns - 1618.41).max() < 0.05, turns
+    kind = ds.special_type.values
+    fold = np.flatnonzero(kind == "fold")
+    assert len(fold) == 1, ds.special_speed_rpm.values[fold]
+    assert ds.special_speed_rpm[fold[0]] == pytest.approx(1618.409, abs=1e-3)
+    assert abs(complex(ds.special_mu_real[fold[0]], ds.special_mu_imag[fold[0]]) - 1) < 1e-2
+
+
+def test_grazing_just_past_stop(doubling_band):
+    """The stable period-2 orbit near 1619.3 r/min continued up to 1620.085 r/min, its grazing
+    (1620.092, tests above) just past stop: the branch ends on stop, complete, with no grazing
+    reported and no point past stop. (The filter that drops diagnosed crossings past an end is
+    not reached here, nor by any run tried: the diagnosis bisects the step onto the end, so
+    its points lie within the band. Stops 0.01-0.06 r/min past the grazing fail: docs,
+    Limits.)"""
+    p, y, _, _ = _other_phase(doubling_band, 1619.3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds = pyspline.continuation(DOUBLING8, "speed_rpm", p, 1620.085, n=2, guess=y,
+                                   progress=False, ds_max=0.5, max_angle=0.3)
+    q = ds.speed_rpm.values
+    assert ds.attrs["status"] == "complete" and q[-1] == pytest.approx(1620.085, abs=1e-9)
+    assert (q <= 1620.085 + 1e-9).all() and ds.attrs["diagnosed_grazings"] == 0, q
+    assert "grazing" not in ds.special_type.values and (ds.switches == ds.switches[0]).all()
 
 
 def test_cli_all_and_fold_keep_what_they_have(tmp_path):
@@ -219,3 +339,36 @@ def test_realisations_transient_within_the_bound():
     assert "the run took longer than its wall-time bound" in str(sw.error.values[0])
     assert str(sw.error.values[1]) == "the wall-time bound of the test, max_seconds = 1 s, " \
         "was reached before this run"
+
+
+def test_cli_band(tmp_path):
+    """`pyspline continue --band LO HI` is continuation's band: from 1623 to 1626 r/min on the
+    doubling scene (the doubling at 1623.61) with --band 1621 1626 the doubled branch goes down
+    past --start to 1621 (without it, it stops at 1623); the command says so. A band that is
+    not two finite values LO < HI holding --start and --stop, or given with --all, is a
+    CaseError naming --band, exit 2, before anything runs."""
+    import xarray as xr
+    from test_continuation import cli
+    path = tmp_path / "doubling.nml"
+    path.write_text(DOUBLING.replace(rtol=1e-8, atol=1e-10, speed_rpm=1623.0, n_out=201,
+                                         t_end=0.2, t_transient=0.1).text())
+    args = ("continue", path, "--field", "speed_rpm", "--start", "1623", "--stop", "1626",
+            "--quiet")
+    for band, why in ((("1626", "1621"), "two finite values LO < HI"),
+                      (("1621", "1621"), "two finite values LO < HI"),
+                      (("nan", "1626"), "two finite values LO < HI"),
+                      (("1624", "1630"), "does not hold --start 1623"),
+                      (("1620", "1625"), "does not hold --stop 1626")):
+        run = cli(tmp_path, *args, "--band", *band, "--out", "bad")
+        assert run.returncode == 2 and f"--band {float(band[0]):g} {float(band[1]):g}: " \
+            f"{why}" in run.stderr, run.stderr
+    run = cli(tmp_path, *args, "--band", "1621", "1626", "--all", "--out", "bad")
+    assert run.returncode == 2 and "--band: " in run.stderr, run.stderr
+    assert not (tmp_path / "bad").exists()
+    run = cli(tmp_path, *args, "--band", "1621", "1626", "--out", "out")
+    assert run.returncode == 0, run.stderr
+    ds = xr.open_dataset(tmp_path / "out" / "continuation.nc", engine="h5netcdf")
+    p, b = ds.speed_rpm.values, ds.branch.values
+    assert "--band 1621 1626" in ds.attrs["command"]
+    assert (ds.n.values[b == 1] == 2).all() and p[b == 1].min() == pytest.approx(1621, abs=1e-9)
+    assert p[b == 0].min() == 1623 and p.max() == pytest.approx(1626, abs=1e-9)

@@ -134,5 +134,5 @@ def test_special_points_lie_on_their_branch(branch):
     ds, s = branch, scale_of(Z24)
     swing = np.ptp(ds.y0.values, axis=0)
     for p, y in zip(ds.special_speed_rpm.values, ds.special_y0.values):
-        assert _on_branch(ds, "speed_rpm", p, y, s), p
-        assert not _on_branch(ds, "speed_rpm", p, y + 0.05 * swing, s), p
+        assert _on_branch(ds, "speed_rpm", p, y, s, ds.attrs["tol"]), p
+        assert not _on_branch(ds, "speed_rpm", p, y + 0.05 * swing, s, ds.attrs["tol"]), p

@@ -252,6 +252,27 @@ def test_variational_run_is_bounded_by_max_total_steps(impacting):
         pyspline.orbits.map_and_monodromy(case, orbit.t0, orbit.t0 + orbit.period, orbit.y0)
 
 
+def test_variational_run_of_erk_is_cvode_adams(impacting):
+    """docs/orbits.md: with method = 'erk' the variational run (the exact monodromy) is CVODE's
+    Adams, not ERKStep: the exact map's end state and M are those of the same case with
+    method = 'adams', bit for bit, and its work bound names CVODE's steps; ERK's own period map
+    (the state run: dF/dp, the trajectories, monodromy = 'fd') ends elsewhere (by about rtol:
+    measured 7e-9 scaled at rtol 1e-7)."""
+    from pyspline.orbits import _period_map, _scale, map_and_monodromy
+    orbit, model = impacting
+    t0, t1 = orbit.t0, orbit.t0 + orbit.period
+    erk, adams = (model.case.replace(method=m) for m in ("erk", "adams"))
+    y1, M, free = map_and_monodromy(erk, t0, t1, orbit.y0)
+    ya, Ma, _ = map_and_monodromy(adams, t0, t1, orbit.y0)
+    assert np.array_equal(y1, ya) and np.array_equal(M, Ma)
+    ym = _period_map(erk.model, t0, t1, orbit.y0[:, None])[0][:, 0]
+    off = np.abs((ym - y1)[free] / _scale(erk.model)[free]).max()
+    assert 0 < off < 1e-7, off
+    with pytest.raises(pyspline.SolverError, match="variational run took max_total_steps = 200 "
+                       "CVODE steps"):
+        map_and_monodromy(erk.replace(max_total_steps=200), t0, t1, orbit.y0)
+
+
 def test_coupled_thermal_level_is_not_covered():
     case, y_eq, _, _ = linear_scene(2.0)
     with pytest.raises(pyspline.CaseError, match="thermal = 'coupled'.*variational equations.*fd"):
