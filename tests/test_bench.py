@@ -188,6 +188,19 @@ def test_race_candidate_is_the_loosest_rung_that_passes_twice():
     assert np.allclose(np.diff(rungs), -0.25)          # quarter decades, both sides alike
 
 
+def test_race_statistics_level_needs_the_spread_too():
+    """A rung at the statistics level has its means within 3 standard errors and its spread
+    within the F bound, and so has its next tighter rung: a noisy rung (z 1, spread 9x the
+    reference's against a bound of 6.4) is not taken, nor the rung above it."""
+    import race
+
+    def rec(rtol, z, spread):
+        return dict(side="pyspline", setting="ERK", atol_ratio=1e-2, rtol=rtol, z_max=z,
+                    spread=spread, spread_bound=6.4)
+    recs = [rec(3e-2, 1.0, 2.0), rec(1e-2, 1.0, 9.0), rec(3e-3, 1.0, 1.5), rec(1e-3, 0.5, 1.0)]
+    assert [r["rtol"] for r in race._robust(recs)] == [3e-3]
+
+
 def test_race_quick_times_the_peer_with_its_forces(tmp_path):
     """A quick race of the paper scene: both sides reach each accuracy with a candidate timed
     in every round, the peer's error from its own forces, and the ratio is of their medians."""

@@ -48,7 +48,6 @@ module spline_integrator
   public :: integrator_t, lib_log_t, integrator_open, cvode_create, erk_create, integrator_advance, &
        integrator_root_info, integrator_root_directions, integrator_land_on_root, &
        integrator_restart, integrator_steps_done, integrator_last_step, integrator_fail_text, &
-       integrator_tolerances, &
        integrator_warnings, add_counters, integrator_free
 
   !> SUNDIALS' own messages of a run (lib_handler), kept instead of printed: the last error's
@@ -74,9 +73,6 @@ module spline_integrator
     type(SUNNonlinearSolver), pointer :: nls => null()
     !> ERKStep: the step that crossed the last located switch, to restart with after it
     real(c_double) :: h_cross = 0.0_c_double
-    !> ERKStep's table set to Dormand-Prince's by integrator_tolerances (its 7 stage vectors,
-    !> freed as 7 whatever the table at the end)
-    logical :: dormand_prince = .false.
     !> the run in messages: 'the run' (spline_solver) or 'the variational run'
     character(len=24) :: run = 'the run'
     integer(8) :: max_steps = 0, max_total_steps = 0   !< the case's work bounds
@@ -480,26 +476,6 @@ contains
     if (flag == 0) flag = FCVodeReInit(mem, tau, sv)
   end function cvode_restart
 
-  !> New tolerances from the next step on (the step size and the integrator's history kept);
-  !> ERKStep also takes Cash-Karp's table (cash_karp) or Dormand-Prince's. Only from
-  !> Dormand-Prince to Cash-Karp or to itself: both are of order 5(4) (the step controller's
-  !> orders stay), Cash-Karp's 6 stages fit the 7 vectors ERKStep allocated for Dormand-Prince's
-  !> at its first step, and its first stage is f at the step's start either way (Dormand-Prince's
-  !> last stage, or evaluated anew); the other way a stage vector would be missing.
-  integer(c_int) function integrator_tolerances(cv, rtol, atol, cash_karp) result(flag)
-    type(integrator_t), intent(inout) :: cv
-    real(wp), intent(in) :: rtol, atol
-    logical, intent(in) :: cash_karp
-    if (cv%erk) then
-      flag = FERKStepSStolerances(cv%mem, real(rtol, c_double), real(atol, c_double))
-      if (flag == 0) flag = FERKStepSetTableNum(cv%mem, merge(ARKODE_CASH_KARP_6_4_5, &
-           ARKODE_DORMAND_PRINCE_7_4_5, cash_karp))
-      cv%dormand_prince = cv%dormand_prince .or. .not. cash_karp
-    else
-      flag = FCVodeSStolerances(cv%mem, real(rtol, c_double), real(atol, c_double))
-    end if
-  end function integrator_tolerances
-
   integer(c_int) function integrator_last_step(cv, h) result(flag)
     type(integrator_t), intent(inout) :: cv
     real(c_double), intent(out) :: h(1)
@@ -660,9 +636,6 @@ contains
     integer(c_int) :: flag
     if (c_associated(cv%mem)) then
       if (cv%erk) then
-        ! ERKStepFree frees as many stage vectors as the table has: Dormand-Prince's 7 if it
-        ! ever ran (integrator_tolerances switches from it to Cash-Karp's 6)
-        if (cv%dormand_prince) flag = FERKStepSetTableNum(cv%mem, ARKODE_DORMAND_PRINCE_7_4_5)
         call FERKStepFree(cv%mem)
       else
         call FCVodeFree(cv%mem)

@@ -58,7 +58,6 @@ contains
     mt = m
     mt%n_out = 1; mt%t_end = m%t0 + m%t_transient; mt%t_transient = 0.0_wp
     mt%section = 0; mt%realisations = 1
-    mt%rtol = m%rtol_transient; mt%atol = m%atol_transient; mt%cash_karp = .false.
     if (m%t_transient > 0.0_wp) then
       call run_case(mt, t, y, tooth, tm, st, ierr, errmsg, interruptible)
       ya = y(:, 1)

@@ -21,8 +21,7 @@ module spline_solver
   use spline_integrator, only: integrator_t, lib_log_t, integrator_open, cvode_create, &
        erk_create, integrator_advance, integrator_root_info, integrator_root_directions, &
        integrator_land_on_root, integrator_restart, integrator_steps_done, integrator_last_step, &
-       integrator_fail_text, integrator_warnings, add_counters, integrator_free, &
-       integrator_tolerances
+       integrator_fail_text, integrator_warnings, add_counters, integrator_free
   use spline_quantities, only: nstats => nsolver_stats, ist_roots_found, &
        ist_last_step, ist_mode_resyncs, ist_coupling_residual, ist_coupling_iterations, &
        ist_linear_tail_t
@@ -102,7 +101,6 @@ contains
     integer, allocatable :: dirs(:), dirs_set(:)   !< root directions wanted, and set in CVODE
     integer :: ks, nsec             !< next section to store; sections
     logical :: use_tail, fresh      !< the linear tail is tried; CVODE has just (re)started
-    logical :: loose                !< the transient runs at its own tolerances (m%rtol_transient)
     character(len=40) :: stage
     type(tail_t) :: tail
 
@@ -117,26 +115,11 @@ contains
            c_loc(ctx), cv, flag, stage)
     end if
     call schedule_tail_checks()
-    ! the transient, up to the first output (the window's start), at its own tolerances, ERKStep
-    ! on Dormand-Prince's table: Cash-Karp's (goal = 'statistics''s window) failed at the
-    ! transient's rtol 1e-1 on a soft-mesh drive (the step at its floor, docs/accuracy.md)
-    loose = m%t_transient > 0.0_wp .and. nt > 1 .and. m%rtol_transient /= m%rtol
-    if (flag == 0 .and. loose) then
-      flag = integrator_tolerances(cv, m%rtol_transient, m%atol_transient, .false.)
-      stage = 'setting the tolerances'
-    end if
     if (flag /= 0) then
       call fail(flag, tau, trim(stage))
     else if (.not. take_linear_tail(0)) then
       outputs: do k = 1, nt
         if (.not. integrate_to_output(k)) exit outputs
-        if (k == 1 .and. loose) then
-          flag = integrator_tolerances(cv, m%rtol, m%atol, m%cash_karp)
-          if (flag /= 0) then
-            call fail(flag, tau, 'setting the tolerances')
-            exit outputs
-          end if
-        end if
         if (.not. store_output(k)) exit outputs
         if (k < nt) then
           if (take_linear_tail(k)) exit outputs

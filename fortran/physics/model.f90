@@ -12,7 +12,7 @@ module spline_model
   use spline_geometry, only: iso4156_radii, pitch_rotation
   use spline_stiffness, only: spline_mesh_stiffness_fillet
   use spline_thermal, only: backlash_coefficient, thermal_backlash
-  use spline_accuracy, only: accuracy_settings, stats_transient_rtol
+  use spline_accuracy, only: accuracy_settings
   implicit none
   private
   public :: model_t, model_from_case, set_thermal_level, model_magic, model_warnings
@@ -58,16 +58,13 @@ module spline_model
     real(wp) :: t_bulk, f_m, u_flash, eta_hertz
     integer  :: method_bdf = 1              !< 1 = BDF, 0 = Adams (CVODE)
     logical  :: erk = .false.               !< ARKODE ERKStep instead of CVODE (spline_integrator)
-    !> ERKStep's table: Cash-Karp, else Dormand-Prince (a loose transient: Dormand-Prince)
+    !> ERKStep's table: Cash-Karp, else Dormand-Prince
     logical  :: cash_karp = .false.
     logical  :: newton = .true.             !< Newton + dense solver, else fixed-point iteration
     logical  :: roots = .false.
     logical  :: stald = .false.
     logical  :: linear_tail = .true.        !< closed-form tail in proven full contact (spline_linear)
     real(wp) :: rtol, atol
-    !> the tolerances of the transient (t0 .. t0 + t_transient) when they differ (goal =
-    !> 'statistics': spline_accuracy::stats_transient_rtol), else rtol and atol
-    real(wp) :: rtol_transient, atol_transient
     !> the case's accuracy target (0: none), an error estimate asked for (accuracy or check),
     !> goal = 'statistics' (spline_accuracy)
     real(wp) :: accuracy = 0.0_wp
@@ -166,10 +163,6 @@ contains
     call accuracy_settings(c, k, m%roots, m%rtol, m%atol)
     m%accuracy = c%accuracy; m%goal_statistics = option_index(goal_values, c%goal) == 2
     m%estimate = (c%accuracy > 0.0_wp .or. c%check) .and. .not. m%goal_statistics
-    m%rtol_transient = m%rtol; m%atol_transient = m%atol
-    if (m%goal_statistics) then
-      m%rtol_transient = stats_transient_rtol; m%atol_transient = 1.0e-2_wp*stats_transient_rtol
-    end if
     m%method_bdf = merge(1, 0, k == 1)
     m%erk = k == 3
     m%cash_karp = m%goal_statistics .or. option_index(erk_table_values, c%erk_table) == 2
