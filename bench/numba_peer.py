@@ -603,8 +603,8 @@ class Setup:
         if method not in self._runs:
             self._runs[method] = _specialised(self.data, method)
         tm, F, ok = self._runs[method][1](np.asarray(y0, float) / self.scale,
-                                          np.asarray(t_eval, float) * self.w, float(rtol),
-                                          float(atol), int(mxstep))
+                                          np.asarray(t_eval, float) * self.w, self.data,
+                                          float(rtol), float(atol), int(mxstep))
         return tm, F, bool(ok)
 
 
@@ -612,7 +612,7 @@ def _specialised(data, method):
     """(cfunc, run) of one case: the fast RHS with the case's `data` frozen into the machine code
     (numba compiles a closure's array as a constant: Z, the coefficients and c_j, s_j, e_j become
     immediates, the tooth loop is unrolled; 48.5 ns a call against 60 ns reading `data` at run
-    time, paper_lx1e-4), and run(u0, tau, rtol, atol, mxstep) -> (T_m, F, ok), numbalsoda's solver
+    time, paper_lx1e-4), and run(u0, tau, data, rtol, atol, mxstep) -> (T_m, F, ok) (data unused), numbalsoda's solver
     and the forces in one compiled call (no Python between them). Compiled per case and method
     (about 1 s; not cached: the closure holds the cfunc's address)."""
     dc = data.copy()
@@ -623,10 +623,9 @@ def _specialised(data, method):
         _rhs_fast(tau, u, du, dc)
     addr = rhs.address
     drive = _driver(method)
-    unused = np.zeros(1)
 
     @nb.njit
-    def run(u0, tau, rtol, atol, mxstep):
+    def run(u0, tau, unused, rtol, atol, mxstep):
         u, ok = drive(addr, u0, tau, unused, rtol, atol, mxstep)
         tm, F = _forces(dc, tau, u)
         return tm, F, ok
