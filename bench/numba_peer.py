@@ -36,7 +36,9 @@ atol*l [m] on lengths and atol*l*w [m/s] on velocities.
 Public names:
   Setup(params, scaled=True, kind=None)      a case packed once: .integrate(y0, t_eval, rtol,
                                              atol, method, mxstep) -> (u scaled, ok);
-                                             .forces(t_eval, u) -> (T_m, F) in SI (the race)
+                                             .forces(t_eval, u) -> (T_m, F) in SI;
+                                             .run(...) -> (T_m, F, ok) on the case's frozen
+                                             RHS (the race)
   make_rhs(params, scaled=True, kind=None) -> (cfunc, data)   numbalsoda-compatible RHS, data
   solve(params, y0, t_eval, rtol=1e-8, atol=1e-10, mxstep=1_000_000, scaled=True,
         method='lsoda', kind=None)   -> (y, success, n_rhs)   y in SI, shape (len(t_eval), 14)
@@ -440,12 +442,12 @@ def _rhs_fast(tau, u, du, d):
 
 
 def _rhs_fast_counted(tau, u, du, d):
-    """The fast RHS counting its calls in d[0] (make_rhs's cfunc; Setup.run's RHS does not count)."""
+    """The fast RHS counting its calls in d[0] (make_rhs's cfunc; _frozen's does not count)."""
     d[_FN] += 1.0
     _rhs_fast(tau, u, du, d)
 
 
-@nb.njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+@nb.njit(cache=True, fastmath=True, error_model="numpy")
 def _forces(d, tau, u):
     """T_m and F_j (SI) at the outputs from the scaled states u (n, 14): the only outputs the race
     compares, formed as the RHS forms them (branch-free and fastmath: 3x faster than with
@@ -576,17 +578,22 @@ class Setup:
         self.kind = "fast" if self.data.shape[0] == _NF + 3 * p.z else "general"
         self.l, self.w = _refs(p, scaled)
         self.scale = np.r_[np.full(7, self.l), np.full(7, self.l * self.w)]
-        self._runs = {}
+        self._frozen = None
 
-    def integrate(self, y0, t_eval, rtol, atol, method="dop853", mxstep=1_000_000):
-        """Scaled states at t_eval (tau = w t_eval) from y0 (SI): (u, success)."""
+    def integrate(self, y0, t_eval, rtol, atol, method="dop853", mxstep=1_000_000, frozen=False):
+        """Scaled states at t_eval (tau = w t_eval) from y0 (SI): (u, success). frozen: on the
+        case's frozen RHS (_frozen; the fast kind only; it does not count calls in data[0])."""
         if method not in ("lsoda", "dop853"):
             raise ValueError(f"method {method!r}: 'lsoda' or 'dop853'")
+        if frozen and self._frozen is None:
+            if self.kind != "fast":
+                raise ValueError("the frozen RHS is the fast one (not the coupled level)")
+            self._frozen = _frozen(self.data)
         self.data[0] = 0.0
-        u, ok = _driver(method)(self.fn.address, np.asarray(y0, float) / self.scale,
-                                            np.asarray(t_eval, float) * self.w, data=self.data,
-                                            rtol=float(rtol), atol=float(atol),
-                                            mxstep=int(mxstep))
+        u, ok = _driver(method)((self._frozen if frozen else self.fn).address,
+                                np.asarray(y0, float) / self.scale,
+                                np.asarray(t_eval, float) * self.w, data=self.data,
+                                rtol=float(rtol), atol=float(atol), mxstep=int(mxstep))
         if self.kind == "general" and self.data[_ERR] != 0.0:
             raise ValueError("thermal interference: backlash c_j <= 0 (Eq. 2) during the solve")
         return u, bool(ok)
@@ -596,40 +603,25 @@ class Setup:
         return _forces(self.data, np.asarray(t_eval, float) * self.w, u)
 
     def run(self, y0, t_eval, rtol, atol, method="dop853", mxstep=1_000_000):
-        """(T_m, F, success) at t_eval from y0 (SI), as integrate then forces, in one compiled
-        call on this case's specialised RHS (_specialised; the fast kind only; no call count)."""
-        if self.kind != "fast":
-            raise ValueError("Setup.run needs the fast RHS (not the coupled level)")
-        if method not in self._runs:
-            self._runs[method] = _specialised(self.data, method)
-        tm, F, ok = self._runs[method][1](np.asarray(y0, float) / self.scale,
-                                          np.asarray(t_eval, float) * self.w, self.data,
-                                          float(rtol), float(atol), int(mxstep))
-        return tm, F, bool(ok)
+        """(T_m, F, success) at t_eval from y0 (SI): the race's peer, integrate on the frozen RHS
+        then forces."""
+        u, ok = self.integrate(y0, t_eval, rtol, atol, method, mxstep, frozen=True)
+        return (*self.forces(t_eval, u), ok)
 
 
-def _specialised(data, method):
-    """(cfunc, run) of one case: the fast RHS with the case's `data` frozen into the machine code
-    (numba compiles a closure's array as a constant: Z, the coefficients and c_j, s_j, e_j become
-    immediates, the tooth loop is unrolled; 48.5 ns a call against 60 ns reading `data` at run
-    time, paper_lx1e-4), and run(u0, tau, data, rtol, atol, mxstep) -> (T_m, F, ok) (data unused), numbalsoda's solver
-    and the forces in one compiled call (no Python between them). Compiled per case and method
-    (about 1 s; not cached: the closure holds the cfunc's address)."""
+def _frozen(data):
+    """The fast RHS of one case with its `data` frozen into the machine code: numba compiles a
+    closure's array as a constant, so Z, the coefficients and c_j, s_j, e_j become immediates and
+    the tooth loop unrolls. 48.5 against 60 ns a call in a loop (paper_lx1e-4); in DOP853 runs,
+    CPU medians against make_rhs's cfunc (which also counts calls): paper_lx1e-4 10.07 against
+    10.75 ms, physical_z24 46.6 against 50.3 ms. Compiled once per case (0.85 s) into numba's
+    cache, keyed by the values of `data`."""
     dc = data.copy()
     dc[_FN] = 0.0
 
-    @cfunc(lsoda_sig, nopython=True, error_model="numpy", fastmath=True)
     def rhs(tau, u, du, _):
         _rhs_fast(tau, u, du, dc)
-    addr = rhs.address
-    drive = _driver(method)
-
-    @nb.njit
-    def run(u0, tau, unused, rtol, atol, mxstep):
-        u, ok = drive(addr, u0, tau, unused, rtol, atol, mxstep)
-        tm, F = _forces(dc, tau, u)
-        return tm, F, ok
-    return rhs, run
+    return cfunc(lsoda_sig, nopython=True, error_model="numpy", fastmath=True, cache=True)(rhs)
 
 
 def rhs_eval(params, t, y, scaled=False, kind=None):

@@ -19,9 +19,9 @@ is not taken). The candidates alone are then timed, `repeat` rounds, each round 
 once in a rotated order: CPU-time medians (process_time; both sides run on one thread, and CPU
 time is what a loaded machine leaves intact) with their min-max, and wall-clock medians. The
 peer's clock covers numbalsoda's solve and the forming of T_m and F at the outputs (the only
-outputs the race compares; pyspline's clock covers simulate, which forms every output), one
-compiled call on the scene's specialised RHS (numba_peer.Setup.run); the peer's case packing
-(0.2 ms) and compilation are before the clock. The ratio of a row is the
+outputs the race compares; pyspline's clock covers simulate, which forms every output), on the
+scene's frozen RHS (numba_peer.Setup.run); the peer's case packing (0.2 ms) and compilation are
+before the clock. The ratio of a row is the
 peer's fastest over pyspline's fastest, and the min-median-max of the per-round ratios of the
 two.
 

@@ -145,16 +145,16 @@ def test_peer_agrees_with_scipy_lsoda_on_oracle(name, method):
 
 
 def test_race_run_matches_oracle():
-    """The race's peer (Setup.run: the case's data frozen into the RHS's machine code, DOP853
-    and the forces in one compiled call): its RHS equals oracle.rhs in the scaled units of Eq. 25
-    on both sides of the dead zone, and its T_m and F equal scipy's LSODA on the oracle's."""
+    """The race's peer (Setup.run: DOP853 on the case's frozen RHS, numba_peer._frozen, then
+    the forces): its RHS equals oracle.rhs in the scaled units of Eq. 25 on both sides of the
+    dead zone, and its T_m and F equal scipy's LSODA on the oracle's."""
     case, p, ref, tmr = scipy_reference("spacing")     # misaligned, with spacing errors
     s = numba_peer.Setup(case)
     tm, F, ok = s.run(Y0, T_EVAL, RTOL, ATOL, "dop853", 10**7)
     Fr = np.array([oracle.mesh(t, yy, p)["F"] for t, yy in zip(T_EVAL, ref.y.T)])
     assert ok and np.abs(F - Fr).max() < 1e-6 * np.abs(Fr).max()
     assert np.abs(tm - tmr).max() < 1e-6 * np.abs(tmr).max()
-    fn = s._runs["dop853"][0]                           # the cfunc that solve called
+    fn = s._frozen                                      # the cfunc that solve called
     P = ctypes.POINTER(ctypes.c_double)
     rng = np.random.default_rng(7)
     n_contact = 0
