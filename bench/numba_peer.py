@@ -611,8 +611,8 @@ class Setup:
 
 def _frozen(data):
     """The fast RHS of one case with its `data` frozen into the machine code: numba compiles a
-    closure's array as a constant, so Z, the coefficients and c_j, s_j, e_j become immediates and
-    the tooth loop unrolls. 48.5 against 60 ns a call in a loop (paper_lx1e-4); in DOP853 runs,
+    closure's array as a constant, so Z, the coefficients and c_j, s_j, e_j are constants the
+    compiler folds. 48.5 against 60 ns a call in a loop (paper_lx1e-4); in DOP853 runs,
     CPU medians against make_rhs's cfunc (which also counts calls): paper_lx1e-4 10.07 against
     10.75 ms, physical_z24 46.6 against 50.3 ms. Compiled once per case (0.85 s) into numba's
     cache, keyed by the values of `data`."""
