@@ -19,8 +19,9 @@ is not taken). The candidates alone are then timed, `repeat` rounds, each round 
 once in a rotated order: CPU-time medians (process_time; both sides run on one thread, and CPU
 time is what a loaded machine leaves intact) with their min-max, and wall-clock medians. The
 peer's clock covers numbalsoda's solve and the forming of T_m and F at the outputs (the only
-outputs the race compares; pyspline's clock covers simulate, which forms every output); the
-peer's case packing (0.2 ms) and compilation are before the clock. The ratio of a row is the
+outputs the race compares; pyspline's clock covers simulate, which forms every output), on the
+scene's frozen RHS (numba_peer.Setup.run); the peer's case packing (0.2 ms) and compilation are
+before the clock. The ratio of a row is the
 peer's fastest over pyspline's fastest, and the min-median-max of the per-round ratios of the
 two.
 
@@ -158,9 +159,9 @@ class _Runner:
         n = len(t) - (len(self.t_peer) - len(self.t_out))
         mx = 10**9 if kw["method"] == "dop853" else 10**7   # DOP853: steps of the whole run
         c0, w0 = time.process_time(), time.perf_counter()
-        u, ok = self.setup.integrate(self.y0s[k], t, rtol, atol, kw["method"], mx)
-        tm, F = self.setup.forces(t[-n:], u[-n:])
+        tm, F, ok = self.setup.run(self.y0s[k], t, rtol, atol, kw["method"], mx)
         cpu, wall = time.process_time() - c0, time.perf_counter() - w0
+        tm, F = tm[-n:], F[-n:]
         if not ok:
             raise RuntimeError(f"peer {kw['method']} failed at rtol {rtol:g}")
         return cpu, wall, tm, F, self.t_out

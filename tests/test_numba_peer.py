@@ -2,6 +2,7 @@
 (tests/oracle.py): both compiled RHS (the fast one and the general one) equal oracle.rhs to 1e-12
 relative, the forces the race times equal oracle.mesh's, and short numbalsoda LSODA and DOP853
 solves agree with scipy's LSODA on the oracle RHS. Does not import pyspline."""
+import ctypes
 import functools
 import importlib.util
 import sys
@@ -141,3 +142,27 @@ def test_peer_agrees_with_scipy_lsoda_on_oracle(name, method):
     # tooth load: T_m agrees too
     tm = np.array([oracle.mesh(t, yy, p)["Tm"] for t, yy in zip(T_EVAL, y)])
     assert np.abs(tm - tmr).max() < 1e-6 * np.abs(tmr).max()
+
+
+def test_race_run_matches_oracle():
+    """The race's peer (Setup.run: DOP853 on the case's frozen RHS, numba_peer._frozen, then
+    the forces): its RHS equals oracle.rhs in the scaled units of Eq. 25 on both sides of the
+    dead zone, and its T_m and F equal scipy's LSODA on the oracle's."""
+    case, p, ref, tmr = scipy_reference("spacing")     # misaligned, with spacing errors
+    s = numba_peer.Setup(case)
+    tm, F, ok = s.run(Y0, T_EVAL, RTOL, ATOL, "dop853", 10**7)
+    Fr = np.array([oracle.mesh(t, yy, p)["F"] for t, yy in zip(T_EVAL, ref.y.T)])
+    assert ok and np.abs(F - Fr).max() < 1e-6 * np.abs(Fr).max()
+    assert np.abs(tm - tmr).max() < 1e-6 * np.abs(tmr).max()
+    fn = s._frozen                                      # the cfunc that solve called
+    P = ctypes.POINTER(ctypes.c_double)
+    rng = np.random.default_rng(7)
+    n_contact = 0
+    for y in random_states(case["c0"], 60, rng):
+        t = rng.uniform(0, 0.05)
+        u, du = y / s.scale, np.zeros(14)
+        fn.ctypes(t * s.w, u.ctypes.data_as(P), du.ctypes.data_as(P), None)
+        fo = oracle.rhs(t, y, p)
+        np.testing.assert_allclose(du * s.scale * s.w, fo, rtol=1e-12, atol=1e-12 * np.abs(fo).max())
+        n_contact += np.count_nonzero(oracle.mesh(t, y, p)["F"])
+    assert 20 < n_contact < 60 * p.z - 20
