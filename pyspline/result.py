@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import contextlib
+import contextvars
 import functools
 import os
 import time
@@ -69,12 +70,35 @@ def sundials_said(what: str):
                       SplineWarning, stacklevel=3)
 
 
+#: the list the core's warnings go to instead of SplineWarning while `collected` runs (per
+#: thread and task: a sweep point's, on any executor)
+_COLLECT = contextvars.ContextVar("pyspline_collect", default=None)
+
+
+@contextlib.contextmanager
+def collected():
+    """The core's warnings of the runs and model builds inside (in this thread), kept in the
+    list it yields (one line each) instead of raised: a sweep point's (pyspline.warned)."""
+    lines: list = []
+    token = _COLLECT.set(lines)
+    try:
+        yield lines
+    finally:
+        _COLLECT.reset(token)
+
+
 def _warn(text, stacklevel: int = 3) -> None:
     """The core's warnings (one per line, the words spline-dyn prints) as SplineWarning,
-    attributed to the frame `stacklevel` up (3: the caller of _warn's caller)."""
+    attributed to the frame `stacklevel` up (3: the caller of _warn's caller); inside
+    `collected`, into its list."""
     text = decode(text)
+    into = _COLLECT.get()
     for line in text.splitlines() if text else ():
-        if line.strip():
+        if not line.strip():
+            continue
+        if into is not None:
+            into.append(line.strip())
+        else:
             warnings.warn(line.strip(), SplineWarning, stacklevel=stacklevel)
 
 

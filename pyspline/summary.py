@@ -32,7 +32,7 @@ def _template(options: dict, stat_names: Sequence[str]) -> dict:
     s.update({k: nan for k in stat_names})
     if options.get("orders") is not None:
         s["Tm_spectrum"] = np.full(len(options["orders"]), nan)
-    s.update(error="", error_class="")
+    s.update(error="", error_class="", warnings="")
     return s
 
 
