@@ -72,10 +72,11 @@ def run_chain(cases: list, options: dict) -> list:
                     out[-1]["final"] = (res.y[-1].copy(), float(res.t[-1]))
                 prev = (res.y[-1].copy(), float(res.t[-1]), run.model.info()["omega"])
             except Exception as exc:        # noqa: BLE001 -- a failed point is a result
-                out.append(failed_summary(exc, options))
+                out.append(dict(failed_summary(exc, options), warnings="\n".join(said)))
                 prev = None
         # the start 'rest' overlap note says nothing here (a chain starts where it was)
-        out[-1]["warnings"] = "\n".join(w for w in said if "start = 'rest' with" not in w)
+        out[-1]["warnings"] = "\n".join(w for w in out[-1]["warnings"].splitlines()
+                                        if "start = 'rest' with" not in w)
     return out
 
 

@@ -129,6 +129,7 @@ def summarise(res, options: dict) -> dict:
             s[k] = float(res.stats[k])
     if options.get("orders") is not None:
         s["Tm_spectrum"] = _binned_spectrum(res.t, res.Tm, case["speed_rpm"], options["orders"])
+    s["warnings"] = "\n".join(res.warnings)
     return s
 
 

@@ -227,11 +227,9 @@ def run_point(case: Case, options: dict) -> dict:
     from .result import SerialExecutor, collected
     with collected() as said:             # the point's warnings: in its summary, not raised
         try:
-            s = summarise(simulate(case, SerialExecutor()), options)
+            return summarise(simulate(case, SerialExecutor()), options)
         except Exception as exc:          # noqa: BLE001 -- a failed point is a result
-            s = failed_summary(exc, options)
-    s["warnings"] = "\n".join(said)
-    return s
+            return dict(failed_summary(exc, options), warnings="\n".join(said))
 
 
 class PointSummaries:
