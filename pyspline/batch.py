@@ -128,6 +128,7 @@ def read_summary(path) -> dict:
 def summary_point(summary: dict, options: dict) -> dict:
     """The sweep point (the keys of `summarise`, without the spectrum) of a read summary."""
     s = _template(options, _stat_names())
+    s["warnings"] = summary.get("warnings") or ""
     if summary["error"]:
         s.update(error=summary["error"], error_class=summary["error_class"])
         return s
@@ -189,12 +190,12 @@ def merge(summaries, out=None, fields=None, command=None, mixed=False):
     paths = [Path(p) for p in summaries]
     if not paths:
         raise CaseError("merge needs at least one summary file")
-    read, said = [], []
+    read = []
     for p in paths:
         with collected() as lines:       # the point's warnings, said once below: the summary's
-            read.append(read_summary(p))  # (an older one's: its case's)
-        said.append(read[-1]["warnings"] if read[-1]["warnings"] is not None else
-                    "\n".join(lines))
+            read.append(read_summary(p))
+        if read[-1]["warnings"] is None:  # an older summary's: its case's
+            read[-1]["warnings"] = "\n".join(lines)
     cases = [r["case"] for r in read]
     have = [c for c in cases if c is not None]
     names = sorted({c.name for c in have})
@@ -246,9 +247,8 @@ def merge(summaries, out=None, fields=None, command=None, mixed=False):
     keys = list(_template(options, _stat_names()))
     points = {}
     with collected():                   # kept above
-        for i, r, text in zip(index_of, read, said):
+        for i, r in zip(index_of, read):
             points[i] = summary_point(r, options)
-            points[i]["warnings"] = text
     hashes = dict(zip(index_of, hashes_of))
     attrs = dict(case=(have[0].text() if have else ""), pyspline_version=_version(),
                  command=command or f"pyspline.merge([{len(paths)} spline-dyn summaries])",

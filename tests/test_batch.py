@@ -142,7 +142,7 @@ def test_summary_is_the_sweep_point_of_shipped_cases(tmp_path, exe, name):
     assert set(swept) == set(merged) and np.isfinite(swept["period_residual"])
     for k, x in swept.items():
         if isinstance(x, str):
-            assert x == merged[k] == "", k
+            assert x == merged[k] and (x == "" or k == "warnings"), k
         elif k not in TIMINGS:
             assert np.array_equal(x, merged[k], equal_nan=True), (k, x, merged[k])
 
