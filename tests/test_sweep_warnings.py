@@ -77,3 +77,15 @@ def test_cli_stderr_has_one_line_per_kind_not_per_point(base, tmp_path, capfd):
     assert err.count("[3 of 3 points; l_x = 0.00025 to 0.00035") == 2
     ds = pyspline.open_sweep(tmp_path / "out")
     assert all(len(str(t).splitlines()) == 2 for t in ds["warnings"].values.ravel())
+
+
+def test_follow_sweep_says_each_kind_once_without_the_chains_start_note(base):
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        ds = pyspline.sweep(base.replace(k_t1=5.0), progress=False, follow="up",
+                            l_x=[2.5e-4, 3e-4, 3.5e-4])
+    said = [str(w.message) for w in rec if issubclass(w.category, pyspline.SplineWarning)]
+    assert (ds["error"] == "").all() and len(said) == 1 and "winds its shaft" in said[0], said
+    assert "[3 of 3 points; l_x = 0.00025 to 0.00035]" in said[0]
+    assert all(str(t).count("\n") == 0 and "winds its shaft" in str(t)
+               for t in ds["warnings"].values)
