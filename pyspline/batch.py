@@ -19,17 +19,18 @@ from __future__ import annotations
 import datetime
 import hashlib
 import re
-import warnings
 from pathlib import Path
 
 import numpy as np
 
 from .case import case_from_text, defaults
 from .dataset import MERGED, build_dataset, write_netcdf
-from .errors import BY_NAME, CaseError, SplineError, SplineWarning
+from .errors import BY_NAME, CaseError, SplineError
+from .result import collected
 from .summary import (SWEEP_EXTREMES, SWEEP_LOADS, _stat_names, _template, _version, lyapunov_summary,
                       section_summary)
 from .sweeps import point_hash
+from .warned import warn_grouped
 
 __all__ = ["merge", "read_summary", "summary_point"]
 
@@ -66,8 +67,9 @@ def read_summary(path) -> dict:
     """A summary file of spline-dyn: {'values': {name: float array}, 'units': {name: unit},
     'case': the Case of the run (its namelist read in memory by the core's reader; None if a
     failed run wrote none), 'case_file', 'sets' (its --set options), 'error' ('' if the run
-    finished), 'error_class' ('' or the exception class name), 'path'}. Every error names
-    the file."""
+    finished), 'error_class' ('' or the exception class name), 'warnings' (the lines spline-dyn
+    printed; None from a summary of a version that did not keep them), 'path'}. Every error
+    names the file."""
     path = Path(path)
     try:
         lines = path.read_text(encoding="utf-8").splitlines()
@@ -119,13 +121,14 @@ def read_summary(path) -> dict:
     if not error:
         _check_values(path, values, case["z"])
     return dict(values=values, units=units, case=case, case_file=text.get("case_file", ""),
-                sets=sets, error=error, path=path,
+                sets=sets, error=error, path=path, warnings=text.get("warnings"),
                 error_class=BY_NAME[kind].__name__ if kind else "")
 
 
 def summary_point(summary: dict, options: dict) -> dict:
     """The sweep point (the keys of `summarise`, without the spectrum) of a read summary."""
     s = _template(options, _stat_names())
+    s["warnings"] = summary.get("warnings") or ""
     if summary["error"]:
         s.update(error=summary["error"], error_class=summary["error_class"])
         return s
@@ -166,17 +169,6 @@ def _column(values: list) -> np.ndarray:
     return np.array(["" if v is None else str(v) for v in values])
 
 
-def _recorded_once(caught: list, n: int) -> None:
-    """The warnings caught over n summaries, each distinct one once, with its count."""
-    counts: dict = {}
-    for w in caught:
-        key = (str(w.message), w.category)
-        counts[key] = counts.get(key, 0) + 1
-    for (msg, category), k in counts.items():
-        warnings.warn(category(f"{msg} ({k} of {n} summaries)" if n > 1 else msg),
-                      stacklevel=3)
-
-
 def merge(summaries, out=None, fields=None, command=None, mixed=False):
     """The sweep dataset of spline-dyn summary files (paths; `pyspline merge`), the same Dataset
     `pyspline.sweep` builds for the same points, without the spectrum of T_m.
@@ -192,18 +184,18 @@ def merge(summaries, out=None, fields=None, command=None, mixed=False):
     file or a --set was refused) has no coordinates: the merge is then along 'point', its
     coordinates NaN (''). The same point twice (by point hash) is refused. The points'
     section and lyapunov must be the same in all summaries. The variable 'summary' names each
-    point's file. A plausibility warning of the cases is given once, with its count.
+    point's file. Each point's 'warnings' are those its run printed (its summary's) and each
+    kind is said once (pyspline.warned), as pyspline.sweep does.
     """
     paths = [Path(p) for p in summaries]
     if not paths:
         raise CaseError("merge needs at least one summary file")
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", SplineWarning)
-        read = [read_summary(p) for p in paths]
-    _recorded_once([w for w in caught if issubclass(w.category, SplineWarning)], len(paths))
-    for w in caught:
-        if not issubclass(w.category, SplineWarning):
-            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    read = []
+    for p in paths:
+        with collected() as lines:       # the point's warnings, said once below: the summary's
+            read.append(read_summary(p))
+        if read[-1]["warnings"] is None:  # an older summary's: its case's
+            read[-1]["warnings"] = "\n".join(lines)
     cases = [r["case"] for r in read]
     have = [c for c in cases if c is not None]
     names = sorted({c.name for c in have})
@@ -254,8 +246,7 @@ def merge(summaries, out=None, fields=None, command=None, mixed=False):
         index_of = [(i,) for i in range(len(cases))]
     keys = list(_template(options, _stat_names()))
     points = {}
-    with warnings.catch_warnings():     # given once above
-        warnings.simplefilter("ignore", SplineWarning)
+    with collected():                   # kept above
         for i, r in zip(index_of, read):
             points[i] = summary_point(r, options)
     hashes = dict(zip(index_of, hashes_of))
@@ -274,4 +265,5 @@ def merge(summaries, out=None, fields=None, command=None, mixed=False):
     ds["summary"] = (tuple(grid), files.astype(str), {"long_name": "the point's summary file"})
     if out is not None:
         write_netcdf(ds, Path(out) / MERGED)
+    warn_grouped(ds)
     return ds

@@ -22,7 +22,7 @@ import numpy as np
 
 from . import bridge
 from .errors import CaseError, decode
-from .result import _names, _warn, raise_for, run
+from .result import _names, _warn, raise_for, run, warning_lines
 
 GROUP = "spline_case"
 _CONTROL = re.compile(rb"[\x00-\x1f\x7f]")
@@ -323,7 +323,7 @@ class Model:
     threads at once. ``Case.model`` keeps one per case."""
 
     __slots__ = ("case", "bytes", "z", "n_out", "n_section", "n_lyapunov", "n_slices",
-                 "__weakref__")
+                 "warnings", "__weakref__")
 
     def __init__(self, case):
         case = load_case(case)
@@ -340,7 +340,8 @@ class Model:
             data.flags.writeable = False
         self.case, self.bytes = case, data
         self.z, self.n_out, self.n_section, self.n_lyapunov, self.n_slices = sizes.tolist()
-        _warn(warn)                              # the core's model warnings (k_m)
+        self.warnings = warning_lines(warn)      # the core's model warnings (plausibility)
+        _warn(warn)
 
     def __getstate__(self):
         return {k: getattr(self, k) for k in self.__slots__ if k != "__weakref__"}

@@ -58,6 +58,7 @@ _VAR_ATTRS = {
     "wall_s": ("wall time of the run (Python call)", "s"),
     "error": ("error message of the point ('' if it ran)", ""),
     "error_class": ("exception class of the point's error ('' if it ran)", ""),
+    "warnings": ("the point's warnings, one per line, the core's words ('' if none)", ""),
     "point_hash": ("hash of the point's case text and summary options (point file name)", ""),
 }
 
@@ -70,6 +71,10 @@ _OF_QUANTITY.update(Tf_max=("max", "Tf"), D2_max=("max", "D2"), D2_min=("min", "
                     section_D2=("section", "D2"), section_vD2=("section", "vD2"))
 _WHAT = {"max": "max of the {}", "min": "min of the {}", "rms": "RMS of the {}",
          "section": "{} on the Poincare section"}
+
+
+#: the text variables of a sweep point
+_TEXT = ("error", "error_class", "warnings")
 
 
 def _stat_attrs(name: str) -> tuple:
@@ -105,7 +110,7 @@ def build_dataset(grid: dict, keys: list, summaries: dict, hashes: dict, options
     n_sec = max([len(np.atleast_1d(s[k])) for s in summaries.values() for k in ragged] or [0])
     data = {}
     for k in keys:
-        if k in ("error", "error_class"):
+        if k in _TEXT:
             data[k] = np.full(shape, "", dtype=object)
         elif k in ragged:
             data[k] = np.full(shape + (n_sec,), np.nan)
@@ -126,7 +131,7 @@ def build_dataset(grid: dict, keys: list, summaries: dict, hashes: dict, options
             if k in ragged:
                 v = np.atleast_1d(np.asarray(v, dtype=float))
                 data[k][index + (slice(0, len(v)),)] = v
-            elif k in ("error", "error_class"):
+            elif k in _TEXT:
                 data[k][index] = str(v)
             else:
                 data[k][index] = v

@@ -10,12 +10,11 @@ is serial: an executor runs one chain per direction ('both': up and down at once
 """
 from __future__ import annotations
 
-import warnings
 from math import inf
 
 import numpy as np
 
-from .errors import SolverError, SplineWarning
+from .errors import SolverError
 from .orbits import repeat_revolutions
 from .summary import failed_summary, summarise
 
@@ -45,7 +44,7 @@ def run_chain(cases: list, options: dict) -> list:
     run is cut to the time left, and once it has passed the rest are not run: failed points
     naming the bound."""
     from .orbits import _wall, out_of_time
-    from .result import run as run_model
+    from .result import collected, run as run_model
     out, prev = [], None
     for case in cases:
         if not isinstance(case, Exception) and (late := out_of_time()):
@@ -54,19 +53,20 @@ def run_chain(cases: list, options: dict) -> list:
             out.append(failed_summary(case, options))
             prev = None
             continue
-        try:
-            run = case if prev is None else continued(case, *prev)
-            with warnings.catch_warnings():     # the start 'rest' overlap note says nothing here
-                warnings.filterwarnings("ignore", message=r".*start = 'rest' with",
-                                        category=SplineWarning)
+        with collected() as said:       # the point's warnings: in its summary, not raised
+            try:
+                run = case if prev is None else continued(case, *prev)
                 res = run_model(run.model, max_seconds=_wall(run.model, inf))
-            out.append(summarise(res, options))
-            if options.get("final_state"):     # sweep(finals=...): pyspline.branches' seeds
-                out[-1]["final"] = (res.y[-1].copy(), float(res.t[-1]))
-            prev = (res.y[-1].copy(), float(res.t[-1]), run.model.info()["omega"])
-        except Exception as exc:        # noqa: BLE001 -- a failed point is a result
-            out.append(failed_summary(exc, options))
-            prev = None
+                out.append(summarise(res, options))
+                if options.get("final_state"):     # sweep(finals=...): pyspline.branches' seeds
+                    out[-1]["final"] = (res.y[-1].copy(), float(res.t[-1]))
+                prev = (res.y[-1].copy(), float(res.t[-1]), run.model.info()["omega"])
+            except Exception as exc:        # noqa: BLE001 -- a failed point is a result
+                out.append(dict(failed_summary(exc, options), warnings="\n".join(said)))
+                prev = None
+        # the start 'rest' overlap note says nothing here (a chain starts where it was)
+        out[-1]["warnings"] = "\n".join(w for w in out[-1]["warnings"].splitlines()
+                                        if "start = 'rest' with" not in w)
     return out
 
 

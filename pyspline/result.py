@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import contextlib
+import contextvars
 import functools
 import os
 import time
@@ -69,13 +70,38 @@ def sundials_said(what: str):
                       SplineWarning, stacklevel=3)
 
 
+#: the list the core's warnings go to instead of SplineWarning while `collected` runs (per
+#: thread and task: a sweep point's, on any executor)
+_COLLECT = contextvars.ContextVar("pyspline_collect", default=None)
+
+
+@contextlib.contextmanager
+def collected():
+    """The core's warnings of the runs and model builds inside (in this thread), kept in the
+    list it yields (one line each) instead of raised: a sweep point's (pyspline.warned)."""
+    lines: list = []
+    token = _COLLECT.set(lines)
+    try:
+        yield lines
+    finally:
+        _COLLECT.reset(token)
+
+
+def warning_lines(text) -> tuple:
+    """The core's warnings text (bytes or str) as its lines, blank ones left out."""
+    return tuple(line.strip() for line in decode(text).splitlines() if line.strip())
+
+
 def _warn(text, stacklevel: int = 3) -> None:
     """The core's warnings (one per line, the words spline-dyn prints) as SplineWarning,
-    attributed to the frame `stacklevel` up (3: the caller of _warn's caller)."""
-    text = decode(text)
-    for line in text.splitlines() if text else ():
-        if line.strip():
-            warnings.warn(line.strip(), SplineWarning, stacklevel=stacklevel)
+    attributed to the frame `stacklevel` up (3: the caller of _warn's caller); inside
+    `collected`, into its list."""
+    into = _COLLECT.get()
+    for line in warning_lines(text):
+        if into is not None:
+            into.append(line)
+        else:
+            warnings.warn(line, SplineWarning, stacklevel=stacklevel)
 
 
 def raise_for(ierr: int, errmsg) -> None:
@@ -175,6 +201,9 @@ class Result:
     #: the tooth spacing errors in use e_j (Z,) [m], the case's list plus the seeded ones
     #: (Model.info()['spacing_error'])
     spacing_error: np.ndarray = None
+    #: the core's warnings of the case and the run, one line each, as raised (SplineWarning):
+    #: the model's (plausibility), SUNDIALS', the run's and its loads' (stresses, T_f)
+    warnings: tuple = ()
 
     F = _tooth_quantity("F")
     Fx = _tooth_quantity("Fx")
@@ -334,7 +363,7 @@ def _copies(model, executor, max_seconds: float = 0.0) -> tuple:
         if own:
             executor.shutdown()
     for o in outs:
-        run_outcome(o[-2], o[-1])            # the first failed copy raises, each one's warnings
+        raise_for(o[-2], o[-1])              # the first failed copy raises
     nqw, consts = outs[0][11], outs[0][12]
     cat = [np.concatenate([o[i] for o in outs], axis=1 if i == 1 else 0) for i in range(11)]
     cat[2] = np.empty((k * n, model.z, nqw), order="F")   # the quantities written (nqw)
@@ -344,7 +373,8 @@ def _copies(model, executor, max_seconds: float = 0.0) -> tuple:
         model.bytes, len(LOAD_QUANTITIES), len(TOOTH_LOAD_QUANTITIES), len(EXTREMES), cat[0],
         cat[1], cat[2], cat[3], np.stack([o[4] for o in outs], axis=1), consts)
     raise_for(ierr, msg)
-    return (*cat, nqw, consts, loads, tload, ext, warned, 0, b"")
+    said = "\n".join(decode(o[-1]) for o in outs)     # each copy's SUNDIALS warnings
+    return (*cat, nqw, consts, loads, tload, ext, warned, 0, said)
 
 
 def run(model, executor=None, max_seconds: float = 0.0) -> Result:
@@ -382,4 +412,5 @@ def run(model, executor=None, max_seconds: float = 0.0) -> Result:
                   section_t=sec_t, section_y=sec_y, lyapunov=lyap,
                   face=face if model.n_slices else None, tilt=tilt if model.n_slices else None,
                   loads=out, extremes={n: float(v) for n, v in zip(EXTREMES, ext)},
-                  spacing_error=model.info()["spacing_error"])
+                  spacing_error=model.info()["spacing_error"],
+                  warnings=model.warnings + warning_lines(msg) + warning_lines(warned))

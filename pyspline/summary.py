@@ -32,7 +32,7 @@ def _template(options: dict, stat_names: Sequence[str]) -> dict:
     s.update({k: nan for k in stat_names})
     if options.get("orders") is not None:
         s["Tm_spectrum"] = np.full(len(options["orders"]), nan)
-    s.update(error="", error_class="")
+    s.update(error="", error_class="", warnings="")
     return s
 
 
@@ -129,6 +129,7 @@ def summarise(res, options: dict) -> dict:
             s[k] = float(res.stats[k])
     if options.get("orders") is not None:
         s["Tm_spectrum"] = _binned_spectrum(res.t, res.Tm, case["speed_rpm"], options["orders"])
+    s["warnings"] = "\n".join(res.warnings)
     return s
 
 

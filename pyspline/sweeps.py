@@ -32,13 +32,15 @@ from .cluster import local_dask_client
 from .dataset import MERGED, build_dataset, open_sweep, write_netcdf
 from .errors import CaseError
 from .summary import _stat_names, _template, _version, failed_summary, summarise
+from .warned import warn_grouped
 
 __all__ = ["local_dask_client", "open_sweep", "parse_values", "point_cases", "read_table",
            "run_point", "summarise", "sweep", "table_cases", "task_points", "write_netcdf"]
 
 #: Bump when the content of a point summary changes: older point files are then recomputed.
 #: 2: the default Benettin separation (lyapunov_d0 = 0: 1e4 rtol, was 1e-8) changed exponents.
-SUMMARY_VERSION = 3
+#: 4: a point keeps its warnings.
+SUMMARY_VERSION = 4
 #: Step of the common shaft-order axis of the T_m spectra [shaft orders].
 ORDER_STEP = 0.05
 SECTIONS = ("shaft", "tooth", "none")
@@ -217,14 +219,17 @@ def run_point(case: Case, options: dict) -> dict:
     the point's case and return its summary. A failure of the case (any Exception: CaseError,
     SolverError, ThermalInterferenceError, ...) is returned as a summary with NaN values and the
     message in 'error' and the class name in 'error_class'; KeyboardInterrupt propagates.
+    The point's warnings (the core's lines) go to 'warnings', not raised: the sweep says each
+    kind once (pyspline.warned).
     A case with realisations > 1 runs its copies one after another (the sweep's workers are the
     parallelism)."""
     from .core import simulate
-    from .result import SerialExecutor
-    try:
-        return summarise(simulate(case, SerialExecutor()), options)
-    except Exception as exc:              # noqa: BLE001 -- a failed point is a result
-        return failed_summary(exc, options)
+    from .result import SerialExecutor, collected
+    with collected() as said:             # the point's warnings: in its summary, not raised
+        try:
+            return summarise(simulate(case, SerialExecutor()), options)
+        except Exception as exc:          # noqa: BLE001 -- a failed point is a result
+            return dict(failed_summary(exc, options), warnings="\n".join(said))
 
 
 class PointSummaries:
@@ -512,6 +517,7 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     ds = build_dataset(grid, keys, summaries, hashes, options, attrs, point_fields)
     if out is not None:
         write_netcdf(ds, out / MERGED)
+    warn_grouped(ds)
     return ds
 
 
@@ -554,4 +560,5 @@ def _follow(base, grid, cases, keys, options, follow, point_fields, executor, pr
     ds = build_dataset(dgrid, keys, summaries, hashes, options, attrs)
     if out is not None:
         write_netcdf(ds, Path(out) / MERGED)
+    warn_grouped(ds, 4)
     return ds

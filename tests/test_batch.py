@@ -142,7 +142,7 @@ def test_summary_is_the_sweep_point_of_shipped_cases(tmp_path, exe, name):
     assert set(swept) == set(merged) and np.isfinite(swept["period_residual"])
     for k, x in swept.items():
         if isinstance(x, str):
-            assert x == merged[k] == "", k
+            assert x == merged[k] and (x == "" or k == "warnings"), k
         elif k not in TIMINGS:
             assert np.array_equal(x, merged[k], equal_nan=True), (k, x, merged[k])
 
@@ -383,5 +383,5 @@ def test_merge_gives_each_warning_once_with_its_count(good):
     with pytest.warns(pyspline.SplineWarning) as rec:
         merge([good / "0.summary", good / "1.summary"])
     msgs = [str(w.message) for w in rec if issubclass(w.category, pyspline.SplineWarning)]
-    assert len(msgs) == 1 and "winds its shaft" in msgs[0] and msgs[0].endswith(
-        "(2 of 2 summaries)"), msgs
+    assert len(msgs) == 1 and "winds its shaft" in msgs[0], msgs
+    assert "[2 of 2 points; l_x = " in msgs[0], msgs

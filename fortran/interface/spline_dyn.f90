@@ -79,6 +79,7 @@ program spline_dyn
   end interface
 
   character(len=:), allocatable :: path, out, arg, tmp, record, summary, stmp, text
+  character(len=:), allocatable :: warned   !< the warnings printed, one per line (the summary's)
   type(string_t), allocatable :: sets(:)
   character(len=msglen) :: errmsg
   character(len=256) :: iomsg
@@ -100,6 +101,7 @@ program spline_dyn
   nsets = 0
   have_out = .false.
   have_summary = .false.
+  warned = ''
   have_case = .false.
   summary_open = .false.
   options_done = .false.
@@ -430,7 +432,8 @@ contains
   !> The summary of the run (what a sweep point keeps; pyspline merge reads it, pyspline/
   !> batch.py): '#' comments; lines NAME [UNIT] = VALUES, the numbers comma-separated with 17
   !> significant digits (every double reads back exactly; units of spline_quantities); lines
-  !> NAME = 'TEXT'; then the case as a namelist (every field). ok: the run finished, else the
+  !> NAME = 'TEXT' (warnings: the 'warning:' lines printed, without their prefix); then the
+  !> case as a namelist (every field). ok: the run finished, else the
   !> summary has the error (msg, its kind and exit code from code), the --set options and the
   !> case if every --set was read (have_case). Written to a temporary name and renamed when
   !> complete.
@@ -447,6 +450,8 @@ contains
          'SI units; NAME [UNIT] = VALUES (17 significant digits), then the case'
     write(su, '(a)', iostat=ios) "format = 'pyspline-summary 1'"
     write(su, '(a)', iostat=ios) 'case_file = '//quoted(path)
+    if (len(warned) > 0) write(su, '(a)', iostat=ios) 'warnings = '// &
+         quoted(warned(1:len(warned) - 1))         ! the lines printed, as a sweep point keeps
     if (.not. ok) then
       write(su, '(a)', iostat=ios) 'error = '//quoted(trim(msg))
       write(su, '(a)', iostat=ios) 'error_kind = '//quoted(trim(err_names(code)))
@@ -540,7 +545,10 @@ contains
       else
         b = a + b - 1
       end if
-      if (b > a) write(error_unit, '(a)') 'spline-dyn: warning: '//text(a:b-1)
+      if (b > a) then
+        write(error_unit, '(a)') 'spline-dyn: warning: '//text(a:b-1)
+        warned = warned//text(a:b-1)//new_line('a')
+      end if
       a = b + 1
     end do
   end subroutine print_warnings
