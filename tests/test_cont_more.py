@@ -78,7 +78,7 @@ def test_chaotic_stretch_in_a_branches_dataset():
     assert "max_points = 2 reached" in ds.attrs["status"]
     ax = frequency_response(ds, sweep=sw).axes[0]
     assert any(t.get_text().startswith("no periodic attractor: chaotic") for t in
-               ax.get_legend().get_texts())
+               ax.figure.legends[0].get_texts())
 
 
 def test_unsettled_periodic_drive_is_not_chaos():
