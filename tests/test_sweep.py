@@ -69,7 +69,8 @@ def test_1d_serial_threads_processes_identical(case):
     with cf.ThreadPoolExecutor(2) as ex, \
             pytest.warns(pyspline.SplineWarning, match=PAST_BACKLASH):
         threads = pyspline.sweep(case, executor=ex, progress=False, lyapunov=True, l_x=LX)
-    with cf.ProcessPoolExecutor(1, mp_context=mp.get_context("spawn")) as ex:   # its imports
+    with cf.ProcessPoolExecutor(1, mp_context=mp.get_context("spawn")) as ex, \
+            pytest.warns(pyspline.SplineWarning, match=PAST_BACKLASH):   # said from processes too
         procs = pyspline.sweep(case, executor=ex, progress=False, lyapunov=True, l_x=LX)
     _same(serial, threads)
     _same(serial, procs)
