@@ -2,7 +2,6 @@
 bit), failed points, resume, interrupts, Dask, the command line (sweep, plot) and
 Result.to_xarray. Short runs: paper_lx1e-4 over 0.25 s (20 shaft revolutions in the window)."""
 import concurrent.futures as cf
-import contextlib
 import multiprocessing as mp
 import os
 import signal
