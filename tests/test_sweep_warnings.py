@@ -98,12 +98,11 @@ def test_follow_sweep_says_each_kind_once_without_the_chains_start_note(base):
 def test_warning_texts_built_on_two_threads(base):
     """12 000 model builds on 2 threads (the core releases the GIL): each warning text equals the
     one the same case gives when built alone. Strict: the day it passes, the mark must go."""
-    cases = [base.replace(l_x=2.5e-4 + 1e-6 * k, k_t1=1e4 if k % 2 else 5.0) for k in range(14)]
-    def built(k):
+    def built(k):       # a new Case each time: its model is built, not reused
         return k, pyspline.load(base.replace(l_x=2.5e-4 + 1e-6 * k,
                                              k_t1=1e4 if k % 2 else 5.0)).warnings
     with warnings.catch_warnings(), cf.ThreadPoolExecutor(2) as pool:
         warnings.simplefilter("ignore", pyspline.SplineWarning)
-        alone = [pyspline.load(c).warnings for c in cases]
+        alone = [built(k)[1] for k in range(14)]
         spliced = sum(w != alone[k] for k, w in pool.map(built, [i % 14 for i in range(12000)]))
     assert spliced == 0, f"{spliced} of 12000 texts spliced"
