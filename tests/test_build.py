@@ -1,6 +1,7 @@
 """The build links the SUNDIALS it was configured with, and the optimised CVODE that
 scripts/setup.sh builds gives the same numbers as Debian's unoptimised one."""
 import os
+import shutil
 import subprocess
 from pathlib import Path
 
@@ -50,3 +51,18 @@ def test_every_module_of_the_source_tree_is_installed():
     for path in src.rglob("*.py"):
         rel = path.relative_to(src)
         assert (installed / rel).exists(), f"{rel} is not in meson.build's py.install_sources"
+
+
+@pytest.mark.skipif(shutil.which("nm") is None, reason="needs nm (binutils)")
+def test_the_core_keeps_no_text_length_in_a_static_variable(exe):
+    """gfortran 12 keeps the length of every call of a function with a deferred-length character
+    result (character(len=:), allocatable) in a static variable slen.N, one for all threads: two
+    threads building texts at once spliced them (issue 33; test_sweep_warnings, docs/developing.md
+    "Thread safety"). The core (the extension and spline-dyn) has none left."""
+    core = next(Path(pyspline.__file__).parent.glob("_core*.so"))
+    for binary in (core, Path(exe)):
+        symbols = subprocess.run(["nm", str(binary)], capture_output=True, text=True,
+                                 check=True).stdout.split()
+        assert "__spline_errors_MOD_err_exit_code" in symbols, f"{binary}: no symbols to read"
+        static = [s for s in symbols if s.startswith("slen.")]
+        assert not static, f"{binary}: {len(static)} static lengths ({static[0]}, ...)"

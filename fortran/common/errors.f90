@@ -9,6 +9,10 @@ module spline_errors
   public :: err_ok, err_case, err_solver, err_thermal, err_interrupted, nerr, err_names
   public :: msglen, err_exit_code, itoa, ftoa, num
 
+  interface num
+    module procedure num_e, num_digits, num_readable
+  end interface num
+
   integer, parameter :: err_ok = 0           !< success
   integer, parameter :: err_case = 1         !< bad case: field missing, ill-typed, out of range
   integer, parameter :: err_solver = 2       !< CVODE failed, or no static equilibrium
@@ -38,42 +42,71 @@ contains
     end select
   end function err_exit_code
 
+  ! The text helpers below are functions whose result length is a specification expression
+  ! (the caller sizes it; the text is formed twice): gfortran 12 keeps the length of every call
+  ! of a function with a deferred-length result (character(len=:), allocatable) in a static
+  ! variable, one for all threads (docs/developing.md, "Thread safety").
+
   !> An integer as text, for messages.
   pure function itoa(i) result(s)
     integer, intent(in) :: i
-    character(len=:), allocatable :: s
+    character(len=len_trim(i0(i))) :: s
+    s = i0(i)
+  end function itoa
+
+  pure function i0(i) result(buf)
+    integer, intent(in) :: i
     character(len=12) :: buf
     write(buf, '(i0)') i
-    s = trim(buf)
-  end function itoa
+  end function i0
 
   !> A real as text in the format f, without blanks, for messages (e.g. '(es10.3)', '(f0.2)').
   pure function ftoa(x, f) result(s)
     real(wp), intent(in) :: x
     character(len=*), intent(in) :: f
-    character(len=:), allocatable :: s
+    character(len=len_trim(fmt_real(x, f))) :: s
+    s = fmt_real(x, f)
+  end function ftoa
+
+  pure function fmt_real(x, f) result(buf)
+    real(wp), intent(in) :: x
+    character(len=*), intent(in) :: f
     character(len=40) :: buf
     write(buf, f) x
-    s = trim(adjustl(buf))
-  end function ftoa
+    buf = adjustl(buf)
+  end function fmt_real
 
   !> A number for messages: 3 decimals (or digits) in E form, a three-digit exponent where
   !> needed (5.000E+06, 1.000E-100). readable (spline_model's plausibility warnings): from 1e-2
   !> to 1e4 fixed, 4 decimals below 10, then 3, 2, 1 (0.2546, 19.096, 1234.5); else the E form
-  !> with 3 decimals, as Fortran's es writes it (5.000E+06, 1.000-100).
-  pure function num(x, digits, readable) result(s)
+  !> with 3 decimals, as Fortran's es writes it (5.000E+06, 1.000-100). The generic num: num(x),
+  !> num(x, digits), num(x, readable=...) (a specification expression takes no optional argument).
+  pure function num_e(x) result(s)
     real(wp), intent(in) :: x
-    integer, intent(in), optional :: digits
-    logical, intent(in), optional :: readable
-    character(len=:), allocatable :: s
+    character(len=len_trim(num_text(x, 3, .false.))) :: s
+    s = num_text(x, 3, .false.)
+  end function num_e
+
+  pure function num_digits(x, digits) result(s)
+    real(wp), intent(in) :: x
+    integer, intent(in) :: digits
+    character(len=len_trim(num_text(x, digits, .false.))) :: s
+    s = num_text(x, digits, .false.)
+  end function num_digits
+
+  pure function num_readable(x, readable) result(s)
+    real(wp), intent(in) :: x
+    logical, intent(in) :: readable
+    character(len=len_trim(num_text(x, 3, readable))) :: s
+    s = num_text(x, 3, readable)
+  end function num_readable
+
+  pure function num_text(x, d, fixed) result(buf)
+    real(wp), intent(in) :: x
+    integer, intent(in) :: d
+    logical, intent(in) :: fixed
     character(len=24) :: buf
     character(len=16) :: fmt
-    integer :: d
-    logical :: fixed
-    d = 3
-    if (present(digits)) d = digits
-    fixed = .false.
-    if (present(readable)) fixed = readable
     if (fixed .and. abs(x) >= 1.0e-2_wp .and. abs(x) < 1.0e4_wp) then
       write(fmt, '(a,i0,a)') '(f12.', 4 - count(abs(x) >= [10.0_wp, 100.0_wp, 1000.0_wp]), ')'
     else if (.not. fixed .and. x /= 0.0_wp .and. &
@@ -83,7 +116,7 @@ contains
       write(fmt, '(a,i0,a,i0,a)') '(es', d + 8, '.', d, ')'
     end if
     write(buf, fmt) x
-    s = trim(adjustl(buf))
-  end function num
+    buf = adjustl(buf)
+  end function num_text
 
 end module spline_errors

@@ -285,13 +285,13 @@ contains
     if (bytes > max_output_bytes) then
       if (c%lyapunov .or. option_index(section_values, c%section) > 1) then
         call fail(nout_name, trim(nout_is)//' with z = '//itoa(c%z)//' teeth, the Poincare '// &
-             'section and the Lyapunov record need '//size_text(bytes)//' of memory for the '// &
-             'outputs, more than the limit of '//size_text(max_output_bytes)//': lower '// &
+             'section and the Lyapunov record need '//trim(size_text(bytes))//' of memory for the '// &
+             'outputs, more than the limit of '//trim(size_text(max_output_bytes))//': lower '// &
              nout_name//' (or shorten the run)'); return
       end if
       call fail(nout_name, trim(nout_is)//' with z = '//itoa(c%z)//' teeth needs '// &
-           size_text(bytes)//' of memory for the outputs, more than the limit of '// &
-           size_text(max_output_bytes)//': lower '//nout_name); return
+           trim(size_text(bytes))//' of memory for the outputs, more than the limit of '// &
+           trim(size_text(max_output_bytes))//': lower '//nout_name); return
     end if
     ierr = err_ok
 

@@ -184,7 +184,7 @@ contains
       name = lower(tok(p))
       f = field_index(name)
       if (f == 0) then
-        call fail(line, 'unknown field '''//clip(tok(p))//''''//hint(name)); return
+        call fail(line, 'unknown field '''//clip(tok(p))//''''//trim(hint(name))); return
       end if
       p = p + 1
       off = case_value_offset(f)
@@ -240,11 +240,11 @@ contains
         if (tk(p) == tk_word) then
           if (field_index(lower(tok(p))) > 0) then
             call fail(tl(p), 'field '//lower(tok(p))//': expected ''='' after the field name, '// &
-                 'found '//after(p)); return
+                 'found '//trim(after(p))); return
           end if
           if (tl(p) > tl(p - 1) .and. .not. is_value(f, tok(p))) then
             call fail(tl(p), ''''//clip(tok(p))//''' is neither a field nor a value of field '// &
-                 trim(fields(f)%name)//' (a missing ''=''?)'//hint(lower(tok(p)))); return
+                 trim(fields(f)%name)//' (a missing ''=''?)'//trim(hint(lower(tok(p))))); return
           end if
         end if
         ! a value: [r*]constant or r*
@@ -256,7 +256,7 @@ contains
           if (q > 0) then
             if (.not. is_digits(v(1:q-1))) then
               call fail(tl(p), 'field '//trim(fields(f)%name)//' = '//clip(v)//': expected '// &
-                   expected(f)); return
+                   trim(expected(f))); return
             end if
             if (q - 1 > 9) then
               r = huge(0)
@@ -344,7 +344,7 @@ contains
       case ('i')
         if (kind /= tk_word .or. .not. is_integer(v)) then
           call fail(line, 'field '//trim(fields(f)%name)//' = '//clip(v)//': expected '// &
-               expected(f)); return
+               trim(expected(f))); return
         end if
         n0 = verify(v, '+-0')          ! first significant digit
         if (n0 == 0) return            ! zero
@@ -367,7 +367,7 @@ contains
       case ('r')
         if (kind /= tk_word .or. .not. is_real(v)) then
           call fail(line, 'field '//trim(fields(f)%name)//' = '//clip(v)//': expected '// &
-               expected(f)); return
+               trim(expected(f))); return
         end if
         u = v
         do n0 = 1, len(u)
@@ -376,7 +376,7 @@ contains
         read(u, *, iostat=ios) x
         if (ios /= 0) then
           call fail(line, 'field '//trim(fields(f)%name)//' = '//clip(v)//': expected '// &
-               expected(f)); return
+               trim(expected(f))); return
         end if
         if (.not. ieee_is_finite(x) .and. .not. ieee_is_nan(x) .and. index(lower(v), 'inf') == 0) then
           call fail(line, 'field '//trim(fields(f)%name)//' = '//clip(v)// &
@@ -386,15 +386,15 @@ contains
       case ('l')
         if (kind /= tk_word .or. .not. is_logical(v)) then
           call fail(line, 'field '//trim(fields(f)%name)//' = '//clip(v)//': expected '// &
-               expected(f)); return
+               trim(expected(f))); return
         end if
         l = index('tT', v(verify(v, '.'):verify(v, '.'))) > 0
       case ('c')
         if (kind /= tk_string) then
           call fail(line, 'field '//trim(fields(f)%name)//' = '//clip(v)//': expected '// &
-               expected(f)//', e.g. '''//clip(v)//''''); return
+               trim(expected(f))//', e.g. '''//clip(v)//''''); return
         end if
-        s = unquote(v)
+        call unquote(v, s)
         if (len_trim(s) > fields(f)%n) then
           call fail(line, 'field '//trim(fields(f)%name)//' = '//clip(v)//' is longer than '// &
                itoa(fields(f)%n)//' characters'); return
@@ -467,14 +467,14 @@ contains
 
     function tok(q) result(s)
       integer, intent(in) :: q
-      character(len=:), allocatable :: s
+      character(len=tb(q) - ta(q) + 1) :: s
       s = text(ta(q):tb(q))
     end function tok
 
-    !> The token after q, for messages: 'TEXT' or the end of the text.
+    !> The token after q, for messages: 'TEXT' or the end of the text (trailing blanks: trim it).
     function after(q) result(s)
       integer, intent(in) :: q
-      character(len=:), allocatable :: s
+      character(len=48) :: s
       if (q < ntok) then
         s = ''''//clip(tok(q + 1))//''''
       else

@@ -7,7 +7,7 @@ module spline_case_text
   use spline_case_type, only: fields, nfields
   implicit none
   private
-  public :: lower, unquote, quoted, shown, clip, size_text, hint, case_suggest
+  public :: lower, unquote, shown, clip, size_text, hint, case_suggest
   public :: word_char, is_digits, is_integer, is_real, is_logical, is_value, expected, kind_word, &
        element
 
@@ -37,10 +37,10 @@ contains
     end function is_value_plain
   end function is_value
 
-  !> What field f expects, for messages.
+  !> What field f expects, for messages (trailing blanks: trim it).
   function expected(f) result(s)
     integer, intent(in) :: f
-    character(len=:), allocatable :: s
+    character(len=48) :: s
     select case (fields(f)%kind)
     case ('i'); s = 'a whole number'
     case ('r'); s = 'a number (e.g. 1.5e-3)'
@@ -51,7 +51,7 @@ contains
 
   function kind_word(k) result(s)
     character(len=1), intent(in) :: k
-    character(len=:), allocatable :: s
+    character(len=12) :: s
     select case (k)
     case ('i'); s = 'whole number'
     case ('r'); s = 'number'
@@ -60,18 +60,19 @@ contains
     end select
   end function kind_word
 
-  !> NAME or NAME(k) for element k of field f.
+  !> NAME or NAME(k) for element k of field f (trailing blanks: trim it).
   function element(f, k) result(s)
     integer, intent(in) :: f, k
-    character(len=:), allocatable :: s
-    s = trim(fields(f)%name)
-    if (fields(f)%n > 1 .and. fields(f)%kind /= 'c') s = s//'('//itoa(k)//')'
+    character(len=40) :: s
+    s = fields(f)%name
+    if (fields(f)%n > 1 .and. fields(f)%kind /= 'c') s = trim(s)//'('//itoa(k)//')'
   end function element
 
-  !> ': did you mean NAME?' for the nearest field, or a pointer to the list of fields.
+  !> ': did you mean NAME?' for the nearest field, or a pointer to the list of fields (trailing
+  !> blanks: trim it).
   function hint(word) result(s)
     character(len=*), intent(in) :: word
-    character(len=:), allocatable :: s
+    character(len=48) :: s
     character(len=24) :: best
     best = case_suggest(word)
     if (len_trim(best) > 0) then
@@ -220,9 +221,9 @@ contains
   end function is_logical
 
   !> The characters of a quoted string (doubled quotes collapsed).
-  pure function unquote(v) result(s)
+  pure subroutine unquote(v, s)
     character(len=*), intent(in) :: v
-    character(len=:), allocatable :: s
+    character(len=:), allocatable, intent(out) :: s
     character(len=max(len(v) - 2, 0)) :: buf
     character :: q
     integer :: i, n, k
@@ -237,28 +238,7 @@ contains
       i = i + 1
     end do
     s = buf(1:k)
-  end function unquote
-
-  !> s in apostrophes, its apostrophes doubled (a namelist string constant).
-  pure function quoted(s) result(q)
-    character(len=*), intent(in) :: s
-    character(len=:), allocatable :: q
-    character(len=2*len(s) + 2) :: buf
-    integer :: i, k
-    buf(1:1) = ''''
-    k = 1
-    do i = 1, len(s)
-      k = k + 1
-      buf(k:k) = s(i:i)
-      if (s(i:i) == '''') then
-        k = k + 1
-        buf(k:k) = ''''
-      end if
-    end do
-    k = k + 1
-    buf(k:k) = ''''
-    q = buf(1:k)
-  end function quoted
+  end subroutine unquote
 
   pure function lower(s) result(l)
     character(len=*), intent(in) :: s
@@ -275,7 +255,7 @@ contains
   !> (pyspline.case._shown says the same).
   pure function shown(path) result(s)
     character(len=*), intent(in) :: path
-    character(len=:), allocatable :: s
+    character(len=min(len(path), 240)) :: s
     if (len(path) > 240) then
       s = '...'//path(len(path)-236:)
     else
@@ -286,7 +266,7 @@ contains
   !> At most 40 characters of a token, for messages.
   pure function clip(s) result(c)
     character(len=*), intent(in) :: s
-    character(len=:), allocatable :: c
+    character(len=min(len(s), 40)) :: c
     if (len(s) > 40) then
       c = s(1:37)//'...'
     else
@@ -294,10 +274,10 @@ contains
     end if
   end function clip
 
-  !> A byte count in kB, MB, GB or TB (powers of 1000).
+  !> A byte count in kB, MB, GB or TB (powers of 1000; trailing blanks: trim it).
   pure function size_text(bytes) result(s)
     real(wp), intent(in) :: bytes
-    character(len=:), allocatable :: s
+    character(len=16) :: s
     character(len=2), parameter :: units(5) = ['B ', 'kB', 'MB', 'GB', 'TB']
     real(wp) :: v
     integer :: k

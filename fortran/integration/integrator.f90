@@ -486,24 +486,44 @@ contains
     end if
   end function integrator_last_step
 
-  function integrator_flag_name(cv, flag) result(fname)
+  !> The name of the integrator's return flag (CVODE's, ERKStep's), from SUNDIALS' C function:
+  !> the Fortran interface's returns a deferred-length result (docs/developing.md, "Thread safety").
+  subroutine integrator_flag_name(cv, flag, fname)
     type(integrator_t), intent(in) :: cv
     integer(c_int), intent(in) :: flag
-    character(len=:), allocatable :: fname
-    if (cv%erk) then
-      fname = FERKStepGetReturnFlagName(int(flag, c_long))
-      if (flag == CV_ROOT_RETURN) fname = 'ARK_ROOT_RETURN'
-    else
-      fname = FCVodeGetReturnFlagName(int(flag, c_long))
+    character(len=*), intent(out) :: fname
+    type(c_ptr) :: p
+    interface
+      type(c_ptr) function cvode_flag_name(flag) bind(C, name='CVodeGetReturnFlagName')
+        import :: c_ptr, c_long
+        integer(c_long), value :: flag
+      end function cvode_flag_name
+      type(c_ptr) function erk_flag_name(flag) bind(C, name='ERKStepGetReturnFlagName')
+        import :: c_ptr, c_long
+        integer(c_long), value :: flag
+      end function erk_flag_name
+      subroutine c_free(p) bind(C, name='free')
+        import :: c_ptr
+        type(c_ptr), value :: p
+      end subroutine c_free
+    end interface
+    if (cv%erk .and. flag == CV_ROOT_RETURN) then
+      fname = 'ARK_ROOT_RETURN'; return
     end if
-  end function integrator_flag_name
+    if (cv%erk) then
+      p = erk_flag_name(int(flag, c_long))
+    else
+      p = cvode_flag_name(int(flag, c_long))
+    end if
+    call c_copy(p, fname)
+    call c_free(p)                ! SUNDIALS allocates the name
+  end subroutine integrator_flag_name
 
   !> The integrator's name in messages.
   pure function integrator_name(cv) result(name)
     type(integrator_t), intent(in) :: cv
-    character(len=:), allocatable :: name
+    character(len=merge(6, 5, cv%erk)) :: name
     name = merge('ARKODE', 'CVODE ', cv%erk)
-    name = trim(name)
   end function integrator_name
 
   !> Add the counters since the last (re)initialisation to stats (positions ist_* of
@@ -548,6 +568,7 @@ contains
     character(len=*), intent(out) :: errmsg
     character(len=:), allocatable :: head, name
     character(len=12) :: at
+    character(len=32) :: fname
     head = 'case '//trim(m%name)//': '//trim(cv%run)
     name = integrator_name(cv)
     write(at, '(es12.5)') tau/m%w_ref
@@ -574,24 +595,25 @@ contains
     else
       if (cv%run /= 'the run') name = name//' failed in '//trim(cv%run)
       if (cv%run == 'the run') name = name//' failed'
+      call integrator_flag_name(cv, flag, fname)
       errmsg = 'case '//trim(m%name)//': '//name//' while '//what//' with flag '// &
-           integrator_flag_name(cv, flag)//' ('//itoa(int(flag))//') at t = '//at//' s'
+           trim(fname)//' ('//itoa(int(flag))//') at t = '//at//' s'
       if (len_trim(cv%log%err) > 0) errmsg = trim(errmsg)//': '//trim(cv%log%err)
     end if
   end subroutine integrator_fail_text
 
   !> The warnings SUNDIALS raised in the runs of log (one line; '' if none): how many, and the
   !> first one's text. The executable prints it as a 'warning:' line, Python as a SplineWarning.
-  function integrator_warnings(log, name) result(text)
+  subroutine integrator_warnings(log, name, text)
     type(lib_log_t), intent(in) :: log
     character(len=*), intent(in) :: name     !< the case's name
-    character(len=:), allocatable :: text
+    character(len=*), intent(out) :: text
     text = ''
     if (log%nwarn == 0) return
     text = 'case '//trim(name)//': SUNDIALS warned '//itoa(log%nwarn)//' time(s) in this run '// &
          '(the steps may have become too small to resolve the motion); the first, from '// &
          trim(log%first)
-  end function integrator_warnings
+  end subroutine integrator_warnings
 
   !> SUNDIALS' message handler (CVodeSetErrHandlerFn, ERKStepSetErrHandlerFn): nothing is
   !> printed. An error's text is kept for the error message; a warning (error_code > 0, e.g.
@@ -600,35 +622,41 @@ contains
     integer(c_int), value :: error_code
     type(c_ptr), value :: module, function, msg, udata
     type(lib_log_t), pointer :: log
+    character(len=msglen) :: mod_name, fun_name, text
     call c_f_pointer(udata, log)
     if (error_code > 0) then
       log%nwarn = log%nwarn + 1
-      if (log%nwarn == 1) log%first = c_string(module)//' in '//c_string(function)//': '// &
-           c_string(msg)
+      if (log%nwarn == 1) then
+        call c_copy(module, mod_name)
+        call c_copy(function, fun_name)
+        call c_copy(msg, text)
+        log%first = trim(mod_name)//' in '//trim(fun_name)//': '//text
+      end if
     else
-      log%err = c_string(msg)
+      call c_copy(msg, log%err)
     end if
   end subroutine lib_handler
 
-  function c_string(p) result(s)
+  !> The C string at p (blank if null) into s, cut at len(s).
+  subroutine c_copy(p, s)
     type(c_ptr), intent(in) :: p
-    character(len=:), allocatable :: s
+    character(len=*), intent(out) :: s
     character(kind=c_char), pointer :: chars(:)
-    integer :: n
+    integer :: n, i
     interface
       integer(c_size_t) function strlen(str) bind(C, name='strlen')
         import :: c_ptr, c_size_t
         type(c_ptr), value :: str
       end function strlen
     end interface
-    if (.not. c_associated(p)) then
-      s = ''; return
-    end if
-    n = int(strlen(p))
+    s = ''
+    if (.not. c_associated(p)) return
+    n = min(int(strlen(p)), len(s))
     call c_f_pointer(p, chars, [n])
-    allocate(character(len=n) :: s)
-    s = transfer(chars, s)
-  end function c_string
+    do i = 1, n
+      s(i:i) = chars(i)
+    end do
+  end subroutine c_copy
 
   !> Free what was made (the statistics read first: integrate's collect_stats).
   subroutine integrator_free(cv)

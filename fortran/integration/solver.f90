@@ -130,7 +130,7 @@ contains
     if (ctx%watch) call sigint_unwatch()
     call integrator_free(cv)
     if (present(msgs)) msgs = cv%log
-    if (ierr == err_ok) errmsg = integrator_warnings(cv%log, m%name)
+    if (ierr == err_ok) call integrator_warnings(cv%log, m%name, errmsg)
 
   contains
 

@@ -163,6 +163,7 @@ contains
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
     type(model_t) :: m
+    character(len=:), allocatable :: start, text
     model = 0; sizes = 0; warn = ''
     call model_from_case(c, m, ierr, errmsg)
     if (ierr == err_ok .and. size(model) /= api_model_size()) then
@@ -172,7 +173,9 @@ contains
     model = transfer(m, model)
     sizes = [m%z, m%n_out, run_sections(m), lyapunov_count(m), &
          merge(m%n_slices, 0, m%n_slices > 1)]       ! realisations > 1: one copy's
-    warn = model_warnings(m, start_warning(m))
+    call start_warning(m, start)
+    call model_warnings(m, start, text)
+    warn = text
   end subroutine load_model
 
   !> The case field nearest to a misspelt name (blank if none is near): the suggestion of the

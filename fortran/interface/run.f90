@@ -110,7 +110,7 @@ contains
     closed = 0.0_wp; t_closed = 0.0_wp
     if (ierr == err_ok) call result_checks(run, t, y, tooth(:, :, 1:nw), tm, closed, t_closed, &
          ierr, errmsg, sec_t, sec_y, lyap_t, lyap_g, fin)
-    if (ierr == err_ok) errmsg = integrator_warnings(lib, m%name)
+    if (ierr == err_ok) call integrator_warnings(lib, m%name, errmsg)
     call system_clock(c1)
     stats(ist_core_wall) = real(c1 - c0, wp)/rate
     stats(ist_dof) = real(run%dof, wp)
@@ -160,7 +160,9 @@ contains
       call run_extremes(m, y, tm, tooth(:, :, 1), &
            spread(spread(consts(iq_tf - 4), 1, size(t)), 2, m%z), ext)
     end if
-    warnings = run_warnings(m, stats)//stress_warnings(m, loads)
+    warnings = ''
+    call run_warnings(m, stats, warnings)
+    call stress_warnings(m, loads, warnings)
   end subroutine run_results
 
   !> The error estimate of a run of m with tooth forces f at the outputs t (docs/accuracy.md):
@@ -306,11 +308,13 @@ contains
   !> one-way flash temperature that would have closed the backlash (result_checks); contact
   !> switches located for CVODE at an rtol above restart_rtol (restart_warning). The
   !> executable prints them to stderr, Python raises pyspline.SplineWarning (run_results).
-  function run_warnings(m, stats) result(text)
+  !> Appended to text, as every warning of the core (docs/developing.md, "Thread safety").
+  subroutine run_warnings(m, stats, text)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: stats(nstats)
-    character(len=:), allocatable :: text
-    text = restart_warning(m, stats)//accuracy_warning(m, stats)
+    character(len=:), allocatable, intent(inout) :: text
+    call restart_warning(m, stats, text)
+    call accuracy_warning(m, stats, text)
     if (stats(ist_closed) > 0.0_wp) then
       text = text//'case '//trim(m%name)//': the one-way flash temperature closes the backlash '// &
            '(Eq. 2: c0 - kappa (T_M + T_f) <= 0) in '//itoa(nint(stats(ist_closed)))//' tooth '// &
@@ -318,23 +322,22 @@ contains
            'result is not physical there (thermal = ''coupled'' stops at the interference)'// &
            new_line('a')
     end if
-  end function run_warnings
+  end subroutine run_warnings
 
   !> The warnings of accuracy and goal (docs/accuracy.md): a Lyapunov exponent asked with
   !> goal = 'statistics' (its settings bias it); an estimate above the case's accuracy (after
   !> max_tighten tightenings); a tighter run that parts from the run (chaos, or impacts the run
   !> misses: its trajectory beyond is not resolved at these settings).
-  function accuracy_warning(m, stats) result(text)
+  subroutine accuracy_warning(m, stats, text)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: stats(nstats)
-    character(len=:), allocatable :: text
-    text = ''
-    if (m%goal_statistics .and. m%lyapunov) text = 'case '//trim(m%name)//': goal = '// &
+    character(len=:), allocatable, intent(inout) :: text
+    if (m%goal_statistics .and. m%lyapunov) text = text//'case '//trim(m%name)//': goal = '// &
          '''statistics'' with lyapunov = .true.: the exponent is not one of the statistics its '// &
          'settings keep (chaos_z24 read 1152 against 965 1/s, docs/accuracy.md); goal = '// &
          '''trajectory'' for the exponent?'//new_line('a')
     if (.not. m%estimate) return
-    if (m%accuracy > 0.0_wp .and. stats(ist_f_error) > m%accuracy) text = 'case '// &
+    if (m%accuracy > 0.0_wp .and. stats(ist_f_error) > m%accuracy) text = text//'case '// &
          trim(m%name)//': the estimated error of the tooth forces F_error_est = '// &
          num(stats(ist_f_error))//' exceeds accuracy = '//num(m%accuracy)//' at rtol '// &
          num(stats(ist_rtol_used))//' (tightened '//itoa(max_tighten)//' times)'//new_line('a')
@@ -344,7 +347,7 @@ contains
          'largest): beyond it the trajectory is not predictable at these settings (chaos? read '// &
          'its statistics: goal = ''statistics''); F_error_est covers the outputs before'// &
          new_line('a')
-  end function accuracy_warning
+  end subroutine accuracy_warning
 
   !> CVODE (method adams or bdf) restarts at order 1 after every contact switch it locates
   !> (spline_integrator::integrator_restart). Above restart_rtol that falsified a rattling drive: chaos_z24
@@ -352,20 +355,19 @@ contains
   !> rtol <= 1e-3, ERK with roots and every method without roots from 1e-2), finding 2-3 times
   !> the reference's switches (docs/performance.md, "Multistep restarts at loose tolerance";
   !> tests/test_solver.py). Warned after a run that located a switch there.
-  function restart_warning(m, stats) result(text)
+  subroutine restart_warning(m, stats, text)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: stats(nstats)
-    character(len=:), allocatable :: text
-    text = ''
+    character(len=:), allocatable, intent(inout) :: text
     if (m%erk .or. .not. m%roots .or. m%rtol <= restart_rtol .or. stats(ist_roots_found) < 1) &
          return
-    text = 'case '//trim(m%name)//': rtol = '//ftoa(m%rtol, '(es10.3)')//' with method = '''// &
+    text = text//'case '//trim(m%name)//': rtol = '//ftoa(m%rtol, '(es10.3)')//' with method = '''// &
          trim(merge('bdf  ', 'adams', m%method_bdf == 1))//''' and '// &
          itoa(nint(stats(ist_roots_found)))//' contact switches located: CVODE restarts at '// &
          'order 1 after each, and above rtol 1e-3 that can falsify the impacts (chaos_z24 '// &
          'read its T_m RMS a third low at rtol 1e-2, atol 1e-4, with 2-3 times the switches); '// &
          'rtol <= 1e-3 or method = ''erk''?'//new_line('a')
-  end function restart_warning
+  end subroutine restart_warning
 
   !> One run of the model at the level m sets (lazy, nw, consts: run_case's nq, consts; fin:
   !> tooth_outputs' finite; y_start: run_case's).

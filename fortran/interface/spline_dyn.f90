@@ -78,7 +78,7 @@ program spline_dyn
     end function c_csv_record
   end interface
 
-  character(len=:), allocatable :: path, out, arg, tmp, record, summary, stmp, text
+  character(len=:), allocatable :: path, out, arg, tmp, record, summary, stmp, text, start
   character(len=:), allocatable :: warned   !< the warnings printed, one per line (the summary's)
   type(string_t), allocatable :: sets(:)
   character(len=msglen) :: errmsg
@@ -107,29 +107,31 @@ program spline_dyn
   options_done = .false.
   i = 1
   do while (i <= nargs)
-    arg = argument(i)
+    call argument(i, arg)
     if (.not. options_done .and. len(arg) > 1 .and. arg(1:1) == '-') then
       select case (arg)
       case ('-h', '--help')
         call usage(output_unit)
         stop 0, quiet=.true.
       case ('--version')
-        write(*, '(a)') 'spline-dyn (pyspline) '//version()
+        call version(arg)
+        write(*, '(a)') 'spline-dyn (pyspline) '//arg
         stop 0, quiet=.true.
       case ('-o', '--output')
         if (i == nargs) call usage_error(arg//' needs a file name')
         i = i + 1
-        out = argument(i)
+        call argument(i, out)
         have_out = .true.
       case ('--summary')
         if (i == nargs) call usage_error(arg//' needs a file name')
         i = i + 1
-        call set_summary(argument(i))
+        call argument(i, arg)
+        call set_summary(arg)
       case ('--set')
         if (i == nargs) call usage_error('--set needs FIELD=VALUE')
         i = i + 1
         nsets = nsets + 1
-        sets(nsets)%s = argument(i)
+        call argument(i, sets(nsets)%s)
       case ('--')
         options_done = .true.
       case default
@@ -174,7 +176,7 @@ program spline_dyn
       if (c_same_file(summary//c_null_char, out//c_null_char) /= 0) &
            call usage_error('the summary '//summary//' and the CSV '//out//' are the same file')
     end if
-    stmp = temp_name(summary)
+    call temp_name(summary, stmp)
     open(newunit=su, file=stmp, status='replace', action='write', iostat=ios, iomsg=iomsg)
     if (ios /= 0) call die('cannot write the summary '//summary//': '//trim(iomsg), err_case)
     summary_open = .true.
@@ -193,7 +195,7 @@ program spline_dyn
 
   ! the CSV, before the run: writable (a temporary name next to it, renamed when complete)
   if (write_csv) then
-    tmp = temp_name(out)
+    call temp_name(out, tmp)
     open(newunit=u, file=tmp, status='replace', action='write', iostat=ios, iomsg=iomsg)
     if (ios /= 0) call die('cannot write the output '//out//': '//trim(iomsg), err_case)
   end if
@@ -201,7 +203,9 @@ program spline_dyn
   ! right-hand side, the temporary file is removed, and the exit status is 130.
   sigint0 = c_sigint_watch()
 
-  call print_warnings(model_warnings(m, start_warning(m)))
+  call start_warning(m, start)
+  call model_warnings(m, start, text)
+  call print_warnings(text)
   nt = m%n_out*m%realisations    ! realisations = K: K copies of n_out outputs, one after another
   allocate(t(nt), y(nstate, nt), tooth(nt, m%z, ntooth_q), tm(nt))
   call system_clock(c0, rate)
@@ -379,18 +383,20 @@ contains
        loads(il_tf_rev), ' +- ', loads(il_tf_rev_se)
   end subroutine report_loads
 
+  ! The text helpers are subroutines, as in the core (docs/developing.md, "Thread safety").
+
   !> Command argument i, whatever its length.
-  function argument(i) result(s)
+  subroutine argument(i, s)
     integer, intent(in) :: i
-    character(len=:), allocatable :: s
+    character(len=:), allocatable, intent(out) :: s
     integer :: n
     call get_command_argument(i, length=n)
     allocate(character(len=n) :: s)
     if (n > 0) call get_command_argument(i, s)
-  end function argument
+  end subroutine argument
 
-  function version() result(s)
-    character(len=:), allocatable :: s
+  subroutine version(s)
+    character(len=:), allocatable, intent(out) :: s
     character(kind=c_char) :: buf(64)
     integer :: i
     buf = c_null_char
@@ -400,18 +406,18 @@ contains
       if (buf(i) == c_null_char) exit
       s = s//buf(i)
     end do
-  end function version
+  end subroutine version
 
   !> A temporary name in the output's directory: .NAME.tmp-PID (hidden, this process's own).
-  function temp_name(file) result(s)
+  subroutine temp_name(file, s)
     character(len=*), intent(in) :: file
-    character(len=:), allocatable :: s
+    character(len=:), allocatable, intent(out) :: s
     character(len=16) :: pid
     integer :: slash
     write(pid, '(i0)') c_getpid()
     slash = index(file, '/', back=.true.)
     s = file(1:slash)//'.'//file(slash+1:)//'.tmp-'//trim(pid)
-  end function temp_name
+  end subroutine temp_name
 
   subroutine rename_into(from, to)
     character(len=*), intent(in) :: from, to
@@ -446,18 +452,19 @@ contains
     integer :: i2, nt
     summary_open = .false.
     ios = 0
-    write(su, '(a)', iostat=ios) '# spline-dyn summary (pyspline '//version()//'): one run, '// &
+    call version(text)
+    write(su, '(a)', iostat=ios) '# spline-dyn summary (pyspline '//text//'): one run, '// &
          'SI units; NAME [UNIT] = VALUES (17 significant digits), then the case'
     write(su, '(a)', iostat=ios) "format = 'pyspline-summary 1'"
-    write(su, '(a)', iostat=ios) 'case_file = '//quoted(path)
-    if (len(warned) > 0) write(su, '(a)', iostat=ios) 'warnings = '// &
-         quoted(warned(1:len(warned) - 1))         ! the lines printed, as a sweep point keeps
+    call put_text('case_file', path)
+    ! the warning lines printed, as a sweep point keeps them
+    if (len(warned) > 0) call put_text('warnings', warned(1:len(warned) - 1))
     if (.not. ok) then
-      write(su, '(a)', iostat=ios) 'error = '//quoted(trim(msg))
-      write(su, '(a)', iostat=ios) 'error_kind = '//quoted(trim(err_names(code)))
+      call put_text('error', trim(msg))
+      call put_text('error_kind', trim(err_names(code)))
       write(su, '(a,i0)', iostat=ios) 'exit_code [] = ', err_exit_code(code)
       do i2 = 1, nsets
-        write(su, '(a)', iostat=ios) 'set = '//quoted(sets(i2)%s)
+        call put_text('set', sets(i2)%s)
       end do
     else
       do i2 = 1, nstats
@@ -508,9 +515,10 @@ contains
          buf(1:max(nb, 0))
   end subroutine put
 
-  !> Text in single quotes, a quote doubled and a line break written as \n.
-  function quoted(text) result(s)
-    character(len=*), intent(in) :: text
+  !> One summary line NAME = 'TEXT': in single quotes, a quote doubled and a line break
+  !> written as \n.
+  subroutine put_text(name, text)
+    character(len=*), intent(in) :: name, text
     character(len=:), allocatable :: s
     integer :: i2
     s = "'"
@@ -523,8 +531,8 @@ contains
         s = s//text(i2:i2)
       end if
     end do
-    s = s//"'"
-  end function quoted
+    write(su, '(a)', iostat=ios) name//' = '//s//"'"
+  end subroutine put_text
 
   !> A SIGINT since the watch began: remove the temporary files, exit 130.
   subroutine check_interrupt()

@@ -377,26 +377,28 @@ contains
   end subroutine tooth_stresses
 
   !> Warnings about a run's loads (loads in the order of load_q, as run_loads makes them), one
-  !> line each (blank if none): a nominal stress of tooth_stresses beyond its limit
+  !> line each, appended to text: a nominal stress of tooth_stresses beyond its limit
   !> (sigma_root_limit, sigma_flank_limit, tau_pitch_limit); the contact temperature beyond
   !> scuffing_temp or tempering_temp (flash_warning). The executable prints them to
   !> stderr, Python raises pyspline.SplineWarning (api_simulate, through spline_run::
   !> run_results): the same words.
-  function stress_warnings(m, loads) result(text)
+  subroutine stress_warnings(m, loads, text)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: loads(nload)
-    character(len=:), allocatable :: text
-    text = over('root bending stress 6 F cos(alpha) h_f / (b t_f^2)', loads(il_sigma_root), &
-         sigma_root_limit)//over('flank bearing stress F cos(alpha) / (b h_w)', &
-         loads(il_sigma_flank), sigma_flank_limit)//over('shear stress at the pitch circle '// &
-         'F cos(alpha) / (b s)', loads(il_tau_pitch), tau_pitch_limit)//flash_warning()
+    character(len=:), allocatable, intent(inout) :: text
+    call over('root bending stress 6 F cos(alpha) h_f / (b t_f^2)', loads(il_sigma_root), &
+         sigma_root_limit)
+    call over('flank bearing stress F cos(alpha) / (b h_w)', loads(il_sigma_flank), &
+         sigma_flank_limit)
+    call over('shear stress at the pitch circle F cos(alpha) / (b s)', loads(il_tau_pitch), &
+         tau_pitch_limit)
+    call flash_warning()
   contains
     !> T_B = T_M + max T_f (a run with flash temperature) beyond scuffing_temp, or, stronger,
     !> beyond tempering_temp.
-    function flash_warning() result(line)
+    subroutine flash_warning()
       character(len=:), allocatable :: line
       real(wp) :: tb
-      line = ''
       tb = m%t_bulk + loads(il_tf_max)
       if (.not. loads(il_tf_max) > 0.0_wp .or. .not. tb > scuffing_temp) return
       line = 'case '//trim(m%name)//': contact temperature T_M + T_f = '// &
@@ -412,26 +414,26 @@ contains
         line = line//itoa(nint(scuffing_temp))//' degC, the top of typical scuffing temperatures '// &
              'of gear oils on steel (Blok''s criterion; ISO/TS 6336-20): scuffing likely. Run as given'
       end if
-      line = line//new_line('a')
-    end function flash_warning
+      text = text//line//new_line('a')
+    end subroutine flash_warning
 
-    function over(what, x, limit) result(line)
+    subroutine over(what, x, limit)
       character(len=*), intent(in) :: what
       real(wp), intent(in) :: x, limit
-      character(len=:), allocatable :: line
-      line = ''
+      character(len=:), allocatable :: h
       if (.not. x > limit) return
-      line = 'case '//trim(m%name)//': '//what//' = '//ftoa(x*1.0e-6_wp, '(f0.1)')// &
+      call hint(x, limit, h)
+      text = text//'case '//trim(m%name)//': '//what//' = '//ftoa(x*1.0e-6_wp, '(f0.1)')// &
            ' MPa at the peak load of tooth '//itoa(nint(loads(il_load_sharing_tooth)))// &
            ' (t_d = '//ftoa(m%t_d, '(es10.3)')//' N m) exceeds '//itoa(nint(limit*1.0e-6_wp))// &
            ' MPa, a typical allowable of case-hardened steel (an estimate, docs/model.md '// &
-           'section 15)'//hint(x, limit)//'. Run as given'//new_line('a')
-    end function over
+           'section 15)'//h//'. Run as given'//new_line('a')
+    end subroutine over
     !> Why: the static load alone (F_static, the peak over the load-sharing factor) beyond the
     !> limit points to the torque's unit, else the run's dynamic peak.
-    function hint(x, limit) result(h)
+    subroutine hint(x, limit, h)
       real(wp), intent(in) :: x, limit
-      character(len=:), allocatable :: h
+      character(len=:), allocatable, intent(out) :: h
       h = ': a dynamic peak (no drive torque)'
       if (.not. loads(il_f_static) > 0.0_wp) return
       if (x/loads(il_load_sharing) > limit) then
@@ -439,8 +441,8 @@ contains
       else
         h = ': a dynamic peak, load-sharing factor '//ftoa(loads(il_load_sharing), '(f0.2)')
       end if
-    end function hint
-  end function stress_warnings
+    end subroutine hint
+  end subroutine stress_warnings
 
   !> Standard errors by batch means (e.g. Law & Kelton, Simulation Modeling and Analysis, ch.
   !> 9.5): output k belongs to revolution floor(omega (t_k - t_1) / 2 pi) + 1, the outputs k0(r)

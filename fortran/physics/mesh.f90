@@ -159,9 +159,9 @@ contains
   !> start = 'rest' (plus dq0) with a tooth overlapping beyond its backlash at t0: the largest
   !> |dn_j| - c of Eq. 11 (face centre, with the tooth's spacing error e_j) over the teeth in
   !> the start state; one of spline_model::model_warnings (its argument start).
-  function start_warning(m) result(text)
+  subroutine start_warning(m, text)
     type(model_t), intent(in) :: m
-    character(len=:), allocatable :: text
+    character(len=:), allocatable, intent(out) :: text
     real(wp) :: sp(m%z), cp(m%z), dn(m%z), ddn(m%z)
     integer :: j
     text = ''
@@ -178,7 +178,7 @@ contains
          num(m%c_bulk, readable=.true.)//' m by '//num(dn(j) - m%c_bulk, readable=.true.)// &
          ' m (Eq. 11 at t0): an impact made by the start, not the drive; '// &
          'start = ''equilibrium''? Run as given'//new_line('a')
-  end function start_warning
+  end subroutine start_warning
 
   !> Eq. 11 and its total time derivative (phi_j' = omega) for one tooth at the face centre, the
   !> one place they are written (right-hand side, switch functions, outputs, loads): the tooth's

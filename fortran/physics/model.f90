@@ -316,10 +316,11 @@ contains
   !> deflection_limit of the module. The executable prints them to stderr, Python raises
   !> pyspline.SplineWarning (api_load_file's and api_load_fields' warn). start: the start
   !> warning, spline_mesh::start_warning(m) (Eq. 11 lives in spline_mesh, which uses this module).
-  function model_warnings(m, start) result(text)
+  !> A subroutine, as every text builder of the core (docs/developing.md, "Thread safety").
+  subroutine model_warnings(m, start, text)
     type(model_t), intent(in) :: m
     character(len=*), intent(in) :: start
-    character(len=:), allocatable :: text
+    character(len=:), allocatable, intent(out) :: text
     text = ''
     if (.not. m%k_m_computed .and. m%k_m_nofillet > 0.0_wp) then
       if (m%k_m*k_m_warn_ratio < m%k_m_nofillet) then
@@ -329,30 +330,32 @@ contains
              'unit slip (N/mm for N/m)? Run as given'//new_line('a')
       end if
     end if
-    text = text//support_warning(m)//windup_warning(m)//start//load_warning(m)// &
-         separation_warning(m)
-  end function model_warnings
+    call support_warning(m, text)
+    call windup_warning(m, text)
+    text = text//start
+    call load_warning(m, text)
+    call separation_warning(m, text)
+  end subroutine model_warnings
 
   !> Benettin's separated copy with a given lyapunov_d0 below the default's (lyapunov_separation)
   !> where the copy's contact switches are not located for it: roots off (a switch falls inside
   !> a step). There a small d0 reads nonsense: 11-82 1/s at d0 = rtol and rtol / 10 on a drive
   !> whose exponent is -1.8 1/s (tests/test_chaos.py). ERK with roots locates the copy's too
   !> (spline_solver::settle_roots: d0 = 1e-8 and 1e-9 read CVODE's -1.8).
-  function separation_warning(m) result(text)
+  subroutine separation_warning(m, text)
     type(model_t), intent(in) :: m
-    character(len=:), allocatable :: text
+    character(len=:), allocatable, intent(inout) :: text
     real(wp) :: d
-    text = ''
     if (.not. m%lyapunov .or. m%lyap_tangent .or. m%roots) return
     d = lyapunov_separation(0.0_wp, m%rtol)
     if (m%lyap_d0 >= d) return
-    text = 'case '//trim(m%name)//': field lyapunov_d0 = '//num(m%lyap_d0, readable=.true.)// &
+    text = text//'case '//trim(m%name)//': field lyapunov_d0 = '//num(m%lyap_d0, readable=.true.)// &
          ' is below the default separation '//num(d, readable=.true.)//' (1e4 rtol) with '// &
          'roots = .false.: the separated copy '// &
          'does not see its own contact switches and can read nonsense (+11 to +82 1/s '// &
          'measured for a true -1.8 1/s); lyapunov_d0 = 0 or lyapunov_method = ''tangent''? '// &
          'Run as given'//new_line('a')
-  end function separation_warning
+  end subroutine separation_warning
 
   !> Supports too soft for the offset to reach the teeth. Under torque every tooth is on its
   !> drive flank and the mesh resists a lateral offset from zero, the backlash taken up by the
@@ -364,11 +367,10 @@ contains
   !> factor 1 + e / delta), and teeth unload beyond it. Warned when the offset would unload teeth
   !> on rigid supports, |l| > delta, but the supports leave e <= support_limit delta (not with a
   !> floating spline, k_p = 0, frozen lateral motion, dof = 3, or no drive torque).
-  function support_warning(m) result(text)
+  subroutine support_warning(m, text)
     type(model_t), intent(in) :: m
-    character(len=:), allocatable :: text
+    character(len=:), allocatable, intent(inout) :: text
     real(wp) :: l, k_mesh, k_s, e, delta
-    text = ''
     l = hypot(m%l_x, m%l_y)
     if (m%dof /= 7 .or. min(m%k_p1, m%k_p2) <= 0.0_wp .or. m%t_d == 0.0_wp) return
     k_mesh = m%z*m%k_m/2.0_wp
@@ -376,7 +378,7 @@ contains
     e = l*k_s/(k_mesh + k_s)
     delta = static_tooth_load(m)/m%k_m
     if (l <= delta .or. e > support_limit*delta) return
-    text = 'case '//trim(m%name)//': fields k_p1 = '//num(m%k_p1, readable=.true.)// &
+    text = text//'case '//trim(m%name)//': fields k_p1 = '//num(m%k_p1, readable=.true.)// &
          ', k_p2 = '//num(m%k_p2, readable=.true.)//' N/m: the supports (in series '// &
          num(k_s, readable=.true.)//' N/m, the mesh Z k_m / 2 = '// &
          num(k_mesh, readable=.true.)//' N/m) leave e = '//num(e, readable=.true.)// &
@@ -387,17 +389,18 @@ contains
          ' %): the teeth barely see the misalignment: it raises the static load-sharing '// &
          'factor to 1 + e / delta = '//num(1.0_wp + e/delta, readable=.true.)// &
          '. Run as given'//new_line('a')
-  end function support_warning
+  end subroutine support_warning
 
   !> Static wind-up of the shafts, T_d / k_t1 and T_L / k_t2, above windup_limit (not for a
   !> free shaft, k_t = 0).
-  function windup_warning(m) result(text)
+  subroutine windup_warning(m, text)
     type(model_t), intent(in) :: m
-    character(len=:), allocatable :: text
-    text = ''
+    character(len=:), allocatable, intent(inout) :: text
+    character(len=:), allocatable :: shafts
+    shafts = ''
     call shaft('k_t1', m%k_t1, 't_d', m%t_d)
     call shaft('k_t2', m%k_t2, 't_l', m%t_l)
-    if (len(text) > 0) text = 'case '//trim(m%name)//': '//text//' (limit '// &
+    if (len(shafts) > 0) text = text//'case '//trim(m%name)//': '//shafts//' (limit '// &
          ftoa(windup_limit, '(f4.2)')//' rad = '//ftoa(windup_limit*180.0_wp/pi, '(f4.1)')// &
          ' deg): shafts this soft? Run as given'//new_line('a')
   contains
@@ -405,22 +408,21 @@ contains
       character(len=*), intent(in) :: kname, tname
       real(wp), intent(in) :: k, t
       if (k <= 0.0_wp .or. abs(t) <= windup_limit*k) return
-      if (len(text) > 0) text = text//'; '
-      text = text//'field '//kname//' = '//num(k, readable=.true.)// &
+      if (len(shafts) > 0) shafts = shafts//'; '
+      shafts = shafts//'field '//kname//' = '//num(k, readable=.true.)// &
            ' N m/rad winds its shaft '//num(abs(t)/k, readable=.true.)//' rad under '// &
            tname//' = '//num(t, readable=.true.)//' N m'
     end subroutine shaft
-  end function windup_warning
+  end subroutine windup_warning
 
   !> The static tooth load T / (Z r_b) of the larger torque, all teeth sharing it, deflects a
   !> tooth by that load over the geometry's Eq. 18 stiffness (whatever k_m the case gives):
   !> above deflection_limit of the module no steel tooth carries it.
-  function load_warning(m) result(text)
+  subroutine load_warning(m, text)
     type(model_t), intent(in) :: m
-    character(len=:), allocatable :: text
+    character(len=:), allocatable, intent(inout) :: text
     real(wp) :: t, f, k, d
     character(len=3) :: tname
-    text = ''
     k = m%k_terms(ik_m)
     if (k <= 0.0_wp) return
     t = m%t_d; tname = 't_d'
@@ -430,13 +432,13 @@ contains
     f = static_tooth_load(m, t)
     d = f/k
     if (d <= deflection_limit*m%m_n) return
-    text = 'case '//trim(m%name)//': field '//tname//' = '//num(t, readable=.true.)// &
+    text = text//'case '//trim(m%name)//': field '//tname//' = '//num(t, readable=.true.)// &
          ' N m loads each tooth with '//num(f, readable=.true.)// &
          ' N (T / (Z r_b)) and deflects it '//num(d, readable=.true.)//' m (Eq. 18: '// &
          num(k, readable=.true.)//' N/m), '//num(100.0_wp*d/m%m_n, readable=.true.)// &
          ' % of the module (limit '// &
          itoa(nint(100.0_wp*deflection_limit))//' %): a torque in N mm? Run as given'//new_line('a')
-  end function load_warning
+  end subroutine load_warning
 
   !> |T| / (Z r_b): the load of each tooth when the Z teeth share the torque T equally (the
   !> static, aligned mesh of Eq. 22) [N]; T: the driving torque T_d unless given.
