@@ -50,6 +50,7 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
+import ctypes.util
 import os
 import statistics
 import sys
@@ -89,8 +90,9 @@ TAILED = "DOP853 + tail"
 
 @contextlib.contextmanager
 def _quiet_stdout():
-    """File descriptor 1 on os.devnull, C's stdio flushed before it is restored: DOP853 (C)
-    prints "the problem seems to become stiff" on stdout, which the race's lines would drown in."""
+    """File descriptor 1 on os.devnull, C's and gfortran's buffers flushed before it is
+    restored: numbalsoda's DOP853 (Fortran, unit 6) writes "the problem seems to become stiff" on
+    stdout, buffered, which the race's lines would drown in."""
     sys.stdout.flush()
     saved, null = os.dup(1), os.open(os.devnull, os.O_WRONLY)
     os.dup2(null, 1)
@@ -98,12 +100,16 @@ def _quiet_stdout():
         yield
     finally:
         _LIBC.fflush(None)
+        if _GFORTRAN is not None:
+            _GFORTRAN._gfortran_flush_i4(None)        # FLUSH of every open unit
         os.dup2(saved, 1)
         os.close(saved)
         os.close(null)
 
 
 _LIBC = ctypes.CDLL(None)
+_GFORTRAN = ctypes.CDLL(ctypes.util.find_library("gfortran")) if ctypes.util.find_library(
+    "gfortran") else None
 
 
 def _realisation(case, k):
