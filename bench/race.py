@@ -296,7 +296,7 @@ def _race_pointwise(scene, case, accuracies, peer, repeat, quick, progress, vari
     rows = []
     for a in accuracies:
         ok = [r for r in timed if a in r["accuracies"]]
-        rows.append(_row(scene, a, ok, [autos[("accuracy", a)]]))
+        rows.append(_row(scene, a, ok, [autos[("accuracy", a)]] if tail else []))
     return rows, scans + timed + list(autos.values())
 
 
@@ -351,7 +351,7 @@ def race(quick=False, repeat=5, progress=print, cases=None, variants=None, tail=
                                      variants, tail)
         else:
             r, rec = _race_statistics(scene, case, peer, repeat, quick, variants)
-        rows += r
+        rows += [dict(x, tail=tail) for x in r]
         runs += rec
     return rows, runs
 
@@ -492,7 +492,8 @@ def format_rows(rows):
                      f"{r['ratio_untailed']:.2f})")
         lines.append(f"{r['scene']} | {acc} | pyspline {cell(r['pyspline'])} | DOP853 "
                      f"{cell(r['dop853'])} | LSODA {cell(r['lsoda'])} | DOP853 + tail "
-                     f"{cell(r['tailed'])} | peer/pyspline {ratio}")
+                     f"{cell(r['tailed']) if r.get('tail', True) else 'not run'} | "
+                     f"peer/pyspline {ratio}")
         for a in r.get("autos", []):
             est = f", F error est {a['F_error_est']:.2g}" if "F_error_est" in a else ""
             err = f"F error {a['err']:.2g}{est}, " if a["err"] == a["err"] else ""
