@@ -184,10 +184,11 @@ def test_tail_system_is_the_oracles_in_full_contact(name):
     import peer_tail
     case = numba_peer.load_case(dict(TAIL_CASES[name], name=name))
     p = oracle.prepare(case)
-    tp = peer_tail.TailPeer(case)
+    l, w = p.c0, p.omega                            # Eq. 25's scales (thermal level none)
+    scale = np.r_[np.full(7, l), np.full(7, l * w)]
     rng = np.random.default_rng(3)
     for s in (-1.0, 1.0):
-        fl = peer_tail.Flank(p, s, tp.c, tp.setup.l, tp.w)
+        fl = peer_tail.Flank(p, s, p.c0, l, w)
         assert fl.ok == (s < 0)
         for _ in range(30):
             y = np.r_[rng.uniform(-0.3, 0.3, 7) * p.c0, rng.uniform(-0.3, 0.3, 7) * p.c0 * p.omega]
@@ -197,8 +198,8 @@ def test_tail_system_is_the_oracles_in_full_contact(name):
             t = rng.uniform(0, 0.05)
             m = oracle.mesh(t, y, p)
             assert np.all(s * m["dn"] > m["c"])
-            fo = oracle.rhs(t, y, p) / tp.setup.scale / tp.w
-            np.testing.assert_allclose(fl.A @ (y / tp.setup.scale) + fl.b, fo, rtol=1e-12,
+            fo = oracle.rhs(t, y, p) / scale / w
+            np.testing.assert_allclose(fl.A @ (y / scale) + fl.b, fo, rtol=1e-12,
                                        atol=1e-12 * np.abs(fo).max())
 
 
