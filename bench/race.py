@@ -9,7 +9,8 @@ switches at rtol 1e-13; its agreement with the peer's DOP853 at rtol 1e-13 is pr
 
 The scenes judged pointwise (issue 34): a setting is a family (pyspline: every CVODE variant of
 speed.PYSPLINE_VARIANTS with and without root finding; the peer: numbalsoda's DOP853 and LSODA on
-bench/numba_peer.py's fast RHS) with an atol of 1e-2 rtol or of rtol (on the scaled states of Eq.
+bench/numba_peer.py's fast RHS, and DOP853 with the peer's own closed-form tail, bench/peer_tail.py;
+`tail=False`: neither side with a tail) with an atol of 1e-2 rtol or of rtol (on the scaled states of Eq.
 25, both sides: LSODA needs 3x fewer RHS calls with atol = rtol, DOP853 and CVODE do not) and an
 rtol on a ladder of quarter decades (RUNGS: the loosest passing rung is then at most 1.8x
 tighter than needed, where decades let one side pay for up to 10x). Each family's ladder is
