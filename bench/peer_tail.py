@@ -70,9 +70,13 @@ class Flank:
         Y = affine_rhs(p, s, c)(np.c_[np.zeros(14), np.eye(14)])    # b, then b + A e_i
         self.A = (Y[:, 1:] - Y[:, :1]) * sc[None, :] / sc[:, None] / w
         self.b = Y[:, 0] / sc / w
-        self.ustar = np.linalg.solve(self.A, -self.b)
-        self.lam, self.V = np.linalg.eig(self.A)
-        self.Vi = np.linalg.inv(self.V)
+        self.ok = False
+        try:                                  # no fixed point (e.g. no support): nothing proven
+            self.ustar = np.linalg.solve(self.A, -self.b)
+            self.lam, self.V = np.linalg.eig(self.A)
+            self.Vi = np.linalg.inv(self.V)
+        except np.linalg.LinAlgError:
+            return
         V, u = self.V, self.ustar
         self.weight = np.abs(V[5]) + np.hypot(np.abs(V[0] - V[2]), np.abs(V[1] - V[3]))
         self.margin = s * u[5] - c / l - math.hypot(u[0] + p.l_x / l - u[2],
