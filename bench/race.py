@@ -9,7 +9,8 @@ switches at rtol 1e-13; its agreement with the peer's DOP853 at rtol 1e-13 is pr
 
 The scenes judged pointwise (issue 34): a setting is a family (pyspline: every CVODE variant of
 speed.PYSPLINE_VARIANTS with and without root finding; the peer: numbalsoda's DOP853 and LSODA on
-bench/numba_peer.py's fast RHS) with an atol of 1e-2 rtol or of rtol (on the scaled states of Eq.
+bench/numba_peer.py's fast RHS, and DOP853 with the peer's own closed-form tail, bench/peer_tail.py;
+`tail=False`: neither side with a tail) with an atol of 1e-2 rtol or of rtol (on the scaled states of Eq.
 25, both sides: LSODA needs 3x fewer RHS calls with atol = rtol, DOP853 and CVODE do not) and an
 rtol on a ladder of quarter decades (RUNGS: the loosest passing rung is then at most 1.8x
 tighter than needed, where decades let one side pay for up to 10x). Each family's ladder is
@@ -48,8 +49,12 @@ its CPU time is both threads'; compare wall times).
 """
 from __future__ import annotations
 
+import contextlib
+import ctypes
+import ctypes.util
 import os
 import statistics
+import sys
 import time
 
 import numpy as np
@@ -80,6 +85,32 @@ RUNGS = tuple(10.0 ** (-k / 4) for k in range(16, 49))
 ATOL_RATIOS = (1e-2, 1.0)
 #: a family's scan stops at a run of more CPU seconds than this (no candidate beyond it)
 SCAN_LIMIT_S = 5.0
+#: the label of the peer with its closed-form tail (DOP853 to the proven hand-over)
+TAILED = "DOP853 + tail"
+
+
+@contextlib.contextmanager
+def _quiet_stdout():
+    """File descriptor 1 on os.devnull, C's and gfortran's buffers flushed before it is
+    restored: numbalsoda's DOP853 (Fortran, unit 6) writes "the problem seems to become stiff" on
+    stdout, buffered, which the race's lines would drown in."""
+    sys.stdout.flush()
+    saved, null = os.dup(1), os.open(os.devnull, os.O_WRONLY)
+    os.dup2(null, 1)
+    try:
+        yield
+    finally:
+        _LIBC.fflush(None)
+        if _GFORTRAN is not None:
+            _GFORTRAN._gfortran_flush_i4(None)        # FLUSH of every open unit
+        os.dup2(saved, 1)
+        os.close(saved)
+        os.close(null)
+
+
+_LIBC = ctypes.CDLL(None)
+_GFORTRAN = ctypes.CDLL(ctypes.util.find_library("gfortran")) if ctypes.util.find_library(
+    "gfortran") else None
 
 
 def _realisation(case, k):
@@ -126,13 +157,16 @@ def statistics_of(case, t, tm):
     return per.mean(axis=0), np.array([std_error(c) for c in per.T])
 
 
-def _families(peer, variants=PYSPLINE_VARIANTS):
-    """(side, label, fields, atol ratio) of every setting family of the pointwise scenes."""
+def _families(peer, variants=PYSPLINE_VARIANTS, tail=True):
+    """(side, label, fields, atol ratio) of every setting family of the pointwise scenes (tail:
+    with the peer's closed-form tail, bench/peer_tail.py)."""
     fam = [("pyspline", f"CVODE {v}{' + roots' if roots else ''}", dict(roots=roots, **_cvode_kw(v)),
             ar) for v in variants for roots in (False, True) for ar in ATOL_RATIOS]
     if peer is not None:
         fam += [("peer", m, dict(method=m.lower()), ar) for m in ("DOP853", "LSODA")
                 for ar in ATOL_RATIOS]
+        if tail:
+            fam += [("peer", TAILED, dict(method="dop853", tail=True), ar) for ar in ATOL_RATIOS]
     return fam
 
 
@@ -145,7 +179,10 @@ class _Runner:
         self.y0s = [start_state(c) for c in reals]
         self.t_peer = np.r_[case["t0"], t_out] if t_out[0] > case["t0"] else t_out
         self.setup = peer.Setup(_peer_fields(case)) if peer is not None else None
+        self.tailed = None
         if self.setup is not None:      # compile the RHS and the forces before any clock
+            import peer_tail
+            self.tailed = peer_tail.TailPeer(_peer_fields(case))
             for m in ("dop853", "lsoda"):
                 self("peer", dict(method=m), 1e-6, 1e-8, t=self.t_peer[:3])
 
@@ -158,9 +195,11 @@ class _Runner:
         t = self.t_peer if t is None else t
         n = len(t) - (len(self.t_peer) - len(self.t_out))
         mx = 10**9 if kw["method"] == "dop853" else 10**7   # DOP853: steps of the whole run
-        c0, w0 = time.process_time(), time.perf_counter()
-        tm, F, ok = self.setup.run(self.y0s[k], t, rtol, atol, kw["method"], mx)
-        cpu, wall = time.process_time() - c0, time.perf_counter() - w0
+        peer = self.tailed if kw.get("tail") else self.setup
+        with _quiet_stdout():
+            c0, w0 = time.process_time(), time.perf_counter()
+            tm, F, ok = peer.run(self.y0s[k], t, rtol, atol, kw["method"], mx)
+            cpu, wall = time.process_time() - c0, time.perf_counter() - w0
         tm, F = tm[-n:], F[-n:]
         if not ok:
             raise RuntimeError(f"peer {kw['method']} failed at rtol {rtol:g}")
@@ -184,10 +223,11 @@ def _candidates(errs, accuracies):
 
 
 def _best(recs):
+    recs = [r for r in recs if r]
     return min(recs, key=lambda r: r["cpu_s"]) if recs else None
 
 
-def _race_pointwise(scene, case, accuracies, peer, repeat, quick, progress, variants):
+def _race_pointwise(scene, case, accuracies, peer, repeat, quick, progress, variants, tail):
     ref = _reference(case, 1e-13)
     fmax = np.abs(ref.F).max()
     runner = _Runner(case, [case], peer, ref.t)
@@ -195,9 +235,13 @@ def _race_pointwise(scene, case, accuracies, peer, repeat, quick, progress, vari
         F_peer = runner("peer", dict(method="dop853"), 1e-13, 1e-15)[3]
         progress(f"{scene}: reference (CVODE BDF + roots, rtol 1e-13) vs peer DOP853 rtol "
                  f"1e-13: F error {np.abs(F_peer - ref.F).max() / fmax:.1e}")
+    if peer is not None and tail:
+        F_tail = runner("peer", dict(method="dop853", tail=True), 1e-13, 1e-15)[3]
+        progress(f"{scene}: the peer's tail from t = {runner.tailed.tail_t:.4g} s; its F at "
+                 f"rtol 1e-13 vs DOP853's without it {np.abs(F_tail - F_peer).max() / fmax:.1e}")
     rungs = RUNGS[::4] if quick else RUNGS          # quick: decades
     scans, cands, errmap = [], {}, {}    # cands: (family index, rung) -> accuracies
-    fams = _families(peer, variants)
+    fams = _families(peer, variants, tail)
     for fi, (side, label, kw, ar) in enumerate(fams):
         errs = []
         for i, rt in enumerate(rungs):
@@ -222,7 +266,7 @@ def _race_pointwise(scene, case, accuracies, peer, repeat, quick, progress, vari
     # the accuracy settings (docs/accuracy.md): pyspline picks the method, rtol and roots and
     # estimates the error; timed in the same rounds as the hand-tuned candidates
     autos = {}
-    for a in accuracies:
+    for a in accuracies if tail else ():
         res = simulate(case.replace(accuracy=a))
         autos[("accuracy", a)] = dict(scene=scene, side="pyspline", setting=f"accuracy = {a:g}",
                                       atol_ratio=1e-2, rtol=res.stats["rtol_used"],
@@ -253,7 +297,7 @@ def _race_pointwise(scene, case, accuracies, peer, repeat, quick, progress, vari
     rows = []
     for a in accuracies:
         ok = [r for r in timed if a in r["accuracies"]]
-        rows.append(_row(scene, a, ok, [autos[("accuracy", a)]]))
+        rows.append(_row(scene, a, ok, [autos[("accuracy", a)]] if tail else []))
     return rows, scans + timed + list(autos.values())
 
 
@@ -264,7 +308,8 @@ def _row(scene, accuracy, ok, autos):
     ratio against the peer (CPU, wall) and its CPU time over the hand-tuned best's (vs_hand)."""
     best = {"pyspline": _best([r for r in ok if r["side"] == "pyspline"]),
             "dop853": _best([r for r in ok if r["setting"] == "DOP853"]),
-            "lsoda": _best([r for r in ok if r["setting"] == "LSODA"])}
+            "lsoda": _best([r for r in ok if r["setting"] == "LSODA"]),
+            "tailed": _best([r for r in ok if r["setting"] == TAILED])}
     fastest = _best([b for n, b in best.items() if n != "pyspline" and b])
     row = dict(scene=scene, accuracy=accuracy, **best, ratio=None, round_ratios=None, autos=autos)
     if fastest and best["pyspline"]:
@@ -272,6 +317,8 @@ def _row(scene, accuracy, ok, autos):
         row["wall_ratio"] = fastest["wall_s"] / best["pyspline"]["wall_s"]
         row["round_ratios"] = [p / q for p, q in zip(fastest["cpu_runs"],
                                                      best["pyspline"]["cpu_runs"])]
+        untailed = _best([best["dop853"], best["lsoda"]]) or fastest
+        row["ratio_untailed"] = untailed["cpu_s"] / best["pyspline"]["cpu_s"]
     for rec in autos:
         rec["ratio"] = fastest["cpu_s"] / rec["cpu_s"] if fastest else None
         rec["wall_ratio"] = fastest["wall_s"] / rec["wall_s"] if fastest else None
@@ -285,10 +332,12 @@ def _pyspline_settings(rtols, variants=PYSPLINE_VARIANTS):
             for rt in rtols]
 
 
-def race(quick=False, repeat=5, progress=print, cases=None, variants=None):
+def race(quick=False, repeat=5, progress=print, cases=None, variants=None, tail=True):
     """Rows of the table (one per scene and accuracy) and every run's record; cases: only the
     scenes of these case names; variants: only these of pyspline's setting families
-    (speed.PYSPLINE_VARIANTS; the accuracy and goal settings always run)."""
+    (speed.PYSPLINE_VARIANTS; the accuracy and goal settings always run); tail False: the
+    race without a tail on either side (pyspline and its reference with linear_tail =
+    .false., the peer without bench/peer_tail.py; no accuracy settings)."""
     variants = tuple(variants or PYSPLINE_VARIANTS)
     peer = _numba_peer()
     rows, runs = [], []
@@ -296,12 +345,14 @@ def race(quick=False, repeat=5, progress=print, cases=None, variants=None):
         if cases and name not in cases:
             continue
         case = _case(name, fields, quick)
+        if not tail:
+            case = case.replace(linear_tail=False)
         if accuracies != ("statistics",):
             r, rec = _race_pointwise(scene, case, accuracies, peer, repeat, quick, progress,
-                                     variants)
+                                     variants, tail)
         else:
             r, rec = _race_statistics(scene, case, peer, repeat, quick, variants)
-        rows += r
+        rows += [dict(x, tail=tail) for x in r]
         runs += rec
     return rows, runs
 
@@ -430,16 +481,20 @@ def format_rows(rows):
                 f"wall {r['wall_s']*1e3:.2f} ({r['setting']}, rtol {r['rtol']:.3g}, atol "
                 f"{r['atol_ratio']:g} rtol)")
     lines = ["scene | accuracy | pyspline CPU median [min-max], wall median (setting) | peer "
-             "DOP853 | peer LSODA | peer/pyspline: CPU medians, per-round min-median-max, wall"]
+             "DOP853 | peer LSODA | peer DOP853 + tail | peer/pyspline: CPU medians, per-round "
+             "min-median-max, wall; the peer without its tail"]
     for r in rows:
         acc = "statistics" if r["accuracy"] == "statistics" else f"F error <= {r['accuracy']:g}"
         ratio = "-"
         if r["ratio"]:
             rr = r["round_ratios"]
             ratio = (f"{r['ratio']:.2f} (rounds {min(rr):.2f}-{statistics.median(rr):.2f}-"
-                     f"{max(rr):.2f}; wall {r['wall_ratio']:.2f})")
+                     f"{max(rr):.2f}; wall {r['wall_ratio']:.2f}; without its tail "
+                     f"{r['ratio_untailed']:.2f})")
         lines.append(f"{r['scene']} | {acc} | pyspline {cell(r['pyspline'])} | DOP853 "
-                     f"{cell(r['dop853'])} | LSODA {cell(r['lsoda'])} | peer/pyspline {ratio}")
+                     f"{cell(r['dop853'])} | LSODA {cell(r['lsoda'])} | DOP853 + tail "
+                     f"{cell(r['tailed']) if r.get('tail', True) else 'not run'} | "
+                     f"peer/pyspline {ratio}")
         for a in r.get("autos", []):
             est = f", F error est {a['F_error_est']:.2g}" if "F_error_est" in a else ""
             err = f"F error {a['err']:.2g}{est}, " if a["err"] == a["err"] else ""

@@ -110,6 +110,8 @@ def main(argv=None) -> int:
     p.add_argument("--variants", nargs="+", choices=PYSPLINE_VARIANTS, help="race: only these "
                    "of pyspline's setting families (default: all; the accuracy and goal settings "
                    "always run)")
+    p.add_argument("--no-tail", action="store_true", help="race: no closed-form tail on either "
+                   "side (pyspline's linear_tail = .false., the peer without bench/peer_tail.py)")
     p.add_argument("--out", default="out/bench", help="output directory (default out/bench)")
     p.add_argument("--quick", action="store_true", help="small sizes (for CI)")
     args = p.parse_args(argv)
@@ -120,7 +122,7 @@ def main(argv=None) -> int:
                                 text=True, cwd=Path(__file__).resolve().parent).stdout.strip()
         print(f"race at commit {commit or '?'}; {race.load()}", flush=True)
         rows, runs = race.race(quick=args.quick, repeat=args.repeats or (2 if args.quick else 5),
-                               cases=args.cases, variants=args.variants,
+                               cases=args.cases, variants=args.variants, tail=not args.no_tail,
                                progress=lambda m: print(m, flush=True))
         print(f"{race.load()} (at the end)")
         print("\n".join(race.format_rows(rows)))

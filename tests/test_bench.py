@@ -204,8 +204,9 @@ def test_race_statistics_level_needs_the_spread_too():
 
 
 def test_race_quick_times_the_peer_with_its_forces(tmp_path):
-    """A quick race of the paper scene: both sides reach each accuracy with a candidate timed
-    in every round, the peer's error from its own forces, and the ratio is of their medians."""
+    """A quick race of the paper scene: both sides (the peer with and without its closed-form
+    tail) reach each accuracy with a candidate timed in every round, the peer's error from its
+    own forces, and the ratio is of their medians."""
     if importlib.util.find_spec("numbalsoda") is None:   # not imported: its import compiles
         pytest.skip("numbalsoda is not installed")
     import race
@@ -213,9 +214,10 @@ def test_race_quick_times_the_peer_with_its_forces(tmp_path):
                            cases=["paper_lx1e-4"])
     assert [r["accuracy"] for r in rows] == [1e-6, 1e-8, 1e-6]
     for r in rows:
-        for side in ("pyspline", "dop853"):
+        for side in ("pyspline", "dop853", "tailed"):
             assert r[side]["err"] <= r["accuracy"] and len(r[side]["cpu_runs"]) == 2
-        fastest = min((b for b in (r["dop853"], r["lsoda"]) if b), key=lambda b: b["cpu_s"])
+        fastest = min((b for b in (r["dop853"], r["lsoda"], r["tailed"]) if b),
+                      key=lambda b: b["cpu_s"])
         assert r["ratio"] == pytest.approx(fastest["cpu_s"] / r["pyspline"]["cpu_s"])
     assert {r["kind"] for r in runs} == {"scan", "timed"}
     assert race.format_rows(rows)[1].startswith("paper_lx1e-4, 1 s, 6401 outputs | F error")

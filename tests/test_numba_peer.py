@@ -166,3 +166,60 @@ def test_race_run_matches_oracle():
         np.testing.assert_allclose(du * s.scale * s.w, fo, rtol=1e-12, atol=1e-12 * np.abs(fo).max())
         n_contact += np.count_nonzero(oracle.mesh(t, y, p)["F"])
     assert 20 < n_contact < 60 * p.z - 20
+
+
+#: the race's peer with its closed-form tail (bench/peer_tail.py) on the paper drive and a stiff
+#: Z = 24 drive with physical mesh damping (physical_z24's numbers, k_m and c_m given)
+TAIL_CASES = {"paper": dict(BASE, l_x=1e-4),
+              "z24": dict(z=24, module_m=1.25e-3, s=1.963e-3, c0=1e-4, speed_rpm=3000.0,
+                          t_d=50.0, t_l=50.0, l_x=5e-5, k_m=7.6e8, c_m=1796.0, k_t1=7744.0,
+                          k_t2=7744.0)}
+
+
+@pytest.mark.parametrize("name", sorted(TAIL_CASES))
+def test_tail_system_is_the_oracles_in_full_contact(name):
+    """The tail's affine system u' = A u + b (its closed form of the mesh in full contact) equals
+    oracle.rhs in the scaled units of Eq. 25 at states with every tooth on flank s, at any
+    angle; the drive's own flank (s = -1 under T_d > 0) is provable, the other is not."""
+    import peer_tail
+    case = numba_peer.load_case(dict(TAIL_CASES[name], name=name))
+    p = oracle.prepare(case)
+    l, w = p.c0, p.omega                            # Eq. 25's scales (thermal level none)
+    scale = np.r_[np.full(7, l), np.full(7, l * w)]
+    rng = np.random.default_rng(3)
+    for s in (-1.0, 1.0):
+        fl = peer_tail.Flank(p, s, p.c0, l, w)
+        assert fl.ok == (s < 0)
+        for _ in range(30):
+            y = np.r_[rng.uniform(-0.3, 0.3, 7) * p.c0, rng.uniform(-0.3, 0.3, 7) * p.c0 * p.omega]
+            y[0] -= p.l_x
+            y[4] = rng.uniform(-300, 300) * p.c0
+            y[5] = s * p.c0 * rng.uniform(2.0, 4.0)
+            t = rng.uniform(0, 0.05)
+            m = oracle.mesh(t, y, p)
+            assert np.all(s * m["dn"] > m["c"])
+            fo = oracle.rhs(t, y, p) / scale / w
+            np.testing.assert_allclose(fl.A @ (y / scale) + fl.b, fo, rtol=1e-12,
+                                       atol=1e-12 * np.abs(fo).max())
+
+
+@pytest.mark.parametrize("name", sorted(TAIL_CASES))
+def test_tailed_peer_is_exact_up_to_its_hand_over(name):
+    """From rest the drive engages and settles into full contact: the tailed peer proves it
+    inside the run, and its T_m and F over the whole run equal DOP853's at rtol 1e-13 without a
+    tail (the RHS held to the oracle above); a window that ends before the proof has no tail
+    (DOP853 in chunks); spacing errors turn the tail off."""
+    import peer_tail
+    case = numba_peer.load_case(dict(TAIL_CASES[name], name=name))
+    tp = peer_tail.TailPeer(case)
+    t = np.linspace(0.0, 0.1, 801)
+    tm0, F0, ok0 = tp.setup.run(Y0, t, 1e-13, 1e-15)
+    tm, F, ok = tp.run(Y0, t, 1e-13, 1e-15)
+    assert ok and ok0 and 0.0 < tp.tail_t < 0.05
+    assert np.abs(F - F0).max() < 1e-9 * np.abs(F0).max()
+    assert np.abs(tm - tm0).max() < 1e-9 * np.abs(tm0).max()
+    early = t[t <= tp.tail_t / 2]
+    F1 = tp.run(Y0, early, 1e-13, 1e-15)[1]
+    assert tp.tail_t == -1.0 and np.abs(F1 - F0[:len(early)]).max() < 1e-9 * np.abs(F0).max()
+    spaced = numba_peer.load_case(dict(case, spacing_error=[1e-6]))
+    assert not peer_tail.TailPeer(spaced).able
