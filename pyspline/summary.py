@@ -100,7 +100,7 @@ def lyapunov_summary(s: dict, lyap_t, log_growth, exponent: float, t0: float) ->
     if len(lyap_t) >= 3 and np.isfinite(log_growth).all():
         fit = analysis.largest_lyapunov_fit(lyap_t, log_growth, t0=t0)
         s.update(lyapunov_spread=fit.spread, lyapunov_rel_spread=fit.rel_spread,
-                 lyapunov_slope=fit.slope, chaotic=float(analysis.is_chaotic(exponent, fit.spread)))
+                 lyapunov_slope=fit.slope, chaotic=float(analysis.is_chaotic(exponent, fit.spread, fit.slope)))
 
 
 def failed_summary(exc: Exception, options: dict) -> dict:
