@@ -280,7 +280,7 @@ def lyapunov_vs_param(ds, param: str, var: str = "lyapunov", path=None,
     handles = [Line2D([], [], **chaotic), Line2D([], [], **ordered)]
     if spread is not None:
         handles.append(Line2D([], [], color="0.5", marker="|", ms=8, ls="",
-                              label="spread of the running estimate"))
+                              label="error bar: spread of the running estimate"))
     if chaos.any():
         ax2 = ax.twinx()
         ax2.plot(x[chaos], 1.0 / lam[chaos], "s", mfc="none", mec="tab:orange", ms=6)
