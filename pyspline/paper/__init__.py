@@ -328,9 +328,10 @@ def meaning(rows) -> str:
 
 - **Start-up transients.** At its static equilibrium an aligned or misaligned drive in full
   contact is steady: the mesh is then a linear, isotropic spring (docs/model.md). The paper's k_v
-  range, its {f} peak forces and its T_m range can only come from a transient, and the
-  paper does not say how its drive starts. Ours starts from rest with T_d applied at once and
-  overshoots to {top}; its low side reaches {low}.
+  range, its {f} peak forces and its T_m range can only come
+  from a transient, and the paper does not say how its drive starts. Ours starts from rest with
+  T_d applied at once and overshoots to {top}; its low side
+  reaches {low}.
 - **Poincare map of the ideal drive.** The strobed points spiral into one fixed point (period 1,
   as the paper says), but the mesh mode (about 100 Hz, at the shaft frequency, with
   c_m = 0.053 N s/m) rings down slowly and is not settled at 1 s.
