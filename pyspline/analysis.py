@@ -11,8 +11,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["LyapunovFit", "amplitude_spectrum", "classify_period", "largest_lyapunov_fit",
-           "orders", "period_tolerance", "predictability_horizon", "stats", "tooth_pass_hz"]
+__all__ = ["LyapunovFit", "amplitude_spectrum", "classify_period", "is_chaotic",
+           "largest_lyapunov_fit", "orders", "period_tolerance", "predictability_horizon", "stats",
+           "tooth_pass_hz"]
 
 #: The periodicity tolerance is this many times the solver's relative tolerance ...
 PERIOD_RTOL_FACTOR = 100.0
@@ -320,11 +321,15 @@ def largest_lyapunov_fit(times, log_growth, t0: float | None = None) -> Lyapunov
     return LyapunovFit(lam_t, lam, spread, float(rel), slope)
 
 
-def is_chaotic(lam, spread=0.0):
-    """Chaos by the largest Lyapunov exponent `lam` [1/s]: positive beyond the `spread` of its
-    own estimate (e.g. `largest_lyapunov_fit`'s; NaN spread counts as 0), lam > max(spread, 0).
-    NaN lam is not chaotic. Works on scalars (returns bool) and arrays."""
-    a = np.asarray(lam, dtype=float)
+def is_chaotic(lam, spread, slope):
+    """Chaos by a Benettin record's fit (`largest_lyapunov_fit`): the running estimate `lam` and
+    the `slope` of the log separation over the last two thirds of the window [1/s] both positive
+    beyond the `spread` of the running estimate over the last third (NaN spread counts as 0):
+    ``min(lam, slope) > max(spread, 0)``. The slope keeps a chaotic transient that died out
+    within the window (the separation grows, then stays flat) from counting: the running
+    estimate s/t still carries its growth, the slope does not. NaN lam or slope is not chaotic.
+    Works on scalars (returns bool) and arrays."""
+    a = np.minimum(np.asarray(lam, dtype=float), np.asarray(slope, dtype=float))
     s = np.nan_to_num(np.asarray(spread, dtype=float), nan=0.0)
     out = np.isfinite(a) & (a > np.maximum(s, 0.0))
     return bool(out) if out.ndim == 0 else out

@@ -423,8 +423,9 @@ def cmd_sweep(args) -> int:
           f"from {out / POINTS_DIR}/")
     if "chaotic" in ds and a["n_ok"]:
         n_chaos = int((ds["chaotic"] == 1).sum())
-        print(f"{n_chaos} of {a['n_ok']} points chaotic (Lyapunov exponent positive beyond its "
-              "spread): read their statistics, sections and spectra, not their trajectories")
+        print(f"{n_chaos} of {a['n_ok']} points chaotic (Lyapunov exponent and the slope of its "
+              "log growth positive beyond its spread): read their statistics, sections and "
+              "spectra, not their trajectories")
     if a["n_failed"] or a["n_missing"]:
         errors = [e for e in ds["error"].values.ravel() if e]
         print(f"first error: {errors[0]}", file=sys.stderr)

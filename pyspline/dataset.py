@@ -51,8 +51,9 @@ _VAR_ATTRS = {
     "lyapunov_rel_spread": ("lyapunov_spread / |lyapunov| (small: converged)", ""),
     "lyapunov_slope": ("slope of the log growth over the last two thirds of the window", "1/s"),
     "predictability_horizon": ("predictability horizon 1/lambda (inf: lambda <= 0)", "s"),
-    "chaotic": ("1: the exponent is positive beyond its own spread (chaos: read statistics, "
-                "not trajectories); 0: not; NaN: no converged estimate", ""),
+    "chaotic": ("1: the exponent and the slope of the log growth are positive beyond the "
+                "exponent's spread (chaos: read statistics, not trajectories); 0: not; NaN: no "
+                "estimate", ""),
     "Tm_spectrum": ("amplitude spectrum of T_m (Hann window, mean removed; max over each order "
                     "bin)", cf_units(QUANTITIES["Tm"][1])),
     "wall_s": ("wall time of the run (Python call)", "s"),

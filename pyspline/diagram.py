@@ -34,9 +34,10 @@ def _without_period(case, final, n, max_n):
     told): its sections' period n beyond max_n (0), or, when they gave none (n = 0), chaotic or
     not, by the largest Lyapunov exponent (Benettin) of a run as long as the sweep's sampled
     window continued from its middle point's final state (y, t), with renormalisations at
-    least every quarter revolution: 'chaotic: ...' (1) when positive beyond the spread of its
-    running estimate (analysis.is_chaotic), else 'no period found within N revolutions, not
-    chaotic: ...' (0: a run not settled, or quasi-periodic); -1 when its run failed."""
+    least every quarter revolution: 'chaotic: ...' (1) when it and the slope of the log
+    separation are positive beyond the spread of its running estimate (analysis.is_chaotic),
+    else 'no period found within N revolutions, not chaotic: ...' (0: a run not settled, or
+    quasi-periodic); -1 when its run failed."""
     from .analysis import is_chaotic, largest_lyapunov_fit
     from .follow import continued
     from .orbits import _wall
@@ -56,7 +57,7 @@ def _without_period(case, final, n, max_n):
     except (SplineError, ValueError) as exc:
         return f"no period found, chaos not told (its Lyapunov run: {exc})", -1
     lam = f"largest Lyapunov exponent {fit.lam:.3g} 1/s (spread {fit.spread:.2g})"
-    if is_chaotic(fit.lam, fit.spread):
+    if is_chaotic(fit.lam, fit.spread, fit.slope):
         return f"chaotic: {lam}", 1
     revs = (res.t[-1] - res.t[0]) * omega / (2 * np.pi)
     return f"no period found within {revs:.0f} revolutions, not chaotic: {lam}", 0

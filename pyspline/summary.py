@@ -99,8 +99,9 @@ def lyapunov_summary(s: dict, lyap_t, log_growth, exponent: float, t0: float) ->
     s.update(lyapunov=exponent, predictability_horizon=analysis.predictability_horizon(exponent))
     if len(lyap_t) >= 3 and np.isfinite(log_growth).all():
         fit = analysis.largest_lyapunov_fit(lyap_t, log_growth, t0=t0)
+        chaotic = analysis.is_chaotic(exponent, fit.spread, fit.slope)
         s.update(lyapunov_spread=fit.spread, lyapunov_rel_spread=fit.rel_spread,
-                 lyapunov_slope=fit.slope, chaotic=float(analysis.is_chaotic(exponent, fit.spread)))
+                 lyapunov_slope=fit.slope, chaotic=float(chaotic))
 
 
 def failed_summary(exc: Exception, options: dict) -> dict:

@@ -40,7 +40,8 @@ __all__ = ["local_dask_client", "open_sweep", "parse_values", "point_cases", "re
 #: Bump when the content of a point summary changes: older point files are then recomputed.
 #: 2: the default Benettin separation (lyapunov_d0 = 0: 1e4 rtol, was 1e-8) changed exponents.
 #: 4: a point keeps its warnings.
-SUMMARY_VERSION = 4
+#: 5: chaotic asks the slope of the Benettin record too (analysis.is_chaotic).
+SUMMARY_VERSION = 5
 #: Step of the common shaft-order axis of the T_m spectra [shaft orders].
 ORDER_STEP = 0.05
 SECTIONS = ("shaft", "tooth", "none")
@@ -338,7 +339,8 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     Dataset: coordinates = the swept values (units from the core's field table); per point
     section_t/section_D2/section_vD2 (dim 'section_point', NaN-padded), period and
     period_residual; lyapunov, lyapunov_spread, lyapunov_rel_spread, lyapunov_slope,
-    predictability_horizon, chaotic (1 if the exponent exceeds its spread; if lyapunov);
+    predictability_horizon, chaotic (analysis.is_chaotic: 1 if the exponent and the slope exceed
+    the spread; if lyapunov);
     Tm_/kv_/F_ max, min, rms, Tf_max, D2_max, D2_min, D2_rms; the loads (SWEEP_LOADS:
     load_sharing, free_frac_max, back_frac_max, teeth_free_mean, teeth_back, impacts_per_rev,
     closing_speed_max, the stresses, the per-revolution means load_sharing_rev, Tf_max_rev,

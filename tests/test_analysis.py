@@ -245,10 +245,29 @@ def test_predictability_horizon():
 
 
 def test_is_chaotic():
-    assert an.is_chaotic(900.0, 30.0) and not an.is_chaotic(1.4, 2.7)
-    assert not an.is_chaotic(-0.5) and not an.is_chaotic(np.nan, 0.0)
-    np.testing.assert_array_equal(an.is_chaotic([5.0, 5.0, -1.0], [1.0, np.nan, 0.0]),
+    assert an.is_chaotic(900.0, 30.0, 880.0) and not an.is_chaotic(1.4, 2.7, 1.4)
+    assert not an.is_chaotic(-0.5, 0.0, -0.5) and not an.is_chaotic(np.nan, 0.0, 1.0)
+    assert not an.is_chaotic(5.0, 1.0, np.nan) and not an.is_chaotic(900.0, 30.0, 20.0)
+    np.testing.assert_array_equal(an.is_chaotic([5.0, 5.0, -1.0], [1.0, np.nan, 0.0], 5.0),
                                   [True, True, False])
+
+
+def test_a_transient_that_dies_is_not_chaos():
+    """A separation that grows at rate r until t1, then stays: log_growth = r min(t, t1). At the
+    end T = 4 t1 the running estimate still reads r t1 / T = r / 4, twice its spread over the
+    last third (r t1 (1 / (2T/3) - 1 / T) = r / 8): the running estimate alone calls it chaos.
+    The slope over the last two thirds (after t1) is 0: not chaotic. Growth all through
+    (t1 = T) is chaos, with both at r."""
+    r, t1 = 200.0, 0.1
+    t = np.linspace(0, 4 * t1, 401)
+    fit = an.largest_lyapunov_fit(t, r * np.minimum(t, t1))
+    assert fit.lam == pytest.approx(r / 4) and fit.spread == pytest.approx(r / 8, rel=0.02)
+    assert fit.slope == pytest.approx(0.0, abs=1e-9)
+    assert an.is_chaotic(fit.lam, fit.spread, fit.lam)         # the running estimate alone
+    assert not an.is_chaotic(fit.lam, fit.spread, fit.slope)
+    grows = an.largest_lyapunov_fit(t, r * t)
+    assert grows.lam == pytest.approx(r) and grows.slope == pytest.approx(r)
+    assert an.is_chaotic(grows.lam, grows.spread, grows.slope)
 
 
 def test_stats():
@@ -313,7 +332,8 @@ def test_plot_bifurcation_xarray(tmp_path):
 def test_plot_lyapunov(tmp_path):
     p = np.linspace(0, 1, 30)
     lam = 40 * np.sin(3 * p) - 15
-    ds = dict(torque=p * 100, lyapunov=lam, lyapunov_spread=np.full(30, 3.0))
+    ds = dict(torque=p * 100, lyapunov=lam, lyapunov_spread=np.full(30, 3.0),
+              lyapunov_slope=lam)
     fig = pl.lyapunov_vs_param(ds, "torque", path=tmp_path / "lyap.png")
     _png_ok(tmp_path / "lyap.png", fig)
     assert len(fig.axes) == 2                                 # the horizon axis

@@ -94,21 +94,47 @@ def test_bifurcation_legend_covers_no_point():
     assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
-def test_lyapunov_shades_chaos_and_gives_horizons_beyond_the_spread(line):
+def _marked(ax):
+    """The x of the filled (chaotic) and of the hollow (not chaotic) markers, and the shaded
+    x-stretches, of a Lyapunov panel."""
+    filled, hollow = ([x for ln in ax.get_lines() if ln.get_marker() == "o"
+                       and (ln.get_markerfacecolor() == "w") == h
+                       for x in ln.get_xdata()] for h in (False, True))
+    spans = [tuple(np.round(p.get_x() + np.r_[0, p.get_width()], 6)) for p in ax.patches]
+    return filled, hollow, spans
+
+
+def test_lyapunov_marks_chaotic_points_and_gives_their_horizons(line):
     fig = sw.lyapunov_vs_param(line, "speed_rpm")
     ax, ax2 = fig.axes
     lam = line["lyapunov"].values
     assert _inside(ax, SPEED[np.isfinite(lam)], lam[np.isfinite(lam)])
     assert ax.get_ylabel() == "largest Lyapunov exponent lambda [1/s]"
     assert ax.get_xlabel() == "shaft speed [r/min]"
-    shade = [p for p in ax.patches if p.get_facecolor()[0] > 0.5]   # tab:red span above 0
-    assert len(shade) == 1 and shade[0].get_y() == 0
-    assert shade[0].get_y() + shade[0].get_height() == pytest.approx(ax.get_ylim()[1])
-    (h,) = ax2.get_lines()          # only 8 +- 2 is chaos (0.5 is within its spread of 2)
+    filled, hollow, spans = _marked(ax)   # only 8 +- 2 is chaos (0.5 is within its spread of 2)
+    assert filled == [3000.0] and hollow == [1000.0, 2000.0, 4000.0, 5000.0]
+    assert spans == [(2500.0, 3500.0)]    # half-way to its neighbours, at that x only
+    (h,) = ax2.get_lines()
     assert h.get_xdata().tolist() == [3000.0] and h.get_ydata().tolist() == [1 / 8.0]
     assert ax2.get_yscale() == "log" and ax2.get_ylabel().endswith("[s]")
-    assert "lambda > 0: chaotic" in _words(fig, ["legend"])
+    words = _words(fig, ["legend"])
+    assert "chaotic: lambda and the slope" in words and "not chaotic" in words
     assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
+
+
+def test_lyapunov_marks_by_the_verdict_of_the_slope_too(line):
+    """A point whose running estimate is positive beyond its spread but whose log separation no
+    longer grows (a chaotic transient that died out) is drawn not chaotic; neighbouring
+    chaotic points share one shaded stretch, from half a step before the first."""
+    slope = [-5.0, 9.0, 0.3, np.nan, 3.0]
+    lam = [-5.0, 10.0, 8.0, np.nan, 4.0]
+    ds = line.assign(lyapunov=("speed_rpm", lam), lyapunov_slope=("speed_rpm", slope))
+    filled, hollow, spans = _marked(sw.lyapunov_vs_param(ds, "speed_rpm").axes[0])
+    assert filled == [2000.0, 5000.0] and hollow == [1000.0, 3000.0, 4000.0]
+    assert spans == [(1500.0, 2500.0), (4500.0, 5500.0)]
+    ds = ds.assign(lyapunov_slope=("speed_rpm", lam))
+    assert _marked(sw.lyapunov_vs_param(ds, "speed_rpm").axes[0])[2] == [(1500.0, 3500.0),
+                                                                          (4500.0, 5500.0)]
 
 
 def test_lyapunov_without_chaos_has_no_horizon_axis(line):

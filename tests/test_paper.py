@@ -79,6 +79,32 @@ def test_a_miss_quotes_its_runs_static_share():
                                                for f in (share, 2 * share)]
 
 
+def test_the_misses_quote_their_runs_numbers():
+    """What the misses mean quotes the runs' own k_v swing and peak tooth forces beside the
+    paper's (ROWS), and each start-up row's reason its run's largest k_v after the engagement:
+    twice the paper's T_d changes the runs (twice T_d and T_l would not: k_v is relative to the
+    static share) and so the words."""
+    names = {r.case for r in paper.ROWS}
+    said = []
+    for factor in (1, 2):
+        cases = {n: paper.load_paper_case(n, CASES, quick=True) for n in names}
+        res = {n: pyspline.simulate(c.replace(t_d=factor * c["t_d"]))
+               for n, c in cases.items()}
+        by = {f"{r['case']}/{r['quantity']}": r for r in paper.verification_rows(res)}
+        text = paper.meaning(by.values())
+        kv_max, kv_min = (by[k]["ours"] for k in (paper.KV_MAX, paper.KV_MIN))
+        forces = [abs(by[k]["ours"]) for k in paper.PEAK_FORCES]
+        words = " ".join(text.split())
+        assert (f"overshoots to k_v = {kv_max:.3g} (paper 1.225); its low side reaches "
+                f"k_v = {kv_min:.3g} (paper 0.69)") in words
+        assert f"its 170-183 N (ours {min(forces):.0f}-{max(forces):.0f} N) peak forces" in words
+        run = res["paper_lx1e-4"]
+        reason = paper.why("paper_lx1e-4/meshing torque |T_m| min (t > 0.1 s)", run)
+        assert f"overshoots to k_v = {run.kv[run.t > 0.1].max():.3g} (the paper's" in reason
+        said.append((text, reason))
+    assert said[0][0] != said[1][0] and said[0][1] != said[1][1]
+
+
 def test_calibration_recovers_known_parameters(tmp_path):
     """Simulate with known k_m and f_m, then fit them back from the two calibration rows."""
     truth = {"k_m": 3.1e5, "f_m": 0.37}

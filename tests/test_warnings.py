@@ -185,6 +185,39 @@ def test_start_overlap_made_by_a_spacing_error():
     assert messages(dict(PLAUSIBLE, spacing_error=[0.0] * 20 + [15e-6])) == []
 
 
+def _start_dn(fields) -> tuple:
+    """|dn_j| of the oracle's Eq. 11 at the core's start state of a case, and its backlash."""
+    case = ps.load_case(fields)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ps.SplineWarning)
+        model = ps.load(case)
+    return np.abs(oracle.mesh(case["t0"], model.start_state(), case)["dn"]), model.info()["c_bulk"]
+
+
+def test_start_overlap_names_dq0_when_it_moves_the_tooth():
+    """An overlap made by the initial displacement dq0 names dq0 (its entries that enter Eq. 11)
+    and what it adds to the tooth's |dn_j|, not the misalignment: aligned, x2 = 90 um and
+    D2 = 2 um overlap tooth 21; on the plausible l_x = 50 um (clear by itself), x1 = 30 um
+    overlaps tooth 8, and both are named. The oracle's dn_j with and without dq0 give the
+    numbers; a dq0 in D1 only (no term of Eq. 11) leaves the misalignment's words."""
+    for fields, tooth, names in ((dict(PLAUSIBLE, l_x=0.0, dq0=[0, 0, 90e-6, 0, 0, 2e-6, 0]), 21,
+                                  "with dq0 (x2 = 9.000E-05, D2 = 2.000E-06 m, adding"),
+                                 (dict(PLAUSIBLE, dq0=[30e-6, 0, 0, 0, 0, 0, 0]), 8,
+                                  "with l_x = 5.000E-05, l_y = 0.000E+00 m and dq0 (x1 = "
+                                  "3.000E-05 m, adding")):
+        dn, c = _start_dn(fields)
+        dn0, _ = _start_dn(dict(fields, dq0=[0.0] * 7))
+        j = int(np.argmax(dn))
+        assert j + 1 == tooth and dn0[j] <= c < dn[j]                 # dq0 made the overlap
+        msg = one(messages(fields), "start")
+        for words in (names, f"adding {dn[j] - dn0[j]:.3E} m to its |dn_j|) starts tooth {tooth} ",
+                      f"by {dn[j] - c:.3E} m"):
+            assert words in msg, (words, msg)
+        assert ("l_x" in msg) == (fields["l_x"] != 0), msg
+    msg = one(messages(dict(EXAMPLE, dq0=[0, 0, 0, 0, 1e-3, 0, 0])), "start")
+    assert "dq0" not in msg and "with l_x = 8.000E-05, l_y = 0.000E+00 m starts tooth 8" in msg
+
+
 def test_tooth_load_of_a_torque_in_n_mm():
     fields = dict(EXAMPLE, t_d=150e3, t_l=150e3)
     f = closed_forms(ps.load_case(fields))

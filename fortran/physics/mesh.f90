@@ -158,23 +158,43 @@ contains
 
   !> start = 'rest' (plus dq0) with a tooth overlapping beyond its backlash at t0: the largest
   !> |dn_j| - c of Eq. 11 (face centre, with the tooth's spacing error e_j) over the teeth in
-  !> the start state; one of spline_model::model_warnings (its argument start).
+  !> the start state; one of spline_model::model_warnings (its argument start). It names what
+  !> moved the tooth: the misalignment (l_x, l_y, when not both 0), and dq0 (its entries that
+  !> enter Eq. 11, and how much it adds to that tooth's |dn_j|) when it moves the tooth.
   subroutine start_warning(m, text)
     type(model_t), intent(in) :: m
     character(len=:), allocatable, intent(out) :: text
-    real(wp) :: sp(m%z), cp(m%z), dn(m%z), ddn(m%z)
-    integer :: j
+    character(len=:), allocatable :: cause, kick
+    character(len=2), parameter :: dof(5) = ['x1', 'y1', 'x2', 'y2', 'D2']
+    real(wp) :: sp(m%z), cp(m%z), dn(m%z), dn0(m%z), ddn(m%z), q(5), added
+    integer :: j, i
     text = ''
     if (m%start_equilibrium) return
     call tooth_angles(m%z, m%omega, m%t0, m%theta0, m%alpha, m%sin_pitch, m%cos_pitch, sp, cp)
     call eq11(m%dq0(1) + m%l_x - m%dq0(3), m%dq0(2) + m%l_y - m%dq0(4), 0.0_wp, 0.0_wp, m%dq0(6), &
          0.0_wp, 0.0_wp, m%spacing_error(1:m%z), sp, cp, dn, ddn)
+    call eq11(m%l_x, m%l_y, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, m%spacing_error(1:m%z), sp, &
+         cp, dn0, ddn)                     ! without dq0
     dn = abs(dn)
     j = maxloc(dn, 1)
     if (dn(j) <= m%c_bulk) return
-    text = 'case '//trim(m%name)//': start = ''rest'' with l_x = '// &
-         num(m%l_x, readable=.true.)//', l_y = '//num(m%l_y, readable=.true.)// &
-         ' m starts tooth '//itoa(j)//' overlapping its backlash c = '// &
+    cause = 'l_x = '//num(m%l_x, readable=.true.)//', l_y = '//num(m%l_y, readable=.true.)//' m'
+    added = dn(j) - abs(dn0(j))
+    if (added /= 0.0_wp) then
+      q = m%dq0([1, 2, 3, 4, 6])
+      kick = ''
+      do i = 1, size(q)
+        if (q(i) /= 0.0_wp) kick = kick//', '//dof(i)//' = '//num(q(i), readable=.true.)
+      end do
+      kick = 'dq0 ('//kick(3:)//' m, adding '//num(added, readable=.true.)//' m to its |dn_j|)'
+      if (m%l_x == 0.0_wp .and. m%l_y == 0.0_wp) then
+        cause = kick
+      else
+        cause = cause//' and '//kick
+      end if
+    end if
+    text = 'case '//trim(m%name)//': start = ''rest'' with '//cause// &
+         ' starts tooth '//itoa(j)//' overlapping its backlash c = '// &
          num(m%c_bulk, readable=.true.)//' m by '//num(dn(j) - m%c_bulk, readable=.true.)// &
          ' m (Eq. 11 at t0): an impact made by the start, not the drive; '// &
          'start = ''equilibrium''? Run as given'//new_line('a')

@@ -315,7 +315,7 @@ contains
   !> windup_limit, a start at rest with teeth overlapping, a tooth deflected beyond
   !> deflection_limit of the module. The executable prints them to stderr, Python raises
   !> pyspline.SplineWarning (api_load_file's and api_load_fields' warn). start: the start
-  !> warning, spline_mesh::start_warning(m) (Eq. 11 lives in spline_mesh, which uses this module).
+  !> warning, spline_mesh::start_warning (Eq. 11 lives in spline_mesh, which uses this module).
   !> A subroutine, as every text builder of the core (docs/developing.md, "Thread safety").
   subroutine model_warnings(m, start, text)
     type(model_t), intent(in) :: m

@@ -18,8 +18,8 @@ import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm, TwoSlopeNorm
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
-from matplotlib.patches import Patch
 
+from .. import analysis
 from . import style as ps
 
 __all__ = ["bifurcation", "bifurcation_grid", "lyapunov_vs_param", "param_map",
@@ -228,15 +228,29 @@ def param_map(ds, var: str, x: str, y: str, path=None, title: str | None = None,
 
 # --------------------------------------------------------------------------- Lyapunov
 
+def _chaotic_stretches(x, chaotic) -> list:
+    """(from, to) of each run of neighbouring chaotic points in x order, each point's stretch
+    reaching half-way to its neighbours (half the nearest step at the ends)."""
+    order = np.argsort(x)
+    xs, c = x[order], chaotic[order]
+    if len(xs) < 2:
+        return [(xs[0], xs[0])] if c.any() else []
+    mid = (xs[1:] + xs[:-1]) / 2
+    edges = np.r_[2 * xs[0] - mid[0], mid, 2 * xs[-1] - mid[-1]]
+    runs = np.flatnonzero(np.diff(np.r_[0, c.astype(int), 0]))      # starts, ends alternate
+    return [(edges[i], edges[j]) for i, j in zip(runs[::2], runs[1::2])]
+
+
 def lyapunov_vs_param(ds, param: str, var: str = "lyapunov", path=None,
                       title: str | None = None, units: dict | None = None) -> Figure:
     """Largest Lyapunov exponent ``ds[var]`` [1/s] against the swept ``ds[param]``, with a zero
-    line (above it, shaded: chaos) and, on the right axis (log scale), the predictability
-    horizon 1/lambda [s] of the runs with lambda > 0 (lambda <= 0: no horizon, infinite).
-    Error bars of half the spread ``ds[var + '_spread']`` when the dataset has it (e.g. the
-    spread of `largest_lyapunov_fit`); a run then counts as chaotic (gets a horizon) only if its
-    exponent exceeds its whole spread, so an estimate of +2 1/s with a spread of 20 is not
-    called chaos.
+    line, each point's verdict (`analysis.is_chaotic`: filled red markers on a shaded stretch of
+    x for chaotic points, hollow markers for the others) and, on the right axis (log scale), the
+    predictability horizon 1/lambda [s] of the chaotic points. The verdict uses the spread
+    ``ds[var + '_spread']`` (error bars of half of it) and the slope ``ds[var + '_slope']`` of
+    the Benettin record when the dataset has them (a sweep's do; without a slope the verdict is
+    lambda > spread, without a spread lambda > 0), so an estimate of +2 1/s with a spread of
+    20 is not called chaos, nor a chaotic transient that died out within the window.
     `units` as in `bifurcation`."""
     p = ps.array(ds, param)
     lam = ps.array(ds, var)
@@ -247,31 +261,35 @@ def lyapunov_vs_param(ds, param: str, var: str = "lyapunov", path=None,
     ax = fig.add_subplot()
     ax.axhline(0, color="k", lw=0.8)
     spread = ps.array(ds, var + "_spread") if var + "_spread" in ds else None
-    ax.errorbar(x, lam, yerr=None if spread is None else spread / 2, fmt="o-", ms=4, lw=1,
+    slope = ps.array(ds, var + "_slope") if var + "_slope" in ds else lam
+    chaos = analysis.is_chaotic(lam, 0.0 if spread is None else spread, slope)
+    ax.errorbar(x, lam, yerr=None if spread is None else spread / 2, fmt="-", lw=1,
                 color="tab:blue", ecolor="0.5", capsize=2)
-    # chaotic: positive beyond its spread (analysis.is_chaotic, restated: this module stands alone)
-    pos = np.isfinite(lam) & (lam > (0.0 if spread is None else
-                                     np.maximum(np.nan_to_num(spread, nan=0.0), 0.0)))
-    lo, hi = ax.get_ylim()
-    if hi > 0:
-        ax.axhspan(0, hi, color="tab:red", alpha=0.06, lw=0)
-        ax.set_ylim(lo, hi)
+    for a, b in _chaotic_stretches(x, chaos):
+        ax.axvspan(a, b, color="tab:red", alpha=0.12, lw=0)
+    marks = dict(ls="", marker="o", ms=6)
+    ordered = dict(marks, mfc="w", mec="tab:blue", label="not chaotic")
+    chaotic = dict(marks, color="tab:red", label="chaotic: lambda and the slope of its log "
+                   "separation > the spread (shaded)")
+    ax.plot(x[~chaos], lam[~chaos], **ordered)
+    ax.plot(x[chaos], lam[chaos], **chaotic)
     ax.set_xlabel(ps.label(ds, param, factor_unit=ux))
     ax.set_ylabel(f"largest Lyapunov exponent lambda [{unit}]")
     ax.grid(alpha=0.3, lw=0.5)
     h_unit = "s" if unit == "1/s" else f"1/({unit})"
-    handles = [Line2D([], [], marker="o", color="tab:blue", label="lambda (left axis)"),
-               Patch(facecolor="tab:red", alpha=0.15, label="lambda > 0: chaotic")]
-    if pos.any():
+    handles = [Line2D([], [], **chaotic), Line2D([], [], **ordered)]
+    if spread is not None:
+        handles.append(Line2D([], [], color="0.5", marker="|", ms=8, ls="",
+                              label="error bar: spread of the running estimate"))
+    if chaos.any():
         ax2 = ax.twinx()
-        ax2.plot(x[pos], 1.0 / lam[pos], "s", mfc="none", mec="tab:orange", ms=6)
+        ax2.plot(x[chaos], 1.0 / lam[chaos], "s", mfc="none", mec="tab:orange", ms=6)
         ax2.set_yscale("log")
         ax2.set_ylabel(f"predictability horizon 1/lambda [{h_unit}]", color="tab:orange")
         ax2.tick_params(axis="y", colors="tab:orange", which="both")
         handles.append(Line2D([], [], ls="", marker="s", mfc="none", mec="tab:orange",
-                              label="horizon 1/lambda where lambda > its spread "
-                                    "(right axis)"))
-    fig.legend(handles=handles, fontsize=8, loc="outside lower center", ncols=3, frameon=False)
+                              label="horizon 1/lambda of the chaotic points (right axis)"))
+    fig.legend(handles=handles, fontsize=8, loc="outside lower center", ncols=2, frameon=False)
     ax.set_title(title or f"largest Lyapunov exponent vs {ps.long_name(ds, param)}")
     return ps.finish(fig, path)
 
