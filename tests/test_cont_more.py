@@ -240,22 +240,35 @@ def test_a_fold_located_twice_is_reported_once(doubling_band):
     assert abs(complex(ds.special_mu_real[fold[0]], ds.special_mu_imag[fold[0]]) - 1) < 1e-2
 
 
-def test_grazing_just_past_stop(doubling_band):
-    """The stable period-2 orbit near 1619.3 r/min continued up to 1620.085 r/min, its grazing
-    (1620.092, tests above) just past stop: the branch ends on stop, complete, with no grazing
-    reported and no point past stop. (The filter that drops diagnosed crossings past an end is
-    not reached here, nor by any run tried: the diagnosis bisects the step onto the end, so
-    its points lie within the band. Stops 0.01-0.06 r/min past the grazing fail: docs,
-    Limits.)"""
+@pytest.mark.parametrize("stop", [1620.085, 1620.1, 1620.12])
+def test_switch_crossing_the_section_time(doubling_band, stop):
+    """The stable period-2 orbit near 1619.3 r/min continued up past 1620.092 r/min, where its
+    16 back flanks' engagement crosses the section time t0 (just before it below, 4.7 us after
+    it at 1620.12): the contact sequence is the same either side (no grazing), and the branch
+    ends on stop, complete, with the case's own settings (no fallback, no diagnosis), no point
+    past it. At 1620.12 the one-output period map of the case's BDF from the last point closes
+    on it to the corrector's tol (before the roots were settled on the landed state it closed
+    1.5 scaled off: the engagement chattered), and an Adams map from a section 2-4.6 us later
+    does too (it did not: 1.4)."""
+    from pyspline.orbits import _period_map, _scale
     p, y, _, _ = _other_phase(doubling_band, 1619.3)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pyspline.SplineWarning)
-        ds = pyspline.continuation(DOUBLING8, "speed_rpm", p, 1620.085, n=2, guess=y,
+        ds = pyspline.continuation(DOUBLING8, "speed_rpm", p, stop, n=2, guess=y,
                                    progress=False, ds_max=0.5, max_angle=0.3)
     q = ds.speed_rpm.values
-    assert ds.attrs["status"] == "complete" and q[-1] == pytest.approx(1620.085, abs=1e-9)
-    assert (q <= 1620.085 + 1e-9).all() and ds.attrs["diagnosed_grazings"] == 0, q
+    assert ds.attrs["status"] == "complete" and q[-1] == pytest.approx(stop, abs=1e-9)
+    assert (q <= stop + 1e-9).all() and ds.attrs["diagnosed_grazings"] == 0, q
+    assert ds.attrs["fallbacks"] == "none" and ds.attrs["rejected_unlocated"] == 0
     assert "grazing" not in ds.special_type.values and (ds.switches == ds.switches[0]).all()
+    if stop != 1620.12:
+        return
+    y, T = ds.y0.values[-1], 2 * 60 / stop
+    for method, ts in (("bdf", 0.0), ("adams", 2e-6), ("adams", 4e-6)):
+        m = DOUBLING8.replace(speed_rpm=stop, method=method).model
+        ys = _period_map(m, 0.0, ts, y[:, None])[0][:, 0] if ts else y
+        y1, free = _period_map(m, ts, ts + T, ys[:, None])
+        assert np.abs((y1[:, 0] - ys)[free] / _scale(m)[free]).max() < 1e-5, (method, ts)
 
 
 def test_cli_all_and_fold_keep_what_they_have(tmp_path):
