@@ -506,9 +506,10 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
     prob = br.prob
     k = len(u0)
     e_q = np.eye(k)[-1]
+    head = np.sign(q_end) * e_q if tau0 is None else tau0     # the way the branch goes
     if tau0 is None:                  # the first branch: start on the orbit, head to stop
         first = br.correct(u0, e_q, u0[-1])
-        first = None if first is None else br.point(first, np.sign(q_end) * e_q)
+        first = None if first is None else br.point(first, head)
         if first is None:
             _fail(br, u0, ds, "at the start")
         pts = [first]
@@ -583,6 +584,7 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
                 _use(prob, *fallbacks.pop(0))
                 prob.log.append(f"{prob.name} = {a['p']:.6g}: {prob.how} monodromy, method "
                                 f"{prob.case['method']} ({getattr(br, 'last_error', '')})")
+                _retangent(br, a, a["u"] - pts[-2]["u"] if len(pts) > 1 else head)
                 ds, on_fallback = min(ds_max, 64 * ds_min), 5
             continue
         it = res[5]
@@ -602,6 +604,18 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
         grow = 1.5 if it <= 2 else (0.6 if it >= 4 else 1.0)
         ds = max(ds_min, min(ds_max, ds * grow, ds * max_angle / max(angle, 1e-12)))
     return pts, f"max_points = {max_points} reached at {prob.name} = {pts[-1]['p']:.6g}"
+
+
+def _retangent(br, a, orient):
+    """a's tangent from the integrator and monodromy now in use (a fallback's): the null vector
+    of their [M - I, dF/dq] at a, oriented along orient (the secant from the point before, or
+    the way the branch goes at its first point), not the tangent a had: the failed
+    integrator's, whose dF/dp can be wrong. Kept when the run fails."""
+    try:
+        a["J"] = br.prob.evaluate(br.y_fixed, a["u"], br.n)[1]
+    except (SolverError, CaseError):
+        return
+    a["tau"], a["null"] = _null_tangent(a["J"], orient), True
 
 
 def _onto(br, u, pred, ds, end):

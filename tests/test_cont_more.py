@@ -385,3 +385,37 @@ def test_cli_band(tmp_path):
     assert "--band 1621 1626" in ds.attrs["command"]
     assert (ds.n.values[b == 1] == 2).all() and p[b == 1].min() == pytest.approx(1621, abs=1e-9)
     assert p[b == 0].min() == 1623 and p.max() == pytest.approx(1626, abs=1e-9)
+
+
+def test_fallback_takes_its_own_tangent(monkeypatch):
+    """The linear scene (full contact, tests/test_continuation.py) whose first method (the
+    exact monodromy) has a wrong dF/dp column (1e3 times a random vector): its null-vector
+    tangent at the start is off the branch and every step from it fails, down to ds_min. The
+    fallback (differenced M, the same integrator) takes the tangent of its own [M - I, dF/dq]
+    at the point, oriented to stop, and traces the branch to stop: every point the
+    closed-form forced response. (With the tangent it had, every fallback failed and the
+    branch was its start alone.)"""
+    import pyspline.arclength as arc
+    from test_continuation import forced_response
+    from test_orbits import A_RIPPLE, linear_scene, scale_of
+    case, *_ = linear_scene(2.0)
+    evaluate = arc._Problem.evaluate
+
+    def wrong(self, y, u, n):
+        F, J, M, yy = evaluate(self, y, u, n)
+        if self.how == "exact":
+            J = np.c_[J[:, :-1], 1e3 * np.random.default_rng(1).standard_normal(len(F))]
+        return F, J, M, yy
+    monkeypatch.setattr(arc._Problem, "evaluate", wrong)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds = pyspline.continuation(case, "speed_rpm", 2600, 2650, progress=False, ds_min=0.01,
+                                   max_points=6)
+    assert ds.attrs["status"] == "complete", ds.attrs["status"]
+    assert ds.attrs["fallbacks"].startswith("speed_rpm = 2600: fd monodromy, method bdf")
+    p = ds.speed_rpm.values
+    assert len(p) >= 2 and p[-1] == pytest.approx(2650) and (np.diff(p) > 0).all(), p
+    s = scale_of(case)
+    for q, y0 in zip(p, ds.y0.values):
+        y_eq, Y, _ = forced_response(case, q, 2.0, A_RIPPLE)
+        assert np.abs((y0 - (y_eq + Y.real)) / s).max() < 1e-7
