@@ -592,6 +592,12 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
         if angle > 2 * max_angle and ds > ds_min:      # the branch turns: a shorter step
             ds = max(ds_min, ds / 2)
             continue
+        try:
+            merged = _merged(br, a, new)
+        except (SolverError, CaseError):     # the half-period run failed: not told
+            merged = ""
+        if merged:
+            return pts, merged
         pts.append(new)
         bar.update(1)
         if end is not None:
@@ -640,12 +646,32 @@ def _use(prob, monodromy, method):
         prob.set_method(method)
 
 
-def _new_orbit(br, y, u):
-    """The doubled branch's point is not the period-n orbit again: P^(n/2)(y) != y."""
+def _half(br, y, u):
+    """u = (z, q) of P^(n/2)(y), y the state of the branch point u: its orbit half a period on."""
     prob = br.prob
     p = prob.p_of(u[-1])
     y1, _, free = _map_only(prob.model(p), prob.t0, prob.t1(p, br.n // 2), y)
-    return np.abs((y1 - y)[free] / prob.d0[free]).max() > 1e3 * br.tol
+    return np.r_[y1[free] / prob.d0[free], u[-1]]
+
+
+def _new_orbit(br, y, u):
+    """The doubled branch's point is not the period-n orbit again: P^(n/2)(y) != y."""
+    return np.abs(_half(br, y, u) - u).max() > 1e3 * br.tol
+
+
+def _merged(br, a, new):
+    """Where a period-n branch (n even) meets the period-n/2 branch at their period doubling
+    (a pitchfork of P^n): new, the point after a, is a fixed point of P^(n/2) (the
+    period-n/2 orbit, not to be labelled n), or lies past the doubling on the branch's own
+    other section points (P^(n/2) of new nearer a than new itself: the same orbit again, to be
+    traced twice). A sentence saying so (the branch ends at a), or ''."""
+    if br.n % 2 or _new_orbit(br, new["y"], new["u"]) and np.linalg.norm(
+            _half(br, new["y"], new["u"]) - a["u"]) >= np.linalg.norm(new["u"] - a["u"]):
+        return ""
+    return (f"the period-{br.n} branch reached a period doubling between {br.prob.name} = "
+            f"{a['p']:.6g} and {new['p']:.6g}, where it merges into the period-{br.n // 2} "
+            f"branch (past it: the period-{br.n // 2} orbit, or this orbit at its other section "
+            "points): it ends there")
 
 
 def _fail(br, u, ds, where):

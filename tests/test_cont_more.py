@@ -218,25 +218,37 @@ def test_period_two_seed_at_its_other_section_point(doubling_band):
     assert list(_distinct(both, "speed_rpm", s, tol)[1]) == [0, 1]
 
 
-def test_a_fold_located_twice_is_reported_once(doubling_band):
-    """The period-2 orbit at 1625 r/min continued down from its other section point P(y) (band
-    1615-1630): its branch runs stable down to the fold at 1618.409 r/min, back up unstable to
-    the doubling, through it onto the other section point's half of the same orbit, down to
-    the same fold again and back up: two turns at 1618.41, one fold reported (located twice,
-    1e-6 r/min apart, once at each section point: specials.once), its multiplier at +1."""
-    p, _, y_b, _ = _other_phase(doubling_band, 1625)
+@pytest.mark.parametrize("phase", [0, 1])
+def test_period_two_branch_ends_at_its_doubling(doubling_band, phase):
+    """The period-2 orbit at 1625 r/min continued down (band 1615-1630) from its first section
+    point y or its other one P(y): stable down to its fold at 1618.409 r/min (multiplier +1),
+    back up unstable towards the period doubling (1623.61), where it meets the period-1
+    branch: it ends there, its status saying so. Before, from P(y) it went through the
+    doubling onto y's half of the same orbit, down to the same fold and back up (traced twice,
+    the fold located twice); from y it went on as period-2 points of the period-1 orbit. No
+    point is a fixed point of P (P(y) 1e3 tol or more from y: 0.05 at 1623.605, next to the
+    doubling, where P(y) - y goes as the root of the distance), the field turns once."""
+    from pyspline.orbits import _period_map
+    from test_orbits import scale_of
+    p, y, y_b, _ = _other_phase(doubling_band, 1625)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pyspline.SplineWarning)
-        ds = pyspline.continuation(DOUBLING8, "speed_rpm", p, 1615, n=2, guess=y_b,
+        ds = pyspline.continuation(DOUBLING8, "speed_rpm", p, 1615, n=2, guess=(y, y_b)[phase],
                                    band=(1615, 1630), progress=False, ds_max=0.5, max_angle=0.3)
-    assert ds.attrs["status"] == "complete"
-    q = ds.speed_rpm.values[ds.branch.values == 0]
-    turns = q[1:-1][(np.diff(q)[:-1] < 0) & (np.diff(q)[1:] > 0)]
-    assert len(turns) == 2 and np.abs(turns - 1618.41).max() < 0.05, turns
-    kind = ds.special_type.values
-    fold = np.flatnonzero(kind == "fold")
-    assert len(fold) == 1, ds.special_speed_rpm.values[fold]
-    assert ds.special_speed_rpm[fold[0]] == pytest.approx(1618.409, abs=1e-3)
+    assert re.fullmatch(r"the period-2 branch reached a period doubling between speed_rpm = "
+                        r"\S+ and \S+, where it merges into the period-1 branch .*",
+                        ds.attrs["status"]), ds.attrs["status"]
+    q = ds.speed_rpm.values
+    assert (ds.n == 2).all() and 1623 < q[-1] < 1623.61 and q.min() > 1618.4
+    assert ((np.diff(q)[:-1] < 0) & (np.diff(q)[1:] > 0)).sum() == 1
+    assert (np.diff(q)[np.argmin(q):] > 0).all() and (np.diff(q)[:np.argmin(q)] < 0).all()
+    s = scale_of(DOUBLING8)
+    for x, y0 in zip(q, ds.y0.values):
+        y1 = _period_map(DOUBLING8.replace(speed_rpm=float(x)).model, 0.0, 60 / x,
+                         y0[:, None])[0][:, 0]
+        assert np.abs((y1 - y0)[:7] / s[:7]).max() > 1e3 * 100 * DOUBLING8["rtol"], x
+    fold = np.flatnonzero(ds.special_type.values == "fold")
+    assert len(fold) == 1 and ds.special_speed_rpm[fold[0]] == pytest.approx(1618.409, abs=1e-3)
     assert abs(complex(ds.special_mu_real[fold[0]], ds.special_mu_imag[fold[0]]) - 1) < 1e-2
 
 
