@@ -431,3 +431,35 @@ def test_fallback_takes_its_own_tangent(monkeypatch):
     for q, y0 in zip(p, ds.y0.values):
         y_eq, Y, _ = forced_response(case, q, 2.0, A_RIPPLE)
         assert np.abs((y0 - (y_eq + Y.real)) / s).max() < 1e-7
+
+
+def test_diagnosed_crossing_past_the_end_is_dropped(monkeypatch):
+    """A failed step whose diagnosis (specials.diagnose) hands back a point past stop (its
+    corrector's hyperplane lies across the tangent, not across the field: made up here, on the
+    linear scene, by a diagnosis that returns the point before it moved 1 r/min past stop, and
+    one corrector that fails) does not put it on the branch: the crossing is dropped, the step
+    goes on as a failed one, and the branch ends on stop, complete, no point past it."""
+    import pyspline.arclength as arc
+    import pyspline.specials as specials
+    from test_orbits import linear_scene
+    case, *_ = linear_scene(2.0)
+    correct, failed, handed = arc._Branch.correct, [], []
+
+    def once_failing(self, u, row, target):
+        if row[-1] != 1 and not failed:             # the first step off the start fails
+            failed.append(True)
+            return None
+        return correct(self, u, row, target)
+
+    def past_stop(br, a, pred, step):
+        u = a["u"].copy()
+        u[-1] = (2621 - 2600) / br.prob.pscale
+        handed.append(dict(a, u=u, p=2621.0))
+        return handed[-1:]
+    monkeypatch.setattr(arc._Branch, "correct", once_failing)
+    monkeypatch.setattr(specials, "diagnose", past_stop)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds = pyspline.continuation(case, "speed_rpm", 2600, 2620, progress=False, max_points=10)
+    assert handed and ds.attrs["status"] == "complete" and ds.attrs["diagnosed_grazings"] == 0
+    assert (ds.speed_rpm <= 2620).all() and float(ds.speed_rpm[-1]) == pytest.approx(2620)
