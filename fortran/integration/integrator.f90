@@ -350,17 +350,30 @@ contains
     type(integrator_t), intent(inout) :: cv
     real(c_double), intent(in) :: tout
     integer(c_int), intent(inout) :: flag
-    real(c_double) :: tn(1)
-    if (cv%erk) then
-      if (FERKStepGetCurrentTime(cv%mem, tn) /= 0) return
-    else
-      if (FCVodeGetCurrentTime(cv%mem, tn) /= 0) return
-    end if
-    if (tn(1) >= tout) return
+    real(c_double) :: tn
+    tn = integrator_time(cv, tout)
+    if (tn >= tout) return
     cv%stalled = .true.
-    cv%t_stalled = tn(1)
+    cv%t_stalled = tn
     flag = stalled_flag
   end subroutine check_reached
+
+  !> Where the integrator stands (its last step's end, scaled time): where a failed call
+  !> stopped; tau when that cannot be read (no integrator made).
+  real(c_double) function integrator_time(cv, tau) result(tn)
+    type(integrator_t), intent(in) :: cv
+    real(c_double), intent(in) :: tau
+    real(c_double) :: t(1)
+    integer(c_int) :: flag
+    tn = tau
+    if (.not. c_associated(cv%mem)) return
+    if (cv%erk) then
+      flag = FERKStepGetCurrentTime(cv%mem, t)
+    else
+      flag = FCVodeGetCurrentTime(cv%mem, t)
+    end if
+    if (flag == 0) tn = t(1)
+  end function integrator_time
 
   !> ERKStep returned at a root troot: redo its last step from its start (tn - h) to land on
   !> troot exactly (stop time), root functions off, contact states still the old ones. The state
@@ -578,11 +591,13 @@ contains
     real(c_double), intent(in) :: tau
     character(len=*), intent(in) :: what
     character(len=*), intent(out) :: errmsg
-    character(len=:), allocatable :: head, name
+    character(len=:), allocatable :: head, name, fl
     character(len=12) :: at
     head = 'case '//trim(m%name)//': '//trim(cv%run)
     name = integrator_name(cv)
-    write(at, '(es12.5)') tau/m%w_ref
+    fl = integrator_flag_name(cv, flag)
+    ! where it stopped: the caller's tau is where the run last restarted (a contact switch)
+    write(at, '(es12.5)') max(tau, integrator_time(cv, tau))/m%w_ref
     if (flag == stalled_flag .and. cv%stalled) then
       errmsg = head//': the '//name//' step fell below round-off of t at t = '// &
            ftoa(cv%t_stalled/m%w_ref, '(es12.5)')//' s, short of t = '//at// &
@@ -594,20 +609,20 @@ contains
            itoa(int(integrator_steps_done(cv)))//' '//name//' steps'
     else if (flag == CV_TOO_MUCH_WORK .and. cv%total_bound) then
       errmsg = head//' took max_total_steps = '//itoa(int(cv%max_total_steps))//' '//name// &
-           ' steps in all by t = '//at//' s (flag CV_TOO_MUCH_WORK): raise max_total_steps, '// &
+           ' steps in all by t = '//at//' s (flag '//fl//'): raise max_total_steps, '// &
            'or find why the steps are so small'
     else if (flag == CV_TOO_MUCH_WORK .and. cv%run == 'the run') then
       errmsg = 'case '//trim(m%name)//': '//name//' took max_steps = '//itoa(int(cv%max_steps))// &
            ' steps between two output times without reaching the next, at t = '//at//' s (flag '// &
-           'CV_TOO_MUCH_WORK): raise max_steps or n_out'
+           fl//'): raise max_steps or n_out'
     else if (flag == CV_TOO_MUCH_WORK) then
       errmsg = head//' took max_steps = '//itoa(int(cv%max_steps))//' '//name//' steps '// &
-           'without reaching its end, at t = '//at//' s (flag CV_TOO_MUCH_WORK): raise max_steps'
+           'without reaching its end, at t = '//at//' s (flag '//fl//'): raise max_steps'
     else
       if (cv%run /= 'the run') name = name//' failed in '//trim(cv%run)
       if (cv%run == 'the run') name = name//' failed'
       errmsg = 'case '//trim(m%name)//': '//name//' while '//what//' with flag '// &
-           integrator_flag_name(cv, flag)//' ('//itoa(int(flag))//') at t = '//at//' s'
+           fl//' ('//itoa(int(flag))//') at t = '//at//' s'
       if (len_trim(cv%log%err) > 0) errmsg = trim(errmsg)//': '//trim(cv%log%err)
     end if
   end subroutine integrator_fail_text
