@@ -12,7 +12,7 @@ import pytest
 
 import pyspline
 import pyspline.orbits
-from conftest import CASES
+from conftest import CASES, PAPER_SHAFTS
 from test_continuation import DOUBLING
 
 BRANCHES = sys.modules["pyspline.diagram"]     # the module of pyspline.branches
@@ -399,6 +399,7 @@ def test_cli_band(tmp_path):
     assert p[b == 0].min() == 1623 and p.max() == pytest.approx(1626, abs=1e-9)
 
 
+@PAPER_SHAFTS
 def test_fallback_takes_its_own_tangent(monkeypatch):
     """The linear scene (full contact, tests/test_continuation.py) whose first method (the
     exact monodromy) has a wrong dF/dp column (1e3 times a random vector): its null-vector
@@ -433,6 +434,7 @@ def test_fallback_takes_its_own_tangent(monkeypatch):
         assert np.abs((y0 - (y_eq + Y.real)) / s).max() < 1e-7
 
 
+@PAPER_SHAFTS
 def test_diagnosed_crossing_past_the_end_is_dropped(monkeypatch):
     """A failed step whose diagnosis (specials.diagnose) hands back a point past stop (its
     corrector's hyperplane lies across the tangent, not across the field: made up here, on the
