@@ -506,9 +506,10 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
     prob = br.prob
     k = len(u0)
     e_q = np.eye(k)[-1]
+    head = np.sign(q_end) * e_q if tau0 is None else tau0     # the way the branch goes
     if tau0 is None:                  # the first branch: start on the orbit, head to stop
         first = br.correct(u0, e_q, u0[-1])
-        first = None if first is None else br.point(first, np.sign(q_end) * e_q)
+        first = None if first is None else br.point(first, head)
         if first is None:
             _fail(br, u0, ds, "at the start")
         pts = [first]
@@ -583,6 +584,7 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
                 _use(prob, *fallbacks.pop(0))
                 prob.log.append(f"{prob.name} = {a['p']:.6g}: {prob.how} monodromy, method "
                                 f"{prob.case['method']} ({getattr(br, 'last_error', '')})")
+                _retangent(br, a, a["u"] - pts[-2]["u"] if len(pts) > 1 else head)
                 ds, on_fallback = min(ds_max, 64 * ds_min), 5
             continue
         it = res[5]
@@ -590,6 +592,12 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
         if angle > 2 * max_angle and ds > ds_min:      # the branch turns: a shorter step
             ds = max(ds_min, ds / 2)
             continue
+        try:
+            merged = _merged(br, a, new)
+        except (SolverError, CaseError):     # the half-period run failed: not told
+            merged = ""
+        if merged:
+            return pts, merged
         pts.append(new)
         bar.update(1)
         if end is not None:
@@ -602,6 +610,18 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
         grow = 1.5 if it <= 2 else (0.6 if it >= 4 else 1.0)
         ds = max(ds_min, min(ds_max, ds * grow, ds * max_angle / max(angle, 1e-12)))
     return pts, f"max_points = {max_points} reached at {prob.name} = {pts[-1]['p']:.6g}"
+
+
+def _retangent(br, a, orient):
+    """a's tangent from the integrator and monodromy now in use (a fallback's): the null vector
+    of their [M - I, dF/dq] at a, oriented along orient (the secant from the point before, or
+    the way the branch goes at its first point), not the tangent a had: the failed
+    integrator's, whose dF/dp can be wrong. Kept when the run fails."""
+    try:
+        a["J"] = br.prob.evaluate(br.y_fixed, a["u"], br.n)[1]
+    except (SolverError, CaseError):
+        return
+    a["tau"], a["null"] = _null_tangent(a["J"], orient), True
 
 
 def _onto(br, u, pred, ds, end):
@@ -626,12 +646,32 @@ def _use(prob, monodromy, method):
         prob.set_method(method)
 
 
-def _new_orbit(br, y, u):
-    """The doubled branch's point is not the period-n orbit again: P^(n/2)(y) != y."""
+def _half(br, y, u):
+    """u = (z, q) of P^(n/2)(y), y the state of the branch point u: its orbit half a period on."""
     prob = br.prob
     p = prob.p_of(u[-1])
     y1, _, free = _map_only(prob.model(p), prob.t0, prob.t1(p, br.n // 2), y)
-    return np.abs((y1 - y)[free] / prob.d0[free]).max() > 1e3 * br.tol
+    return np.r_[y1[free] / prob.d0[free], u[-1]]
+
+
+def _new_orbit(br, y, u):
+    """The doubled branch's point is not the period-n orbit again: P^(n/2)(y) != y."""
+    return np.abs(_half(br, y, u) - u).max() > 1e3 * br.tol
+
+
+def _merged(br, a, new):
+    """Where a period-n branch (n even) meets the period-n/2 branch at their period doubling
+    (a pitchfork of P^n): new, the point after a, is a fixed point of P^(n/2) (the
+    period-n/2 orbit, not to be labelled n), or lies past the doubling on the branch's own
+    other section points (P^(n/2) of new nearer a than new itself: the same orbit again, to be
+    traced twice). A sentence saying so (the branch ends at a), or ''."""
+    if br.n % 2 or _new_orbit(br, new["y"], new["u"]) and np.linalg.norm(
+            _half(br, new["y"], new["u"]) - a["u"]) >= np.linalg.norm(new["u"] - a["u"]):
+        return ""
+    return (f"the period-{br.n} branch reached a period doubling between {br.prob.name} = "
+            f"{a['p']:.6g} and {new['p']:.6g}, where it merges into the period-{br.n // 2} "
+            f"branch (past it: the period-{br.n // 2} orbit, or this orbit at its other section "
+            "points): it ends there")
 
 
 def _fail(br, u, ds, where):

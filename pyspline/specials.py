@@ -40,16 +40,18 @@ def tests(mu) -> dict:
 def contact_measures(tr) -> dict:
     """From one period of the orbit's trajectory (a Result): s_j(t) = |dn_j| - c_j, the contact
     deflection of tooth j (> 0 in contact on either flank, < 0 its gap): the signature of the
-    contact sequence (per tooth: the sign at t0 and the number of sign changes over the period,
-    at the case's output samples), and the closest approach: the smallest |s_j| over the
-    teeth whose contact does not change over the period (NaN if every tooth switches)."""
+    contact sequence (per tooth: the number of sign changes over the period, at the case's
+    output samples, and the side of a tooth that never changes, -1 for one that does: not the
+    side at t0 of a tooth that switches, which changes where a switch crosses the section time
+    with the sequence unchanged), and the closest approach: the smallest |s_j| over the teeth
+    whose contact does not change over the period (NaN if every tooth switches)."""
     s = np.abs(tr.dn) - tr.c
     pos = s > 0
     changes = (pos[1:] != pos[:-1]).sum(axis=0)
     steady = changes == 0
     closest = float(np.abs(s[:, steady]).min()) if steady.any() else np.nan
-    return {"signature": tuple(map(int, np.r_[pos[0], changes])), "closest_approach": closest,
-            "switches": int(changes.sum())}
+    return {"signature": tuple(map(int, np.r_[np.where(steady, pos[0], -1), changes])),
+            "closest_approach": closest, "switches": int(changes.sum())}
 
 
 def far(u, pred, ds) -> bool:

@@ -12,7 +12,7 @@ import pytest
 
 import pyspline
 import pyspline.orbits
-from conftest import CASES
+from conftest import CASES, PAPER_SHAFTS
 from test_continuation import DOUBLING
 
 BRANCHES = sys.modules["pyspline.diagram"]     # the module of pyspline.branches
@@ -218,44 +218,69 @@ def test_period_two_seed_at_its_other_section_point(doubling_band):
     assert list(_distinct(both, "speed_rpm", s, tol)[1]) == [0, 1]
 
 
-def test_a_fold_located_twice_is_reported_once(doubling_band):
-    """The period-2 orbit at 1625 r/min continued down from its other section point P(y) (band
-    1615-1630): its branch runs stable down to the fold at 1618.409 r/min, back up unstable to
-    the doubling, through it onto the other section point's half of the same orbit, down to
-    the same fold again and back up: two turns at 1618.41, one fold reported (located twice,
-    1e-6 r/min apart, once at each section point: specials.once), its multiplier at +1."""
-    p, _, y_b, _ = _other_phase(doubling_band, 1625)
+@pytest.mark.parametrize("phase", [0, 1])
+def test_period_two_branch_ends_at_its_doubling(doubling_band, phase):
+    """The period-2 orbit at 1625 r/min continued down (band 1615-1630) from its first section
+    point y or its other one P(y): stable down to its fold at 1618.409 r/min (multiplier +1),
+    back up unstable towards the period doubling (1623.61), where it meets the period-1
+    branch: it ends there, its status saying so. Before, from P(y) it went through the
+    doubling onto y's half of the same orbit, down to the same fold and back up (traced twice,
+    the fold located twice); from y it went on as period-2 points of the period-1 orbit. No
+    point is a fixed point of P (P(y) 1e3 tol or more from y: 0.05 at 1623.605, next to the
+    doubling, where P(y) - y goes as the root of the distance), the field turns once."""
+    from pyspline.orbits import _period_map
+    from test_orbits import scale_of
+    p, y, y_b, _ = _other_phase(doubling_band, 1625)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pyspline.SplineWarning)
-        ds = pyspline.continuation(DOUBLING8, "speed_rpm", p, 1615, n=2, guess=y_b,
+        ds = pyspline.continuation(DOUBLING8, "speed_rpm", p, 1615, n=2, guess=(y, y_b)[phase],
                                    band=(1615, 1630), progress=False, ds_max=0.5, max_angle=0.3)
-    assert ds.attrs["status"] == "complete"
-    q = ds.speed_rpm.values[ds.branch.values == 0]
-    turns = q[1:-1][(np.diff(q)[:-1] < 0) & (np.diff(q)[1:] > 0)]
-    assert len(turns) == 2 and np.abs(turns - 1618.41).max() < 0.05, turns
-    kind = ds.special_type.values
-    fold = np.flatnonzero(kind == "fold")
-    assert len(fold) == 1, ds.special_speed_rpm.values[fold]
-    assert ds.special_speed_rpm[fold[0]] == pytest.approx(1618.409, abs=1e-3)
+    assert re.fullmatch(r"the period-2 branch reached a period doubling between speed_rpm = "
+                        r"\S+ and \S+, where it merges into the period-1 branch .*",
+                        ds.attrs["status"]), ds.attrs["status"]
+    q = ds.speed_rpm.values
+    assert (ds.n == 2).all() and 1623 < q[-1] < 1623.61 and q.min() > 1618.4
+    assert ((np.diff(q)[:-1] < 0) & (np.diff(q)[1:] > 0)).sum() == 1
+    assert (np.diff(q)[np.argmin(q):] > 0).all() and (np.diff(q)[:np.argmin(q)] < 0).all()
+    s = scale_of(DOUBLING8)
+    for x, y0 in zip(q, ds.y0.values):
+        y1 = _period_map(DOUBLING8.replace(speed_rpm=float(x)).model, 0.0, 60 / x,
+                         y0[:, None])[0][:, 0]
+        assert np.abs((y1 - y0)[:7] / s[:7]).max() > 1e3 * 100 * DOUBLING8["rtol"], x
+    fold = np.flatnonzero(ds.special_type.values == "fold")
+    assert len(fold) == 1 and ds.special_speed_rpm[fold[0]] == pytest.approx(1618.409, abs=1e-3)
     assert abs(complex(ds.special_mu_real[fold[0]], ds.special_mu_imag[fold[0]]) - 1) < 1e-2
 
 
-def test_grazing_just_past_stop(doubling_band):
-    """The stable period-2 orbit near 1619.3 r/min continued up to 1620.085 r/min, its grazing
-    (1620.092, tests above) just past stop: the branch ends on stop, complete, with no grazing
-    reported and no point past stop. (The filter that drops diagnosed crossings past an end is
-    not reached here, nor by any run tried: the diagnosis bisects the step onto the end, so
-    its points lie within the band. Stops 0.01-0.06 r/min past the grazing fail: docs,
-    Limits.)"""
+@pytest.mark.parametrize("stop", [1620.085, 1620.1, 1620.12])
+def test_switch_crossing_the_section_time(doubling_band, stop):
+    """The stable period-2 orbit near 1619.3 r/min continued up past 1620.092 r/min, where its
+    16 back flanks' engagement crosses the section time t0 (just before it below, 4.7 us after
+    it at 1620.12): the contact sequence is the same either side (no grazing), and the branch
+    ends on stop, complete, with the case's own settings (no fallback, no diagnosis), no point
+    past it. At 1620.12 the one-output period map of the case's BDF from the last point closes
+    on it to the corrector's tol (before the roots were settled on the landed state it closed
+    1.5 scaled off: the engagement chattered), and an Adams map from a section 2-4.6 us later
+    does too (it did not: 1.4)."""
+    from pyspline.orbits import _period_map, _scale
     p, y, _, _ = _other_phase(doubling_band, 1619.3)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pyspline.SplineWarning)
-        ds = pyspline.continuation(DOUBLING8, "speed_rpm", p, 1620.085, n=2, guess=y,
+        ds = pyspline.continuation(DOUBLING8, "speed_rpm", p, stop, n=2, guess=y,
                                    progress=False, ds_max=0.5, max_angle=0.3)
     q = ds.speed_rpm.values
-    assert ds.attrs["status"] == "complete" and q[-1] == pytest.approx(1620.085, abs=1e-9)
-    assert (q <= 1620.085 + 1e-9).all() and ds.attrs["diagnosed_grazings"] == 0, q
+    assert ds.attrs["status"] == "complete" and q[-1] == pytest.approx(stop, abs=1e-9)
+    assert (q <= stop + 1e-9).all() and ds.attrs["diagnosed_grazings"] == 0, q
+    assert ds.attrs["fallbacks"] == "none" and ds.attrs["rejected_unlocated"] == 0
     assert "grazing" not in ds.special_type.values and (ds.switches == ds.switches[0]).all()
+    if stop != 1620.12:
+        return
+    y, T = ds.y0.values[-1], 2 * 60 / stop
+    for method, ts in (("bdf", 0.0), ("adams", 2e-6), ("adams", 4e-6)):
+        m = DOUBLING8.replace(speed_rpm=stop, method=method).model
+        ys = _period_map(m, 0.0, ts, y[:, None])[0][:, 0] if ts else y
+        y1, free = _period_map(m, ts, ts + T, ys[:, None])
+        assert np.abs((y1[:, 0] - ys)[free] / _scale(m)[free]).max() < 1e-5, (method, ts)
 
 
 def test_cli_all_and_fold_keep_what_they_have(tmp_path):
@@ -372,3 +397,71 @@ def test_cli_band(tmp_path):
     assert "--band 1621 1626" in ds.attrs["command"]
     assert (ds.n.values[b == 1] == 2).all() and p[b == 1].min() == pytest.approx(1621, abs=1e-9)
     assert p[b == 0].min() == 1623 and p.max() == pytest.approx(1626, abs=1e-9)
+
+
+@PAPER_SHAFTS
+def test_fallback_takes_its_own_tangent(monkeypatch):
+    """The linear scene (full contact, tests/test_continuation.py) whose first method (the
+    exact monodromy) has a wrong dF/dp column (1e3 times a random vector): its null-vector
+    tangent at the start is off the branch and every step from it fails, down to ds_min. The
+    fallback (differenced M, the same integrator) takes the tangent of its own [M - I, dF/dq]
+    at the point, oriented to stop, and traces the branch to stop: every point the
+    closed-form forced response. (With the tangent it had, every fallback failed and the
+    branch was its start alone.)"""
+    import pyspline.arclength as arc
+    from test_continuation import forced_response
+    from test_orbits import A_RIPPLE, linear_scene, scale_of
+    case, *_ = linear_scene(2.0)
+    evaluate = arc._Problem.evaluate
+
+    def wrong(self, y, u, n):
+        F, J, M, yy = evaluate(self, y, u, n)
+        if self.how == "exact":
+            J = np.c_[J[:, :-1], 1e3 * np.random.default_rng(1).standard_normal(len(F))]
+        return F, J, M, yy
+    monkeypatch.setattr(arc._Problem, "evaluate", wrong)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds = pyspline.continuation(case, "speed_rpm", 2600, 2650, progress=False, ds_min=0.01,
+                                   max_points=6)
+    assert ds.attrs["status"] == "complete", ds.attrs["status"]
+    assert ds.attrs["fallbacks"].startswith("speed_rpm = 2600: fd monodromy, method bdf")
+    p = ds.speed_rpm.values
+    assert len(p) >= 2 and p[-1] == pytest.approx(2650) and (np.diff(p) > 0).all(), p
+    s = scale_of(case)
+    for q, y0 in zip(p, ds.y0.values):
+        y_eq, Y, _ = forced_response(case, q, 2.0, A_RIPPLE)
+        assert np.abs((y0 - (y_eq + Y.real)) / s).max() < 1e-7
+
+
+@PAPER_SHAFTS
+def test_diagnosed_crossing_past_the_end_is_dropped(monkeypatch):
+    """A failed step whose diagnosis (specials.diagnose) hands back a point past stop (its
+    corrector's hyperplane lies across the tangent, not across the field: made up here, on the
+    linear scene, by a diagnosis that returns the point before it moved 1 r/min past stop, and
+    one corrector that fails) does not put it on the branch: the crossing is dropped, the step
+    goes on as a failed one, and the branch ends on stop, complete, no point past it."""
+    import pyspline.arclength as arc
+    import pyspline.specials as specials
+    from test_orbits import linear_scene
+    case, *_ = linear_scene(2.0)
+    correct, failed, handed = arc._Branch.correct, [], []
+
+    def once_failing(self, u, row, target):
+        if row[-1] != 1 and not failed:             # the first step off the start fails
+            failed.append(True)
+            return None
+        return correct(self, u, row, target)
+
+    def past_stop(br, a, pred, step):
+        u = a["u"].copy()
+        u[-1] = (2621 - 2600) / br.prob.pscale
+        handed.append(dict(a, u=u, p=2621.0))
+        return handed[-1:]
+    monkeypatch.setattr(arc._Branch, "correct", once_failing)
+    monkeypatch.setattr(specials, "diagnose", past_stop)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds = pyspline.continuation(case, "speed_rpm", 2600, 2620, progress=False, max_points=10)
+    assert handed and ds.attrs["status"] == "complete" and ds.attrs["diagnosed_grazings"] == 0
+    assert (ds.speed_rpm <= 2620).all() and float(ds.speed_rpm[-1]) == pytest.approx(2620)

@@ -1,6 +1,8 @@
 """Periodic orbits (pyspline.periodic_orbit, docs/orbits.md): Newton on the core's period map,
 the monodromy by central differences. Held against the closed form of the linear full-contact
 drive (its forced response and exp(lambda T) of its matrix), and bad input."""
+import re
+
 import numpy as np
 import pytest
 
@@ -281,3 +283,27 @@ def test_coupled_thermal_level_is_not_covered():
         pyspline.periodic_orbit(case, monodromy="newton")
     with pytest.raises(pyspline.CaseError, match=r"y \(shape \(6,\)\) must be a state of 14"):
         pyspline.orbits.map_and_monodromy(case, 0.0, 0.01, y_eq[:6])
+
+
+def test_step_bound_says_where_the_run_stopped():
+    """A run cut by its step bounds says where it stopped, not where it last restarted, and
+    names its own integrator's flag: the linear scene (full contact: no switch, no restart,
+    where the time said was 0 for every bound) stops later with twice the steps, inside its
+    period; ERK's state run names ARK_TOO_MUCH_WORK, CVODE's CV_TOO_MUCH_WORK."""
+    from pyspline.orbits import _period_map, map_and_monodromy
+    case, y_eq, _, _ = linear_scene(2.0)
+    t1 = 60 / case["speed_rpm"]
+
+    def stopped(run, *args):
+        with pytest.raises(pyspline.SolverError) as err:
+            run(*args)
+        t = re.search(r"t = +(\S+) s \(flag (\w+)\)", str(err.value))
+        assert t, err.value
+        return float(t.group(1)), t.group(2)
+    var = [stopped(map_and_monodromy, case.replace(max_total_steps=n), 0.0, t1, y_eq)
+           for n in (20, 40)]
+    assert 0 < var[0][0] < var[1][0] < t1 and {f for _, f in var} == {"CV_TOO_MUCH_WORK"}
+    for method, flag in (("erk", "ARK_TOO_MUCH_WORK"), ("bdf", "CV_TOO_MUCH_WORK")):
+        t, said = stopped(_period_map, case.replace(method=method, max_steps=20).model, 0.0, t1,
+                          y_eq[:, None])
+        assert 0 < t < t1 and said == flag, (method, said)

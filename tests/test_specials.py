@@ -47,3 +47,17 @@ def test_a_fold_beside_a_turning_grazing(monkeypatch, critical, expected):
     monkeypatch.setattr(specials, "_secant", lambda br, a, b, sigma_b, kind: dict(
         a, p=2.2, sigma=0.3, type=kind, critical=critical))
     assert kinds(specials.locate(None, pts)) == expected
+
+
+def test_a_point_located_twice_is_reported_once():
+    """A special point of the same kind and branch at the same field value as one kept before,
+    at one of that one's other section points (the same orbit), is reported once
+    (specials.once); on another branch, or not at a section point, it is kept."""
+    def sp(u, branch=0):
+        return dict(type="fold", branch=branch, u=np.array(u, float))
+    first, other = [0.0, 0.0, 5.0], [1.0, 1.0, 5.0]
+    sections = lambda k: [k["u"], np.array(other)] if list(k["u"]) == first else [k["u"]]
+    kept = specials.once([sp(first), sp(other), sp(other, 1), sp([2.0, 2.0, 5.0])], sections,
+                         1e-6)
+    assert [(list(k["u"]), k["branch"]) for k in kept] == [
+        (first, 0), (other, 1), ([2.0, 2.0, 5.0], 0)]

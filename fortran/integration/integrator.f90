@@ -3,10 +3,10 @@
 !> (spline_variational::tangent_flow) alike: CVODE (Adams or BDF, fixed-point or Newton with a
 !> dense or a band Jacobian; cvode_create) and ARKODE's ERKStep (erk_create), their work bounds
 !> (max_steps between outputs, max_total_steps over the run, a wall-time bound on request:
-!> integrator_advance), failure messages (integrator_fail_text), root finding and the restart
-!> after a located switch (integrator_land_on_root, integrator_restart), counters, and
-!> SUNDIALS' own messages (lib_handler: never printed; an error's text joins the error
-!> message, warnings are counted and reported with the first one, integrator_warnings).
+!> integrator_advance), root finding and the restart after a located switch
+!> (integrator_land_on_root, integrator_restart), and SUNDIALS' own messages (lib_handler: never
+!> printed; an error's text joins the error message, warnings are counted in the run's log).
+!> Counters of a run: add_counters; its failure messages and warnings: spline_integrator_report.
 !> Reentrant: everything a run changes sits in its integrator_t (the caller's, a target); the
 !> message handler's user data is that run's log, never a module variable.
 !>
@@ -39,7 +39,7 @@ module spline_integrator
   use fsunlinsol_band_mod, only: FSUNLinSol_Band
   use fsunnonlinsol_fixedpoint_mod, only: FSUNNonlinSol_FixedPoint
   use spline_kinds, only: wp
-  use spline_errors, only: msglen, itoa, ftoa
+  use spline_errors, only: msglen
   use spline_model, only: model_t
   use spline_quantities, only: nstats => nsolver_stats, ist_steps, ist_rhs_evals, ist_jac_evals, &
        ist_lin_rhs_evals, ist_err_test_fails, ist_nonlin_conv_fails, ist_root_fn_evals
@@ -47,8 +47,8 @@ module spline_integrator
   private
   public :: integrator_t, lib_log_t, integrator_open, cvode_create, erk_create, integrator_advance, &
        integrator_root_info, integrator_root_directions, integrator_land_on_root, &
-       integrator_restart, integrator_steps_done, integrator_last_step, integrator_fail_text, &
-       integrator_warnings, add_counters, integrator_free
+       integrator_restart, integrator_steps_done, integrator_last_step, integrator_free, &
+       root_crossings, integrator_time, integrator_name, c_copy, stalled_flag, add_counters
 
   !> SUNDIALS' own messages of a run (lib_handler), kept instead of printed: the last error's
   !> text, and the warnings (how many, the first one's text).
@@ -350,17 +350,30 @@ contains
     type(integrator_t), intent(inout) :: cv
     real(c_double), intent(in) :: tout
     integer(c_int), intent(inout) :: flag
-    real(c_double) :: tn(1)
-    if (cv%erk) then
-      if (FERKStepGetCurrentTime(cv%mem, tn) /= 0) return
-    else
-      if (FCVodeGetCurrentTime(cv%mem, tn) /= 0) return
-    end if
-    if (tn(1) >= tout) return
+    real(c_double) :: tn
+    tn = integrator_time(cv, tout)
+    if (tn >= tout) return
     cv%stalled = .true.
-    cv%t_stalled = tn(1)
+    cv%t_stalled = tn
     flag = stalled_flag
   end subroutine check_reached
+
+  !> Where the integrator stands (its last step's end, scaled time): where a failed call
+  !> stopped; tau when that cannot be read (no integrator made).
+  real(c_double) function integrator_time(cv, tau) result(tn)
+    type(integrator_t), intent(in) :: cv
+    real(c_double), intent(in) :: tau
+    real(c_double) :: t(1)
+    integer(c_int) :: flag
+    tn = tau
+    if (.not. c_associated(cv%mem)) return
+    if (cv%erk) then
+      flag = FERKStepGetCurrentTime(cv%mem, t)
+    else
+      flag = FCVodeGetCurrentTime(cv%mem, t)
+    end if
+    if (flag == 0) tn = t(1)
+  end function integrator_time
 
   !> ERKStep returned at a root troot: redo its last step from its start (tn - h) to land on
   !> troot exactly (stop time), root functions off, contact states still the old ones. The state
@@ -388,6 +401,38 @@ contains
     if (flag == ARK_TSTOP_RETURN) flag = 0
     if (flag == 0) flag = root_init(cv, cv%nroot, cv%groots)
   end function integrator_land_on_root
+
+  !> The switches to apply where a run stopped on located roots (rootsfound: +-1 per root
+  !> function reported, 0 others), from the switch functions g and their rates dg in the landed
+  !> state and the directions dirs that change a contact state (eq16_root_directions): a
+  !> reported root whose function has reached or crossed zero in its direction; one not yet
+  !> crossed there (the root is found on the interpolant of the crossing step, the landed state
+  !> may be 1e-15 of c short) keeps its state until it does, and root finding reports it again.
+  !> A function exactly zero counts as crossed: root finding leaves out a function that is
+  !> zero at its start, and would miss that switch. The other way round, a function not
+  !> reported that has crossed in dirs, or stands at exactly zero moving that way (its rate),
+  !> switches too: the restart's root search starts on the far side (ARKODE takes a function
+  !> zero at its start from a look a tenth of a step ahead) and would never see it. In a
+  !> cluster of near-simultaneous switches (the 16 teeth of an aligned drive, 1e-11 apart on
+  !> the scaled time) the interpolant reports the teeth a few at a time while the landed state
+  !> has crossed more: with ERK those were lost, their teeth held in the wrong contact state for
+  !> the rest of the run (the Z16 drive at 2356.25 r/min: 34 of 64 switches located, lateral
+  !> speeds 0.4 scaled off the symmetric orbit; tests/test_erk.py).
+  pure function root_crossings(rootsfound, dirs, g, dg) result(crossed)
+    integer(c_int), intent(in) :: rootsfound(:)
+    integer, intent(in) :: dirs(:)
+    real(wp), intent(in) :: g(:), dg(:)
+    integer(c_int) :: crossed(size(rootsfound))
+    integer :: i
+    crossed = 0
+    do i = 1, size(rootsfound)
+      if (rootsfound(i) /= 0) then
+        if (rootsfound(i)*g(i) >= 0.0_wp) crossed(i) = rootsfound(i)
+      else if (dirs(i)*g(i) > 0.0_wp .or. (g(i) == 0.0_wp .and. dirs(i)*dg(i) > 0.0_wp)) then
+        crossed(i) = int(dirs(i), c_int)
+      end if
+    end do
+  end function root_crossings
 
   !> Locate only the crossings of root function i in direction dirs(i) (+1 rising, -1 falling,
   !> 0 either) from the next call on. CVODE only: ERKStep's landing on a root
@@ -486,38 +531,6 @@ contains
     end if
   end function integrator_last_step
 
-  !> The name of the integrator's return flag (CVODE's, ERKStep's), from SUNDIALS' C function:
-  !> the Fortran interface's returns a deferred-length result (docs/developing.md, "Thread safety").
-  subroutine integrator_flag_name(cv, flag, fname)
-    type(integrator_t), intent(in) :: cv
-    integer(c_int), intent(in) :: flag
-    character(len=*), intent(out) :: fname
-    type(c_ptr) :: p
-    interface
-      type(c_ptr) function cvode_flag_name(flag) bind(C, name='CVodeGetReturnFlagName')
-        import :: c_ptr, c_long
-        integer(c_long), value :: flag
-      end function cvode_flag_name
-      type(c_ptr) function erk_flag_name(flag) bind(C, name='ERKStepGetReturnFlagName')
-        import :: c_ptr, c_long
-        integer(c_long), value :: flag
-      end function erk_flag_name
-      subroutine c_free(p) bind(C, name='free')
-        import :: c_ptr
-        type(c_ptr), value :: p
-      end subroutine c_free
-    end interface
-    if (cv%erk .and. flag == CV_ROOT_RETURN) then
-      fname = 'ARK_ROOT_RETURN'; return
-    end if
-    if (cv%erk) then
-      p = erk_flag_name(int(flag, c_long))
-    else
-      p = cvode_flag_name(int(flag, c_long))
-    end if
-    call c_copy(p, fname)
-    call c_free(p)                ! SUNDIALS allocates the name
-  end subroutine integrator_flag_name
 
   !> The integrator's name in messages.
   pure function integrator_name(cv) result(name)
@@ -525,6 +538,9 @@ contains
     character(len=merge(6, 5, cv%erk)) :: name
     name = merge('ARKODE', 'CVODE ', cv%erk)
   end function integrator_name
+
+
+
 
   !> Add the counters since the last (re)initialisation to stats (positions ist_* of
   !> spline_quantities). A counter that cannot be read (nonzero flag) adds nothing.
@@ -555,65 +571,6 @@ contains
       if (flag == 0) stats(i) = stats(i) + cnt(1)
     end subroutine add
   end subroutine add_counters
-
-  !> The message of a run that failed at tau with flag while doing what: the wall-time or work
-  !> bound met, naming the field or argument that sets it, or the integrator's flag with
-  !> SUNDIALS' own text (lib_handler). Callers report their callbacks' errors and SIGINT first.
-  subroutine integrator_fail_text(cv, m, flag, tau, what, errmsg)
-    type(integrator_t), intent(in) :: cv
-    type(model_t), intent(in) :: m
-    integer(c_int), intent(in) :: flag
-    real(c_double), intent(in) :: tau
-    character(len=*), intent(in) :: what
-    character(len=*), intent(out) :: errmsg
-    character(len=:), allocatable :: head, name
-    character(len=12) :: at
-    character(len=32) :: fname
-    head = 'case '//trim(m%name)//': '//trim(cv%run)
-    name = integrator_name(cv)
-    write(at, '(es12.5)') tau/m%w_ref
-    if (flag == stalled_flag .and. cv%stalled) then
-      errmsg = head//': the '//name//' step fell below round-off of t at t = '// &
-           ftoa(cv%t_stalled/m%w_ref, '(es12.5)')//' s, short of t = '//at// &
-           ' s where the state was asked for (no state there: a chain of restarts at contact '// &
-           'switches)'
-    else if (flag == CV_TOO_MUCH_WORK .and. cv%wall_bound) then
-      errmsg = head//' took longer than its wall-time bound max_seconds = '// &
-           ftoa(cv%max_seconds, '(es9.2)')//' s, at t = '//at//' s, after '// &
-           itoa(int(integrator_steps_done(cv)))//' '//name//' steps'
-    else if (flag == CV_TOO_MUCH_WORK .and. cv%total_bound) then
-      errmsg = head//' took max_total_steps = '//itoa(int(cv%max_total_steps))//' '//name// &
-           ' steps in all by t = '//at//' s (flag CV_TOO_MUCH_WORK): raise max_total_steps, '// &
-           'or find why the steps are so small'
-    else if (flag == CV_TOO_MUCH_WORK .and. cv%run == 'the run') then
-      errmsg = 'case '//trim(m%name)//': '//name//' took max_steps = '//itoa(int(cv%max_steps))// &
-           ' steps between two output times without reaching the next, at t = '//at//' s (flag '// &
-           'CV_TOO_MUCH_WORK): raise max_steps or n_out'
-    else if (flag == CV_TOO_MUCH_WORK) then
-      errmsg = head//' took max_steps = '//itoa(int(cv%max_steps))//' '//name//' steps '// &
-           'without reaching its end, at t = '//at//' s (flag CV_TOO_MUCH_WORK): raise max_steps'
-    else
-      if (cv%run /= 'the run') name = name//' failed in '//trim(cv%run)
-      if (cv%run == 'the run') name = name//' failed'
-      call integrator_flag_name(cv, flag, fname)
-      errmsg = 'case '//trim(m%name)//': '//name//' while '//what//' with flag '// &
-           trim(fname)//' ('//itoa(int(flag))//') at t = '//at//' s'
-      if (len_trim(cv%log%err) > 0) errmsg = trim(errmsg)//': '//trim(cv%log%err)
-    end if
-  end subroutine integrator_fail_text
-
-  !> The warnings SUNDIALS raised in the runs of log (one line; '' if none): how many, and the
-  !> first one's text. The executable prints it as a 'warning:' line, Python as a SplineWarning.
-  subroutine integrator_warnings(log, name, text)
-    type(lib_log_t), intent(in) :: log
-    character(len=*), intent(in) :: name     !< the case's name
-    character(len=*), intent(out) :: text
-    text = ''
-    if (log%nwarn == 0) return
-    text = 'case '//trim(name)//': SUNDIALS warned '//itoa(log%nwarn)//' time(s) in this run '// &
-         '(the steps may have become too small to resolve the motion); the first, from '// &
-         trim(log%first)
-  end subroutine integrator_warnings
 
   !> SUNDIALS' message handler (CVodeSetErrHandlerFn, ERKStepSetErrHandlerFn): nothing is
   !> printed. An error's text is kept for the error message; a warning (error_code > 0, e.g.

@@ -21,7 +21,8 @@ module spline_solver
   use spline_integrator, only: integrator_t, lib_log_t, integrator_open, cvode_create, &
        erk_create, integrator_advance, integrator_root_info, integrator_root_directions, &
        integrator_land_on_root, integrator_restart, integrator_steps_done, integrator_last_step, &
-       integrator_fail_text, integrator_warnings, add_counters, integrator_free
+       add_counters, integrator_free, root_crossings
+  use spline_integrator_report, only: integrator_fail_text, integrator_warnings
   use spline_quantities, only: nstats => nsolver_stats, ist_roots_found, &
        ist_last_step, ist_mode_resyncs, ist_coupling_residual, ist_coupling_iterations, &
        ist_linear_tail_t
@@ -280,11 +281,7 @@ contains
         call fail(flag, tau, 'stepping onto a contact switch')
         return
       end if
-      if (cv%erk) then
-        call settle_roots(ctx, rootsfound, tau, yr, nroots)
-      else
-        call apply_roots(ctx, rootsfound, nroots)
-      end if
+      call settle_roots(ctx, rootsfound, tau, yr, nroots)
       ok = restart_cvode('restarting at a contact switch')
     end function switch_contacts
 
@@ -432,22 +429,14 @@ contains
     nroots = nroots + count(rootsfound /= 0)
   end subroutine apply_roots
 
-  !> ERKStep landed on located roots (integrator_land_on_root): a root whose switch function has
-  !> reached or crossed zero in the landed state v, in its direction, switches its tooth as
-  !> apply_roots does. The root was found on the interpolant of the crossing step; the landed
-  !> state, of the method's order, may not have crossed yet (by 1e-15 of c): that tooth keeps its
-  !> state until it does (a contact switched early adds its damping force c_m d(dn)/dt at once,
-  !> at the impact speed). A switch function exactly zero there counts as crossed: root finding
-  !> leaves out a function that is zero at its start, and would miss that switch. The other way
-  !> round, a switch function not reported that has crossed in the landed state in a direction
-  !> that changes its contact state (eq16_root_directions), or stands at exactly zero moving
-  !> that way (its rate), switches its tooth too: the restart's root search starts on the far
-  !> side (ARKODE takes a function zero at its start from a look a tenth of a step ahead) and
-  !> would never see it. In a cluster of near-simultaneous switches (the 16 teeth of an aligned
-  !> drive, 1e-11 apart on the scaled time) the interpolant reports the teeth a few at a time
-  !> while the landed state has crossed more: those were lost, their teeth held in the wrong
-  !> contact state for the rest of the run (the Z16 drive at 2356.25 r/min: 34 of 64 switches
-  !> located, lateral speeds 0.4 scaled off the symmetric orbit; tests/test_erk.py).
+  !> The integrator stopped on located roots (ERKStep landed on them: integrator_land_on_root;
+  !> CVODE returns the interpolated state at the root): the teeth whose switch functions have
+  !> crossed in the landed state v switch (spline_integrator::root_crossings), the others keep
+  !> their contact states until they do. Applying a reported root that had not crossed yet
+  !> switched a contact early (its damping force at the impact speed at once); with CVODE, an
+  !> aligned drive's 16 back flanks engaging 4.7 us after the section time (the doubling scene's
+  !> period-2 orbit at 1620.12 r/min) chattered in and out there and the one-output period map
+  !> closed 1.5 scaled off the orbit (tests/test_solver.py).
   subroutine settle_roots(ctx, rootsfound, tau, v, nroots)
     type(solver_ctx_t), intent(inout) :: ctx
     integer(c_int), intent(in) :: rootsfound(:)
@@ -455,20 +444,13 @@ contains
     integer, intent(inout) :: nroots
     real(wp) :: y(nstate), g(ctx%nrc), dg(ctx%nrc)
     integer(c_int) :: crossed(size(rootsfound))
-    integer :: c, o, i, dirs(ctx%nrc)
-    crossed = 0
+    integer :: c, o
     do c = 1, ctx%ncopy
       o = (c - 1)*ctx%nrc
       call from_scaled(ctx%m, copy_state(ctx, v, c), y)
       call mesh_switch_functions(ctx%m, tau/ctx%m%w_ref, y(1:ndof), g, y(ndof+1:), dg)
-      dirs = eq16_root_directions(ctx%modes(:, c))
-      do i = 1, ctx%nrc
-        if (rootsfound(o + i) /= 0) then
-          if (rootsfound(o + i)*g(i) >= 0.0_wp) crossed(o + i) = rootsfound(o + i)
-        else if (dirs(i)*g(i) > 0.0_wp .or. (g(i) == 0.0_wp .and. dirs(i)*dg(i) > 0.0_wp)) then
-          crossed(o + i) = int(dirs(i), c_int)
-        end if
-      end do
+      crossed(o+1:o+ctx%nrc) = root_crossings(rootsfound(o+1:o+ctx%nrc), &
+           eq16_root_directions(ctx%modes(:, c)), g, dg)
     end do
     call apply_roots(ctx, crossed, nroots)
   end subroutine settle_roots

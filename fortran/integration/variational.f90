@@ -28,7 +28,8 @@ module spline_variational
        eq16_root_directions, tooth_approach, slice_approach
   use spline_integrator, only: integrator_t, lib_log_t, integrator_open, cvode_create, &
        integrator_advance, integrator_root_info, integrator_root_directions, integrator_restart, &
-       integrator_fail_text, integrator_warnings, integrator_free
+       integrator_free, root_crossings
+  use spline_integrator_report, only: integrator_fail_text, integrator_warnings
   implicit none
   private
   public :: tangent_flow, variational_check
@@ -175,14 +176,20 @@ contains
 
   contains
 
-    !> Flip the contact states of the contacts whose switch was located, one at a time, each
+    !> Flip the contact states of the contacts whose switch functions have crossed in the
+    !> landed state (spline_integrator::root_crossings, as the state run), one at a time, each
     !> with its saltation matrix applied to the tangents.
     subroutine switch(rootsfound)
       integer(c_int), intent(in) :: rootsfound(:)
+      integer(c_int) :: crossed(size(rootsfound))
+      real(wp) :: y(nstate), g(2*ctx%nc), dg(2*ctx%nc)
       integer :: j, new
       ctx%ys_full(ctx%idx(1:n)) = yr(1:n)
+      call from_scaled(m, ctx%ys_full, y)
+      call mesh_switch_functions(m, tau/m%w_ref, y(1:ndof), g, y(ndof+1:), dg)
+      crossed = root_crossings(rootsfound, eq16_root_directions(ctx%modes), g, dg)
       do j = 1, ctx%nc
-        new = eq16_root_mode(ctx%modes(j), rootsfound(2*j - 1), rootsfound(2*j))
+        new = eq16_root_mode(ctx%modes(j), crossed(2*j - 1), crossed(2*j))
         if (new == ctx%modes(j)) cycle
         nsw = nsw + 1
         if (salt) call apply_saltation(ctx, tau, j, new, yr)

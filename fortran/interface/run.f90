@@ -18,7 +18,8 @@ module spline_run
   use spline_fidelity, only: auto_level, auto_tol, backlash_estimate
   use spline_sections, only: section_count, section_times
   use spline_lyapunov, only: lyapunov_benettin, lyapunov_tangent
-  use spline_integrator, only: lib_log_t, integrator_warnings
+  use spline_integrator, only: lib_log_t
+  use spline_integrator_report, only: integrator_warnings
   use spline_loads, only: combined_loads, run_extremes, stress_warnings
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none

@@ -458,8 +458,9 @@ contains
   !> one, and each switch restarts BDF at order 1). Adams with a given (calibrated) k_m, and from
   !> rest with Benettin's separated copy (lyapunov_method = 'copy'): chosen when ERK lost the
   !> copy's switches (physical_z24 unbalanced, d0 = 1e-8: +402 1/s against CVODE's -2.2); ERK
-  !> keeps them since (spline_solver::settle_roots: -2.18 as CVODE; test_chaos), the choice
-  !> not measured again.
+  !> keeps them since (spline_solver::settle_roots: -2.18 as CVODE; test_chaos), and is not
+  !> cheaper: the same exponents, ERK 15 % faster on physical_z24, 40 % slower on its
+  !> unbalanced variant, up to 30 % on chaos_z24 (docs/running.md section 2).
   pure integer function chosen_method(c) result(k)
     type(case_t), intent(in) :: c
     k = option_index(method_values, c%method)
