@@ -407,7 +407,7 @@ def _guess_at(ds, p):
 
 def fold_curve(case, field: str, start: float, stop: float, field2: str, values2, n: int = 1,
                *, check=(), check_points: int = 31, check_case=None, progress: bool = True,
-               command: str | None = None, narrow: bool = True,
+               command: str | None = None, method: str = "extended", narrow: bool = True,
                max_seconds: float = CALL_SECONDS, **cont):
     """The folds and grazings of the period-n branch over `field` in [start, stop], followed in
     a second field: at each of `values2` (in the order given) the branch is continued over the
@@ -444,9 +444,17 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
         raise CaseError(f"check_points = {check_points!r}: the check sweeps' number of values, "
                         "a whole number >= 2")
     check_handed_on(case, field, start, stop, n, cont)
+    if method not in ("extended", "repeated"):
+        raise CaseError(f"method = {method!r}: 'extended' (the fold followed by the extended "
+                        "system) or 'repeated' (a continuation per value of field2)")
     with time_bound(max_seconds, "fold_curve"):
-        out = _fold_values(case, field, start, stop, name2, index2, values2, n, narrow,
-                           progress, cont)
+        if method == "extended":
+            from .foldcurve import curve_dataset, extended
+            out = curve_dataset(*extended(case, field, start, stop, name2, index2, values2, n,
+                                          progress, cont), field_label(name2, index2), values2)
+        else:
+            out = _fold_values(case, field, start, stop, name2, index2, values2, n, narrow,
+                               progress, cont)
         if len(check):
             _check(out, case if check_case is None else check_case, field, start, stop, name2,
                    index2, check, check_points, progress)

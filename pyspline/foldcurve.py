@@ -167,7 +167,8 @@ def trace(sys, seed, y_fixed, bounds, direction, ds=0.05, ds_min=1e-3, ds_max=0.
     k2 = len(seed["u"])
     sig0 = seed["contact"]["signature"]
     tau = _null_tangent(seed["J"], direction * np.eye(k2)[-1])
-    pts, a = [seed], dict(seed, tau=tau)
+    a = dict(seed, tau=tau)
+    pts = [a]
     lo, hi = np.array(bounds).T
     while len(pts) < max_points:
         if late := out_of_time():
@@ -197,15 +198,12 @@ def trace(sys, seed, y_fixed, bounds, direction, ds=0.05, ds_min=1e-3, ds_max=0.
                 sys.last_error = str(exc)
         if new is not None and new["contact"]["signature"] != sig0:
             if ds / 2 < ds_min or end is not None and step / 2 < ds_min:
-                return pts, (f"grazing at {_at(sys, new['u'])}: the contact sequence changes "
-                             f"between it and {_at(sys, a['u'])} (a fold past a grazing, "
-                             "non-smooth, is not followed by the extended system)")
+                return pts, _grazing(sys, a, new["u"], sig0, new["contact"]["signature"])
             new = None
         if new is None:
             ds = min(ds, step) / 2
             if ds < ds_min:
-                return pts, (f"the fold curve's corrector failed at {_at(sys, pred)} with the "
-                             f"step down to {ds:.3g}: {sys.last_error}")
+                return pts, _failed(sys, a, pred, ds, sig0, y_fixed)
             continue
         sec = new["u"] - a["u"]
         new["tau"] = sec / np.linalg.norm(sec)
@@ -221,6 +219,39 @@ def trace(sys, seed, y_fixed, bounds, direction, ds=0.05, ds_min=1e-3, ds_max=0.
         grow = 1.5 if new["iterations"] <= 2 else (0.6 if new["iterations"] >= 4 else 1.0)
         ds = max(ds_min, min(ds_max, ds * grow, ds * max_angle / max(angle, 1e-12)))
     return pts, f"max_points = {max_points} reached at {_at(sys, pts[-1]['u'])}"
+
+
+def _grazing(sys, a, u, sig0, sig):
+    """'grazing at ...': the contact signature changes between point a and u, and how."""
+    z = len(sig0) // 2
+    how = ("a contact switch crosses the section time t0 (contact at t0 of tooth "
+           f"{', '.join(str(j + 1) for j in range(z) if sig0[j] != sig[j])} changes; the "
+           "switches per period do not)" if sig0[z:] == sig[z:] else
+           f"the contact changes per period go from {sum(sig0[z:])} to {sum(sig[z:])}")
+    return (f"grazing at {_at(sys, u)}: the contact sequence changes between it and "
+            f"{_at(sys, a['u'])}: {how} (the saltation in M holds within one sequence; a "
+            "non-smooth fold past it is not followed by the extended system)")
+
+
+def _failed(sys, a, pred, ds, sig0, y_fixed):
+    """What ended a direction whose step failed below ds_min: a grazing when the run of one
+    period from the predictor has another contact signature, else the corrector's failure."""
+    try:
+        import warnings
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SplineWarning)
+            p = sys.p_of(pred)
+            model = sys.model(p)
+            tr = _trajectory(model.case, sys.t0, sys.t0 + 2 * np.pi * sys.n /
+                             model.info()["omega"], sys.state(pred, y_fixed))
+        sig = contact_measures(tr)["signature"]
+    except (SolverError, CaseError):
+        sig = sig0
+    if sig != sig0:
+        return _grazing(sys, a, pred, sig0, sig) + f" (the corrector failed next to it: " \
+            f"{sys.last_error})"
+    return (f"the fold curve's corrector failed at {_at(sys, pred)} with the step down to "
+            f"{ds:.3g}: {sys.last_error}")
 
 
 def _at(sys, u):
@@ -246,21 +277,145 @@ def cusps(pts):
 
 
 def at_value(sys, pts, q2, y_fixed):
-    """The fold points of the traced curve at q2 (the field fixed there): the crossings of
-    each segment, corrected from the chord's point; a point on q2 itself as it is. (p1s,
-    states)."""
-    found = []
-    for a, b in zip(pts, pts[1:]):
-        fa, fb = a["u"][-1] - q2, b["u"][-1] - q2
-        if fa == 0 or fa * fb >= 0:
-            continue
-        if fb == 0:
-            found.append(b)
-            continue
-        u = a["u"] + fa / (fa - fb) * (b["u"] - a["u"])
-        res = sys.correct(u, np.eye(len(u))[-1], q2, y_fixed)
-        found.append(dict(u=u, y=sys.state(u, y_fixed)) if res is None else
-                     dict(u=res[0], y=sys.state(res[0], y_fixed)))
-    if pts and pts[0]["u"][-1] == q2:
-        found.insert(0, pts[0])
+    """The fold points of a traced curve at q2: its points on q2 and, on each segment that
+    crosses it, the point corrected with q2 fixed from the chord's (the chord's own when
+    that fails: 'exact' False)."""
+    f = [0.0 if abs(p["u"][-1] - q2) < 1e-12 else p["u"][-1] - q2 for p in pts]
+    found = [dict(u=p["u"], exact=True) for p, x in zip(pts, f) if x == 0]
+    for a, b, fa, fb in zip(pts, pts[1:], f, f[1:]):
+        if fa * fb < 0:
+            u = a["u"] + fa / (fa - fb) * (b["u"] - a["u"])
+            res = sys.correct(u, np.eye(len(u))[-1], q2, y_fixed)
+            found.append(dict(u=u, exact=False) if res is None else dict(u=res[0], exact=True))
     return found
+
+
+def extended(case, field, start, stop, name2, index2, values2, n, progress, cont):
+    """fold_curve by the extended system: the branch continued over [start, stop] at the
+    first value of field2 (the seed), each of its smooth folds not on a curve traced before
+    followed both ways within [start, stop] x [min, max of values2]. Returns (curves: lists
+    of point records, ends: (last point or None, what ended each direction), the seed's
+    continuation; the FoldSystem first, None when the seed has no fold)."""
+    import warnings
+    from .arclength import _map_only, continuation, parse_field
+    from .core import load
+    v0 = float(values2[0])
+    at = set_field(case, name2, index2, v0)
+    with warnings.catch_warnings(record=True):
+        warnings.simplefilter("always", SplineWarning)
+        ds = continuation(at, field, start, stop, n=n, progress=progress, **cont)
+    fold = (ds.special_type.values.astype(str) == "fold") & (ds.special_smooth.values == 1)
+    if not fold.any():
+        return None, [], [], ds
+    steps = {k: cont[k] for k in ("ds", "ds_min", "ds_max", "max_angle", "max_points")
+             if k in cont}
+    pscale = (0.1 * max(abs(start), abs(stop)), 0.1 * np.abs(values2).max() or 1.0)
+    model, y_fixed = load(at), ds.special_y0.values[fold][0]
+    free = _map_only(model, case["t0"], case["t0"] + 2 * np.pi * n / model.info()["omega"],
+                     y_fixed)[2]
+    sys = FoldSystem(case, parse_field(case, field), (name2, index2), n, (start, v0), pscale,
+                     free, _scale(model), cont.get("tol") or 100 * case["rtol"])
+    bounds = (sorted([0.0, (stop - start) / pscale[0]]),
+              [(values2.min() - v0) / pscale[1], (values2.max() - v0) / pscale[1]])
+    curves, ends = [], []
+    for p1, y in zip(ds[f"special_{ds.attrs['field']}"].values[fold], ds.special_y0.values[fold]):
+        q1 = (p1 - start) / pscale[0]
+        if any(abs(x["u"][-2] - q1) < 1e-6 for c in curves for x in at_value(sys, c, 0.0, y)):
+            continue                            # on a curve traced before
+        if late := out_of_time():
+            ends.append((None, f"{late} was reached before the fold at {_at(sys, [q1, 0])} "
+                               "was followed"))
+            continue
+        u0 = np.r_[y[free] / sys.d0[free], q1, 0.0]
+        try:
+            sys.border(sys.run(u0, y)[1])
+            res = sys.correct(u0, np.eye(len(u0))[-1], 0.0, y)
+            seed = None if res is None else sys.point(res, y)
+        except (SolverError, np.linalg.LinAlgError) as exc:
+            seed, sys.last_error = None, str(exc)
+        if seed is None:
+            ends.append((None, f"the fold at {_at(sys, u0)} was not corrected onto the "
+                               f"extended system: {sys.last_error}"))
+            continue
+        halves = []
+        for d in (-1, 1):
+            sys.border(seed["M"])
+            pts, why = trace(sys, seed, y, bounds, d, **steps)
+            halves.append(pts)
+            ends.append((pts[-1], why))
+        curves.append(halves[0][::-1] + halves[1][1:])
+    return sys, curves, ends, ds
+
+
+def _status(sys, ends, q2):
+    """Each value's status: 'complete', or why the curves may miss a fold there: a value
+    between the ends of two directions that stopped next to each other (within 0.05 in the
+    scaled fields: the same grazing from either side), or past a direction's stop that no
+    other end meets."""
+    out, left = ["complete"] * len(q2), [(p, w) for p, w in ends if w != "complete"]
+    while left:
+        p, why = left.pop(0)
+        if p is None:
+            out = [why if s == "complete" else s for s in out]
+            continue
+        near = [j for j, (r, _) in enumerate(left) if r is not None and
+                np.abs(r["u"][-2:] - p["u"][-2:]).max() < 0.05]
+        if near:
+            r, _ = left.pop(near[0])
+            lo, hi = sorted((p["u"][-1], r["u"][-1]))
+            text = f"the fold curve has a gap between {_at(sys, p['u'])} and {_at(sys, r['u'])}"
+            hit = (q2 >= lo) & (q2 <= hi)
+        else:
+            text, t = "the fold curve stops there", p["tau"][-1]
+            hit = (q2 - p["u"][-1]) * t >= 0
+        for j in np.flatnonzero(hit):
+            out[j] = f"{text}: {why}" if out[j] == "complete" else out[j]
+    return out
+
+
+def curve_dataset(sys, curves, ends, ds, label2, values2, margin=1e-4):
+    """The fold curves as fold_curve's variables: fold (value2, fold), status (value2), and
+    along the curves (dim curve_point): curve, the two fields, y0, Tm_pp, the largest |mu|
+    besides the one at +1 (mu_other) and stable; cusps (dim cusp); the seed's grazings."""
+    import xarray as xr
+    q2 = np.array([0.0 if sys is None else (v - sys.p0[1]) / sys.pscale[1] for v in values2])
+    folds, status = [], _status(sys, ends, q2) if sys else [
+        f"no smooth fold of the branch at {label2} = {values2[0]:g} over the band (the seed: "
+        f"{ds.attrs['status']})"] * len(values2)
+    for j, q in enumerate(q2):
+        xs = [x for c in curves for x in at_value(sys, c, q, c[0]["y"])]
+        folds.append(np.sort([sys.p_of(x["u"])[0] for x in xs]))
+        if not all(x["exact"] for x in xs) and status[j] == "complete":
+            status[j] = "a fold interpolated on the curve's chord (its corrector failed)"
+    pts = [(i, x) for i, c in enumerate(curves) for x in c]
+    other = [np.abs(np.delete(x["mu"], np.argmin(np.abs(x["mu"] - 1)))).max() for _, x in pts]
+    cu = [(i, sys.p_of(np.r_[0.0, q])) for i, c in enumerate(curves) for _, q in cusps(c)]
+    kinds = ds.special_type.values.astype(str)
+    grazing = np.full((len(values2), max(1, (kinds == "grazing").sum())), np.nan)
+    grazing[0, :(kinds == "grazing").sum()] = ds[f"special_{ds.attrs['field']}"].values[kinds == "grazing"]
+    out = xr.Dataset({
+        "fold": (("value2", "fold"), _padded(folds)),
+        "grazing": (("value2", "grazing"), grazing),
+        "status": (("value2",), np.array(status, dtype=object)),
+        "curve": (("curve_point",), np.array([i for i, _ in pts], int)),
+        "curve_field": (("curve_point",), np.array([x["p"][0] for _, x in pts])),
+        "curve_field2": (("curve_point",), np.array([x["p"][1] for _, x in pts])),
+        "curve_y0": (("curve_point", "state"), np.array([x["y"] for _, x in pts]).reshape(-1, 14)),
+        "curve_Tm_pp": (("curve_point",), np.array([x["Tm_pp"] for _, x in pts])),
+        "curve_mu_other": (("curve_point",), np.array(other)),
+        "curve_stable": (("curve_point",), (np.array(other) < 1 - margin).astype(np.int8)),
+        "cusp_field": (("cusp",), np.array([p[0] for _, p in cu])),
+        "cusp_field2": (("cusp",), np.array([p[1] for _, p in cu]))},
+        coords={"value2": values2})
+    out.attrs.update(field=ds.attrs["field"], method="extended", seed_status=ds.attrs["status"],
+                     curve_status="; ".join(w for _, w in ends) or "none traced",
+                     cusp="; ".join(f"{ds.attrs['field']} = {p[0]:.6g}, {label2} = {p[1]:.6g}"
+                                    for _, p in cu) or "none")
+    return out
+
+
+def _padded(rows):
+    out = np.full((len(rows), max([len(r) for r in rows] + [1])), np.nan)
+    for i, r in enumerate(rows):
+        out[i, :len(r)] = r
+    return out
