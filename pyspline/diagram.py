@@ -451,14 +451,17 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
         if method == "extended":
             from .foldcurve import curve_dataset, extended
             out = curve_dataset(*extended(case, field, start, stop, name2, index2, values2, n,
-                                          progress, cont), field_label(name2, index2), values2)
+                                          progress, cont), field_label(*parse_field(case, field)),
+                                field_label(name2, index2), values2)
+            out["band"] = (("value2", "end"), np.tile([start, stop], (len(values2), 1)))
+            out.attrs["field"] = field_label(*parse_field(case, field))
         else:
             out = _fold_values(case, field, start, stop, name2, index2, values2, n, narrow,
                                progress, cont)
         if len(check):
             _check(out, case if check_case is None else check_case, field, start, stop, name2,
                    index2, check, check_points, progress)
-    bad = [str(x) for x in out.status.values if x != "complete"]
+    bad = list(dict.fromkeys(str(x) for x in out.status.values if x != "complete"))
     if "coexist" in out and (out.coexist < 0).any():
         late = out.check_value.values[(out.coexist < 0).any("check_point")]
         bad.append(f"the wall-time bound of fold_curve, max_seconds = {max_seconds:g} s, was "

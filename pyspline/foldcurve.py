@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from .arclength import _null_tangent, field_label, set_field
-from .errors import CaseError, SolverError, SplineWarning
+from .errors import CaseError, SolverError, SplineError, SplineWarning
 from .orbits import _scale, _trajectory, forcing_periods, map_and_monodromy, out_of_time
 from .specials import contact_measures, multipliers
 
@@ -165,7 +165,7 @@ def trace(sys, seed, y_fixed, bounds, direction, ds=0.05, ds_min=1e-3, ds_max=0.
     hi), (q2 lo, hi)), its last point put on the side it crossed; 'grazing at ...': the contact
     signature changed, located to ds_min along the curve; or where and why it failed)."""
     k2 = len(seed["u"])
-    sig0 = seed["contact"]["signature"]
+    sig0 = _sequence(seed)
     tau = _null_tangent(seed["J"], direction * np.eye(k2)[-1])
     a = dict(seed, tau=tau)
     pts = [a]
@@ -184,6 +184,8 @@ def trace(sys, seed, y_fixed, bounds, direction, ds=0.05, ds_min=1e-3, ds_max=0.
             i = int(np.argmin(frac))
             end = (i, hi[i] if t[i] > 0 else lo[i])
             step = frac[i]
+            if step < 1e-9:             # on that side already (the seed's value): the end
+                return pts, "complete"
             res = sys.correct(a["u"] + step * a["tau"], np.eye(k2)[k2 - 2 + i], end[1], y_fixed)
         else:
             step = ds
@@ -196,9 +198,9 @@ def trace(sys, seed, y_fixed, bounds, direction, ds=0.05, ds_min=1e-3, ds_max=0.
                 new = sys.point(res, y_fixed)
             except SolverError as exc:
                 sys.last_error = str(exc)
-        if new is not None and new["contact"]["signature"] != sig0:
+        if new is not None and _sequence(new) != sig0:
             if ds / 2 < ds_min or end is not None and step / 2 < ds_min:
-                return pts, _grazing(sys, a, new["u"], sig0, new["contact"]["signature"])
+                return pts, _grazing(sys, a, new["u"], sig0, _sequence(new))
             new = None
         if new is None:
             ds = min(ds, step) / 2
@@ -221,13 +223,17 @@ def trace(sys, seed, y_fixed, bounds, direction, ds=0.05, ds_min=1e-3, ds_max=0.
     return pts, f"max_points = {max_points} reached at {_at(sys, pts[-1]['u'])}"
 
 
+def _sequence(pt):
+    """The contact sequence of a point's orbit: per tooth its contact changes over the period
+    (the contact signature without the contact at t0: a switch crossing the section time
+    shifts the sequence, it does not change it, and M's saltations stay the same)."""
+    sig = pt["contact"]["signature"]
+    return sig[len(sig) // 2:]
+
+
 def _grazing(sys, a, u, sig0, sig):
-    """'grazing at ...': the contact signature changes between point a and u, and how."""
-    z = len(sig0) // 2
-    how = ("a contact switch crosses the section time t0 (contact at t0 of tooth "
-           f"{', '.join(str(j + 1) for j in range(z) if sig0[j] != sig[j])} changes; the "
-           "switches per period do not)" if sig0[z:] == sig[z:] else
-           f"the contact changes per period go from {sum(sig0[z:])} to {sum(sig[z:])}")
+    """'grazing at ...': the contact sequence changes between point a and u, and how."""
+    how = f"the contact changes per period go from {sum(sig0)} to {sum(sig)}"
     return (f"grazing at {_at(sys, u)}: the contact sequence changes between it and "
             f"{_at(sys, a['u'])}: {how} (the saltation in M holds within one sequence; a "
             "non-smooth fold past it is not followed by the extended system)")
@@ -244,7 +250,7 @@ def _failed(sys, a, pred, ds, sig0, y_fixed):
             model = sys.model(p)
             tr = _trajectory(model.case, sys.t0, sys.t0 + 2 * np.pi * sys.n /
                              model.info()["omega"], sys.state(pred, y_fixed))
-        sig = contact_measures(tr)["signature"]
+        sig = _sequence(dict(contact=contact_measures(tr)))
     except (SolverError, CaseError):
         sig = sig0
     if sig != sig0:
@@ -295,15 +301,21 @@ def extended(case, field, start, stop, name2, index2, values2, n, progress, cont
     first value of field2 (the seed), each of its smooth folds not on a curve traced before
     followed both ways within [start, stop] x [min, max of values2]. Returns (curves: lists
     of point records, ends: (last point or None, what ended each direction), the seed's
-    continuation; the FoldSystem first, None when the seed has no fold)."""
+    continuation (its error's text when it found no orbit); the FoldSystem first, None
+    when the seed has no fold)."""
     import warnings
     from .arclength import _map_only, continuation, parse_field
     from .core import load
     v0 = float(values2[0])
     at = set_field(case, name2, index2, v0)
-    with warnings.catch_warnings(record=True):
-        warnings.simplefilter("always", SplineWarning)
-        ds = continuation(at, field, start, stop, n=n, progress=progress, **cont)
+    try:
+        with warnings.catch_warnings(record=True):
+            warnings.simplefilter("always", SplineWarning)
+            ds = continuation(at, field, start, stop, n=n, progress=progress, **cont)
+    except CaseError:
+        raise
+    except SplineError as exc:      # no orbit at the seed's start: no fold to follow
+        return None, [], [], f"{type(exc).__name__}: {exc}"
     fold = (ds.special_type.values.astype(str) == "fold") & (ds.special_smooth.values == 1)
     if not fold.any():
         return None, [], [], ds
@@ -373,15 +385,16 @@ def _status(sys, ends, q2):
     return out
 
 
-def curve_dataset(sys, curves, ends, ds, label2, values2, margin=1e-4):
+def curve_dataset(sys, curves, ends, ds, label1, label2, values2, margin=1e-4):
     """The fold curves as fold_curve's variables: fold (value2, fold), status (value2), and
     along the curves (dim curve_point): curve, the two fields, y0, Tm_pp, the largest |mu|
     besides the one at +1 (mu_other) and stable; cusps (dim cusp); the seed's grazings."""
     import xarray as xr
     q2 = np.array([0.0 if sys is None else (v - sys.p0[1]) / sys.pscale[1] for v in values2])
+    seed = ds if isinstance(ds, str) else ds.attrs["status"]
     folds, status = [], _status(sys, ends, q2) if sys else [
-        f"no smooth fold of the branch at {label2} = {values2[0]:g} over the band (the seed: "
-        f"{ds.attrs['status']})"] * len(values2)
+        f"no smooth fold of the branch at {label2} = {values2[0]:g} over the band (the seed's "
+        f"continuation: {seed})"] * len(values2)
     for j, q in enumerate(q2):
         xs = [x for c in curves for x in at_value(sys, c, q, c[0]["y"])]
         folds.append(np.sort([sys.p_of(x["u"])[0] for x in xs]))
@@ -390,9 +403,10 @@ def curve_dataset(sys, curves, ends, ds, label2, values2, margin=1e-4):
     pts = [(i, x) for i, c in enumerate(curves) for x in c]
     other = [np.abs(np.delete(x["mu"], np.argmin(np.abs(x["mu"] - 1)))).max() for _, x in pts]
     cu = [(i, sys.p_of(np.r_[0.0, q])) for i, c in enumerate(curves) for _, q in cusps(c)]
-    kinds = ds.special_type.values.astype(str)
+    kinds = np.zeros(0, str) if isinstance(ds, str) else ds.special_type.values.astype(str)
     grazing = np.full((len(values2), max(1, (kinds == "grazing").sum())), np.nan)
-    grazing[0, :(kinds == "grazing").sum()] = ds[f"special_{ds.attrs['field']}"].values[kinds == "grazing"]
+    if len(kinds):      # the seed's grazings, in order along its branch
+        grazing[0, :(kinds == "grazing").sum()] = ds[f"special_{label1}"].values[kinds == "grazing"]
     out = xr.Dataset({
         "fold": (("value2", "fold"), _padded(folds)),
         "grazing": (("value2", "grazing"), grazing),
@@ -407,9 +421,9 @@ def curve_dataset(sys, curves, ends, ds, label2, values2, margin=1e-4):
         "cusp_field": (("cusp",), np.array([p[0] for _, p in cu])),
         "cusp_field2": (("cusp",), np.array([p[1] for _, p in cu]))},
         coords={"value2": values2})
-    out.attrs.update(field=ds.attrs["field"], method="extended", seed_status=ds.attrs["status"],
+    out.attrs.update(method="extended", seed_status=seed,
                      curve_status="; ".join(w for _, w in ends) or "none traced",
-                     cusp="; ".join(f"{ds.attrs['field']} = {p[0]:.6g}, {label2} = {p[1]:.6g}"
+                     cusp="; ".join(f"{label1} = {p[0]:.6g}, {label2} = {p[1]:.6g}"
                                     for _, p in cu) or "none")
     return out
 
