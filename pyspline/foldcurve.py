@@ -298,27 +298,32 @@ def at_value(sys, pts, q2, y_fixed):
 
 def extended(case, field, start, stop, name2, index2, values2, n, progress, cont):
     """fold_curve by the extended system: the branch continued over [start, stop] at the
-    first value of field2 (the seed), each of its smooth folds not on a curve traced before
-    followed both ways within [start, stop] x [min, max of values2]. Returns (curves: lists
-    of point records, ends: (last point or None, what ended each direction), the seed's
-    continuation (its error's text when it found no orbit); the FoldSystem first, None
-    when the seed has no fold)."""
+    values of field2 in turn until one has a smooth fold (the seed), each of its folds not on
+    a curve traced before followed both ways within [start, stop] x [min, max of values2].
+    Returns (the FoldSystem, None when no value has a fold; curves: lists of point records;
+    ends: (last point or None, what ended each direction); tried: the continuation of each
+    value tried, in order (its error's text where it found no orbit), the seed's last)."""
     import warnings
     from .arclength import _map_only, continuation, parse_field
     from .core import load
-    v0 = float(values2[0])
-    at = set_field(case, name2, index2, v0)
-    try:
-        with warnings.catch_warnings(record=True):
-            warnings.simplefilter("always", SplineWarning)
-            ds = continuation(at, field, start, stop, n=n, progress=progress, **cont)
-    except CaseError:
-        raise
-    except SplineError as exc:      # no orbit at the seed's start: no fold to follow
-        return None, [], [], f"{type(exc).__name__}: {exc}"
-    fold = (ds.special_type.values.astype(str) == "fold") & (ds.special_smooth.values == 1)
-    if not fold.any():
-        return None, [], [], ds
+    tried, fold = [], np.zeros(0, bool)
+    for v0 in map(float, values2):
+        at = set_field(case, name2, index2, v0)
+        try:
+            with warnings.catch_warnings(record=True):
+                warnings.simplefilter("always", SplineWarning)
+                ds = continuation(at, field, start, stop, n=n, progress=progress, **cont)
+        except CaseError:
+            raise
+        except SplineError as exc:      # no orbit at the band's start: the next value
+            tried.append(f"{type(exc).__name__}: {exc}")
+            continue
+        tried.append(ds)
+        fold = (ds.special_type.values.astype(str) == "fold") & (ds.special_smooth.values == 1)
+        if fold.any() or out_of_time():
+            break
+    if not tried or isinstance(tried[-1], str) or not fold.any():
+        return None, [], [], tried
     steps = {k: cont[k] for k in ("ds", "ds_min", "ds_max", "max_angle", "max_points")
              if k in cont}
     pscale = (0.1 * max(abs(start), abs(stop)), 0.1 * np.abs(values2).max() or 1.0)
@@ -356,7 +361,7 @@ def extended(case, field, start, stop, name2, index2, values2, n, progress, cont
             halves.append(pts)
             ends.append((pts[-1], why))
         curves.append(halves[0][::-1] + halves[1][1:])
-    return sys, curves, ends, ds
+    return sys, curves, ends, tried
 
 
 def _status(sys, ends, q2):
@@ -385,31 +390,36 @@ def _status(sys, ends, q2):
     return out
 
 
-def curve_dataset(sys, curves, ends, ds, label1, label2, values2, margin=1e-4):
+def curve_dataset(sys, curves, ends, tried, label1, label2, values2, margin=1e-4):
     """The fold curves as fold_curve's variables: fold (value2, fold), status (value2), and
     along the curves (dim curve_point): curve, the two fields, y0, Tm_pp, the largest |mu|
-    besides the one at +1 (mu_other) and stable; cusps (dim cusp); the seed's grazings."""
+    besides the one at +1 (mu_other) and stable; cusps (dim cusp); the grazings of the
+    values continued (those tried for a seed)."""
     import xarray as xr
-    q2 = np.array([0.0 if sys is None else (v - sys.p0[1]) / sys.pscale[1] for v in values2])
-    seed = ds if isinstance(ds, str) else ds.attrs["status"]
-    folds, status = [], _status(sys, ends, q2) if sys else [
-        f"no smooth fold of the branch at {label2} = {values2[0]:g} over the band (the seed's "
-        f"continuation: {seed})"] * len(values2)
-    for j, q in enumerate(q2):
-        xs = [x for c in curves for x in at_value(sys, c, q, c[0]["y"])]
+    said = [d if isinstance(d, str) else d.attrs["status"] for d in tried]
+    if sys is None:     # no value with a fold: each value continued says what it found
+        status = [f"{out_of_time()} was reached before {label2} = {v:g} was continued"
+                  for v in values2]     # (the values tried say what they found, below)
+    else:
+        status = _status(sys, ends, (np.asarray(values2) - sys.p0[1]) / sys.pscale[1])
+    folds = []
+    for j, v in enumerate(values2):
+        if j < len(tried) - (sys is not None):      # continued, no fold: its own answer
+            status[j], xs = said[j], []
+        else:
+            xs = [] if sys is None else [x for c in curves for x in at_value(
+                sys, c, (v - sys.p0[1]) / sys.pscale[1], c[0]["y"])]
         folds.append(np.sort([sys.p_of(x["u"])[0] for x in xs]))
         if not all(x["exact"] for x in xs) and status[j] == "complete":
             status[j] = "a fold interpolated on the curve's chord (its corrector failed)"
     pts = [(i, x) for i, c in enumerate(curves) for x in c]
     other = [np.abs(np.delete(x["mu"], np.argmin(np.abs(x["mu"] - 1)))).max() for _, x in pts]
     cu = [(i, sys.p_of(np.r_[0.0, q])) for i, c in enumerate(curves) for _, q in cusps(c)]
-    kinds = np.zeros(0, str) if isinstance(ds, str) else ds.special_type.values.astype(str)
-    grazing = np.full((len(values2), max(1, (kinds == "grazing").sum())), np.nan)
-    if len(kinds):      # the seed's grazings, in order along its branch
-        grazing[0, :(kinds == "grazing").sum()] = ds[f"special_{label1}"].values[kinds == "grazing"]
+    graze = [[] if isinstance(d, str) else d[f"special_{label1}"].values[
+        d.special_type.values.astype(str) == "grazing"] for d in tried]
     out = xr.Dataset({
         "fold": (("value2", "fold"), _padded(folds)),
-        "grazing": (("value2", "grazing"), grazing),
+        "grazing": (("value2", "grazing"), _padded(graze + [[]] * (len(values2) - len(graze)))),
         "status": (("value2",), np.array(status, dtype=object)),
         "curve": (("curve_point",), np.array([i for i, _ in pts], int)),
         "curve_field": (("curve_point",), np.array([x["p"][0] for _, x in pts])),
@@ -421,7 +431,7 @@ def curve_dataset(sys, curves, ends, ds, label1, label2, values2, margin=1e-4):
         "cusp_field": (("cusp",), np.array([p[0] for _, p in cu])),
         "cusp_field2": (("cusp",), np.array([p[1] for _, p in cu]))},
         coords={"value2": values2})
-    out.attrs.update(method="extended", seed_status=seed,
+    out.attrs.update(method="extended", seed_status=said[-1] if said else "none",
                      curve_status="; ".join(w for _, w in ends) or "none traced",
                      cusp="; ".join(f"{label1} = {p[0]:.6g}, {label2} = {p[1]:.6g}"
                                     for _, p in cu) or "none")

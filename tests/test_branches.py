@@ -191,8 +191,9 @@ def test_fold_curve_through_its_cusp(cusp_curve):
     a = 0.08 and 0.085 (docs: the pair 1.5 r/min wide at 0.085, none at 0.08) and comes back
     up as the upper fold: one curve, traced through the cusp (points either side of it, their
     speeds higher past it). Its folds at a = 0.0875 equal those of the one-parameter
-    continuation there (4e-4 r/min at rtol 1e-7: the corrector's tol of 1e-5 near a fold,
-    where M - I is singular, moves a fold by about its square root in the scaled speed);
+    continuation there (measured 1.1e-4 and 1.2e-4 r/min at rtol 1e-7: both correctors stop
+    at the scaled residual tol = 1e-5, and the secant of the one-parameter location stops on
+    the arclength to 1e-6 of the step);
     none at 0.08. Follow sweeps at the middle of the 0.085 pair and 8 r/min either side say
     two orbits there and one outside; at 0.08, at the same speeds, the up and the down chains
     end on the same orbit (T_m peak-to-peak to 0.5 %): no hysteresis past the cusp."""
@@ -213,7 +214,7 @@ def test_fold_curve_through_its_cusp(cusp_curve):
         ds = pyspline.continuation(FAST.replace(ripple_amp=[0.0875, 0, 0, 0]), "speed_rpm",
                                    2575, 2600, progress=False, ds_max=0.5, max_angle=0.3)
     one = np.sort(ds.special_speed_rpm.values[ds.special_type.values.astype(str) == "fold"])
-    assert np.abs(f[1, :2] - one).max() < 1e-3, (f[1], one)
+    assert np.abs(f[1, :2] - one).max() < 5e-4, (f[1], one)
     lo, hi = f[0, :2]
     speeds = [lo - 8, (lo + hi) / 2, hi + 8]
     pp = {}
@@ -233,8 +234,9 @@ def test_fold_curve_through_its_cusp(cusp_curve):
 def test_g_derivatives_against_differences(cusp_curve):
     """At a point of the fold curve the extended system's last Jacobian row, g's gradient
     (from two variational runs along v for the states, M(p +- h) v for the fields), equals
-    central differences of g itself (b and c held), component by component, to 1e-3 of the
-    gradient's size; F = 0 and g = 0 there."""
+    central differences of g itself (b and c held; steps 1e-4 in the scaled unknowns),
+    component by component, to 1e-4 of the gradient's size (measured 5e-6); F = 0 and g = 0
+    there."""
     from pyspline.arclength import parse_field
     from pyspline.foldcurve import FoldSystem
     from pyspline.orbits import _scale
@@ -253,7 +255,7 @@ def test_g_derivatives_against_differences(cusp_curve):
     h = 1e-4 * np.maximum(1, np.abs(u))
     fd = np.array([(fs.g(u + h[j] * np.eye(16)[j], y) - fs.g(u - h[j] * np.eye(16)[j], y))
                    / (2 * h[j]) for j in range(16)])
-    assert np.abs(J[-1] - fd).max() < 1e-3 * np.abs(fd).max(), np.c_[J[-1], fd]
+    assert np.abs(J[-1] - fd).max() < 1e-4 * np.abs(fd).max(), np.c_[J[-1], fd]
 
 
 def test_bad_input_is_a_case_error(monkeypatch):

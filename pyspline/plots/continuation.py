@@ -171,8 +171,8 @@ def fold_plane(fc, path=None, title: str | None = None) -> Figure:
         ok = np.isfinite(folds[:, j])
         ax.plot(folds[ok, j], v[ok], "o" if curve else "o-", color="#D55E00",
                 mfc="white" if j else "#D55E00", ms=5, lw=1.4,
-                label=f"{name} at the values of {field2} (mu = +1)" if j < 2 and ok.any()
-                else None)
+                label=None if j >= 2 or not ok.any() else f"{name} (mu = +1)" + (
+                    f" at the values of {field2}" if curve else ""))
     if curve:       # the extended system's curves, their ends and cusps
         for i in np.unique(fc.curve.values):
             on = fc.curve.values == i
