@@ -267,13 +267,15 @@ def _at(sys, u):
 
 def cusps(pts):
     """The cusps of a traced curve (points in order): where the q2 component of the secant
-    changes sign, the field values at the q2 extremum of the parabola in arclength through
-    the three points around it."""
+    changes sign and the q1 component too (the curve's projection on the two fields turns
+    back: the two folds meet; where only q2 turns, the fold curve has an extremum in the
+    second field, not a cusp), the field values at the q2 extremum of the parabola in
+    arclength through the three points around it."""
     u = np.array([p["u"] for p in pts])
     out = []
     for i in range(1, len(u) - 1):
-        d0, d1 = u[i, -1] - u[i - 1, -1], u[i + 1, -1] - u[i, -1]
-        if d0 * d1 < 0:
+        d0, d1 = u[i] - u[i - 1], u[i + 1] - u[i]
+        if d0[-1] * d1[-1] < 0 and d0[-2] * d1[-2] < 0:
             s = np.r_[0, np.cumsum(np.linalg.norm(np.diff(u[i - 1:i + 2], axis=0), axis=1))]
             c = np.polyfit(s, u[i - 1:i + 2, -1], 2)
             sc = -c[1] / (2 * c[0])
@@ -367,15 +369,13 @@ def extended(case, field, start, stop, name2, index2, values2, n, progress, cont
 def _status(sys, ends, q2):
     """Each value's status: 'complete', or why the curves may miss a fold there: a value
     between the ends of two directions that stopped next to each other (within 0.05 in the
-    scaled fields: the same grazing from either side), or past a direction's stop that no
-    other end meets."""
+    scaled fields: the same grazing from either side: a gap in the curve), or, where a
+    direction stopped and no other end meets it, every value (the curve past the stop is not
+    known: it may come back to any value)."""
     out, left = ["complete"] * len(q2), [(p, w) for p, w in ends if w != "complete"]
     while left:
         p, why = left.pop(0)
-        if p is None:
-            out = [why if s == "complete" else s for s in out]
-            continue
-        near = [j for j, (r, _) in enumerate(left) if r is not None and
+        near = [j for j, (r, _) in enumerate(left) if p is not None and r is not None and
                 np.abs(r["u"][-2:] - p["u"][-2:]).max() < 0.05]
         if near:
             r, _ = left.pop(near[0])
@@ -383,8 +383,8 @@ def _status(sys, ends, q2):
             text = f"the fold curve has a gap between {_at(sys, p['u'])} and {_at(sys, r['u'])}"
             hit = (q2 >= lo) & (q2 <= hi)
         else:
-            text, t = "the fold curve stops there", p["tau"][-1]
-            hit = (q2 - p["u"][-1]) * t >= 0
+            text, hit = "the fold curve stops (its folds past the stop are not followed)", \
+                np.ones(len(q2), bool)
         for j in np.flatnonzero(hit):
             out[j] = f"{text}: {why}" if out[j] == "complete" else out[j]
     return out
@@ -413,6 +413,7 @@ def curve_dataset(sys, curves, ends, tried, label1, label2, values2, margin=1e-4
         if not all(x["exact"] for x in xs) and status[j] == "complete":
             status[j] = "a fold interpolated on the curve's chord (its corrector failed)"
     pts = [(i, x) for i, c in enumerate(curves) for x in c]
+    stops = [p for p, w in ends if p is not None and w != "complete"]
     other = [np.abs(np.delete(x["mu"], np.argmin(np.abs(x["mu"] - 1)))).max() for _, x in pts]
     cu = [(i, sys.p_of(np.r_[0.0, q])) for i, c in enumerate(curves) for _, q in cusps(c)]
     graze = [[] if isinstance(d, str) else d[f"special_{label1}"].values[
@@ -428,6 +429,10 @@ def curve_dataset(sys, curves, ends, tried, label1, label2, values2, margin=1e-4
         "curve_Tm_pp": (("curve_point",), np.array([x["Tm_pp"] for _, x in pts])),
         "curve_mu_other": (("curve_point",), np.array(other)),
         "curve_stable": (("curve_point",), (np.array(other) < 1 - margin).astype(np.int8)),
+        "stop_field": (("stop",), np.array([p["p"][0] for p in stops])),
+        "stop_field2": (("stop",), np.array([p["p"][1] for p in stops])),
+        "stop_status": (("stop",), np.array([w for p, w in ends if p is not None
+                                             and w != "complete"], dtype=object)),
         "cusp_field": (("cusp",), np.array([p[0] for _, p in cu])),
         "cusp_field2": (("cusp",), np.array([p[1] for _, p in cu]))},
         coords={"value2": values2})

@@ -179,8 +179,9 @@ def fold_plane(fc, path=None, title: str | None = None) -> Figure:
             x, y = fc.curve_field.values[on], fc.curve_field2.values[on]
             ax.plot(x, y, "-", color="#D55E00", lw=1.4,
                     label=None if i else "fold curve (extended system)")
-            ax.plot(x[[0, -1]], y[[0, -1]], "|", color="#D55E00", ms=12, mew=1.5,
-                    label=None if i else "where a traced curve ends (attrs['curve_status'])")
+        if fc.sizes["stop"]:
+            ax.plot(fc.stop_field.values, fc.stop_field2.values, "x", color="#D55E00", ms=9,
+                    mew=2, label="the curve stops: its contact sequence changes (stop_status)")
         if fc.sizes["cusp"]:
             ax.plot(fc.cusp_field.values, fc.cusp_field2.values, "*", color="k", ms=12,
                     label="cusp (the two folds meet)")
