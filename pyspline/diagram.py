@@ -550,14 +550,9 @@ def _fold_values(case, field, start, stop, name2, index2, values2, n, narrow, pr
         folds.append(np.sort(sp[kinds == "fold"]))
         grazes.append(sp[kinds == "grazing"])       # in order along the branch from b0
         pairs.append((v, *folds[-1][:2]) if len(folds[-1]) >= 2 else (v,))
-
-    def padded(rows):
-        out = np.full((len(rows), max([len(r) for r in rows] + [1])), np.nan)
-        for i, r in enumerate(rows):
-            out[i, :len(r)] = r
-        return out
-    return xr.Dataset({"fold": (("value2", "fold"), padded(folds)),
-                       "grazing": (("value2", "grazing"), padded(grazes)),
+    from .foldcurve import _padded
+    return xr.Dataset({"fold": (("value2", "fold"), _padded(folds)),
+                       "grazing": (("value2", "grazing"), _padded(grazes)),
                        "band": (("value2", "end"), np.array(bands, float)),
                        "status": (("value2",), np.array(status, dtype=object))},
                       coords={"value2": values2},

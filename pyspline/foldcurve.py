@@ -16,6 +16,8 @@ where it changes, the direction stops ('grazing at ...'). Nothing here computes 
 map, M and the trajectories are the core's."""
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from .arclength import _null_tangent, field_label, set_field
@@ -45,7 +47,6 @@ class FoldSystem:
         key = tuple(map(float, p))
         m = self.models.get(key)
         if m is None:
-            import warnings
             from .core import load
             if len(self.models) > 16:
                 self.models.clear()
@@ -150,7 +151,6 @@ class FoldSystem:
         y = self.state(u, y_fixed)
         model = self.model(p)
         t1 = self.t0 + 2 * np.pi * self.n / model.info()["omega"]
-        import warnings
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", SplineWarning)
             tr = _trajectory(model.case, self.t0, t1, y)
@@ -243,7 +243,6 @@ def _failed(sys, a, pred, ds, sig0, y_fixed):
     """What ended a direction whose step failed below ds_min: a grazing when the run of one
     period from the predictor has another contact signature, else the corrector's failure."""
     try:
-        import warnings
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", SplineWarning)
             p = sys.p_of(pred)
@@ -305,7 +304,6 @@ def extended(case, field, start, stop, name2, index2, values2, n, progress, cont
     Returns (the FoldSystem, None when no value has a fold; curves: lists of point records;
     ends: (last point or None, what ended each direction); tried: the continuation of each
     value tried, in order (its error's text where it found no orbit), the seed's last)."""
-    import warnings
     from .arclength import _map_only, continuation, parse_field
     from .core import load
     tried, fold = [], np.zeros(0, bool)
@@ -444,6 +442,7 @@ def curve_dataset(sys, curves, ends, tried, label1, label2, values2, margin=1e-4
 
 
 def _padded(rows):
+    """Rows of different lengths as one array, NaN padded (at least one column)."""
     out = np.full((len(rows), max([len(r) for r in rows] + [1])), np.nan)
     for i, r in enumerate(rows):
         out[i, :len(r)] = r
