@@ -314,8 +314,8 @@ def test_cli_all(tmp_path):
 def test_cli_fold_input(tmp_path, every_branch):
     """`pyspline continue --fold` writes the folds at one amplitude (the Python --all call's)
     with the follow sweeps' verdict (2330, 2395, 2460 r/min: two orbits exactly between the
-    folds, 2354.6 and 2439.3), exit 0; a --fold without numbers is a CaseError naming it,
-    exit 2."""
+    folds, 2354.6 and 2439.3), exit 0; a --fold without numbers, or --repeated without
+    --fold, is a CaseError naming it, exit 2."""
     import xarray as xr
     from test_continuation import cli
     path = tmp_path / "drive.nml"
@@ -333,3 +333,6 @@ def test_cli_fold_input(tmp_path, every_branch):
     run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
               "--stop", "2500", "--fold", "ripple_amp(1)=0.2,x")
     assert run.returncode == 2 and "--fold ripple_amp(1)=" in run.stderr, run.stderr
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
+              "--stop", "2500", "--repeated")
+    assert run.returncode == 2 and "--repeated: the method of --fold" in run.stderr, run.stderr
