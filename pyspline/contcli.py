@@ -31,10 +31,11 @@ With --band LO HI the doubled branches that period doublings start are followed 
 With --all: every periodic branch of the band (pyspline.branches): a follow sweep of --sweep N
 points (default 31; runs of the case's t_end: let it settle them, e.g. --fix t_end=1
 --fix t_transient=0.5) seeds a continuation from each distinct attractor; branches.nc (the
-branches), sweep.nc and branches.png. With --fold FIELD2=V1,V2,...: the folds and grazings of
-the branch from --start followed in FIELD2 (pyspline.fold_curve), the brute-force verdicts of
-follow sweeps of --sweep N points (default 31) at the values of --check V,V,... overlaid;
-fold_curve.nc and fold_curve.png.
+branches), sweep.nc and branches.png. With --fold FIELD2=V1,V2,...: the folds of the branch
+over --start..--stop at V1 followed in FIELD2 over the values' range by the extended system,
+through cusps (pyspline.fold_curve; --repeated: a continuation at each value instead), the
+folds at each value, the brute-force verdicts of follow sweeps of --sweep N points (default
+31) at the values of --check V,V,... overlaid; fold_curve.nc and fold_curve.png.
 
 example: pyspline continue cases/physical_ripple.nml --field speed_rpm --start 5000 --stop 7000
 """
@@ -59,6 +60,8 @@ def cmd_continue(args, fixed, exit_code) -> int:
             raise CaseError(f"--sweep: a follow sweep runs whole fields; {args.field} is "
                             "one element of an array field")
         band = _band(args)
+        if args.repeated and not args.fold:
+            raise CaseError("--repeated: the method of --fold; give --fold FIELD2=V1,V2,...")
         if args.all or args.fold:
             if band is not None:
                 raise CaseError("--band: the range of continue's doubled branches; --all and "
@@ -163,13 +166,17 @@ def _other(args, case, name, index, command, out) -> int:
         fc = fold_curve(case, args.field, args.start, args.stop, field2.strip(),
                         _values(text, f"--fold {field2}="), n=args.n, progress=not args.quiet,
                         check=_values(args.check, "--check") if args.check else (),
-                        check_points=points, command=command + f" --fold {args.fold}",
+                        check_points=points, command=command + f" --fold {args.fold}"
+                        + " --repeated" * args.repeated,
                         ds=args.ds, max_points=args.max_points, tol=args.tol,
-                        max_seconds=args.max_seconds)
+                        max_seconds=args.max_seconds,
+                        method="repeated" if args.repeated else "extended")
         write_netcdf(fc, out / "fold_curve.nc")
         for v, f, g in zip(fc.value2.values, fc.fold.values, fc.grazing.values):
             print(f"{field2.strip()} = {v:.6g}: folds {np.round(f[np.isfinite(f)], 2)}, "
                   f"grazings {np.round(g[np.isfinite(g)], 2)}")
+        if "cusp" in fc.attrs:
+            print(f"cusps: {fc.attrs['cusp']}")
         fold_plane(fc, path=out / "fold_curve.png")
         print(f"wrote {out / 'fold_curve.nc'}, {out / 'fold_curve.png'}")
         status = fc.attrs["status"]
@@ -207,6 +214,9 @@ def add_continue(sub, fixed, exit_code) -> None:
                    "seeded by follow sweeps of --sweep N points (default 31): branches.nc, .png")
     r.add_argument("--fold", metavar="FIELD2=V1,V2,...", help="the folds and grazings followed "
                    "in a second field: fold_curve.nc and fold_curve.png")
+    r.add_argument("--repeated", action="store_true", help="with --fold: a continuation at "
+                   "each value of FIELD2 instead of the extended system (gives every value's "
+                   "grazings)")
     r.add_argument("--check", metavar="V1,V2,...", help="with --fold: values of FIELD2 with a "
                    "follow sweep's verdict (one orbit or two) overlaid")
     r.add_argument("--max-seconds", type=float, default=CALL_SECONDS, metavar="S",

@@ -408,23 +408,31 @@ def _guess_at(ds, p):
 
 def fold_curve(case, field: str, start: float, stop: float, field2: str, values2, n: int = 1,
                *, check=(), check_points: int = 31, check_case=None, progress: bool = True,
-               command: str | None = None, narrow: bool = True,
+               command: str | None = None, method: str = "extended", narrow: bool = True,
                max_seconds: float = CALL_SECONDS, **cont):
-    """The folds and grazings of the period-n branch over `field` in [start, stop], followed in
-    a second field: at each of `values2` (in the order given) the branch is continued over the
-    band (a fold curve by repeated one-parameter continuation; `cont`: continuation's
-    keywords), from the previous value's orbit at the band's start. Two folds bound the band
-    where two orbits coexist; where the fold curves meet (a cusp) the hysteresis ends.
+    """The folds of the period-n branch over `field` in [start, stop], followed in a second
+    field: two folds bound the band where two orbits coexist; where they meet (a cusp) the
+    hysteresis ends.
 
-    narrow : once a value has a fold pair, the next value's band is narrowed around where its
-        folds are predicted (the last pair moved by the last shift, linear in field2; margins
-        of the larger of the pair's width, twice the shift and 2 % of the band): the branch
-        outside the folds is not traced again. A narrowed band that does not give a fold pair
-        is traced again over [start, stop].
-    max_seconds : the wall time of the whole call (orbits.CALL_SECONDS; math.inf: none),
-        shared: each value gets what is left over the values left, so a slow value cannot take
-        the others' time; its status says when its share ran out. The check sweeps run after
-        the values, in what is left (a run is cut where it passes, the runs after it not
+    method : 'extended' (default): the branch is continued over the band at values2[0] (at
+        the next values in turn while one gives no smooth fold), and each of its folds is
+        followed in (field, field2) by the minimally extended system (pyspline.foldcurve:
+        F = P^n(y) - y = 0, g = 0 from the bordered M - I; exact M with saltation, seven
+        variational runs per Newton step) within [start, stop] x [min, max of values2], both
+        ways, through cusps, until it leaves that rectangle or the orbit's contact sequence
+        changes ('grazing at ...': a fold past it is not followed). The folds at each value
+        of field2 are where the curves cross it, corrected there. 'repeated': a continuation
+        over the band at each value in turn (`cont`: continuation's keywords, for both), from
+        the previous value's orbit at the band's start; gives every value's grazings.
+    narrow : (repeated) once a value has a fold pair, the next value's band is narrowed around
+        where its folds are predicted (the last pair moved by the last shift, linear in field2;
+        margins of the larger of the pair's width, twice the shift and 2 % of the band): the
+        branch outside the folds is not traced again. A narrowed band that does not give a
+        fold pair is traced again over [start, stop].
+    max_seconds : the wall time of the whole call (orbits.CALL_SECONDS; math.inf: none);
+        repeated: each value gets what is left over the values left, so a slow value cannot
+        take the others' time; its status says when its share ran out. The check sweeps run
+        after the folds, in what is left (a run is cut where it passes, the runs after it not
         run: those values' verdicts -1).
     check : values of field2 at which a follow sweep up and down (`check_points` values over
     the band, runs of `check_case`, default `case`: give it a t_end that settles) gives the
@@ -432,11 +440,18 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
 
     Returns a Dataset: dim `value2` (field2's values): `fold` (value2, fold; sorted, NaN
     padded), `grazing` (value2, grazing; in order along the branch from the band's start: the
-    first is where the orbit there changes its contact sequence), `band` (value2, end: the
-    band continued), `status` (each continuation's); with check, dims `check` and
-    `check_point`: `check_value`, `check_field`, `coexist` (-1: a run of either direction cut
-    or not run, the time bound had passed). A value at which no orbit is found at its band's
-    start (OrbitError, SolverError) has no folds and says so in `status`. attrs['status']: 'complete' or what was not."""
+    first is where the orbit there changes its contact sequence; extended: only the values
+    continued), `band` (value2, end: the band continued), `status` (each value's: 'complete'
+    or why a fold may be missing there). Extended, along the curves (dim `curve_point`):
+    `curve` (which), `curve_field`, `curve_field2`, `curve_y0`, `curve_Tm_pp`,
+    `curve_mu_other` (the largest |mu| besides the one at +1), `curve_stable`; dims `cusp`
+    (`cusp_field`, `cusp_field2`; attrs['cusp']) and `stop` (`stop_field`, `stop_field2`,
+    `stop_status`: where a direction stopped short of the rectangle's side, and why);
+    attrs['curve_status'] each direction's. With check, dims `check` and `check_point`:
+    `check_value`, `check_field`, `coexist` (-1: a run of either direction cut or not run, the
+    time bound had passed). A value at which no orbit is found at its band's start
+    (OrbitError, SolverError) has no folds and says so in `status`. attrs['status']:
+    'complete' or what was not, with a SplineWarning."""
     name2, index2 = parse_field(case, field2)
     values2 = _values(case, name2, index2, "values2", values2, 1)
     check = _values(case, name2, index2, "check", check, 0)
@@ -445,13 +460,24 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
         raise CaseError(f"check_points = {check_points!r}: the check sweeps' number of values, "
                         "a whole number >= 2")
     check_handed_on(case, field, start, stop, n, cont)
+    if method not in ("extended", "repeated"):
+        raise CaseError(f"method = {method!r}: 'extended' (the fold followed by the extended "
+                        "system) or 'repeated' (a continuation per value of field2)")
     with time_bound(max_seconds, "fold_curve"):
-        out = _fold_values(case, field, start, stop, name2, index2, values2, n, narrow,
-                           progress, cont)
+        if method == "extended":
+            from .foldcurve import curve_dataset, extended
+            out = curve_dataset(*extended(case, field, start, stop, name2, index2, values2, n,
+                                          progress, cont), field_label(*parse_field(case, field)),
+                                field_label(name2, index2), values2)
+            out["band"] = (("value2", "end"), np.tile([start, stop], (len(values2), 1)))
+            out.attrs["field"] = field_label(*parse_field(case, field))
+        else:
+            out = _fold_values(case, field, start, stop, name2, index2, values2, n, narrow,
+                               progress, cont)
         if len(check):
             _check(out, case if check_case is None else check_case, field, start, stop, name2,
                    index2, check, check_points, progress)
-    bad = [str(x) for x in out.status.values if x != "complete"]
+    bad = list(dict.fromkeys(str(x) for x in out.status.values if x != "complete"))
     if "coexist" in out and (out.coexist < 0).any():
         late = out.check_value.values[(out.coexist < 0).any("check_point")]
         bad.append(f"the wall-time bound of fold_curve, max_seconds = {max_seconds:g} s, was "
@@ -525,14 +551,9 @@ def _fold_values(case, field, start, stop, name2, index2, values2, n, narrow, pr
         folds.append(np.sort(sp[kinds == "fold"]))
         grazes.append(sp[kinds == "grazing"])       # in order along the branch from b0
         pairs.append((v, *folds[-1][:2]) if len(folds[-1]) >= 2 else (v,))
-
-    def padded(rows):
-        out = np.full((len(rows), max([len(r) for r in rows] + [1])), np.nan)
-        for i, r in enumerate(rows):
-            out[i, :len(r)] = r
-        return out
-    return xr.Dataset({"fold": (("value2", "fold"), padded(folds)),
-                       "grazing": (("value2", "grazing"), padded(grazes)),
+    from .foldcurve import _padded
+    return xr.Dataset({"fold": (("value2", "fold"), _padded(folds)),
+                       "grazing": (("value2", "grazing"), _padded(grazes)),
                        "band": (("value2", "end"), np.array(bands, float)),
                        "status": (("value2",), np.array(status, dtype=object))},
                       coords={"value2": values2},

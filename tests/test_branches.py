@@ -127,35 +127,35 @@ def test_branches_folds_where_the_follow_sweeps_jump(every_branch, follow_sweeps
 
 
 #: the fold curve's values of the ripple amplitude a: four with a fold pair in 2300-2500 r/min,
-#: the last with none there (its folds lie at 2549 and 2568)
-AMPS = [0.25, 0.22, 0.2, 0.18, 0.1]
+#: values of a with a fold pair in the band 2300-2500 r/min (docs/continuation.md)
+AMPS = [0.25, 0.22, 0.2, 0.18]
+FAST = DRIVE.replace(rtol=1e-7, atol=1e-9)   # the folds within 1e-4 r/min of rtol 1e-8
 
 
 @pytest.fixture(scope="module")
 def fold_curves():
-    """The folds followed in a over 2300-2500 r/min, at rtol 1e-7 with steps up to twice the
-    default's (the folds within 1e-4 r/min of rtol 1e-8 and the default steps; half the
-    time), and fold_curve's own check sweep at the last value: 6 speeds, 40 r/min apart."""
-    return pyspline.fold_curve(DRIVE.replace(rtol=1e-7, atol=1e-9), "speed_rpm", 2300, 2500,
-                               "ripple_amp(1)", AMPS,
-                               progress=False, ds_max=0.5, max_angle=0.3, check=AMPS[-1:],
-                               check_points=6, check_case=SETTLED)
+    """The folds of a = 0.25 over 2300-2500 r/min followed in a down to 0.18 by the extended
+    system, at rtol 1e-7 with steps up to twice the default's."""
+    return pyspline.fold_curve(FAST, "speed_rpm", 2300, 2500, "ripple_amp(1)", AMPS,
+                               progress=False, ds_max=0.5, max_angle=0.3)
 
 
 def test_fold_curve_against_follow_sweeps(fold_curves):
-    """At each of the five values of a, follow sweeps up and down say two orbits between its
+    """At each of the four values of a, follow sweeps up and down say two orbits between its
     folds and one outside: at a with a fold pair (lo, hi), the speeds lo - 30, lo - 15 and
     hi + 15 (one orbit) and lo + 10, the middle and hi - 10 (two: the up chain stays on the
     full-contact branch, the down chain on the contact-loss one; 10 r/min of margin: runs
-    next to a fold do not settle); at a = 0.1 one orbit at every speed of the band. The folds
-    move up in speed as a falls."""
+    next to a fold do not settle). The folds move up in speed as a falls; the curve is one
+    per fold of the seed, each complete (it leaves the rectangle), and every point of it has
+    a multiplier at +1 and its others inside the unit circle."""
     fc = fold_curves
-    assert (fc.status == "complete").all(), fc.status.values
+    assert (fc.status == "complete").all() and fc.attrs["status"] == "complete", fc.status.values
+    assert fc.attrs["curve_status"] == "; ".join(["complete"] * 4), fc.attrs["curve_status"]
     f = fc.fold.values
-    assert np.isfinite(f[:4, :2]).all() and np.isnan(f[:4, 2:]).all() and np.isnan(f[4]).all()
-    assert (np.diff(f[:4, 0]) > 0).all() and (np.diff(f[:4, 1]) > 0).all()
-    assert not fc.coexist.values[0].any() and len(fc.check_field) == 6
-    for a, (lo, hi) in zip(AMPS, f[:4, :2]):
+    assert f.shape == (4, 2) and np.isfinite(f).all(), f
+    assert (np.diff(f[:, 0]) > 0).all() and (np.diff(f[:, 1]) > 0).all()
+    assert set(fc.curve.values) == {0, 1} and fc.curve_stable.all() and fc.sizes["cusp"] == 0
+    for a, (lo, hi) in zip(AMPS, f):
         speeds = np.array([lo - 30, lo - 15, lo + 10, (lo + hi) / 2, hi - 10, hi + 15])
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", pyspline.SplineWarning)
@@ -166,37 +166,56 @@ def test_fold_curve_against_follow_sweeps(fold_curves):
 
 
 def test_fold_curve_grazing_below_the_upper_fold(fold_curves):
-    """Along each value's branch from the band's start the first grazing (where the
-    full-contact orbit opens its teeth) lies just below the upper fold (within 4 r/min), and
-    the other grazings lie on the S-curve's span, between the folds' neighbourhoods."""
+    """Along the seed's branch (a = 0.25) from the band's start the first grazing (where the
+    full-contact orbit opens its teeth) lies just below the upper fold (within 4 r/min), the
+    other grazings on the S-curve's span, between the folds' neighbourhoods; the extended
+    system gives no grazings at the other values."""
     g, f = fold_curves.grazing.values, fold_curves.fold.values
-    for k in range(4):
-        assert 0 < f[k, 1] - g[k, 0] < 4, (AMPS[k], g[k], f[k])
-        rest = g[k][1:][np.isfinite(g[k][1:])]
-        assert ((rest > f[k, 0] - 5) & (rest < f[k, 1] + 5)).all(), (AMPS[k], g[k], f[k])
-    assert np.isnan(g[4]).all()
+    assert 0 < f[0, 1] - g[0, 0] < 4, (g[0], f[0])
+    rest = g[0][1:][np.isfinite(g[0][1:])]
+    assert ((rest > f[0, 0] - 5) & (rest < f[0, 1] + 5)).all(), (g[0], f[0])
+    assert np.isnan(g[1:]).all()
 
 
-def test_fold_pair_closes_at_a_cusp():
-    """Near the cusp (docs: between a = 0.08 and 0.085) over 2575-2600 r/min: the fold pair
-    narrows as a falls (0.0875, 0.085) and is gone at 0.08. At a cusp the width closes as
-    (a - a_c)^(3/2): its 2/3 power, linear in a through the two pairs, reaches zero between
-    0.08 and 0.085. Follow sweeps at the middle of the 0.085 pair and 8 r/min either side say
+@pytest.fixture(scope="module")
+def cusp_curve():
+    """The fold pair of a = 0.085 over 2575-2600 r/min (docs: 1.5 r/min wide) followed in a
+    over 0.08-0.0875."""
+    return pyspline.fold_curve(FAST, "speed_rpm", 2575, 2600, "ripple_amp(1)",
+                               [0.085, 0.0875, 0.08], progress=False, ds_max=0.5,
+                               max_angle=0.3)
+
+
+def test_fold_curve_through_its_cusp(cusp_curve):
+    """From a = 0.085 the curve of the lower fold goes down in a, turns at the cusp between
+    a = 0.08 and 0.085 (docs: the pair 1.5 r/min wide at 0.085, none at 0.08) and comes back
+    up as the upper fold: one curve, traced through the cusp (points either side of it, their
+    speeds higher past it). Its folds at a = 0.0875 equal those of the one-parameter
+    continuation there (measured 1.1e-4 and 1.2e-4 r/min at rtol 1e-7: both correctors stop
+    at the scaled residual tol = 1e-5, and the secant of the one-parameter location stops on
+    the arclength to 1e-6 of the step);
+    none at 0.08. Follow sweeps at the middle of the 0.085 pair and 8 r/min either side say
     two orbits there and one outside; at 0.08, at the same speeds, the up and the down chains
     end on the same orbit (T_m peak-to-peak to 0.5 %): no hysteresis past the cusp."""
-    fc = pyspline.fold_curve(DRIVE.replace(rtol=1e-7, atol=1e-9), "speed_rpm", 2575, 2600,
-                             "ripple_amp(1)", [0.0875, 0.085, 0.08], progress=False,
-                             ds_max=0.5, max_angle=0.3, narrow=False)
-    assert (fc.status == "complete").all(), fc.status.values
+    fc = cusp_curve
+    assert fc.sizes["cusp"] == 1 and fc.attrs["cusp"].startswith("speed_rpm = "), fc.attrs
+    a_c, p_c = float(fc.cusp_field2[0]), float(fc.cusp_field[0])
+    assert 0.08 < a_c < 0.085, a_c
     f = fc.fold.values
     assert np.isfinite(f[:2, :2]).all() and np.isnan(f[2]).all(), f
-    width = f[:2, 1] - f[:2, 0]
-    assert width[0] > width[1] > 0, width
-    a = fc.value2.values
-    w23 = width ** (2 / 3)
-    cusp = a[1] - w23[1] * (a[0] - a[1]) / (w23[0] - w23[1])
-    assert a[2] < cusp < a[1], (cusp, width)
-    lo, hi = f[1, :2]
+    on = fc.curve.values == fc.curve.values[np.argmin(fc.curve_field2.values)]
+    x, y = fc.curve_field.values[on], fc.curve_field2.values[on]
+    k = np.argmin(y)
+    assert 0 < k < len(y) - 1 and y[k] == pytest.approx(a_c, abs=2e-4)
+    assert x[:k].min() > f[1, 0] - 1e-6 and x[k] == pytest.approx(p_c, abs=1)
+    assert np.isclose(x, f[1, 0], atol=1e-3).any() and np.isclose(x, f[1, 1], atol=1e-3).any()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        ds = pyspline.continuation(FAST.replace(ripple_amp=[0.0875, 0, 0, 0]), "speed_rpm",
+                                   2575, 2600, progress=False, ds_max=0.5, max_angle=0.3)
+    one = np.sort(ds.special_speed_rpm.values[ds.special_type.values.astype(str) == "fold"])
+    assert np.abs(f[1, :2] - one).max() < 5e-4, (f[1], one)
+    lo, hi = f[0, :2]
     speeds = [lo - 8, (lo + hi) / 2, hi + 8]
     pp = {}
     for amp in (0.085, 0.08):
@@ -210,6 +229,33 @@ def test_fold_pair_closes_at_a_cusp():
         assert list(coexistence(sw)) == ([False, True, False] if amp == 0.085 else
                                          [False] * 3), (amp, pp[amp])
     assert (np.abs(pp[0.08][0] - pp[0.08][1]) < 5e-3 * pp[0.08].max(0)).all(), pp[0.08]
+
+
+def test_g_derivatives_against_differences(cusp_curve):
+    """At a point of the fold curve the extended system's last Jacobian row, g's gradient
+    (from two variational runs along v for the states, M(p +- h) v for the fields), equals
+    central differences of g itself (b and c held; steps 1e-4 in the scaled unknowns),
+    component by component, to 1e-4 of the gradient's size (measured 5e-6); F = 0 and g = 0
+    there."""
+    from pyspline.arclength import parse_field
+    from pyspline.foldcurve import FoldSystem
+    from pyspline.orbits import _scale
+    fc = cusp_curve
+    i = fc.sizes["curve_point"] // 3
+    p = np.array([float(fc.curve_field[i]), float(fc.curve_field2[i])])
+    y = fc.curve_y0.values[i]
+    case = FAST.replace(speed_rpm=p[0], ripple_amp=[p[1], 0, 0, 0])
+    d0 = _scale(case.model)
+    fs = FoldSystem(FAST, parse_field(FAST, "speed_rpm"), parse_field(FAST, "ripple_amp(1)"),
+                    1, p, (260.0, 0.00875), np.ones(14, bool), d0, 1e-5)
+    u = np.r_[y / d0, 0.0, 0.0]
+    fs.border(fs.run(u, y)[1])
+    F, g, J, M = fs.evaluate(u, y)
+    assert np.abs(F).max() < 1e-5 and abs(g) < 1e-5, (np.abs(F).max(), g)
+    h = 1e-4 * np.maximum(1, np.abs(u))
+    fd = np.array([(fs.g(u + h[j] * np.eye(16)[j], y) - fs.g(u - h[j] * np.eye(16)[j], y))
+                   / (2 * h[j]) for j in range(16)])
+    assert np.abs(J[-1] - fd).max() < 1e-4 * np.abs(fd).max(), np.c_[J[-1], fd]
 
 
 def test_bad_input_is_a_case_error(monkeypatch):
@@ -228,7 +274,7 @@ def test_bad_input_is_a_case_error(monkeypatch):
             pyspline.branches(DRIVE, "speed_rpm", BAND[0], progress=False, **args)
     for kw in (dict(values2=[np.nan]), dict(values2="x"), dict(values2=[0.2, 1e9]),
                dict(check=[np.nan]), dict(check="x"), dict(check_points=1),
-               dict(check_points=2.5), dict(ds_min=0.5), dict(bogus=1)):
+               dict(check_points=2.5), dict(ds_min=0.5), dict(bogus=1), dict(method="x")):
         args = dict(values2=[0.2]) | kw
         with pytest.raises(pyspline.CaseError, match=list(kw)[0]):
             pyspline.fold_curve(DRIVE, "speed_rpm", *BAND, "ripple_amp(1)", progress=False,
@@ -268,8 +314,8 @@ def test_cli_all(tmp_path):
 def test_cli_fold_input(tmp_path, every_branch):
     """`pyspline continue --fold` writes the folds at one amplitude (the Python --all call's)
     with the follow sweeps' verdict (2330, 2395, 2460 r/min: two orbits exactly between the
-    folds, 2354.6 and 2439.3), exit 0; a --fold without numbers is a CaseError naming it,
-    exit 2."""
+    folds, 2354.6 and 2439.3), exit 0; a --fold without numbers, or --repeated without
+    --fold, is a CaseError naming it, exit 2."""
     import xarray as xr
     from test_continuation import cli
     path = tmp_path / "drive.nml"
@@ -287,3 +333,6 @@ def test_cli_fold_input(tmp_path, every_branch):
     run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
               "--stop", "2500", "--fold", "ripple_amp(1)=0.2,x")
     assert run.returncode == 2 and "--fold ripple_amp(1)=" in run.stderr, run.stderr
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
+              "--stop", "2500", "--repeated")
+    assert run.returncode == 2 and "--repeated: the method of --fold" in run.stderr, run.stderr

@@ -67,7 +67,8 @@ def test_continuation_keeps_its_points_at_the_bound():
 def test_branches_and_fold_curve_end_at_their_bounds():
     """branches: a bound that passes within the seeding sweep leaves no branch traced: an
     OrbitError naming it. fold_curve over three values of the ripple amplitude within 1.5 s:
-    each value gets its share of what is left (0.5 s for the first), every one stops at it
+    the extended system's seed stops at it, every value's status names it; the repeated
+    method's each value gets its share of what is left (0.5 s for the first), every one stops at it
     (its status names the share), the call within the bound and the slack, a SplineWarning;
     the check sweep after it is not run (-1)."""
     with pytest.raises(pyspline.OrbitError, match=r"branches, max_seconds = 0.001 s, was "
@@ -77,6 +78,13 @@ def test_branches_and_fold_curve_end_at_their_bounds():
     fc, took, said = timed(lambda: pyspline.fold_curve(
         DRIVE, "speed_rpm", *BAND, "ripple_amp(1)", [0.25, 0.2, 0.18], progress=False,
         check=[0.25], max_seconds=1.5))
+    assert took < 1.5 + SLACK
+    assert all("fold_curve, max_seconds = 1.5 s, was reached" in s for s in fc.status.values)
+    assert (fc.coexist == -1).all() and "before the check sweeps at 0.25" in fc.attrs["status"]
+    assert len(said) == 1 and fc.attrs["status"] in said[0]
+    fc, took, said = timed(lambda: pyspline.fold_curve(
+        DRIVE, "speed_rpm", *BAND, "ripple_amp(1)", [0.25, 0.2, 0.18], progress=False,
+        check=[0.25], max_seconds=1.5, method="repeated"))
     assert took < 1.5 + SLACK
     st = fc.status.values
     assert re.search(r"fold_curve at ripple_amp\(1\) = 0.25, max_seconds = 0.(5|49\d) s, was "

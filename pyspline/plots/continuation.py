@@ -165,15 +165,30 @@ def fold_plane(fc, path=None, title: str | None = None) -> Figure:
     if pair.any():
         ax.fill_betweenx(v[pair], folds[pair, 0], folds[pair, 1], color="#D55E00", alpha=0.12,
                          lw=0, label="between the folds: two stable orbits coexist")
+    curve = "curve_field" in fc and fc.sizes["curve_point"] > 0
     for j, name in enumerate(["lower fold", "upper fold"] + [f"fold {j + 1}" for j in
                                                             range(2, folds.shape[1])]):
         ok = np.isfinite(folds[:, j])
-        ax.plot(folds[ok, j], v[ok], "o-", color="#D55E00", mfc="white" if j else "#D55E00",
-                ms=5, lw=1.4, label=f"{name} (mu = +1)" if j < 2 and ok.any() else None)
+        ax.plot(folds[ok, j], v[ok], "o" if curve else "o-", color="#D55E00",
+                mfc="white" if j else "#D55E00", ms=5, lw=1.4,
+                label=None if j >= 2 or not ok.any() else f"{name} (mu = +1)" + (
+                    f" at the values of {field2}" if curve else ""))
+    if curve:       # the extended system's curves, their ends and cusps
+        for i in np.unique(fc.curve.values):
+            on = fc.curve.values == i
+            x, y = fc.curve_field.values[on], fc.curve_field2.values[on]
+            ax.plot(x, y, "-", color="#D55E00", lw=1.4,
+                    label=None if i else "fold curve (extended system)")
+        if fc.sizes["stop"]:
+            ax.plot(fc.stop_field.values, fc.stop_field2.values, "x", color="#D55E00", ms=9,
+                    mew=2, label="the curve stops: its contact sequence changes (stop_status)")
+        if fc.sizes["cusp"]:
+            ax.plot(fc.cusp_field.values, fc.cusp_field2.values, "*", color="k", ms=12,
+                    label="cusp (the two folds meet)")
     g = fc.grazing.values[:, 0]
     ok = np.isfinite(g)
     if ok.any():
-        ax.plot(g[ok], v[ok], "x--", color="0.3", lw=1,
+        ax.plot(g[ok], v[ok], "x" if curve else "x--", color="0.3", lw=1,
                 label="first grazing along the branch (its contact sequence changes)")
     rest = fc.grazing.values[:, 1:]
     ok = np.isfinite(rest)
