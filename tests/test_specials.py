@@ -1,9 +1,10 @@
 """The classification of a continued branch's special points (pyspline/specials.py,
 docs/continuation.md) on branch records made up here: a grazing at which the field turns back
 is a non-smooth fold, one the branch passes through is a grazing, and a grazing next to a
-smooth fold (a multiplier at +1) stays a grazing beside that fold. (None of the project's
-scenes turns at a grazing: their folds are smooth, 0.8 to 4.3 r/min from the nearest grazing;
-the records stand in for one.)"""
+smooth fold (a multiplier at +1) stays a grazing beside that fold. No drive turns at a
+grazing (the contact force is continuous there, so are the multipliers: docs/continuation.md),
+so the records stand in for one; the Z16 drive near its cusp, whose turn lies 1.57 r/min past
+its grazing, is held as a smooth fold and a grazing, with no jump of the multipliers."""
 import numpy as np
 import pytest
 
@@ -61,3 +62,34 @@ def test_a_point_located_twice_is_reported_once():
                          1e-6)
     assert [(list(k["u"]), k["branch"]) for k in kept] == [
         (first, 0), (other, 1), ([2.0, 2.0, 5.0], 0)]
+
+
+@pytest.mark.filterwarnings("ignore:SUNDIALS warned:pyspline.SplineWarning")
+def test_the_z16_drive_turns_at_a_smooth_fold_past_its_grazing():
+    """The 7-DOF Z16 drive near its cusp (ripple amplitude a = 0.085, docs/continuation.md):
+    up the full-contact branch the teeth open at a grazing, and the branch turns 1.57 r/min
+    further on, at a smooth fold (a real multiplier at +1), not at the grazing: no
+    non-smooth fold is reported. At the grazing the multipliers do not jump: the rightmost
+    pair either side of it differs by a square root of the distance (d at 0.003 r/min
+    either side about a third of d at 0.03; a jump would keep d), so the branch cannot turn
+    there."""
+    from test_cont_drives import DRIVE
+    import pyspline
+    case = DRIVE.replace(rtol=1e-7, atol=1e-9, ripple_amp=[0.085, 0, 0, 0])
+    ds = pyspline.continuation(case, "speed_rpm", 2587.0, 2590.0, progress=False,
+                               ds_max=0.05, max_angle=0.3)
+    kind, p = ds.special_type.values, ds.special_speed_rpm.values
+    assert "nonsmooth_fold" not in kind and kind[0] == "grazing" and list(kind).count("fold") == 2
+    g, (lo, hi) = p[0], np.sort(p[kind == "fold"])
+    assert ds.switches.values[ds.speed_rpm.values < g].max() == 0       # full contact below
+    assert 1.0 < hi - g < 2.5 and lo < hi, (g, lo, hi)
+    crit = (ds.special_mu_real + 1j * ds.special_mu_imag).values[kind == "fold"]
+    assert (np.abs(crit - 1) < 1e-2).all() and (ds.special_smooth.values[kind == "fold"] == 1).all()
+    guess = ds.y0.values[np.argmin(np.abs(ds.speed_rpm.values - g))]
+
+    def rightmost(x):
+        mu = pyspline.periodic_orbit(case.replace(speed_rpm=x), guess=guess).multipliers
+        pair = mu[np.argsort(-mu.real)][:2]
+        return pair[np.argsort(pair.imag)]
+    d = [np.abs(rightmost(g + h) - rightmost(g - h)).max() for h in (0.003, 0.03)]
+    assert d[0] < 1e-2 and d[0] < 0.5 * d[1], d
