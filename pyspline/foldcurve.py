@@ -1,5 +1,5 @@
 """A fold of a periodic orbit followed in two fields by the minimally extended system
-(docs/continuation.md, `fold_curve`).
+(docs/branches.md, `fold_curve`).
 
 Unknowns u = (z, q1, q2): z the orbit's section state over the integrated states, scaled by
 Eq. 25 with the seed's scales, q1, q2 the two fields, each scaled by a tenth of its magnitude
