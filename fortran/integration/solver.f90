@@ -316,19 +316,19 @@ contains
     logical function take_linear_tail(k0) result(taken)
       integer, intent(in) :: k0
       real(c_double) :: yt(nstate)
-      real(c_double), allocatable :: yts(:, :)
       integer :: j
       taken = .false.
       if (.not. use_tail) return
       taken = tail_try(tail, m, ctx%idx, ctx%n, tau, copy_state(ctx, yr, 1))
       if (.not. taken) return
       stats(ist_linear_tail_t) = tau/m%w_ref
-      allocate(yts(nstate, k0 + 1:nt))
-      call tail_states(tail, tout(k0+1:nt)*m%w_ref, yts)
+      ! the scaled states straight into yout, each column then turned into SI in place
+      call tail_states(tail, tout(k0+1:nt)*m%w_ref, yout(:, k0+1:nt))
       do j = k0 + 1, nt
-        call from_scaled(m, yts(:, j), yout(:, j))
-        if (ctx%frozen) modes_out(:, j) = tail%flank
+        yt = yout(:, j)
+        call from_scaled(m, yt, yout(:, j))
       end do
+      if (ctx%frozen) modes_out(:, k0+1:nt) = tail%flank
       do j = ks, nsec
         call tail_state(tail, tsec(j)*m%w_ref, yt)
         call from_scaled(m, yt, ysec(:, j))

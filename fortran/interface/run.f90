@@ -156,10 +156,9 @@ contains
     character(len=:), allocatable, intent(out) :: warnings
     call combined_loads(m, t, y, tooth, tm, loads, tload)
     if (size(tooth, 3) >= iq_tf) then
-      call run_extremes(m, y, tm, tooth(:, :, 1), tooth(:, :, iq_tf), ext)
-    else                               ! T_f a constant of the level: as its every output
-      call run_extremes(m, y, tm, tooth(:, :, 1), &
-           spread(spread(consts(iq_tf - 4), 1, size(t)), 2, m%z), ext)
+      call run_extremes(m, y, tm, tooth(:, :, 1), ext, tf=tooth(:, :, iq_tf))
+    else                               ! T_f a constant of the level
+      call run_extremes(m, y, tm, tooth(:, :, 1), ext, tf_const=consts(iq_tf - 4))
     end if
     warnings = ''
     call run_warnings(m, stats, warnings)

@@ -327,23 +327,44 @@ contains
   !> The extremes and RMS of a run's outputs x(nextreme), spline_quantities' extreme_q: max, min
   !> and RMS (sqrt(sum(x**2)/n), a sequential sum) of T_m (tm), k_v = |T_m|/T_d, the tooth loads
   !> f(nt, Z) and flash temperatures tf(nt, Z) over all teeth, D_2 and dD_2/dt (y: SI states,
-  !> a column per output). The one computation of them: spline-dyn's summary and Python's
-  !> (Result.extremes, the sweep point's summary).
-  pure subroutine run_extremes(m, y, tm, f, tf, x)
+  !> a column per output). tf absent: T_f is the level's constant tf_const at every output (0
+  !> without flash temperature: its RMS |tf_const|). The one computation of them: spline-dyn's
+  !> summary and Python's (Result.extremes, the sweep point's summary). The arrays are read in
+  !> place (a tooth array of 6401 outputs and 16 teeth copied or broadcast cost more than the run's
+  !> tail).
+  pure subroutine run_extremes(m, y, tm, f, x, tf, tf_const)
     type(model_t), intent(in) :: m
-    real(wp), intent(in) :: y(:, :), tm(:), f(:, :), tf(:, :)
+    real(wp), intent(in) :: y(:, :), tm(:)
+    real(wp), intent(in), contiguous :: f(:, :)
     real(wp), intent(out) :: x(nextreme)
-    x(1:3) = three(tm)
-    x(4:6) = three(abs(tm)/m%t_d)
-    x(7:9) = three(reshape(f, [size(f)]))
-    x(10:12) = three(reshape(tf, [size(tf)]))
-    x(13:15) = three(y(6, :))
-    x(16:18) = three(y(13, :))
+    real(wp), intent(in), contiguous, optional :: tf(:, :)
+    real(wp), intent(in), optional :: tf_const
+    x(1:3) = three(size(tm), tm)
+    x(4:6) = three(size(tm), abs(tm)/m%t_d)
+    x(7:9) = three(size(f), f)
+    if (present(tf)) then
+      x(10:12) = three(size(tf), tf)
+    else
+      x(10:12) = [tf_const, tf_const, abs(tf_const)]
+    end if
+    x(13:15) = three(size(y, 2), y(6, :))
+    x(16:18) = three(size(y, 2), y(13, :))
   contains
-    pure function three(v) result(r)
-      real(wp), intent(in) :: v(:)
-      real(wp) :: r(3)
-      r = [maxval(v), minval(v), rms_of(v)]
+    !> [maxval(v), minval(v), rms_of(v)] of finite v (the run's checked outputs), n >= 1, in
+    !> one pass: the first of equal extremes (strict comparisons, as maxval and minval), the
+    !> squares summed in order.
+    pure function three(n, v) result(r)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: v(n)       ! explicit shape: a contiguous 2-D array read as it is
+      real(wp) :: r(3), mx, mn, sq
+      integer :: i
+      mx = v(1); mn = v(1); sq = 0.0_wp
+      do i = 1, n
+        if (v(i) > mx) mx = v(i)
+        if (v(i) < mn) mn = v(i)
+        sq = sq + v(i)**2
+      end do
+      r = [mx, mn, sqrt(sq/n)]
     end function three
   end subroutine run_extremes
 
