@@ -61,7 +61,7 @@ module spline_case_type
     character(len=optlen) :: thermal = 'none'
     real(wp) :: t_bulk = 0.0_wp, f_m = 0.1_wp, u_flash = 0.83_wp, eta_hertz = 1.127_wp
     !> The solver defaults: method 'auto' picks per scene (docs/running.md section 2) what won where
-    !> it was measured (docs/performance.md, "Impacting scenes, and how the defaults were
+    !> it was measured (docs/running.md, "Impacting scenes, and how the defaults were
     !> chosen"), with located contact switches.
     character(len=optlen) :: method = 'auto', jacobian = 'dq', nonlinear = 'auto'
     !> ERKStep's Butcher table (method = 'erk'; goal = 'statistics' runs its window on 'cash_karp')

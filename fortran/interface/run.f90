@@ -353,7 +353,7 @@ contains
   !> (spline_integrator::integrator_restart). Above restart_rtol that falsified a rattling drive: chaos_z24
   !> with Adams or BDF and roots read its T_m RMS 2.3-2.7 N m against 3.5-3.8 (every method at
   !> rtol <= 1e-3, ERK with roots and every method without roots from 1e-2), finding 2-3 times
-  !> the reference's switches (docs/performance.md, "Multistep restarts at loose tolerance";
+  !> the reference's switches (docs/running.md, "Multistep restarts at loose tolerance";
   !> tests/test_solver.py). Warned after a run that located a switch there.
   subroutine restart_warning(m, stats, text)
     type(model_t), intent(in) :: m
