@@ -249,10 +249,7 @@ class _Problem:
         p = self.p_of(u[-1])
         y = self.state(y_fixed, u)
         model = self.model(p)
-        y1, Mp, free = self.monodromy(model, self.t0, self.t1(p, n), y)
-        d = _scale(model)[free] / self.d0[free]     # M in the start's scales
-        M = d[:, None] * Mp / d[None, :]
-        F = (y1 - y)[free] / self.d0[free]
+        F, M, free = scaled_map(self.monodromy, model, self.t0, self.t1(p, n), y, self.d0)
         hp = self.h * max(abs(p), self.pscale)
         Fq = {}
         for pp in (p + hp, p - hp):
@@ -268,6 +265,15 @@ class _Problem:
         (pa, Fa), (pb, Fb) = (list(Fq.items()) + [(p, F)])[:2]
         J = np.c_[M - np.eye(len(M)), (Fa - Fb) / ((pa - pb) / self.pscale)]
         return F, J, M, y
+
+
+def scaled_map(monodromy, model, t0, t1, y, d0):
+    """F = P(y) - y and M = dP/dy over the integrated states of the period map from (t0, y) to
+    t1 (monodromy: orbits.map_and_monodromy or fd_monodromy), in the scales d0 (Eq. 25 at the
+    start: one unit of each state however far the field moves), and those states' indices."""
+    y1, Mp, free = monodromy(model, t0, t1, y)
+    d = _scale(model)[free] / d0[free]
+    return (y1 - y)[free] / d0[free], d[:, None] * Mp / d[None, :], free
 
 
 def _null_tangent(J, orient):

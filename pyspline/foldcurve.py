@@ -11,7 +11,7 @@ derivatives: g_z = -w^T (M(z + eps v) - M(z - eps v)) / (2 eps) (the symmetry of
 derivatives: the whole gradient from two variational runs), g_q = -w^T (M(q + h) - M(q - h))
 v / (2 h), with [w^T, g'] the transposed bordered solve; F_q from the same runs at q +- h:
 seven variational runs per Newton iteration whatever the state's size. The contact signature
-of the orbit must stay the seed's (the saltation in M holds within one contact sequence):
+of the orbit (specials.contact_measures) must stay the seed's (the saltation in M holds within one contact sequence):
 where it changes, the direction stops ('grazing at ...'). Nothing here computes physics: the
 map, M and the trajectories are the core's."""
 from __future__ import annotations
@@ -20,7 +20,7 @@ import warnings
 
 import numpy as np
 
-from .arclength import _null_tangent, field_label, set_field
+from .arclength import _null_tangent, field_label, scaled_map, set_field
 from .errors import CaseError, SolverError, SplineError, SplineWarning
 from .orbits import _scale, _trajectory, forcing_periods, map_and_monodromy, out_of_time
 from .specials import contact_measures, multipliers
@@ -65,15 +65,23 @@ class FoldSystem:
         y[self.free] = u[:-2] * self.d0[self.free]
         return y
 
+    def t1(self, p):
+        return self.t0 + 2 * np.pi * self.n / self.model(p).info()["omega"]
+
+    def orbit(self, u, y_fixed):
+        """The run of one period from u's state: the contact signature of its orbit
+        (specials.contact_measures) and its trajectory."""
+        p = self.p_of(u)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SplineWarning)
+            tr = _trajectory(self.model(p).case, self.t0, self.t1(p), self.state(u, y_fixed))
+        return contact_measures(tr), tr
+
     def run(self, u, y_fixed):
         """(F, M) at u, in the seed's scales (one variational run)."""
         p = self.p_of(u)
-        model = self.model(p)
-        y = self.state(u, y_fixed)
-        t1 = self.t0 + 2 * np.pi * self.n / model.info()["omega"]
-        y1, Mp, free = map_and_monodromy(model, self.t0, t1, y)
-        d = _scale(model)[free] / self.d0[free]
-        return (y1 - y)[free] / self.d0[free], d[:, None] * Mp / d[None, :]
+        return scaled_map(map_and_monodromy, self.model(p), self.t0, self.t1(p),
+                          self.state(u, y_fixed), self.d0)[:2]
 
     def border(self, M):
         """b, c: the left and right singular vectors of M - I of its smallest singular value."""
@@ -147,15 +155,9 @@ class FoldSystem:
     def point(self, res, y_fixed):
         """The record of a converged point: u, p, y, M, its multipliers and contact."""
         u, J, M, it = res
-        p = self.p_of(u)
-        y = self.state(u, y_fixed)
-        model = self.model(p)
-        t1 = self.t0 + 2 * np.pi * self.n / model.info()["omega"]
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", SplineWarning)
-            tr = _trajectory(model.case, self.t0, t1, y)
-        return dict(u=u, J=J, p=p, y=y, M=M, mu=multipliers(M), iterations=it,
-                    contact=contact_measures(tr), Tm_pp=float(np.ptp(tr.Tm)))
+        contact, tr = self.orbit(u, y_fixed)
+        return dict(u=u, J=J, p=self.p_of(u), y=self.state(u, y_fixed), M=M, mu=multipliers(M),
+                    iterations=it, contact=contact, Tm_pp=float(np.ptp(tr.Tm)))
 
 
 def trace(sys, seed, y_fixed, bounds, direction, ds=0.05, ds_min=1e-3, ds_max=0.5,
@@ -165,7 +167,7 @@ def trace(sys, seed, y_fixed, bounds, direction, ds=0.05, ds_min=1e-3, ds_max=0.
     hi), (q2 lo, hi)), its last point put on the side it crossed; 'grazing at ...': the contact
     signature changed, located to ds_min along the curve; or where and why it failed)."""
     k2 = len(seed["u"])
-    sig0 = _sequence(seed)
+    sig0 = seed["contact"]["signature"]
     tau = _null_tangent(seed["J"], direction * np.eye(k2)[-1])
     a = dict(seed, tau=tau)
     pts = [a]
@@ -198,9 +200,9 @@ def trace(sys, seed, y_fixed, bounds, direction, ds=0.05, ds_min=1e-3, ds_max=0.
                 new = sys.point(res, y_fixed)
             except SolverError as exc:
                 sys.last_error = str(exc)
-        if new is not None and _sequence(new) != sig0:
+        if new is not None and new["contact"]["signature"] != sig0:
             if ds / 2 < ds_min or end is not None and step / 2 < ds_min:
-                return pts, _grazing(sys, a, new["u"], sig0, _sequence(new))
+                return pts, _grazing(sys, a, new["u"], sig0, new["contact"]["signature"])
             new = None
         if new is None:
             ds = min(ds, step) / 2
@@ -223,17 +225,10 @@ def trace(sys, seed, y_fixed, bounds, direction, ds=0.05, ds_min=1e-3, ds_max=0.
     return pts, f"max_points = {max_points} reached at {_at(sys, pts[-1]['u'])}"
 
 
-def _sequence(pt):
-    """The contact sequence of a point's orbit: per tooth its contact changes over the period
-    (the contact signature without the contact at t0: a switch crossing the section time
-    shifts the sequence, it does not change it, and M's saltations stay the same)."""
-    sig = pt["contact"]["signature"]
-    return sig[len(sig) // 2:]
-
-
 def _grazing(sys, a, u, sig0, sig):
     """'grazing at ...': the contact sequence changes between point a and u, and how."""
-    how = f"the contact changes per period go from {sum(sig0)} to {sum(sig)}"
+    changes = [sum(x[len(x) // 2:]) for x in (sig0, sig)]     # (steady sides, changes)
+    how = f"the contact changes per period go from {changes[0]} to {changes[1]}"
     return (f"grazing at {_at(sys, u)}: the contact sequence changes between it and "
             f"{_at(sys, a['u'])}: {how} (the saltation in M holds within one sequence; a "
             "non-smooth fold past it is not followed by the extended system)")
@@ -243,13 +238,7 @@ def _failed(sys, a, pred, ds, sig0, y_fixed):
     """What ended a direction whose step failed below ds_min: a grazing when the run of one
     period from the predictor has another contact signature, else the corrector's failure."""
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", SplineWarning)
-            p = sys.p_of(pred)
-            model = sys.model(p)
-            tr = _trajectory(model.case, sys.t0, sys.t0 + 2 * np.pi * sys.n /
-                             model.info()["omega"], sys.state(pred, y_fixed))
-        sig = _sequence(dict(contact=contact_measures(tr)))
+        sig = sys.orbit(pred, y_fixed)[0]["signature"]
     except (SolverError, CaseError):
         sig = sig0
     if sig != sig0:
