@@ -63,7 +63,7 @@ import numpy as np
 
 import pyspline
 from pyspline.paper import cases_dir
-from speed import _write_csv
+from speed import _write_csv, build
 
 
 def _warm_up_n(_):
@@ -218,9 +218,7 @@ def main(args) -> int:
         with cf.ThreadPoolExecutor(2) as pool:
             draw(pyspline.sweep(case, executor=pool, progress=False, l_x=l_x), out)
         return 0
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True, cwd=Path(__file__).parent).stdout.strip()
-    print(f"commit {commit}, {os.cpu_count()} cores; {n} points of paper_lx1e-4 over l_x, "
+    print(f"{build()}, {os.cpu_count()} cores; {n} points of paper_lx1e-4 over l_x, "
           f"120 revolutions each (20 transient), rtol {case['rtol']:g}"
           + (f"; {blocks} interleaved blocks" if blocks > 1 else "")
           + (f"; {repeats} repeats" if repeats > 1 else ""))

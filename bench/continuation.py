@@ -22,7 +22,6 @@ from __future__ import annotations
 import importlib
 import os
 import statistics
-import subprocess
 import time
 import warnings
 from pathlib import Path
@@ -32,7 +31,7 @@ import numpy as np
 import pyspline
 from pyspline.orbits import _scale
 from pyspline.paper import cases_dir
-from speed import _write_csv
+from speed import _write_csv, build
 
 cont = importlib.import_module("pyspline.arclength")   # the module of pyspline.continuation
 MONODROMY = ("exact", "fd")
@@ -182,9 +181,7 @@ def format_summary(summary, repeat) -> list[str]:
 def main(args) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True, cwd=Path(__file__).parent).stdout.strip()
-    print(f"commit {commit}, {os.cpu_count()} cores, load {os.getloadavg()[0]:.2f}, "
+    print(f"{build()}, {os.cpu_count()} cores, load {os.getloadavg()[0]:.2f}, "
           f"CVODE {pyspline.core.cvode_library()}")
     repeat = args.repeats or (1 if args.quick else 3)
     rows, summary = measure(args.quick, repeat)

@@ -14,7 +14,6 @@ from __future__ import annotations
 import concurrent.futures as cf
 import os
 import statistics
-import subprocess
 import time
 from pathlib import Path
 
@@ -22,7 +21,7 @@ import numpy as np
 
 import pyspline
 from pyspline.paper import cases_dir
-from speed import _write_csv
+from speed import _write_csv, build
 
 
 def _wall(fn, repeat):
@@ -98,9 +97,7 @@ def measure(quick=False):
 def main(args) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True, cwd=Path(__file__).parent).stdout.strip()
-    print(f"commit {commit}, {os.cpu_count()} cores, CVODE {pyspline.core.cvode_library()}")
+    print(f"{build()}, {os.cpu_count()} cores, CVODE {pyspline.core.cvode_library()}")
     rows = measure(args.quick)
     for r in rows:
         sec = r["seconds"]

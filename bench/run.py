@@ -116,11 +116,9 @@ def main(argv=None) -> int:
     p.add_argument("--quick", action="store_true", help="small sizes (for CI)")
     args = p.parse_args(argv)
     if args.what == "race":
-        import subprocess
         import race
-        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
-                                text=True, cwd=Path(__file__).resolve().parent).stdout.strip()
-        print(f"race at commit {commit or '?'}; {race.load()}", flush=True)
+        from speed import build
+        print(f"race of {build()}; {race.load()}", flush=True)
         rows, runs = race.race(quick=args.quick, repeat=args.repeats or (2 if args.quick else 5),
                                cases=args.cases, variants=args.variants, tail=not args.no_tail,
                                progress=lambda m: print(m, flush=True))

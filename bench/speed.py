@@ -267,6 +267,14 @@ def speed_ratios(rows, accuracy=1e-6):
     return out
 
 
+def build() -> str:
+    """The pyspline build being measured: the commit it was built from and where it is installed
+    (the working tree's commit can differ from the build on PYTHONPATH)."""
+    import pyspline
+    from pyspline._build_info import COMMIT
+    return f"pyspline {COMMIT or '(commit unknown)'} at {Path(pyspline.__file__).parent}"
+
+
 def _write_csv(path, rows):
     keys = list(dict.fromkeys(k for r in rows for k in r))
     with open(path, "w", newline="") as f:
