@@ -48,7 +48,8 @@ module spline_integrator
   public :: integrator_t, lib_log_t, integrator_open, cvode_create, erk_create, integrator_advance, &
        integrator_root_info, integrator_root_directions, integrator_land_on_root, &
        integrator_restart, integrator_steps_done, integrator_last_step, integrator_free, &
-       root_crossings, integrator_time, integrator_name, c_copy, stalled_flag, add_counters
+       root_crossings, integrator_time, integrator_name, c_copy, stalled_flag, add_counters, &
+       integrator_tolerances
 
   !> SUNDIALS' own messages of a run (lib_handler), kept instead of printed: the last error's
   !> text, and the warnings (how many, the first one's text).
@@ -472,6 +473,17 @@ contains
     end if
     if (flag == 0) n = n + cnt(1)
   end function integrator_steps_done
+
+  !> Set the run's tolerances to rtol, atol (scalar) from its next step on.
+  integer(c_int) function integrator_tolerances(cv, rtol, atol) result(flag)
+    type(integrator_t), intent(inout) :: cv
+    real(wp), intent(in) :: rtol, atol
+    if (cv%erk) then
+      flag = FERKStepSStolerances(cv%mem, real(rtol, c_double), real(atol, c_double))
+    else
+      flag = FCVodeSStolerances(cv%mem, real(rtol, c_double), real(atol, c_double))
+    end if
+  end function integrator_tolerances
 
   !> Restart at tau from the state in cv%sv (a contact switch: the right-hand side's branch
   !> changed). CVODE: its counters added to stats first (CVodeReInit zeroes them), then it

@@ -58,6 +58,9 @@ contains
     mt = m
     mt%n_out = 1; mt%t_end = m%t0 + m%t_transient; mt%t_transient = 0.0_wp
     mt%section = 0; mt%realisations = 1
+    if (m%rtol_transient > 0.0_wp) then          ! the transient's own tolerances
+      mt%rtol = m%rtol_transient; mt%atol = 1.0e-2_wp*m%rtol_transient; mt%rtol_transient = 0.0_wp
+    end if
     if (m%t_transient > 0.0_wp) then
       call run_case(mt, t, y, tooth, tm, st, ierr, errmsg, interruptible)
       ya = y(:, 1)

@@ -21,7 +21,7 @@ module spline_solver
   use spline_integrator, only: integrator_t, lib_log_t, integrator_open, cvode_create, &
        erk_create, integrator_advance, integrator_root_info, integrator_root_directions, &
        integrator_land_on_root, integrator_restart, integrator_steps_done, integrator_last_step, &
-       add_counters, integrator_free, root_crossings
+       add_counters, integrator_free, root_crossings, integrator_tolerances
   use spline_integrator_report, only: integrator_fail_text, integrator_warnings
   use spline_quantities, only: nstats => nsolver_stats, ist_roots_found, &
        ist_last_step, ist_mode_resyncs, ist_coupling_residual, ist_coupling_iterations, &
@@ -102,6 +102,7 @@ contains
     integer, allocatable :: dirs(:), dirs_set(:)   !< root directions wanted, and set in CVODE
     integer :: ks, nsec             !< next section to store; sections
     logical :: use_tail, fresh      !< the linear tail is tried; CVODE has just (re)started
+    logical :: loose                !< the transient runs at its own tolerances
     character(len=40) :: stage
     type(tail_t) :: tail
 
@@ -115,6 +116,13 @@ contains
       call cvode_create(m, tau, nroot, c_funloc(rhs_cb), c_funloc(roots_cb), c_null_funptr, 0, &
            c_loc(ctx), cv, flag, stage)
     end if
+    ! a transient of its own tolerances (goal = 'statistics', spline_accuracy): up to the first
+    ! output, then the window's
+    loose = m%rtol_transient > 0.0_wp .and. m%t_transient > 0.0_wp
+    if (flag == 0 .and. loose) then
+      stage = 'setting the transient''s tolerances'
+      flag = integrator_tolerances(cv, m%rtol_transient, 1.0e-2_wp*m%rtol_transient)
+    end if
     call schedule_tail_checks()
     if (flag /= 0) then
       call fail(flag, tau, trim(stage))
@@ -122,6 +130,13 @@ contains
       outputs: do k = 1, nt
         if (.not. integrate_to_output(k)) exit outputs
         if (.not. store_output(k)) exit outputs
+        if (k == 1 .and. loose) then
+          flag = integrator_tolerances(cv, m%rtol, m%atol)
+          if (flag /= 0) then
+            call fail(flag, tau, 'setting the window''s tolerances')
+            exit outputs
+          end if
+        end if
         if (k < nt) then
           if (take_linear_tail(k)) exit outputs
         end if

@@ -65,6 +65,8 @@ module spline_model
     logical  :: stald = .false.
     logical  :: linear_tail = .true.        !< closed-form tail in proven full contact (spline_linear)
     real(wp) :: rtol, atol
+    !> the transient's rtol, atol 1e-2 of it (goal = 'statistics'; 0: the window's rtol, atol)
+    real(wp) :: rtol_transient = 0.0_wp
     !> the case's accuracy target (0: none), an error estimate asked for (accuracy or check),
     !> goal = 'statistics' (spline_accuracy)
     real(wp) :: accuracy = 0.0_wp
@@ -160,7 +162,7 @@ contains
     m%dof = c%dof; m%fidelity_tol = c%fidelity_tol
     m%auto = option_index(fidelity_values, c%fidelity) == 2
     k = chosen_method(c)        ! the integrator, roots and tolerances an accuracy or goal picks
-    call accuracy_settings(c, k, m%roots, m%rtol, m%atol)
+    call accuracy_settings(c, k, m%roots, m%rtol, m%atol, m%rtol_transient)
     m%accuracy = c%accuracy; m%goal_statistics = option_index(goal_values, c%goal) == 2
     m%estimate = (c%accuracy > 0.0_wp .or. c%check) .and. .not. m%goal_statistics
     m%method_bdf = merge(1, 0, k == 1)
