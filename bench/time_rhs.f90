@@ -33,7 +33,7 @@ program time_rhs
   allocate(bytes(max(nbytes, 0)/4))
   read(u, iostat=ierr) bytes
   close(u)
-  if (ierr /= 0 .or. size(bytes) /= (storage_size(m) + 31)/32) &
+  if (ierr /= 0 .or. size(bytes) /= size(transfer(m, bytes))) &
        call stop_with(err_case, trim(path)//' is not a loaded case of this build')
   m = transfer(bytes, m)
   if (m%magic /= model_magic) call stop_with(err_case, trim(path)//' is not a loaded case of this build')

@@ -38,7 +38,7 @@ def _without_period(case, final, n, max_n):
     separation are positive beyond the spread of its running estimate (analysis.is_chaotic),
     else 'no period found within N revolutions, not chaotic: ...' (0: a run not settled, or
     quasi-periodic); -1 when its run failed."""
-    from .analysis import is_chaotic, largest_lyapunov_fit
+    from .analysis import largest_lyapunov_fit
     from .follow import continued
     from .orbits import _wall
     from .result import run
@@ -56,11 +56,21 @@ def _without_period(case, final, n, max_n):
         fit = largest_lyapunov_fit(ly["t"], ly["log_growth"], t0=float(res.t[0]))
     except (SplineError, ValueError) as exc:
         return f"no period found, chaos not told (its Lyapunov run: {exc})", -1
-    lam = f"largest Lyapunov exponent {fit.lam:.3g} 1/s (spread {fit.spread:.2g})"
-    if is_chaotic(fit.lam, fit.spread, fit.slope):
-        return f"chaotic: {lam}", 1
+    text, chaotic = lyapunov_verdict(fit)
+    if chaotic:
+        return f"chaotic: {text}", 1
     revs = (res.t[-1] - res.t[0]) * omega / (2 * np.pi)
-    return f"no period found within {revs:.0f} revolutions, not chaotic: {lam}", 0
+    return f"no period found within {revs:.0f} revolutions, not chaotic: {text}", 0
+
+
+def lyapunov_verdict(fit):
+    """The chaos verdict of a Benettin record's fit (analysis.is_chaotic) and the evidence it
+    rests on, as (text, chaotic): the running estimate, the slope of the log separation over
+    the last two thirds and the spread both are held against."""
+    from .analysis import is_chaotic
+    return (f"largest Lyapunov exponent {fit.lam:.3g} 1/s, slope of the log separation "
+            f"{fit.slope:.3g} 1/s (spread {fit.spread:.2g})",
+            is_chaotic(fit.lam, fit.spread, fit.slope))
 
 
 def _cut(sw):

@@ -84,6 +84,25 @@ def _covered(ax, legend=None, lines=False) -> list:
                    p.get_window_extent(r).overlaps(box)]
 
 
+def _notes_over_data(fig) -> list:
+    """The notes (boxed texts of an axes) whose box covers a plotted point of any axes of the
+    figure: a marker or a point of a line within the axes' limits, or a colour map."""
+    r = _renderer(fig)
+    out = []
+    for note in (t for ax in fig.axes for t in ax.texts if t.get_bbox_patch() is not None):
+        box = note.get_bbox_patch().get_window_extent(r)
+        for ax in fig.axes:
+            xy = _markers(ax, lines=True)
+            (x0, x1), (y0, y1) = sorted(ax.get_xlim()), sorted(ax.get_ylim())
+            xy = xy[(x0 <= xy[:, 0]) & (xy[:, 0] <= x1) & (y0 <= xy[:, 1]) & (xy[:, 1] <= y1)]
+            shown = ax.transData.transform(xy) if len(xy) else np.empty((0, 2))
+            if any(box.contains(*d) for d in shown) or any(
+                    im.get_window_extent(r).overlaps(box) for im in ax.get_images()):
+                out.append(note.get_text())
+                break
+    return out
+
+
 def _shown(axis, v) -> bool:
     lo, hi = sorted(axis.get_view_interval())
     return lo <= v <= hi

@@ -18,6 +18,25 @@ from test_continuation import DOUBLING
 BRANCHES = sys.modules["pyspline.diagram"]     # the module of pyspline.branches
 
 
+def test_a_stretchs_words_give_the_verdicts_evidence():
+    """A stretch without a period is said chaotic or not by analysis.is_chaotic on the running
+    estimate, the slope and the spread, and its words quote all three: a separation that grows
+    at r = 200 1/s until a quarter of the window, then stays (a chaotic transient that died
+    out), reads lam = r/4 but slope 0: not chaotic, and the words say slope 0; growth all
+    through is chaotic with both at r."""
+    from pyspline.analysis import largest_lyapunov_fit
+    t = np.linspace(0, 0.4, 401)
+    for growth, chaotic in ((200 * np.minimum(t, 0.1), False), (200 * t, True)):
+        fit = largest_lyapunov_fit(t, growth)
+        text, verdict = BRANCHES.lyapunov_verdict(fit)
+        lam, slope, spread = map(float, re.fullmatch(
+            r"largest Lyapunov exponent (\S+) 1/s, slope of the log separation (\S+) 1/s "
+            r"\(spread (\S+)\)", text).groups())
+        assert verdict == chaotic and (min(lam, slope) > spread) == chaotic, text
+        assert (lam, slope) == pytest.approx((fit.lam, fit.slope), rel=1e-3, abs=1e-9)
+        assert lam == pytest.approx(50 if not chaotic else 200, rel=1e-3)
+
+
 def test_chaotic_drive_seeds_no_branch(monkeypatch):
     """chaos_z24 (a vibro-impact drive with a Lyapunov exponent near 900 1/s,
     tests/test_chaos.py) swept up and down over 5900-6100 r/min: no run's sections give a
@@ -44,9 +63,10 @@ def test_chaotic_drive_seeds_no_branch(monkeypatch):
             pyspline.branches(case, "speed_rpm", 5900, 6100, points=3, max_n=1,
                               progress=False)
     assert tried == [1, 1]      # one seed tried per stretch, at its middle
-    said = re.findall(r"largest Lyapunov exponent (\S+) 1/s \(spread ([\d.e+-]+)\)",
-                      str(err.value))
-    assert len(said) == 2 and all(300 < float(lam) and float(sp) < float(lam) for lam, sp in said)
+    said = re.findall(r"largest Lyapunov exponent (\S+) 1/s, slope of the log separation (\S+) "
+                      r"1/s \(spread ([\d.e+-]+)\)", str(err.value))
+    assert len(said) == 2 and all(300 < float(lam) and float(sp) < min(float(lam), float(sl))
+                                  for lam, sl, sp in said)
 
 
 def test_chaotic_stretch_in_a_branches_dataset():
@@ -70,10 +90,10 @@ def test_chaotic_stretch_in_a_branches_dataset():
     assert sw.period.sel(direction="up").values[0] == 0
     assert ds.no_period_range.values.tolist() == [[0.01, 0.01]]
     assert ds.no_period_chaotic.values.tolist() == [1]
-    lam, spread = map(float, re.fullmatch(r"up 0.01..0.01 \(chaotic: largest Lyapunov exponent "
-                                          r"(\S+) 1/s \(spread (\S+)\)\)",
-                                          ds.attrs["no_period"]).groups())
-    assert lam > 300 and spread < lam
+    lam, slope, spread = map(float, re.fullmatch(
+        r"up 0.01..0.01 \(chaotic: largest Lyapunov exponent (\S+) 1/s, slope of the log "
+        r"separation (\S+) 1/s \(spread (\S+)\)\)", ds.attrs["no_period"]).groups())
+    assert lam > 300 and spread < min(lam, slope)
     assert ds.attrs["seeds"] == "0.07 up n=1" and (ds.n == 1).all() and ds.stable.all()
     assert "max_points = 2 reached" in ds.attrs["status"]
     ax = frequency_response(ds, sweep=sw).axes[0]

@@ -19,7 +19,7 @@ from pyspline.plots import sweeps as sw
 
 from conftest import CASES  # noqa: E402
 from figtools import (_covered, _crowded, _cut_off, _inside, _legend_over_words,  # noqa: E402
-                      _points, _words)
+                      _notes_over_data, _points, _words)
 
 xr = pytest.importorskip("xarray")
 
@@ -356,6 +356,7 @@ def test_scene_shows_a_run_with_its_start_transient_left_out():
         2.5 * z * rpm / 60)                           # up to 2.5 Z shaft orders
     assert _words(ax_s, ["legend"]) == "shaft orders 1x, 2x | tooth pass 16x, 32x"
     assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
+    assert _notes_over_data(fig) == []      # the clipped transient crosses every corner
 
 
 # --------------------------------------------------------------------------- a sweep

@@ -169,6 +169,31 @@ def test_waterfall_stops_at_nyquist_and_warns_about_tooth_pass():
     assert (1922 - 1) / (2 * 0.3) > 3200.0 >= (1921 - 1) / (2 * 0.3)
 
 
+@pytest.mark.parametrize("f_nyq", [4880.0, 4905.0, 4950.0, 8000.0])
+def test_waterfall_labels_stay_clear_of_the_colour_bar(f_nyq):
+    """A narrow speed sweep (5900-6100 r/min, Z = 24) whose data end just before, at, or past
+    where the 48x line leaves the top of the plot (4900 Hz), or far beyond: after a draw at the
+    default size, every order label lies within the axes' width and none overlaps the colour
+    bar (its ticks and label included)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    rpm = np.linspace(5900, 6100, 5)
+    f = np.linspace(0, 8000.0, 801)
+    a = np.exp(-((f[None, :] - 24 * rpm[:, None] / 60) / 30) ** 2) + 1e-3
+    a[:, f > f_nyq] = np.nan
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SplineWarning)      # 48x past the data: said
+        fig = pl.waterfall(dict(speed_rpm=rpm, freq_hz=f, amplitude=a), z=24)
+    FigureCanvasAgg(fig).draw()
+    renderer = fig.canvas.get_renderer()
+    ax, bar = fig.axes
+    edge, bar_box = ax.get_window_extent(renderer).x1, bar.get_tightbbox(renderer)
+    labels = [t for t in ax.texts if t.get_text().strip().endswith("x")]
+    assert {t.get_text().strip() for t in labels} == {"1x", "2x", "24x", "48x"}
+    for t in labels:
+        box = t.get_window_extent(renderer)
+        assert box.x1 <= edge + 0.5 and not box.overlaps(bar_box), (t.get_text(), box, edge)
+
+
 def test_waterfall_of_round_off_says_so():
     """Amplitudes of 1e-7 of a signal's size are round-off (the run plots' rule): the map says
     so; at 1e-5 of it they are content and it does not."""

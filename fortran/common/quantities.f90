@@ -105,8 +105,8 @@ module spline_quantities
             &0.1 max |F_j|: the trajectories part (chaos; -1: never, or not estimated)'), &
        quantity_t('rtol_used', '-', 'relative tolerance of the run (the case''s, or what accuracy &
             &or goal picked)'), &
-       quantity_t('outputs_fallback', '', '1: the per-tooth outputs fell back to mesh_eval at every &
-            &output, as mesh_outputs differed from it at the first or last (a drift; 0 expected)')]
+       quantity_t('outputs_fallback', '', '1: per-tooth outputs from mesh_eval at every output, &
+            &as mesh_outputs differed from it at the first or last (a drift; 0 expected)')]
 
   !> The loads of a run (spline_loads::run_loads, docs/model.md section 15), per tooth: their
   !> positions in a run's tooth-load array (ilt_*) and the table.

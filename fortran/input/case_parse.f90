@@ -171,6 +171,7 @@ contains
       real(wp) :: x
       integer :: iv
       logical :: lv
+      v = ''          ! its length defined before the first reallocating assignment reads it
       line = tl(p)
       if (tk(p) /= tk_word) then
         select case (tk(p))

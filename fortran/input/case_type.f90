@@ -210,8 +210,8 @@ module spline_case_type
                'and atol as given)'), &
        field_t('goal', 'c', optlen, '', 'trajectory | statistics (cheapest unbiased settings)'), &
        field_t('check', 'l', 1, '', 'estimate the error of F_j against a tighter run (F_error_est)'), &
-       field_t('realisations', 'i', 1, '', 'goal statistics: perturbed copies after the '// &
-               'transient, 1/K of the window each'), &
+       field_t('realisations', 'i', 1, '', 'goal statistics: K perturbed copies after the '// &
+               'transient, 1/K window each'), &
        ! times: within a million seconds (11.6 days) of 0, where a double still resolves the
        ! tooth angle omega t to 1e-5 rad at the largest speed
        field_t('t0', 'r', 1, 's', 'start time', 'r', -1.0e6_wp, 1.0e6_wp, &

@@ -179,13 +179,14 @@ contains
     tl%off = .false.
   end subroutine build
 
-  !> The full scaled state of the tail at scaled time tau (>= its start).
+  !> The full scaled state of the tail at scaled time tau (>= its start): tail_states at one time.
   subroutine tail_state(tl, tau, ys)
     type(tail_t), intent(in) :: tl
     real(wp), intent(in) :: tau
     real(wp), intent(out) :: ys(nstate)
-    ys = tl%held
-    ys(tl%idx(1:tl%n)) = tl%ystar + real(matmul(tl%v, tl%c*exp(tl%lam*(tau - tl%tau0))))
+    real(wp) :: one(nstate, 1)
+    call tail_states(tl, [tau], one)
+    ys = one(:, 1)
   end subroutine tail_state
 
   !> The tail at the ascending scaled times taus(i) (>= its start) into ys(:, i), as tail_state

@@ -47,6 +47,15 @@ module spline_variational
     character(len=msglen) :: cb_msg = ''
   end type tan_ctx_t
 
+  interface
+    !> CVODE's Jacobian callback of the run (fortran/integration/tan_jac.c): calls tan_jac.
+    integer(c_int) function tan_jac_cvode(tau, y, fy, jmat, udata, tmp1, tmp2, tmp3) bind(C)
+      import :: c_int, c_double, c_ptr
+      real(c_double), value :: tau
+      type(c_ptr), value :: y, fy, jmat, udata, tmp1, tmp2, tmp3
+    end function tan_jac_cvode
+  end interface
+
 contains
 
   !> ierr = err_case (errmsg says why) for a model the variational equations do not cover:
@@ -128,11 +137,11 @@ contains
     if (ctx%watch) ctx%sigint0 = sigint_watch()
     if (present(msgs)) cv%log = msgs
     call integrator_open(m, 'the variational run', yr, cv, flag, stage, max_seconds)
-    ! Newton: the exact block-diagonal Jacobian (tan_jac_cb) in a band of half-width n - 1; its
+    ! Newton: the exact block-diagonal Jacobian (tan_jac) in a band of half-width n - 1; its
     ! LU costs (1 + ntan) n^3 instead of ((1 + ntan) n)^3 at every restart (a rattling drive
     ! restarts thousands of times a revolution)
     if (flag == 0) call cvode_create(m, tau, nroot, c_funloc(tan_rhs_cb), c_funloc(tan_roots_cb), &
-         c_funloc(tan_jac_cb), n - 1, c_loc(ctx), cv, flag, stage)
+         c_funloc(tan_jac_cvode), n - 1, c_loc(ctx), cv, flag, stage)
     do while (flag == 0 .and. tau < tau1)
       ! only the crossings that change a contact state are switches (as in spline_solver)
       stage = 'setting the directions of the contact switches'
@@ -312,9 +321,9 @@ contains
 
   !> The augmented system's Jacobian: J on the diagonal blocks (the state's and each tangent's;
   !> J does not depend on the state between switches, so the blocks off the diagonal are 0).
-  integer(c_int) function tan_jac_cb(tau, sv_y, sv_f, jmat, udata, t1, t2, t3) result(ret) bind(C)
+  !> CVODE calls it through tan_jac.c's tan_jac_cvode, which drops the arguments it needs not.
+  integer(c_int) function tan_jac(tau, jmat, udata) result(ret) bind(C, name='tan_jac')
     real(c_double), value :: tau
-    type(N_Vector) :: sv_y, sv_f, t1, t2, t3
     type(SUNMatrix) :: jmat
     type(c_ptr), value :: udata
     type(tan_ctx_t), pointer :: ctx
@@ -337,7 +346,7 @@ contains
       end do
     end do
     ret = 0
-  end function tan_jac_cb
+  end function tan_jac
 
   !> Root functions: the contact switches of Eq. 16 (spline_mesh::mesh_switch_functions).
   integer(c_int) function tan_roots_cb(tau, sv_y, gout, udata) result(ret) bind(C)

@@ -166,7 +166,7 @@ contains
     character(len=:), allocatable :: start, text
     model = 0; sizes = 0; warn = ''
     call model_from_case(c, m, ierr, errmsg)
-    if (ierr == err_ok .and. size(model) /= api_model_size()) then
+    if (ierr == err_ok .and. size(model) /= model_words()) then
       ierr = err_case; errmsg = 'api_load: the model array has the wrong size (api_model_size)'
     end if
     if (ierr /= err_ok) return
@@ -186,11 +186,19 @@ contains
     hint = case_suggest(word)
   end subroutine api_field_hint
 
-  !> 4-byte words in a loaded model (the size of the array the api_load_* calls fill).
-  integer(c_int) function api_model_size() result(nb)
+  !> 4-byte words in a loaded model (the size of the array the api_load_* calls fill), for
+  !> Python (a subroutine: f2py's wrapper of a module function without arguments does not
+  !> match its own interface).
+  subroutine api_model_size(nb)
+    integer(c_int), intent(out) :: nb
+    nb = model_words()
+  end subroutine api_model_size
+
+  !> 4-byte words in a loaded model: those transfer packs a model_t into.
+  integer(c_int) function model_words() result(nb)
     type(model_t) :: m
-    nb = int((storage_size(m) + 31)/32, c_int)
-  end function api_model_size
+    nb = size(transfer(m, [0_c_int]))
+  end function model_words
 
   !> The model_t in the bytes of a loaded model; ierr = err_case if they are not one.
   !> max_seconds (optional, > 0): the call's wall-time bound over all its runs, from now
@@ -203,7 +211,7 @@ contains
     real(c_double), intent(in), optional :: max_seconds
     ierr = err_ok
     errmsg = ''
-    if (size(model) == api_model_size()) then
+    if (size(model) == model_words()) then
       m = transfer(model, m)
       if (m%magic == model_magic) then
         if (present(max_seconds)) then

@@ -3,7 +3,7 @@
  * device from a file, and opening a FIFO blocks), whether two names are the same file, an
  * atomic rename, the process id (for a temporary name) and the version of the build.
  * Every function is reentrant; messages are strerror's text (as Python's os.strerror). */
-#define _POSIX_C_SOURCE 200809L
+#define _XOPEN_SOURCE 700      /* POSIX.1-2008 with XSI: realpath is declared by stdlib.h */
 #include <errno.h>
 #include <limits.h>
 #include <stdlib.h>

@@ -91,7 +91,8 @@ def frequency_response(branch, measure: str = "Tm_pp", sweep=None, path=None,
     ranges = branch["no_period_range"].values if "no_period_range" in branch else []
     chaotic = branch["no_period_chaotic"].values if "no_period_chaotic" in branch else \
         [-1] * len(ranges)                # pyspline.branches: no seed there; -1: not told
-    said = {1: ("0.7", "no periodic attractor: chaotic (largest Lyapunov exponent > 0)"),
+    said = {1: ("0.7", "no periodic attractor: chaotic (largest Lyapunov exponent and "
+                  "its slope positive beyond the spread)"),
             0: ("0.85", "no periodic attractor (n <= max_n): not settled, quasi-periodic or a "
                 "longer period; not chaotic"),
             -1: ("0.85", "no periodic attractor (n <= max_n): chaotic, quasi-periodic or not "

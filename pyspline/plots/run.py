@@ -43,7 +43,7 @@ def _time_signal(ax, t, x, name, unit, colour, rtol, scale=0.0):
         ps.note(ax, ps.no_content(span, unit))
     elif late:
         ax.set_ylim(late[0] / k, late[1] / k)
-        ps.note(ax, late[2])
+        ps.note(ax, late[2], loc="below")        # the clipped transient crosses the corners
     return k, u, span
 
 
@@ -200,8 +200,8 @@ def _phase_plane(ax, D2, vD2, section, d_axis, v_scale, t=None, rtol=1e-8):
         if late:
             setlim(late[0] / k, late[1] / k)
             words.append(f"{label}: {late[2]}")
-    if words:                               # the panel is about 4.5 in wide
-        ps.note(ax, "\n".join(ps.wrap(w, 4.2, 8) for w in words), loc="lower left")
+    if words:      # the panel is about 4.5 in wide; the trajectory may fill every corner
+        ps.note(ax, "\n".join(ps.wrap(w, 4.2, 8) for w in words), loc="below")
 
 
 def _spectrum(ax, spectrum, f_shaft, z, speed_rpm, duration, tm_flat):

@@ -170,7 +170,13 @@ def flat_limits(centre, scale) -> tuple[float, float]:
 
 
 def note(ax, text, loc="upper left", **kw):
-    """A boxed note on a panel (in axes coordinates)."""
+    """A boxed note on a panel: in a corner of the axes (`loc`), or with loc='below' under its
+    x label, left-aligned with the axes, for a panel whose data may reach every corner (the
+    figure's constrained layout makes room)."""
+    if loc == "below":
+        return ax.annotate(text, (0.0, 0.0), xycoords=("axes fraction", ax.xaxis.label),
+                           xytext=(0, -4), textcoords="offset points", ha="left", va="top",
+                           fontsize=8, bbox=NOTE_BOX, zorder=5, **kw)
     x, ha = (0.01, "left") if "left" in loc else (0.99, "right")
     y, va = (0.97, "top") if "upper" in loc else (0.03, "bottom")
     return ax.text(x, y, text, transform=ax.transAxes, ha=ha, va=va, fontsize=8,

@@ -368,12 +368,15 @@ def waterfall(ds, speed: str = "speed_rpm", freq: str = "freq_hz", amp: str = "a
     for k, text, st in ps.order_marks(z):
         colour = "w" if dark and st is ps.SHAFT_STYLE else st["color"]
         ax.plot([0.0, k * y_hi / 60.0], [0.0, y_hi], **dict(st, color=colour))
-        if k * y_hi / 60.0 <= f_max:      # label where the line leaves the plot
+        # label where the line leaves the plot, centred above its top; near or past the right
+        # edge, right-aligned at it (never over the edge, towards the colour bar)
+        if k * y_hi / 60.0 <= 0.96 * f_max:
             ax.text(k * y_hi / 60.0, y_hi, text, ha="center", va="bottom", fontsize=8,
                     color=st["color"])
-        else:
-            ax.text(f_max, 60.0 * f_max / k, text + " ", ha="right", va="bottom", fontsize=8,
-                    color=colour, fontweight="bold")
+        else:                             # through the right edge (at the corner: inside)
+            y = 60.0 * f_max / k
+            ax.text(f_max, min(y, y_hi), text + " ", ha="right", va="top" if y >= y_hi else
+                    "bottom", fontsize=8, color=colour, fontweight="bold")
     ax.set_ylim(y_lo, y_hi)
     if words:
         ps.note(ax, words, loc="lower right")
