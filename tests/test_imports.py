@@ -95,11 +95,15 @@ def test_no_import_cycle():
 
 
 #: Imports each module named in argv in a process of its own, forked from one interpreter that
-#: has loaded numpy only (every module imports it through pyspline/__init__.py; numpy binds no
-#: name in another module, so it hides no missing import): prints each failure's traceback.
+#: has loaded numpy and the three matplotlib modules of pyspline/plots/style.py (every module
+#: imports numpy through pyspline/__init__.py, every figure module those through
+#: pyspline.plots; third-party modules bind no name in a pyspline module, so they hide no
+#: missing import, and each child's matplotlib import cost 0.8-1 s of CPU, 5 s in all): prints
+#: each failure's traceback.
 ALONE = """
 import os, sys, traceback
 import numpy
+import matplotlib.backends.backend_agg, matplotlib.figure, matplotlib.ticker
 for module in sys.argv[1:]:
     read, write = os.pipe()
     pid = os.fork()
