@@ -475,7 +475,7 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
                         sp["branch"] = len(branches) - 1
                         found.append(sp)
                         if (sp["type"] == "period_doubling" and switch and len(branches) < 4
-                        and nb <= 4 * n and smooth(sp) and not sp.get("merge")):
+                                and nb <= 4 * n and smooth(sp) and not sp.get("merge")):
                             todo.append(_doubled_start(sp, nb, y_fixed))
         finally:
             bar.close()
@@ -509,10 +509,11 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
     ds_min with every fallback (the other monodromy, then the other integrator) or after
     ends.FAILED_EVALS corrector iterations from its point, a period doubling where the branch
     merges into the period-n/2 one (located: the last point's 'merge') or its own orbit
-    reached again (ends): a sentence saying where and why. A converged point further from its predictor than the step
-    itself, or whose contact sequence changed with no grazing located between (specials.graze),
-    is on another branch: a rejected step. A failed step whose predictor changes the contact
-    sequence is carried across the grazing (specials.diagnose) before it is shrunk."""
+    reached again (ends): a sentence saying where and why. A converged point further from its
+    predictor than the step itself, or whose contact sequence changed with no grazing located
+    between (specials.graze), is on another branch: a rejected step. A failed step whose
+    predictor changes the contact sequence is carried across the grazing (specials.diagnose)
+    before it is shrunk."""
     prob = br.prob
     k = len(u0)
     e_q = np.eye(k)[-1]

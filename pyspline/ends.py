@@ -87,7 +87,8 @@ def merge_doubling(br, pts, new):
         q_a, q_star = a["u"][-1], new["u"][-1]
         if len(pts) > 1:
             b = pts[-2]
-            d_a, d_b = np.linalg.norm(ha - a["u"]), np.linalg.norm(half(br, b["y"], b["u"]) - b["u"])
+            d_a = np.linalg.norm(ha - a["u"])
+            d_b = np.linalg.norm(half(br, b["y"], b["u"]) - b["u"])
             if d_b > d_a:
                 q_star = (q_a * d_b ** 2 - b["u"][-1] * d_a ** 2) / (d_b ** 2 - d_a ** 2)
         for f in (2, 4):
