@@ -26,7 +26,7 @@ from .errors import CaseError, SolverError, SplineWarning
 from .orbits import (CALL_SECONDS, OrbitError, _period_map, _scale, _trajectory, fd_monodromy,
                      forcing_periods, map_and_monodromy, out_of_time, periodic_orbit,
                      section_points, time_bound)
-from . import specials
+from . import ends, specials
 from .specials import SPECIAL_TYPES, contact_measures, locate, multipliers, smooth, tests
 
 __all__ = ["continuation", "SPECIAL_TYPES"]
@@ -189,6 +189,7 @@ class _Problem:
         self.p0, self.pscale = float(start), 0.1 * max(abs(float(start)), abs(float(stop)))
         self.t0 = t0
         self.models, self.log, self.jumps, self.unlocated, self.diagnosed = {}, [], 0, 0, 0
+        self.evals = 0      # corrector iterations so far (ends.FAILED_EVALS)
         self.d0 = _scale(self.model(self.p0))
         self.rtol = case["rtol"]
         # dF/dp's difference step: rtol^(1/2), not the smooth optimum rtol^(1/3) (+-5 r/min
@@ -249,6 +250,7 @@ class _Problem:
         p = self.p_of(u[-1])
         y = self.state(y_fixed, u)
         model = self.model(p)
+        self.evals += 1
         F, M, free = scaled_map(self.monodromy, model, self.t0, self.t1(p, n), y, self.d0)
         hp = self.h * max(abs(p), self.pscale)
         Fq = {}
@@ -473,7 +475,7 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
                         sp["branch"] = len(branches) - 1
                         found.append(sp)
                         if (sp["type"] == "period_doubling" and switch and len(branches) < 4
-                                and nb <= 4 * n and smooth(sp)):
+                                and nb <= 4 * n and smooth(sp) and not sp.get("merge")):
                             todo.append(_doubled_start(sp, nb, y_fixed))
         finally:
             bar.close()
@@ -503,12 +505,15 @@ def _doubled_start(sp, nb, y_fixed):
 def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_points, ibranch,
             bar):
     """The points of one branch from u0 and what ended it: predictor-corrector until q leaves
-    bounds (the last point put on its end: 'complete'), max_points, or a step that fails
-    below ds_min with every fallback (the other monodromy, then the other integrator): a
-    sentence saying where and why. A converged point further from its predictor than the step
-    itself, or whose contact sequence changed with no grazing located between (specials.graze),
-    is on another branch: a rejected step. A failed step whose predictor changes the contact
-    sequence is carried across the grazing (specials.diagnose) before it is shrunk."""
+    bounds (the last point put on its end: 'complete'), max_points, a step that fails below
+    ds_min with every fallback (the other monodromy, then the other integrator) or after
+    ends.FAILED_EVALS corrector iterations from its point, a period doubling where the branch
+    merges into the period-n/2 one (located: the last point's 'merge') or its own orbit
+    reached again (ends): a sentence saying where and why. A converged point further from its
+    predictor than the step itself, or whose contact sequence changed with no grazing located
+    between (specials.graze), is on another branch: a rejected step. A failed step whose
+    predictor changes the contact sequence is carried across the grazing (specials.diagnose)
+    before it is shrunk."""
     prob = br.prob
     k = len(u0)
     e_q = np.eye(k)[-1]
@@ -522,7 +527,7 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
     else:                             # a doubled branch: off the point along tau0
         tau = tau0
         res = br.correct(u0 + ds * tau, tau, tau @ (u0 + ds * tau))
-        new = None if res is None or not _new_orbit(br, res[4], res[0]) else br.point(res, tau)
+        new = None if res is None or not ends.new_orbit(br, res[4], res[0]) else br.point(res, tau)
         if new is None:
             warnings.warn(f"case {prob.case.name}: no period-{br.n} branch found next to the "
                           f"period doubling at {prob.name} = {prob.p_of(u0[-1]):.6g}",
@@ -536,6 +541,7 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
         return lo - 1e-12 <= q <= hi + 1e-12
     fallbacks = _fallbacks(prob)
     primary, on_fallback = (prob.how, prob.case["method"]), 0
+    mark = prob.evals               # corrector iterations at the last point (but diagnoses)
     while len(pts) < max_points:
         if late := out_of_time():
             return pts, f"{late} was reached at {prob.name} = {pts[-1]['p']:.6g}"
@@ -572,13 +578,20 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
             else:
                 new["grazing"] = loc[-1]
         if new is None:
+            lost = prob.evals - mark
+            if lost > ends.FAILED_EVALS:
+                return pts, _where(br, pred, ds, f"after point {len(pts)} of branch {ibranch} "
+                                   f"within the bound of {ends.FAILED_EVALS} corrector iterations "
+                                   f"for a point's failed steps ({lost} taken)")
+            e = prob.evals      # the diagnosis, once a point, is bounded on its own
             crossed = specials.diagnose(br, a, pred, step) if step > 0 else None
+            mark += prob.evals - e
             # none past the end (those crossings are not the branch's: it ends before them)
             crossed = [c for c in crossed or () if inside(c["u"][-1])]
             if crossed:
                 pts += crossed
                 bar.update(len(crossed))
-                prob.diagnosed += 1
+                prob.diagnosed, mark = prob.diagnosed + 1, prob.evals
                 continue
             if not a.get("null"):   # the secant can be off after a kink: the null vector once
                 a["tau"], a["null"] = _null_tangent(a["J"], a["tau"]), True
@@ -598,14 +611,16 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
         if angle > 2 * max_angle and ds > ds_min:      # the branch turns: a shorter step
             ds = max(ds_min, ds / 2)
             continue
-        try:
-            merged = _merged(br, a, new)
-        except (SolverError, CaseError):     # the half-period run failed: not told
-            merged = ""
-        if merged:
+        secs = prob.sections(new)
+        if merged := ends.merged(br, a, new, secs):
+            if sp := ends.merge_doubling(br, pts, new):
+                a["merge"] = sp
             return pts, merged
+        if back := ends.returned(br, pts, new, secs):
+            return pts, back
         pts.append(new)
         bar.update(1)
+        mark = prob.evals
         if end is not None:
             return pts, "complete"
         if on_fallback:                 # a few points on the fallback, then the primary again
@@ -650,34 +665,6 @@ def _use(prob, monodromy, method):
     prob.set_monodromy(monodromy)
     if method != prob.case["method"]:
         prob.set_method(method)
-
-
-def _half(br, y, u):
-    """u = (z, q) of P^(n/2)(y), y the state of the branch point u: its orbit half a period on."""
-    prob = br.prob
-    p = prob.p_of(u[-1])
-    y1, _, free = _map_only(prob.model(p), prob.t0, prob.t1(p, br.n // 2), y)
-    return np.r_[y1[free] / prob.d0[free], u[-1]]
-
-
-def _new_orbit(br, y, u):
-    """The doubled branch's point is not the period-n orbit again: P^(n/2)(y) != y."""
-    return np.abs(_half(br, y, u) - u).max() > 1e3 * br.tol
-
-
-def _merged(br, a, new):
-    """Where a period-n branch (n even) meets the period-n/2 branch at their period doubling
-    (a pitchfork of P^n): new, the point after a, is a fixed point of P^(n/2) (the
-    period-n/2 orbit, not to be labelled n), or lies past the doubling on the branch's own
-    other section points (P^(n/2) of new nearer a than new itself: the same orbit again, to be
-    traced twice). A sentence saying so (the branch ends at a), or ''."""
-    if br.n % 2 or _new_orbit(br, new["y"], new["u"]) and np.linalg.norm(
-            _half(br, new["y"], new["u"]) - a["u"]) >= np.linalg.norm(new["u"] - a["u"]):
-        return ""
-    return (f"the period-{br.n} branch reached a period doubling between {br.prob.name} = "
-            f"{a['p']:.6g} and {new['p']:.6g}, where it merges into the period-{br.n // 2} "
-            f"branch (past it: the period-{br.n // 2} orbit, or this orbit at its other section "
-            "points): it ends there")
 
 
 def _fail(br, u, ds, where):

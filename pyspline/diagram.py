@@ -14,6 +14,7 @@ from .arclength import (check_handed_on, continuation, field_label, parse_field,
 from .errors import CaseError, SolverError, SplineError, SplineWarning
 from .orbits import (CALL_SECONDS, OrbitError, out_of_time, repeat_revolutions,
                      section_points, time_bound)
+from .specials import on_polyline
 
 
 def _stretches(period):
@@ -122,23 +123,14 @@ def _seed(case, final, n, max_n):
 
 
 def _on_branch(ds, label, p, y, scale, tol):
-    """Whether (p, y) lies on a branch of `ds`: within a tenth of a chord (the sagitta at the
-    continuation's max_angle is about 2 % of it), and at least sqrt(tol) (specials.same_point),
-    of the segment between two consecutive points of the branch, in the continuation's scaled
-    unknowns (the states by Eq. 25, the field by a tenth of its magnitude): the nearest point
-    of the segment, so that a point at a fold, beyond the field values sampled on either side
-    of it, is found too."""
+    """Whether (p, y) lies on a branch of `ds` (specials.on_polyline), in the continuation's
+    scaled unknowns (the states by Eq. 25, the field by a tenth of its magnitude)."""
     pscale = 0.1 * max(abs(p), np.abs(ds[label].values).max())
     x = np.r_[p / pscale, np.asarray(y) / scale]
-    for b in np.unique(ds.branch.values):
-        rows = np.flatnonzero(ds.branch.values == b)
-        X = np.c_[ds[label].values[rows] / pscale, ds.y0.values[rows] / scale]
-        d, r = np.diff(X, axis=0), x - X[:-1]
-        w = np.clip((r * d).sum(1) / np.maximum((d * d).sum(1), 1e-300), 0, 1)
-        dist = np.abs(r - w[:, None] * d).max(1)
-        if (dist <= np.maximum(0.1 * np.abs(d).max(1), np.sqrt(tol))).any():
-            return True
-    return False
+    return any(on_polyline(np.c_[ds[label].values[rows] / pscale, ds.y0.values[rows] / scale],
+                           x, tol)
+               for rows in (np.flatnonzero(ds.branch.values == b)
+                            for b in np.unique(ds.branch.values)))
 
 
 def merged(pieces, label, scale, tol, phases=None):

@@ -142,6 +142,8 @@ def locate(br, pts):
         out += [dict(sp, at=i) for sp in _multiplier_points(br, a, b)]
         if "grazing" in b:
             out.append(dict(b["grazing"], at=i))
+    # the doubling where a period-n branch ends (ends.merge_doubling), at its last point
+    out += [dict(pt["merge"], at=i) for i, pt in enumerate(pts) if "merge" in pt]
     for g in out:
         if g["type"] == "grazing" and _turns(pts, g) and not any(
                 sp["type"] == "fold" and smooth(sp) and abs(sp["at"] - g["at"]) <= 2
@@ -232,6 +234,19 @@ def same_point(u, v, tol) -> bool:
     by about tol, and near a fold, where M - I is singular along the branch, by about its
     square root)."""
     return bool(np.abs(np.asarray(u) - np.asarray(v)).max() <= np.sqrt(tol))
+
+
+def on_polyline(X, x, tol) -> bool:
+    """Whether x lies on the polyline through the rows of X (consecutive points of a branch):
+    within a tenth of a chord (the sagitta at the continuation's max_angle is about 2 % of
+    it), and at least sqrt(tol) (same_point), of the nearest point of a segment, so that a
+    point at a fold, beyond the field values sampled on either side of it, is found too."""
+    if len(X) < 2:
+        return False
+    d, r = np.diff(X, axis=0), np.asarray(x) - X[:-1]
+    w = np.clip((r * d).sum(1) / np.maximum((d * d).sum(1), 1e-300), 0, 1)
+    dist = np.abs(r - w[:, None] * d).max(1)
+    return bool((dist <= np.maximum(0.1 * np.abs(d).max(1), np.sqrt(tol))).any())
 
 
 def once(sps, sections, tol):

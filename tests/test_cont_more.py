@@ -243,7 +243,8 @@ def test_period_two_branch_ends_at_its_doubling(doubling_band, phase):
     """The period-2 orbit at 1625 r/min continued down (band 1615-1630) from its first section
     point y or its other one P(y): stable down to its fold at 1618.409 r/min (multiplier +1),
     back up unstable towards the period doubling (1623.61), where it meets the period-1
-    branch: it ends there, its status saying so. Before, from P(y) it went through the
+    branch: it ends there, its status saying so, and the doubling is located there, as on the
+    period-1 branch. Before, from P(y) it went through the
     doubling onto y's half of the same orbit, down to the same fold and back up (traced twice,
     the fold located twice); from y it went on as period-2 points of the period-1 orbit. No
     point is a fixed point of P (P(y) 1e3 tol or more from y: 0.05 at 1623.605, next to the
@@ -270,6 +271,50 @@ def test_period_two_branch_ends_at_its_doubling(doubling_band, phase):
     fold = np.flatnonzero(ds.special_type.values == "fold")
     assert len(fold) == 1 and ds.special_speed_rpm[fold[0]] == pytest.approx(1618.409, abs=1e-3)
     assert abs(complex(ds.special_mu_real[fold[0]], ds.special_mu_imag[fold[0]]) - 1) < 1e-2
+    # the doubling where it ends, located on the period-1 orbit (ends.merge_doubling): the
+    # period-1 branch's own to 1e-4 r/min (the corrector's tol 1e-6 moves a multiplier by
+    # about 1e-6, and -1 moves by 0.018 per r/min there), its multiplier at -1
+    pd, ref = (np.flatnonzero(d.special_type.values == "period_doubling") for d in
+               (ds, doubling_band))
+    assert len(pd) == 1 and ds.special_n[pd[0]] == 1 and ds.special_branch[pd[0]] == 0
+    assert ds.special_speed_rpm[pd[0]] == pytest.approx(
+        float(doubling_band.special_speed_rpm[ref[0]]), abs=1e-4)
+    assert abs(complex(ds.special_mu_real[pd[0]], ds.special_mu_imag[pd[0]]) + 1) < 1e-3
+    assert ds.special_smooth[pd[0]] == 1 and ds.special_n[fold[0]] == 2
+    assert np.abs((ds.special_y0.values[pd[0]] - doubling_band.special_y0.values[ref[0]])
+                  / s).max() < 1e-3
+
+
+def test_period_two_branch_doubles_to_period_four():
+    """The doubling scene's period-2 branch (stable at 1723.5 r/min, from a settled run)
+    continued down doubles at 1722.90 r/min (a multiplier of P^2 at -1), and the period-4
+    branch is followed from there: its points are fixed points of P^4 (to 1e-5 scaled) and not
+    of P^2 (1e3 tol or more away)."""
+    from pyspline.orbits import _period_map, periodic_orbit
+    from test_orbits import scale_of
+    T = 60 / 1723.5
+    case = DOUBLING8.replace(speed_rpm=1723.5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        orbit = periodic_orbit(case.replace(t_end=60 * T, t_transient=40 * T), n=2)
+        ds = pyspline.continuation(case, "speed_rpm", 1723.5, 1722.7, n=2, guess=orbit.y0,
+                                   band=(1722.7, 1725), progress=False, ds_max=0.5,
+                                   max_angle=0.3)
+    assert orbit.stable and ds.attrs["status"] == "complete", ds.attrs["status"]
+    kind, b = ds.special_type.values, ds.branch.values
+    pd = np.flatnonzero(kind == "period_doubling")
+    assert len(pd) == 1 and ds.special_n[pd[0]] == 2 and ds.special_branch[pd[0]] == 0
+    assert abs(complex(ds.special_mu_real[pd[0]], ds.special_mu_imag[pd[0]]) + 1) < 1e-3
+    assert 1722.8 < float(ds.special_speed_rpm[pd[0]]) < 1723.0
+    assert (ds.n.values[b == 0] == 2).all() and (ds.n.values[b == 1] == 4).all()
+    assert (b == 1).sum() >= 2
+    s = scale_of(case)
+    for x, y in zip(ds.speed_rpm.values[b == 1], ds.y0.values[b == 1]):
+        m = case.replace(speed_rpm=float(x)).model
+        y2, free = _period_map(m, 0.0, 2 * 60 / x, y[:, None])
+        y4, _ = _period_map(m, 0.0, 4 * 60 / x, y[:, None])
+        assert np.abs((y4[:, 0] - y)[free] / s[free]).max() < 1e-5, x
+        assert np.abs((y2[:, 0] - y)[free] / s[free]).max() > 1e3 * 100 * case["rtol"], x
 
 
 @pytest.mark.parametrize("stop", [1620.085, 1620.1, 1620.12])
