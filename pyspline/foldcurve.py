@@ -22,6 +22,7 @@ import numpy as np
 
 from .arclength import _null_tangent, field_label, scaled_map, set_field
 from .errors import CaseError, SolverError, SplineError, SplineWarning
+from .result import sundials_said
 from .orbits import _scale, _trajectory, forcing_periods, map_and_monodromy, out_of_time
 from .specials import contact_measures, multipliers
 
@@ -448,19 +449,17 @@ def curve_dataset(sys, curves, ends, tried, label1, label2, values2, margin=1e-4
     else:
         status = _status(sys, ends, (np.asarray(values2) - sys.p0[1]) / sys.pscale[1])
     folds, near = [], []
-    for j, v in enumerate(values2):
-        if j < len(tried) - (sys is not None):      # continued, no fold: its own answer
-            status[j], xs = said[j], []
-        else:
-            xs = [] if sys is None else [dict(x, y=c[0]["y"]) for c in curves for x in
-                                         at_value(sys, c, (v - sys.p0[1]) / sys.pscale[1],
-                                                  c[0]["y"])]
-        xs.sort(key=lambda x: sys.p_of(x["u"])[0])
-        folds.append([sys.p_of(x["u"])[0] for x in xs])
-        near.append([fold_grazing(sys, x["u"], x["y"]) if x["exact"] else (None, "no exact fold")
-                     for x in xs])
-        if not all(x["exact"] for x in xs) and status[j] == "complete":
-            status[j] = "a fold interpolated on the curve's chord (its corrector failed)"
+    with sundials_said("the runs from the folds to their nearest grazings"):
+        for j, v in enumerate(values2):
+            if j < len(tried) - (sys is not None):      # continued, no fold: its own answer
+                status[j], xs = said[j], []
+            else:
+                xs = _folds_at(sys, curves, v)
+            folds.append([sys.p_of(x["u"])[0] for x in xs])
+            near.append([fold_grazing(sys, x["u"], x["y"]) if x["exact"] else
+                         (None, "no exact fold") for x in xs])
+            if not all(x["exact"] for x in xs) and status[j] == "complete":
+                status[j] = "a fold interpolated on the curve's chord (its corrector failed)"
     pts = [(i, x) for i, c in enumerate(curves) for x in c]
     stops = [p for p, w in ends if p is not None and w != "complete"]
     other = [np.abs(np.delete(x["mu"], np.argmin(np.abs(x["mu"] - 1)))).max() for _, x in pts]
@@ -498,6 +497,14 @@ def curve_dataset(sys, curves, ends, tried, label1, label2, values2, margin=1e-4
                          for v, fs, r in zip(values2, folds, near) for f, (_, why) in zip(fs, r)
                          if why != "found") or "complete")
     return out
+
+
+def _folds_at(sys, curves, v):
+    """The fold points of the curves at the value v of field2 (at_value), in the order of the
+    first field, each with its curve's fixed states y."""
+    xs = [] if sys is None else [dict(x, y=c[0]["y"]) for c in curves for x in
+                                 at_value(sys, c, (v - sys.p0[1]) / sys.pscale[1], c[0]["y"])]
+    return sorted(xs, key=lambda x: sys.p_of(x["u"])[0])
 
 
 def _padded(rows):
