@@ -298,6 +298,8 @@ def fold_grazing(sys, u, y_fixed, ds=0.02, ds_min=1e-4, ds_max=0.25, reach=2.0, 
     `reach` (scaled) either way, or the way's corrector failed)."""
     from .arclength import _Branch, _Problem
     from . import specials
+    if late := out_of_time():
+        return None, f"{late} was reached"
     (name, index), (name2, index2) = sys.fields
     with warnings.catch_warnings():     # the case's notes: said by the seed's run
         warnings.simplefilter("ignore", SplineWarning)
@@ -448,18 +450,23 @@ def curve_dataset(sys, curves, ends, tried, label1, label2, values2, margin=1e-4
                   for v in values2]     # (the values tried say what they found, below)
     else:
         status = _status(sys, ends, (np.asarray(values2) - sys.p0[1]) / sys.pscale[1])
-    folds, near = [], []
-    with sundials_said("the runs from the folds to their nearest grazings"):
-        for j, v in enumerate(values2):
-            if j < len(tried) - (sys is not None):      # continued, no fold: its own answer
-                status[j], xs = said[j], []
-            else:
-                xs = _folds_at(sys, curves, v)
-            folds.append([sys.p_of(x["u"])[0] for x in xs])
-            near.append([fold_grazing(sys, x["u"], x["y"]) if x["exact"] else
-                         (None, "no exact fold") for x in xs])
-            if not all(x["exact"] for x in xs) and status[j] == "complete":
-                status[j] = "a fold interpolated on the curve's chord (its corrector failed)"
+    at = []
+    for j, v in enumerate(values2):
+        if j < len(tried) - (sys is not None):      # continued, no fold: its own answer
+            status[j], xs = said[j], []
+        else:
+            xs = _folds_at(sys, curves, v)
+        at.append(xs)
+        if not all(x["exact"] for x in xs) and status[j] == "complete":
+            status[j] = "a fold interpolated on the curve's chord (its corrector failed)"
+    folds = [[sys.p_of(x["u"])[0] for x in xs] for xs in at]
+    with sundials_said("the runs from the folds to their nearest grazings"):   # after the
+        near = [[fold_grazing(sys, x["u"], x["y"]) if x["exact"] else   # folds: a time bound
+                 (None, "no exact fold") for x in xs] for xs in at]     # cuts only these
+    for j, r in enumerate(near):
+        cut = [why for _, why in r if why.endswith(" was reached")]
+        if cut and status[j] == "complete":
+            status[j] = f"the grazing nearest a fold not searched: {cut[0]}"
     pts = [(i, x) for i, c in enumerate(curves) for x in c]
     stops = [p for p, w in ends if p is not None and w != "complete"]
     other = [np.abs(np.delete(x["mu"], np.argmin(np.abs(x["mu"] - 1)))).max() for _, x in pts]
