@@ -12,8 +12,10 @@ derivatives: the whole gradient from two variational runs), g_q = -w^T (M(q + h)
 v / (2 h), with [w^T, g'] the transposed bordered solve; F_q from the same runs at q +- h:
 seven variational runs per Newton iteration whatever the state's size. The contact signature
 of the orbit (specials.contact_measures) must stay the seed's (the saltation in M holds within one contact sequence):
-where it changes, the direction stops ('grazing at ...'). Nothing here computes physics: the
-map, M and the trajectories are the core's."""
+where it changes, the direction stops ('grazing at ...'). At each value of field2 the grazing
+nearest each fold is found along that value's branch from the fold's orbit (fold_grazing:
+arclength's corrector, specials' bisection). Nothing here computes physics: the map, M and
+the trajectories are the core's."""
 from __future__ import annotations
 
 import warnings
@@ -22,8 +24,8 @@ import numpy as np
 
 from .arclength import _null_tangent, field_label, scaled_map, set_field
 from .errors import CaseError, SolverError, SplineError, SplineWarning
-from .result import sundials_said
 from .orbits import _scale, _trajectory, forcing_periods, map_and_monodromy, out_of_time
+from .result import sundials_said
 from .specials import contact_measures, multipliers
 
 
