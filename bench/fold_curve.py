@@ -33,8 +33,9 @@ fc = pyspline.fold_curve(drive, "speed_rpm", 2300, 2700, "ripple_amp(1)", AMPS, 
                          method="repeated" if args.repeated else "extended", progress=False,
                          max_seconds=np.inf if args.unbounded else 300.0)
 print(f"fold part: {time.process_time() - t:.1f} s CPU, {time.perf_counter() - w:.1f} s wall")
-for a, f in zip(AMPS, fc.fold.values):
-    print(f"a = {a:g}: folds {np.round(f[np.isfinite(f)], 3)}")
+for a, f, g in zip(AMPS, fc.fold.values, fc.get("fold_grazing", fc.fold * np.nan).values):
+    print(f"a = {a:g}: folds {np.round(f[np.isfinite(f)], 3)}, the grazing nearest each "
+          f"{np.round(g[np.isfinite(f)], 3)}")
 print("status:", fc.attrs["status"])
 print("cusp:", fc.attrs.get("cusp"), "\ncurves:", fc.attrs.get("curve_status"))
 if not args.no_check:
