@@ -25,7 +25,7 @@ ap = argparse.ArgumentParser()
 ap.add_argument("--repeated", action="store_true")
 ap.add_argument("--no-check", action="store_true")
 ap.add_argument("--png")
-ap.add_argument("--unbounded", action="store_true", help="max_seconds = inf")
+ap.add_argument("--unbounded", action="store_true", help="max_seconds = inf (both calls)")
 args = ap.parse_args()
 drive = DRIVE.replace(n_out=1001)
 t, w = time.process_time(), time.perf_counter()
@@ -33,8 +33,9 @@ fc = pyspline.fold_curve(drive, "speed_rpm", 2300, 2700, "ripple_amp(1)", AMPS, 
                          method="repeated" if args.repeated else "extended", progress=False,
                          max_seconds=np.inf if args.unbounded else 300.0)
 print(f"fold part: {time.process_time() - t:.1f} s CPU, {time.perf_counter() - w:.1f} s wall")
-for a, f in zip(AMPS, fc.fold.values):
-    print(f"a = {a:g}: folds {np.round(f[np.isfinite(f)], 3)}")
+for a, f, g in zip(AMPS, fc.fold.values, fc.get("fold_grazing", fc.fold * np.nan).values):
+    print(f"a = {a:g}: folds {np.round(f[np.isfinite(f)], 3)}, the grazing nearest each "
+          f"{np.round(g[np.isfinite(f)], 3)}")
 print("status:", fc.attrs["status"])
 print("cusp:", fc.attrs.get("cusp"), "\ncurves:", fc.attrs.get("curve_status"))
 if not args.no_check:
@@ -43,7 +44,7 @@ if not args.no_check:
                              max_points=400, check=CHECK, check_points=41,
                              check_case=drive.replace(t_end=2.0, t_transient=1.0, n_out=8001),
                              method="repeated" if args.repeated else "extended",
-                             progress=False)
+                             progress=False, max_seconds=np.inf if args.unbounded else 300.0)
     print(f"with the check sweeps: {time.process_time() - t:.1f} s CPU, "
           f"{time.perf_counter() - w:.1f} s wall")
 if args.png:

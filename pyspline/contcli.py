@@ -172,9 +172,12 @@ def _other(args, case, name, index, command, out) -> int:
                         max_seconds=args.max_seconds,
                         method="repeated" if args.repeated else "extended")
         write_netcdf(fc, out / "fold_curve.nc")
-        for v, f, g in zip(fc.value2.values, fc.fold.values, fc.grazing.values):
+        near = fc.fold_grazing.values if "fold_grazing" in fc else fc.fold.values * np.nan
+        for v, f, g, h in zip(fc.value2.values, fc.fold.values, fc.grazing.values, near):
             print(f"{field2.strip()} = {v:.6g}: folds {np.round(f[np.isfinite(f)], 2)}, "
-                  f"grazings {np.round(g[np.isfinite(g)], 2)}")
+                  f"grazings {np.round(g[np.isfinite(g)], 2)}"
+                  + (f", nearest each fold {np.round(h[np.isfinite(f)], 2)}"
+                     if np.isfinite(h).any() else ""))
         if "cusp" in fc.attrs:
             print(f"cusps: {fc.attrs['cusp']}")
         fold_plane(fc, path=out / "fold_curve.png")

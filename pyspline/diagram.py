@@ -423,7 +423,9 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
         variational runs per Newton step) within [start, stop] x [min, max of values2], both
         ways, through cusps, until it leaves that rectangle or the orbit's contact sequence
         changes ('grazing at ...': a fold past it is not followed). The folds at each value
-        of field2 are where the curves cross it, corrected there. 'repeated': a continuation
+        of field2 are where the curves cross it, corrected there, and from each the value's
+        branch is walked both ways to the nearest grazing (a grazing curve per fold curve,
+        sampled at the values). 'repeated': a continuation
         over the band at each value in turn (`cont`: continuation's keywords, for both), from
         the previous value's orbit at the band's start; gives every value's grazings.
     narrow : (repeated) once a value has a fold pair, the next value's band is narrowed around
@@ -444,7 +446,11 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
     padded), `grazing` (value2, grazing; in order along the branch from the band's start: the
     first is where the orbit there changes its contact sequence; extended: only the values
     continued), `band` (value2, end: the band continued), `status` (each value's: 'complete'
-    or why a fold may be missing there). Extended, along the curves (dim `curve_point`):
+    or why a fold may be missing there). Extended: `fold_grazing` (value2, fold; beside
+    `fold`): the grazing nearest each fold along the value's branch, walked from the fold's
+    orbit both ways (NaN where none within reach: attrs['fold_grazing_status'] says why),
+    `fold_grazing_bracket` the field's span it was located to; along the curves (dim
+    `curve_point`):
     `curve` (which), `curve_field`, `curve_field2`, `curve_y0`, `curve_Tm_pp`,
     `curve_mu_other` (the largest |mu| besides the one at +1), `curve_stable`; dims `cusp`
     (`cusp_field`, `cusp_field2`; attrs['cusp']) and `stop` (`stop_field`, `stop_field2`,

@@ -12,8 +12,10 @@ derivatives: the whole gradient from two variational runs), g_q = -w^T (M(q + h)
 v / (2 h), with [w^T, g'] the transposed bordered solve; F_q from the same runs at q +- h:
 seven variational runs per Newton iteration whatever the state's size. The contact signature
 of the orbit (specials.contact_measures) must stay the seed's (the saltation in M holds within one contact sequence):
-where it changes, the direction stops ('grazing at ...'). Nothing here computes physics: the
-map, M and the trajectories are the core's."""
+where it changes, the direction stops ('grazing at ...'). At each value of field2 the grazing
+nearest each fold is found along that value's branch from the fold's orbit (fold_grazing:
+arclength's corrector, specials' bisection). Nothing here computes physics: the map, M and
+the trajectories are the core's."""
 from __future__ import annotations
 
 import warnings
@@ -23,6 +25,7 @@ import numpy as np
 from .arclength import _null_tangent, field_label, scaled_map, set_field
 from .errors import CaseError, SolverError, SplineError, SplineWarning
 from .orbits import _scale, _trajectory, forcing_periods, map_and_monodromy, out_of_time
+from .result import sundials_said
 from .specials import contact_measures, multipliers
 
 
@@ -286,6 +289,66 @@ def at_value(sys, pts, q2, y_fixed):
     return found
 
 
+def fold_grazing(sys, u, y_fixed, ds=0.02, ds_min=1e-4, ds_max=0.25, reach=2.0, iters=12):
+    """The grazing nearest the fold point u (converged, at field2 fixed) along its
+    one-parameter branch in the first field: the branch followed from the fold both ways by
+    arclength steps (continuation's corrector, the secant as predictor), always the way walked
+    less, until the contact signature changes at a point (or, in a failed step, at its
+    predictor), the grazing then bisected (`iters` times) as continuation locates it
+    (specials.graze). (the grazing's special record with 'bracket': the field's span between
+    the points either side of it, or None; 'found' or why not: none within the arclength
+    `reach` (scaled) either way, or the way's corrector failed)."""
+    from .arclength import _Branch, _Problem
+    from . import specials
+    if late := out_of_time():
+        return None, f"{late} was reached"
+    (name, index), (name2, index2) = sys.fields
+    with warnings.catch_warnings():     # the case's notes: said by the seed's run
+        warnings.simplefilter("ignore", SplineWarning)
+        prob = _Problem(set_field(sys.case, name2, index2, sys.p_of(u)[1]), name, index,
+                        sys.n, sys.p0[0], sys.p0[0], sys.t0)
+    prob.pscale, prob.d0, prob.free = sys.pscale[0], sys.d0, sys.free     # sys's unknowns
+    br = _Branch(prob, sys.n, y_fixed, sys.tol, 6)
+    try:
+        F, J, M, y = prob.evaluate(y_fixed, u[:-1], sys.n)
+        a = br.point((u[:-1], F, J, M, y, 0, [float(np.abs(F).max())]),
+                     np.linalg.svd(J)[2][-1])
+    except (SolverError, CaseError) as exc:
+        a, br.last_error = None, str(exc)
+    if a is None:
+        return None, f"the fold's orbit did not run: {br.last_error}"
+    ways = [dict(a, tau=s * a["tau"], s=0.0, ds=ds) for s in (1, -1)]
+    why = f"no grazing within {reach:g} of arclength (scaled) either way"
+    while ways:
+        if late := out_of_time():
+            return None, f"{late} was reached"
+        i = min(range(len(ways)), key=lambda j: ways[j]["s"])
+        w, sig = ways[i], ways[i]["contact"]["signature"]
+        pred = np.r_[w["u"] + w["ds"] * w["tau"], u[-1]]
+        b, loc = specials.point_at(br, w, w["ds"]), False
+        if b is not None and b["contact"]["signature"] != sig:
+            loc = specials.graze(br, w, b, w["ds"], iters)
+        elif b is None and not w.get("diagnosed") and br.signature(pred[:-1]) != sig:
+            w["diagnosed"] = True       # once from a point, as continuation's diagnosis
+            loc = specials.graze(br, w, None, w["ds"], iters)
+        if loc:
+            return dict(loc[-1], bracket=abs(loc[1]["p"] - loc[0]["p"])), "found"
+        if b is None:
+            w["ds"] /= 2
+            if w["ds"] < ds_min:
+                why = (f"the branch's corrector failed at {_at(sys, pred)} with the step down "
+                       f"to {w['ds']:.3g}: {getattr(br, 'last_error', '')}")
+                ways.pop(i)
+        elif loc is None:
+            why = f"a contact change with no grazing located next to {_at(sys, pred)}"
+            ways.pop(i)
+        else:
+            ways[i] = dict(b, s=w["s"] + w["ds"], ds=min(ds_max, 1.5 * w["ds"]))
+            if ways[i]["s"] >= reach:
+                ways.pop(i)
+    return None, why
+
+
 def extended(case, field, start, stop, name2, index2, values2, n, progress, cont):
     """fold_curve by the extended system: the branch continued over [start, stop] at the
     values of field2 in turn until one has a smooth fold (the seed), each of its folds not on
@@ -389,16 +452,23 @@ def curve_dataset(sys, curves, ends, tried, label1, label2, values2, margin=1e-4
                   for v in values2]     # (the values tried say what they found, below)
     else:
         status = _status(sys, ends, (np.asarray(values2) - sys.p0[1]) / sys.pscale[1])
-    folds = []
+    at = []
     for j, v in enumerate(values2):
         if j < len(tried) - (sys is not None):      # continued, no fold: its own answer
             status[j], xs = said[j], []
         else:
-            xs = [] if sys is None else [x for c in curves for x in at_value(
-                sys, c, (v - sys.p0[1]) / sys.pscale[1], c[0]["y"])]
-        folds.append(np.sort([sys.p_of(x["u"])[0] for x in xs]))
+            xs = _folds_at(sys, curves, v)
+        at.append(xs)
         if not all(x["exact"] for x in xs) and status[j] == "complete":
             status[j] = "a fold interpolated on the curve's chord (its corrector failed)"
+    folds = [[sys.p_of(x["u"])[0] for x in xs] for xs in at]
+    with sundials_said("the runs from the folds to their nearest grazings"):   # after the
+        near = [[fold_grazing(sys, x["u"], x["y"]) if x["exact"] else   # folds: a time bound
+                 (None, "no exact fold") for x in xs] for xs in at]     # cuts only these
+    for j, r in enumerate(near):
+        cut = [why for _, why in r if why.endswith(" was reached")]
+        if cut and status[j] == "complete":
+            status[j] = f"the grazing nearest a fold not searched: {cut[0]}"
     pts = [(i, x) for i, c in enumerate(curves) for x in c]
     stops = [p for p, w in ends if p is not None and w != "complete"]
     other = [np.abs(np.delete(x["mu"], np.argmin(np.abs(x["mu"] - 1)))).max() for _, x in pts]
@@ -408,6 +478,10 @@ def curve_dataset(sys, curves, ends, tried, label1, label2, values2, margin=1e-4
     out = xr.Dataset({
         "fold": (("value2", "fold"), _padded(folds)),
         "grazing": (("value2", "grazing"), _padded(graze + [[]] * (len(values2) - len(graze)))),
+        "fold_grazing": (("value2", "fold"), _padded([[np.nan if g is None else g["p"]
+                                                       for g, _ in r] for r in near])),
+        "fold_grazing_bracket": (("value2", "fold"), _padded(
+            [[np.nan if g is None else g["bracket"] for g, _ in r] for r in near])),
         "status": (("value2",), np.array(status, dtype=object)),
         "curve": (("curve_point",), np.array([i for i, _ in pts], int)),
         "curve_field": (("curve_point",), np.array([x["p"][0] for _, x in pts])),
@@ -426,8 +500,20 @@ def curve_dataset(sys, curves, ends, tried, label1, label2, values2, margin=1e-4
     out.attrs.update(method="extended", seed_status=said[-1] if said else "none",
                      curve_status="; ".join(w for _, w in ends) or "none traced",
                      cusp="; ".join(f"{label1} = {p[0]:.6g}, {label2} = {p[1]:.6g}"
-                                    for _, p in cu) or "none")
+                                    for _, p in cu) or "none",
+                     fold_grazing_status="; ".join(
+                         f"{label2} = {v:g}, the fold at {label1} = {f:.6g}: {why}"
+                         for v, fs, r in zip(values2, folds, near) for f, (_, why) in zip(fs, r)
+                         if why != "found") or "complete")
     return out
+
+
+def _folds_at(sys, curves, v):
+    """The fold points of the curves at the value v of field2 (at_value), in the order of the
+    first field, each with its curve's fixed states y."""
+    xs = [] if sys is None else [dict(x, y=c[0]["y"]) for c in curves for x in
+                                 at_value(sys, c, (v - sys.p0[1]) / sys.pscale[1], c[0]["y"])]
+    return sorted(xs, key=lambda x: sys.p_of(x["u"])[0])
 
 
 def _padded(rows):

@@ -169,21 +169,31 @@ def test_fold_curve_grazing_below_the_upper_fold(fold_curves):
     """Along the seed's branch (a = 0.25) from the band's start the first grazing (where the
     full-contact orbit opens its teeth) lies just below the upper fold (within 4 r/min), the
     other grazings on the S-curve's span, between the folds' neighbourhoods; the extended
-    system gives no grazings at the other values."""
+    system gives no whole branch's grazings at the other values. The grazing nearest each
+    fold (fold_grazing, from the fold's own orbit) is, at a = 0.25, one of the continuation's
+    (to 0.05 r/min: the continuation bisects its step 8 times, fold_grazing 12 times; measured
+    0.01 and 0.035), and at every value the upper fold's lies 0-4 r/min below it: the
+    grazing curve follows the upper fold's."""
     g, f = fold_curves.grazing.values, fold_curves.fold.values
     assert 0 < f[0, 1] - g[0, 0] < 4, (g[0], f[0])
     rest = g[0][1:][np.isfinite(g[0][1:])]
     assert ((rest > f[0, 0] - 5) & (rest < f[0, 1] + 5)).all(), (g[0], f[0])
     assert np.isnan(g[1:]).all()
+    near = fold_curves.fold_grazing.values
+    assert fold_curves.attrs["fold_grazing_status"] == "complete" and np.isfinite(near).all()
+    assert np.abs(near[0][:, None] - g[0][None, :]).min(axis=1).max() < 0.05, (near[0], g[0])
+    assert ((f[:, 1] - near[:, 1] > 0) & (f[:, 1] - near[:, 1] < 4)).all(), (near, f)
 
 
 @pytest.fixture(scope="module")
 def cusp_curve():
     """The fold pair of a = 0.085 over 2575-2600 r/min (docs: 1.5 r/min wide) followed in a
-    over 0.08-0.0875."""
-    return pyspline.fold_curve(FAST, "speed_rpm", 2575, 2600, "ripple_amp(1)",
-                               [0.085, 0.0875, 0.08], progress=False, ds_max=0.5,
-                               max_angle=0.3)
+    over 0.08-0.0875 (the folds also at 0.0865, inside)."""
+    return pyspline.fold_curve(FAST, "speed_rpm", 2575, 2600, "ripple_amp(1)", CUSP_AMPS,
+                               progress=False, ds_max=0.5, max_angle=0.3)
+
+
+CUSP_AMPS = [0.085, 0.0875, 0.08, 0.0865]
 
 
 def test_fold_curve_through_its_cusp(cusp_curve):
@@ -229,6 +239,29 @@ def test_fold_curve_through_its_cusp(cusp_curve):
         assert list(coexistence(sw)) == ([False, True, False] if amp == 0.085 else
                                          [False] * 3), (amp, pp[amp])
     assert (np.abs(pp[0.08][0] - pp[0.08][1]) < 5e-3 * pp[0.08].max(0)).all(), pp[0.08]
+
+
+def test_fold_grazings_are_the_repeated_methods(cusp_curve):
+    """At the three values of a with a fold pair (0.085, 0.0875, 0.0865) the extended system's
+    grazing nearest each fold (the branch at that value walked from the fold's orbit both
+    ways, the grazing bisected 12 times) is the grazing of `method='repeated'` (a
+    continuation at each value, bisected 8 times) to 0.03 r/min (measured 0.004-0.016), both
+    folds reach the same one (the pair is 1.5-4.3 r/min wide, the grazing 1.2-1.6 r/min below
+    its upper fold, on the full-contact branch) to their brackets' sum; none at 0.08 (no
+    fold)."""
+    fc = cusp_curve
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        rep = pyspline.fold_curve(FAST, "speed_rpm", 2575, 2600, "ripple_amp(1)",
+                                  [CUSP_AMPS[i] for i in (0, 1, 3)], method="repeated",
+                                  progress=False, ds_max=0.5, max_angle=0.3)
+    near, width = fc.fold_grazing.values[[0, 1, 3], :2], fc.fold_grazing_bracket.values
+    g = rep.grazing.values
+    assert np.isfinite(near).all() and np.isnan(fc.fold_grazing.values[2]).all(), near
+    assert np.abs(near - g[:, :1]).max() < 0.03, (near, g)
+    assert (np.abs(near[:, 0] - near[:, 1]) <= width[[0, 1, 3], :2].sum(axis=1)).all(), near
+    upper = fc.fold.values[[0, 1, 3], 1:2]
+    assert ((near < upper) & (near > upper - 2)).all(), (near, upper)
 
 
 def test_g_derivatives_against_differences(cusp_curve):

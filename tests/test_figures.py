@@ -302,6 +302,12 @@ def test_fold_plane_shades_the_band_between_the_folds():
                     coords={"value2": lx, "check_field": [2500.0, 3500.0, 4000.0],
                             "check_value": [5e-5, 1e-4]},
                     attrs={"field": "speed_rpm", "field2": "l_x"})
+    assert "nearest each fold" not in _words(pc.fold_plane(fc), ["legend"])  # none given
+    fc["fold_grazing"] = (("value2", "k"), folds - 10)      # the grazing nearest each fold
+    shuffled = pc.fold_plane(fc.isel(value2=[0, 3, 2, 1]))  # drawn in the values' order
+    near = [x for x in shuffled.axes[0].get_lines() if x.get_color() == "#009E73"]
+    assert [x.get_xdata().tolist()[:3] for x in near] == [[2390.0, 2290.0, 2240.0],
+                                                          [2590.0, 2790.0, 2940.0]]
     fig = pc.fold_plane(fc)
     ax = fig.axes[0]
     (band,) = ax.collections
@@ -318,7 +324,8 @@ def test_fold_plane_shades_the_band_between_the_folds():
     assert ax.get_ylabel().endswith("(l_x) [m]")
     legend = _words(fig, ["legend"])
     for words in ("between the folds: two stable orbits coexist", "lower fold (mu = +1)",
-                  "first grazing", "the other grazings", "two orbits", "one orbit"):
+                  "first grazing", "the other grazings", "two orbits", "one orbit",
+                  "grazing nearest each fold"):
         assert words in legend
     assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 

@@ -196,6 +196,8 @@ def fold_plane(fc, path=None, title: str | None = None) -> Figure:
     if ok.any():
         ax.plot(rest[ok], np.broadcast_to(v[:, None], rest.shape)[ok], "x", color="0.55", ms=4,
                 label="the other grazings along the branch")
+    if "fold_grazing" in fc:       # the extended system's grazing nearest each fold
+        _grazing_curves(ax, fc, v)
     if "coexist" in fc:
         xs, ys = np.meshgrid(fc.check_field.values, fc.check_value.values)
         two, one = fc.coexist.values == 1, fc.coexist.values == 0   # -1: not run (time)
@@ -217,3 +219,17 @@ def fold_plane(fc, path=None, title: str | None = None) -> Figure:
     ax.set_title(title or f"folds of the periodic orbits in ({field}, {field2}): the region "
                           "of coexistence")
     return ps.finish(fig, path)
+
+
+def _grazing_curves(ax, fc, v):
+    """fold_grazing per fold column, through the values of field2 in order; the line broken
+    between two values with another number of folds (the columns pair other folds there)."""
+    o = np.argsort(v)
+    count = np.isfinite(fc.fold.values).sum(axis=1)[o]
+    cut = np.flatnonzero(count[1:] != count[:-1]) + 1
+    for j, x in enumerate(fc.fold_grazing.values[o].T):
+        ok = np.isfinite(x)
+        if ok.any():
+            ax.plot(np.insert(x, cut, np.nan), np.insert(v[o], cut, np.nan), "d--",
+                    color="#009E73", ms=4, lw=1, label=None if j else
+                    "grazing nearest each fold (its contact sequence changes): fold_grazing")
