@@ -12,23 +12,24 @@ module spline_accuracy
   public :: stats_rtol, check_factor, parted, max_tighten
 
   !> A row of the rule: the scene it applies to, the integrator (position in method_values:
-  !> 1 bdf, 2 adams, 3 erk), root finding, and rtol = factor x accuracy (atol = rtol / 100 on the
-  !> scaled states of Eq. 25). The factor keeps the measured force error below the accuracy:
-  !> the largest error / rtol over rtol 1e-4 .. 1e-10 was 14 (Adams, paper_lx1e-4), 3000 (ERK,
+  !> 1 bdf, 2 adams, 3 erk), root finding, rtol = factor x accuracy and atol = atol_ratio x rtol
+  !> (on the scaled states of Eq. 25). The factor keeps the measured force error below the
+  !> accuracy: the largest error / rtol over rtol 1e-4 .. 1e-8 was 6.8 (ERK with atol = rtol,
+  !> the paper's scenes; 17-64 at 1e-9 .. 1e-10 with the flash temperature), 3000 (ERK,
   !> physical_z24 from rest), 1.4 (Adams, physical_tilt), 1e5 (Adams with roots on an impacting
   !> scene), and BDF from the static equilibrium stays within 1e-6 from rtol 1e-4.
   type :: rule_t
     character(len=48) :: scene
     integer :: method
     logical :: roots
-    real(wp) :: factor
+    real(wp) :: factor, atol_ratio
   end type rule_t
   type(rule_t), parameter :: rules(5) = [ &
-       rule_t('given k_m (the calibrated soft mesh)', 2, .true., 0.05_wp), &
-       rule_t('computed k_m, from rest (impacts)', 3, .true., 3.0e-4_wp), &
-       rule_t('computed k_m, from rest, Lyapunov copy', 2, .true., 1.0e-5_wp), &
-       rule_t('computed k_m, from equilibrium, one slice', 1, .true., 0.1_wp), &
-       rule_t('computed k_m, from equilibrium, sliced face', 2, .true., 0.1_wp)]
+       rule_t('given k_m (the calibrated soft mesh)', 3, .true., 0.05_wp, 1.0_wp), &
+       rule_t('computed k_m, from rest (impacts)', 3, .true., 3.0e-4_wp, 1.0e-2_wp), &
+       rule_t('computed k_m, from rest, Lyapunov copy', 2, .true., 1.0e-5_wp, 1.0e-2_wp), &
+       rule_t('computed k_m, from equilibrium, one slice', 1, .true., 0.1_wp, 1.0e-2_wp), &
+       rule_t('computed k_m, from equilibrium, sliced face', 2, .true., 0.1_wp, 1.0e-2_wp)]
   !> goal = 'statistics': ERK without roots at rtol 1e-2 (atol 1e-4) reads chaos_z24's
   !> statistics unbiased (docs/performance.md); CVODE with roots at such rtol reads them low.
   !> The transient runs at the same settings, so that it ends on the attractor the window
@@ -74,7 +75,7 @@ contains
     else if (c%accuracy > 0.0_wp) then
       i = scene_rule(c)
       method = rules(i)%method; roots = rules(i)%roots
-      rtol = max(1.0e-13_wp, rules(i)%factor*c%accuracy); atol = 1.0e-2_wp*rtol
+      rtol = max(1.0e-13_wp, rules(i)%factor*c%accuracy); atol = rules(i)%atol_ratio*rtol
     end if
   end subroutine accuracy_settings
 
