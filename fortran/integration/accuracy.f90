@@ -26,7 +26,7 @@ module spline_accuracy
   end type rule_t
   type(rule_t), parameter :: rules(5) = [ &
        rule_t('given k_m (the calibrated soft mesh)', 3, .true., 0.05_wp, 1.0_wp), &
-       rule_t('computed k_m, from rest (impacts)', 3, .true., 3.0e-4_wp, 1.0e-2_wp), &
+       rule_t('computed k_m, from rest (impacts)', 3, .true., 3.0e-5_wp, 1.0_wp), &
        rule_t('computed k_m, from rest, Lyapunov copy', 2, .true., 1.0e-5_wp, 1.0e-2_wp), &
        rule_t('computed k_m, from equilibrium, one slice', 1, .true., 0.1_wp, 1.0e-2_wp), &
        rule_t('computed k_m, from equilibrium, sliced face', 2, .true., 0.1_wp, 1.0e-2_wp)]
