@@ -16,10 +16,10 @@ module spline_accuracy
   !> (on the scaled states of Eq. 25); the error estimate's tighter run at rtol and atol / check.
   !> The factor keeps the measured force error below the
   !> accuracy: the largest error / rtol over rtol 1e-4 .. 1e-8 was 6.8 (ERK with atol = rtol,
-  !> the paper's scenes; 17-64 at 1e-9 .. 1e-10 with the flash temperature), 3000 (ERK,
-  !> physical_z24 from rest), 1.4 (Adams, physical_tilt), 1e5 (Adams with roots on an impacting
+  !> the paper's scenes; 17-64 at 1e-9 .. 1e-10 with the flash temperature), 1.2e4 (ERK with
+  !> atol = rtol, physical_z24 from rest), 1.4 (Adams, physical_tilt), 1e5 (Adams with roots on an impacting
   !> scene), and BDF from the static equilibrium stays within 1e-6 from rtol 1e-4. ERK with roots
-  !> at atol = rtol errs in proportion to rtol (those ratios within 2x over 4 decades), so a
+  !> at atol = rtol errs in proportion to rtol (those ratios within 2x over 3-4 decades), so a
   !> tighter run at rtol / 3 errs a third as much: the estimate read 0.59-0.97 of the error on
   !> the shipped scenes; the others' errors are not proportional (Adams' 0.05-18 x rtol on the
   !> paper's scenes) and their tighter run is at rtol / check_factor.
