@@ -166,8 +166,9 @@ contains
   end subroutine run_results
 
   !> The error estimate of a run of m with tooth forces f at the outputs t (docs/accuracy.md):
-  !> m at rtol and atol / check_factor over the outputs up to the first after the run's linear
-  !> tail began (tail_t; beyond it the closed form carries the error it started from), its forces
+  !> m at rtol and atol / m%check_div over the outputs up to the first at or after the time the
+  !> run's linear tail began (tail_t; beyond it the closed form carries the error it started from:
+  !> with root finding the tail begins at an output, the last one integrated), its forces
   !> compared by spline_accuracy's force_error. est = (F_error_est, F_error_t_s, F_parted_t_s) of
   !> spline_quantities (-1: none).
   subroutine estimate_error(m, t, f, tail_t, est, ierr, errmsg, interruptible)
@@ -183,10 +184,13 @@ contains
     integer :: n, k, nw
     logical :: fin, part
     n = size(t)
-    if (tail_t > t(1)) n = min(n, count(t <= tail_t) + 1)
+    if (tail_t > t(1)) n = min(n, count(t < tail_t) + 1)
     b = m
-    b%rtol = m%rtol/check_factor; b%atol = m%atol/check_factor
+    b%rtol = m%rtol/m%check_div; b%atol = m%atol/m%check_div
     b%lyapunov = .false.; b%t_end = t(n); b%n_out = n
+    ! no tail of its own where it ends at the output where the run's tail began: its tries (the
+    ! flank's eigenpairs, a bound at every output) cost 6-11 % of it on paper_lx1e-4
+    b%linear_tail = m%linear_tail .and. tail_t <= t(1)
     allocate(tb(n), yb(nstate, n), fb(n, m%z, ntooth_q), tmb(n))
     call run_level(b, tb, yb, fb, tmb, stb, ierr, errmsg, interruptible, lazy=.true., nw=nw, &
          consts=cq, fin=fin)
@@ -342,7 +346,7 @@ contains
          num(stats(ist_f_error))//' exceeds accuracy = '//num(m%accuracy)//' at rtol '// &
          num(stats(ist_rtol_used))//' (tightened '//itoa(max_tighten)//' times)'//new_line('a')
     if (stats(ist_f_parted_t) >= 0.0_wp) text = text//'case '//trim(m%name)//': a run at rtol '// &
-         num(stats(ist_rtol_used)/check_factor)//' parts from this one at t = '// &
+         num(stats(ist_rtol_used)/m%check_div)//' parts from this one at t = '// &
          num(stats(ist_f_parted_t))//' s (the tooth forces differ by over a tenth of the '// &
          'largest): beyond it the trajectory is not predictable at these settings (chaos? read '// &
          'its statistics: goal = ''statistics''); F_error_est covers the outputs before'// &

@@ -12,7 +12,7 @@ module spline_model
   use spline_geometry, only: iso4156_radii, pitch_rotation
   use spline_stiffness, only: spline_mesh_stiffness_fillet
   use spline_thermal, only: backlash_coefficient, thermal_backlash
-  use spline_accuracy, only: accuracy_settings
+  use spline_accuracy, only: accuracy_settings, check_factor
   implicit none
   private
   public :: model_t, model_from_case, set_thermal_level, model_magic, model_warnings
@@ -71,6 +71,7 @@ module spline_model
     !> goal = 'statistics' (spline_accuracy)
     real(wp) :: accuracy = 0.0_wp
     logical  :: estimate = .false., goal_statistics = .false.
+    real(wp) :: check_div = check_factor    !< the estimate's tighter run: rtol, atol / check_div
     integer  :: max_steps, max_total_steps, n_out
     real(wp) :: t0, t_end, t_transient
     !> realisations = K > 1 (spline_realisations): n_out and t_end are one copy's, the first
@@ -162,7 +163,7 @@ contains
     m%dof = c%dof; m%fidelity_tol = c%fidelity_tol
     m%auto = option_index(fidelity_values, c%fidelity) == 2
     k = chosen_method(c)        ! the integrator, roots and tolerances an accuracy or goal picks
-    call accuracy_settings(c, k, m%roots, m%rtol, m%atol, m%rtol_transient)
+    call accuracy_settings(c, k, m%roots, m%rtol, m%atol, m%rtol_transient, m%check_div)
     m%accuracy = c%accuracy; m%goal_statistics = option_index(goal_values, c%goal) == 2
     m%estimate = (c%accuracy > 0.0_wp .or. c%check) .and. .not. m%goal_statistics
     m%method_bdf = merge(1, 0, k == 1)
