@@ -231,7 +231,9 @@ contains
         x(1:n) = real(matmul(tl%v, tl%c*exp(tl%lam*(taus(i) - tl%tau0))))
       end if
       ys(:, i) = tl%held
-      ys(tl%idx(1:n), i) = tl%ystar + x(1:n)
+      do j = 1, n                      ! element by element: no temporary at each time
+        ys(tl%idx(j), i) = tl%ystar(j) + x(j)
+      end do
     end do
   end subroutine tail_states
 
