@@ -297,7 +297,9 @@ contains
   !> mesh_eval), in blocks of nblk outputs, one pass per tooth (f(k, j) is contiguous in k;
   !> tooth_angles_at: the block's angles at once). finite: whether every
   !> value written to f, fx, fy and dn is finite (x*0 is 0 for a finite x, NaN otherwise),
-  !> formed while they are in registers, so the run's checks need not read them again.
+  !> formed while they are in registers, so the run's checks need not read them again: from F
+  !> and dn alone, since F_x and F_y are F times a sine or cosine of |.| <= 1 that dn also
+  !> multiplies (a non-finite angle makes dn NaN).
   pure subroutine mesh_outputs(m, nt, t, y, modes, f, fx, fy, dn, tm, finite)
     type(model_t), intent(in) :: m
     integer, intent(in) :: nt
