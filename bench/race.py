@@ -357,6 +357,33 @@ def race(quick=False, repeat=5, progress=print, cases=None, variants=None, tail=
     return rows, runs
 
 
+def output_growth(repeat=7, rtol=1e-7):
+    """What outputs cost each side (issue 34): paper_lx1e-4 over 1 s with 6401 and with 101
+    outputs, pyspline (ERK + roots) and the peer with its tail (DOP853 + tail), both at rtol =
+    atol = `rtol`, `repeat` rounds (the sides in alternating order, each side's two runs back
+    to back): per side the CPU medians of both runs and of the per-round differences
+    [min-max], also per added output. Both hand over to their tail at about 35 ms, so the
+    difference is the outputs'."""
+    peer = _numba_peer()
+    runners = {}
+    for n in (6401, 101):
+        case = _case("paper_lx1e-4", dict(t_end=1.0, n_out=n), False)
+        runners[n] = _Runner(case, [case], peer, simulate(case).t)
+    kw = {"pyspline": dict(method="erk", roots=True), "peer": dict(method="dop853", tail=True)}
+    cpu = {(side, n): [] for side in kw for n in runners}
+    for r in range(repeat):
+        for side in (("pyspline", "peer") if r % 2 == 0 else ("peer", "pyspline")):
+            for n, run in runners.items():
+                cpu[(side, n)].append(run(side, kw[side], rtol, rtol)[0])
+    lines = []
+    for side in kw:
+        d = [a - b for a, b in zip(cpu[(side, 6401)], cpu[(side, 101)])]
+        lines.append(f"{side}: 6401 outputs {np.median(cpu[(side, 6401)])*1e3:.2f} ms, 101 "
+                     f"{np.median(cpu[(side, 101)])*1e3:.2f} ms, growth {np.median(d)*1e3:.2f} ms "
+                     f"[{min(d)*1e3:.2f}-{max(d)*1e3:.2f}], {np.median(d)/6300*1e6:.3f} us per output")
+    return "\n".join(lines)
+
+
 def _race_statistics(scene, case, peer, repeat, quick, variants):
     """chaos_z24: every setting of a decade-and-a-half ladder timed in every round, each round
     another realisation; the statistics level by Welch's t against the reference's."""

@@ -112,6 +112,9 @@ def main(argv=None) -> int:
                    "always run)")
     p.add_argument("--no-tail", action="store_true", help="race: no closed-form tail on either "
                    "side (pyspline's linear_tail = .false., the peer without bench/peer_tail.py)")
+    p.add_argument("--growth", action="store_true", help="race: only what outputs cost, the "
+                   "time of paper_lx1e-4 with 6401 outputs less that with 101, both sides (race."
+                   "output_growth)")
     p.add_argument("--out", default="out/bench", help="output directory (default out/bench)")
     p.add_argument("--quick", action="store_true", help="small sizes (for CI)")
     args = p.parse_args(argv)
@@ -119,6 +122,10 @@ def main(argv=None) -> int:
         import race
         from speed import build
         print(f"race of {build()}; {race.load()}", flush=True)
+        if args.growth:
+            print(race.output_growth(repeat=args.repeats or (2 if args.quick else 7)))
+            print(f"{race.load()} (at the end)")
+            return 0
         rows, runs = race.race(quick=args.quick, repeat=args.repeats or (2 if args.quick else 5),
                                cases=args.cases, variants=args.variants, tail=not args.no_tail,
                                progress=lambda m: print(m, flush=True))

@@ -327,11 +327,14 @@ def _simulate(model, copy: int = 0, ya=None, max_seconds: float = 0.0) -> tuple:
     executor can take it."""
     nq, ns = len(_names("tooth")), len(_names("stats"))
     nft = model.n_out if model.n_slices else 0
-    # the per-tooth array (the largest) is allocated here, not zeroed (f2py zeroes its own)
-    tooth = np.empty((model.n_out, model.z, nq), order="F")
-    return bridge.simulate(model.bytes, model.z, model.n_out, nq, ns, model.n_section,
+    # the arrays of every output (the core writes each element) are allocated here, not zeroed
+    # (f2py zeroes its own)
+    nt = model.n_out
+    t, y, tm = np.empty(nt), np.empty((14, nt), order="F"), np.empty(nt)
+    tooth = np.empty((nt, model.z, nq), order="F")
+    return bridge.simulate(model.bytes, model.z, nt, nq, ns, model.n_section,
                            model.n_lyapunov, nft, model.n_slices, len(LOAD_QUANTITIES),
-                           len(TOOTH_LOAD_QUANTITIES), len(EXTREMES), tooth, copy,
+                           len(TOOTH_LOAD_QUANTITIES), len(EXTREMES), t, y, tooth, tm, copy,
                            np.zeros(14) if ya is None else ya, max_seconds)
 
 

@@ -196,17 +196,23 @@ contains
   !> one real n x n product per time instead of n complex exponentials and an n x n complex
   !> product. Each step adds round-off of order n eps |P| |x|, at most nanchor - 1 steps from
   !> an exact anchor (about 1e-13 of the motion; tests/fortran/test_linear.f90).
-  subroutine tail_states(tl, taus, ys)
+  !> units (optional): each state's times units(i) (spline_dynamics::state_units: the SI states
+  !> of from_scaled, to the bit, written once).
+  subroutine tail_states(tl, taus, ys, units)
     type(tail_t), intent(in) :: tl
     real(wp), intent(in) :: taus(:)
     real(wp), intent(out) :: ys(:, :)
+    real(wp), intent(in), optional :: units(nstate)
     integer, parameter :: nanchor = 32
     complex(wp) :: vh(tl%n, tl%n)
     ! fixed size (nstate; the rows and columns past n zero, never used): the compiler keeps the
     ! product's 14 sums in registers (with n's size they went through memory at every column)
-    real(wp) :: p(nstate, nstate), x(nstate), xn(nstate), h
+    real(wp) :: p(nstate, nstate), x(nstate), xn(nstate), h, u(nstate), held(nstate)
     integer :: i, j, n, nt
     logical :: uniform
+    u = 1.0_wp
+    if (present(units)) u = units
+    held = tl%held*u
     n = tl%n
     nt = size(taus)
     uniform = nt > 2
@@ -231,8 +237,10 @@ contains
       else
         x(1:n) = real(matmul(tl%v, tl%c*exp(tl%lam*(taus(i) - tl%tau0))))
       end if
-      ys(:, i) = tl%held
-      ys(tl%idx(1:n), i) = tl%ystar + x(1:n)
+      ys(:, i) = held
+      do j = 1, n                      ! element by element: no temporary at each time
+        ys(tl%idx(j), i) = (tl%ystar(j) + x(j))*u(tl%idx(j))
+      end do
     end do
   end subroutine tail_states
 

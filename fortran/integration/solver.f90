@@ -14,7 +14,7 @@ module spline_solver
   use spline_kinds, only: wp, pi
   use spline_errors, only: err_ok, err_solver, err_interrupted, msglen
   use spline_model, only: model_t, nstate, ndof
-  use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, integrated_states
+  use spline_dynamics, only: rhs_scaled, to_scaled, from_scaled, state_units, integrated_states
   use spline_mesh, only: mesh_switch_functions, coupling_stats_t, eq16_mode, eq16_root_mode, &
        eq16_root_directions
   use spline_linear, only: tail_t, tail_possible, tail_try, tail_state, tail_states
@@ -99,6 +99,7 @@ contains
     real(c_double) :: tau_chk, dchk                !< next linear-tail check, and their spacing
     integer(c_int) :: flag, nroot
     integer :: k, nroots, nresync   !< output; switches located; missed switches resynchronised
+    integer :: kdone                !< outputs stored (those after it are zeroed at the end)
     integer, allocatable :: dirs(:), dirs_set(:)   !< root directions wanted, and set in CVODE
     integer :: ks, nsec             !< next section to store; sections
     logical :: use_tail, fresh      !< the linear tail is tried; CVODE has just (re)started
@@ -142,6 +143,8 @@ contains
         end if
       end do outputs
     end if
+    yout(:, kdone+1:) = 0.0_wp        ! the outputs not reached (stored ones written once)
+    if (present(youtb)) youtb(:, kdone+1:) = 0.0_wp
     call collect_stats()
     if (ctx%watch) call sigint_unwatch()
     call integrator_free(cv)
@@ -159,13 +162,12 @@ contains
       errmsg = ''
       stats = 0.0_wp
       stats(ist_linear_tail_t) = -1.0_wp
-      yout = 0.0_wp
+      kdone = 0
       modes_out = 2
       ctx%m = m
       nroots = 0; nresync = 0
       ctx%frozen = m%roots
       if (present(y0b)) ctx%ncopy = 2
-      if (present(youtb)) youtb = 0.0_wp
       nroot = 0
       if (ctx%frozen) then
         allocate(ctx%modes(m%z*m%n_slices, ctx%ncopy))
@@ -323,6 +325,7 @@ contains
       call from_scaled(m, copy_state(ctx, yr, 1), yout(:, k))
       if (present(youtb)) call from_scaled(m, copy_state(ctx, yr, 2), youtb(:, k))
       if (ctx%frozen) modes_out(:, k) = ctx%modes(:, 1)
+      kdone = k
       going = .true.
     end function store_output
 
@@ -337,13 +340,9 @@ contains
       taken = tail_try(tail, m, ctx%idx, ctx%n, tau, copy_state(ctx, yr, 1))
       if (.not. taken) return
       stats(ist_linear_tail_t) = tau/m%w_ref
-      ! the scaled states straight into yout, each column then turned into SI in place
-      call tail_states(tail, tout(k0+1:nt)*m%w_ref, yout(:, k0+1:nt))
-      do j = k0 + 1, nt
-        yt = yout(:, j)
-        call from_scaled(m, yt, yout(:, j))
-      end do
+      call tail_states(tail, tout(k0+1:nt)*m%w_ref, yout(:, k0+1:nt), state_units(m))   ! SI
       if (ctx%frozen) modes_out(:, k0+1:nt) = tail%flank
+      kdone = nt
       do j = ks, nsec
         call tail_state(tail, tsec(j)*m%w_ref, yt)
         call from_scaled(m, yt, ysec(:, j))

@@ -397,7 +397,6 @@ contains
     errmsg = ''
     stats = 0.0_wp
     nw = ntooth_q; consts = 0.0_wp; fin = .false.
-    t = 0.0_wp; y = 0.0_wp
     allocate(modes(m%z*m%n_slices, m%n_out))
     call output_times(m, t)
     if (present(y_start)) then
@@ -405,7 +404,11 @@ contains
     else
       call start_state(m, y0, ierr, errmsg)
     end if
-    if (ierr == err_ok) call integrate_level()
+    if (ierr == err_ok) then
+      call integrate_level()           ! y: zero where it did not reach
+    else
+      y = 0.0_wp
+    end if
     ! tooth and tm are zero where the run did not reach (every output is written otherwise)
     if (ierr /= err_ok) then
       tooth = 0.0_wp; tm = 0.0_wp

@@ -11,7 +11,7 @@ module spline_dynamics
   implicit none
   private
   public :: accelerations, accel_jacobian, rhs_jacobian, driving_torque, unbalance_forces, rhs_scaled, &
-       to_scaled, from_scaled, static_equilibrium, start_state, integrated_states
+       to_scaled, from_scaled, state_units, static_equilibrium, start_state, integrated_states
 
   integer, parameter :: max_newton = 100    !< Newton steps of the static equilibrium
 
@@ -169,9 +169,17 @@ contains
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: ys(nstate)
     real(wp), intent(out) :: y(nstate)
-    y(1:ndof) = ys(1:ndof)*m%l_ref
-    y(ndof+1:) = ys(ndof+1:)*(m%l_ref*m%w_ref)
+    y = ys*state_units(m)
   end subroutine from_scaled
+
+  !> The SI unit of each scaled state (from_scaled: y = ys state_units): l for the
+  !> displacements, l w for the velocities.
+  pure function state_units(m) result(u)
+    type(model_t), intent(in) :: m
+    real(wp) :: u(nstate)
+    u(1:ndof) = m%l_ref
+    u(ndof+1:) = m%l_ref*m%w_ref
+  end function state_units
 
   !> Eq. 25: d(ys)/d(tau) for the scaled state, ys' = (vs, a / (l w^2)).
   subroutine rhs_scaled(m, tau, ys, dys, ierr, errmsg, mode, cstats)

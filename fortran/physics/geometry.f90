@@ -4,7 +4,8 @@ module spline_geometry
   use spline_kinds, only: wp, pi
   implicit none
   private
-  public :: tooth_angles, tooth1_angle, pitch_step, pitch_rotation, contact_radius, profile_shift, iso4156_radii, active_profile, &
+  public :: tooth_angles, tooth_angles_at, tooth1_angle, pitch_rotation, contact_radius, &
+       profile_shift, iso4156_radii, active_profile, &
        root_section
 
 contains
@@ -71,14 +72,26 @@ contains
     phi = 2.0_wp*pi/z + omega*t + theta0 - alpha
   end function angle1
 
-  !> Eqs. 8-9 from one tooth to the next: (sn, cn) = sin and cos of phi_j + 2 pi / Z from
-  !> (s, c) of phi_j, with sd, cd of the pitch angle (pitch_rotation). For other modules; this
-  !> one calls step, inlined.
-  elemental subroutine pitch_step(sd, cd, s, c, sn, cn)
-    real(wp), intent(in) :: sd, cd, s, c
-    real(wp), intent(out) :: sn, cn
-    call step(sd, cd, s, c, sn, cn)
-  end subroutine pitch_step
+  !> tooth_angles at the n times t(1:n) at once (bit for bit): sphi(i, j), cphi(i, j) of tooth j
+  !> at t(i), ld >= n the leading dimension of the caller's block. For other modules (the mesh's
+  !> outputs); here angle1 and step are inlined and each pitch rotation runs over the n times.
+  pure subroutine tooth_angles_at(z, n, ld, omega, t, theta0, alpha, sd, cd, sphi, cphi)
+    integer, intent(in) :: z, n, ld
+    real(wp), intent(in) :: omega, t(n), theta0, alpha, sd, cd
+    real(wp), intent(inout) :: sphi(ld, z), cphi(ld, z)
+    integer :: i, j
+    real(wp) :: phi
+    do i = 1, n
+      phi = angle1(z, omega, t(i), theta0, alpha)
+      sphi(i, 1) = sin(phi)
+      cphi(i, 1) = cos(phi)
+    end do
+    do j = 2, z
+      do i = 1, n
+        call step(sd, cd, sphi(i, j-1), cphi(i, j-1), sphi(i, j), cphi(i, j))
+      end do
+    end do
+  end subroutine tooth_angles_at
 
   elemental subroutine step(sd, cd, s, c, sn, cn)
     real(wp), intent(in) :: sd, cd, s, c

@@ -5,7 +5,7 @@ module spline_mesh
   use spline_kinds, only: wp, max_teeth
   use spline_errors, only: err_ok, err_solver, err_thermal, itoa, num
   use spline_model, only: model_t, thermal_oneway, thermal_coupled
-  use spline_geometry, only: tooth_angles, tooth1_angle, pitch_step, profile_shift, contact_radius, &
+  use spline_geometry, only: tooth_angles, tooth_angles_at, tooth1_angle, profile_shift, contact_radius, &
        active_profile
   use spline_thermal, only: thermal_backlash, flash_temperature
   implicit none
@@ -295,9 +295,11 @@ contains
   !> slices: Eqs. 8-9, 11, 15-17 and 19-22 as tooth_angles and mesh_eval evaluate them,
   !> operation for operation (run.f90's tooth_outputs checks the first and last output against
   !> mesh_eval), in blocks of nblk outputs, one pass per tooth (f(k, j) is contiguous in k;
-  !> tooth_angles' pitch_step runs over the block's outputs at once). finite: whether every
+  !> tooth_angles_at: the block's angles at once). finite: whether every
   !> value written to f, fx, fy and dn is finite (x*0 is 0 for a finite x, NaN otherwise),
-  !> formed while they are in registers, so the run's checks need not read them again.
+  !> formed while they are in registers, so the run's checks need not read them again: from F
+  !> and dn alone, since F_x and F_y are F times a sine or cosine of |.| <= 1 that dn also
+  !> multiplies (a non-finite angle makes dn NaN).
   pure subroutine mesh_outputs(m, nt, t, y, modes, f, fx, fy, dn, tm, finite)
     type(model_t), intent(in) :: m
     integer, intent(in) :: nt
@@ -308,32 +310,29 @@ contains
     logical, intent(out) :: finite
     integer, parameter :: nblk = 64
     real(wp) :: sp(nblk, m%z), cp(nblk, m%z)
-    real(wp), dimension(nblk) :: ex, ey, evx, evy, sumf, fin
-    real(wp) :: phi, dnj, ddnj, fj, fxj, fyj, cb, km, cm, om
+    real(wp), dimension(nblk) :: ex, ey, evx, evy, q6, v6, sumf, fin
+    real(wp) :: dnj, ddnj, fj, fxj, fyj, cb, km, cm, om
     integer :: k0, nk, i, j, k, mi
     cb = m%c_bulk; km = m%k_m; cm = m%c_m; om = m%omega
     fin = 0.0_wp
     do k0 = 0, nt - 1, nblk
       nk = min(nblk, nt - k0)
+      call tooth_angles_at(m%z, nk, nblk, m%omega, t(k0+1:k0+nk), m%theta0, m%alpha, &
+           m%sin_pitch, m%cos_pitch, sp, cp)
       do i = 1, nk
         k = k0 + i
-        phi = tooth1_angle(m%z, m%omega, t(k), m%theta0, m%alpha)
-        sp(i, 1) = sin(phi)
-        cp(i, 1) = cos(phi)
         ex(i) = y(1, k) + m%l_x - y(3, k)
         ey(i) = y(2, k) + m%l_y - y(4, k)
         evx(i) = y(8, k) - y(10, k)
         evy(i) = y(9, k) - y(11, k)
-      end do
-      do j = 2, m%z             ! tooth_angles' rotation by the pitch, for nk outputs at once
-        call pitch_step(m%sin_pitch, m%cos_pitch, sp(1:nk, j-1), cp(1:nk, j-1), sp(1:nk, j), &
-             cp(1:nk, j))
+        q6(i) = y(6, k)
+        v6(i) = y(13, k)
       end do
       sumf = 0.0_wp
       do j = 1, m%z    ! scalar: a branch-free form the compiler vectorises measured slower
         do i = 1, nk
           k = k0 + i
-          call eq11(ex(i), ey(i), evx(i), evy(i), y(6, k), y(13, k), om, m%spacing_error(j), &
+          call eq11(ex(i), ey(i), evx(i), evy(i), q6(i), v6(i), om, m%spacing_error(j), &
                sp(i, j), cp(i, j), dnj, ddnj)
           mi = modes(j, k)
           if (mi == 2) mi = contact_state(dnj, cb)
@@ -345,7 +344,7 @@ contains
           fy(k, j) = fyj
           dn(k, j) = dnj
           sumf(i) = sumf(i) + fj
-          fin(i) = fin(i) + (dnj*0.0_wp + fj*0.0_wp) + (fxj*0.0_wp + fyj*0.0_wp)
+          fin(i) = fin(i) + (dnj*0.0_wp + fj*0.0_wp)
         end do
       end do
       tm(k0+1:k0+nk) = m%r_b*sumf(1:nk)

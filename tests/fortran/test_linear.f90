@@ -2,12 +2,13 @@
 !> (tail_states) against the tail at each time (tail_state): the same bits at every anchor and
 !> wherever the times are not uniformly spaced; between anchors (the step matrix advancing the
 !> motion about the equilibrium) within 1e-12 of the motion's largest excursion per state kind,
-!> displacements and velocities (the bound of tail_states: about nanchor n eps |P| ~ 1e-13).
+!> displacements and velocities (the bound of tail_states: about nanchor n eps |P| ~ 1e-13); in
+!> SI units (units = state_units, as the run asks for them) from_scaled's bits of every column.
 program test_linear
   use spline_kinds, only: wp
   use spline_case, only: case_t
   use spline_model, only: model_t, nstate, ndof
-  use spline_dynamics, only: start_state, to_scaled, integrated_states
+  use spline_dynamics, only: start_state, to_scaled, from_scaled, state_units, integrated_states
   use spline_linear, only: tail_t, tail_try, tail_state, tail_states
   use check, only: check_true, check_done, default_case_model
   implicit none
@@ -16,7 +17,7 @@ program test_linear
   type(model_t) :: md
   type(tail_t) :: tl
   real(wp) :: y(nstate), ys(nstate), taus(nt), tau0, ref(nstate, nt), got(nstate, nt), ex(nstate), &
-       err(nstate), scale(2), tol(nstate)
+       err(nstate), scale(2), tol(nstate), si(nstate, nt), col(nstate)
   integer :: idx(nstate), n, i, ierr
   character(len=512) :: msg
   logical :: ok
@@ -50,6 +51,13 @@ program test_linear
        'worst relative error '//trim(fmt(maxval(err/max(tol*1.0e12_wp, tiny(1.0_wp))))))
   call check_true('tail_states: the motion is not trivial', scale(1) > 0 .and. scale(2) > 0 .and. &
        any(got(:, 2::32) /= ref(:, 2::32)))
+  call tail_states(tl, taus, si, state_units(md))
+  ok = .true.
+  do i = 1, nt
+    call from_scaled(md, got(:, i), col)
+    ok = ok .and. all(si(:, i) == col)
+  end do
+  call check_true('tail_states in SI units: from_scaled of its scaled states, to the bit', ok)
   ! non-uniform times: every time exact
   taus(2:) = taus(2:) + 1.0e-3_wp*[(mod(i, 3), i = 2, nt)]
   do i = 1, nt
