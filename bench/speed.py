@@ -188,8 +188,8 @@ def work_precision(out, quick=False, progress=True, cases=None):
     out.mkdir(parents=True, exist_ok=True)
     oracle = _oracle()
     peer = _numba_peer()
-    rtols_cv = [1e-3, 1e-7] if quick else [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10]
-    rtols_sp = [1e-3] if quick else [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8]
+    rtols_cv = [1e-3, 1e-5, 1e-7] if quick else [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10]
+    rtols_sp = [1e-3, 1e-5] if quick else [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8]
     budget = 20_000 if quick else 400_000
     repeat = 1 if quick else 3
     rows, notes = [], []
