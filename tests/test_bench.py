@@ -141,7 +141,7 @@ def test_bifurcation_repeats_quick(tmp_path, exe, monkeypatch):
 
     import bifurcation
     monkeypatch.setenv("SPLINE_DYN", exe)
-    args = argparse.Namespace(out=str(tmp_path), accuracy=False, points=4, blocks=2, repeats=2,
+    args = argparse.Namespace(out=str(tmp_path), accuracy=False, points=2, blocks=2, repeats=2,
                               rtol=1e-6, quick=True, scaling=False, host=True, figure=False)
     with pytest.warns(pyspline.SplineWarning, match=PAST_BACKLASH):
         assert bifurcation.main(args) == 0
