@@ -474,11 +474,12 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
     with time_bound(max_seconds, "fold_curve"):
         if method == "extended":
             from .foldcurve import curve_dataset, extended
+            label = field_label(*parse_field(case, field))
             out = curve_dataset(*extended(case, field, start, stop, name2, index2, values2, n,
-                                          progress, cont), field_label(*parse_field(case, field)),
-                                field_label(name2, index2), values2)
+                                          progress, cont), label, field_label(name2, index2),
+                                values2)
             out["band"] = (("value2", "end"), np.tile([start, stop], (len(values2), 1)))
-            out.attrs["field"] = field_label(*parse_field(case, field))
+            out.attrs["field"] = label
         else:
             out = _fold_values(case, field, start, stop, name2, index2, values2, n, narrow,
                                progress, cont)

@@ -22,11 +22,12 @@ import warnings
 
 import numpy as np
 
-from .arclength import _null_tangent, field_label, scaled_map, set_field
+from .arclength import (_Branch, _Problem, _map_only, _null_tangent, continuation, field_label,
+                        parse_field, scaled_map, set_field)
 from .errors import CaseError, SolverError, SplineError, SplineWarning
 from .orbits import _scale, _trajectory, forcing_periods, map_and_monodromy, out_of_time
 from .result import sundials_said
-from .specials import contact_measures, multipliers
+from .specials import contact_measures, graze, multipliers, point_at
 
 
 class FoldSystem:
@@ -298,8 +299,6 @@ def fold_grazing(sys, u, y_fixed, ds=0.02, ds_min=1e-4, ds_max=0.25, reach=2.0, 
     (specials.graze). (the grazing's special record with 'bracket': the field's span between
     the points either side of it, or None; 'found' or why not: none within the arclength
     `reach` (scaled) either way, or the way's corrector failed)."""
-    from .arclength import _Branch, _Problem
-    from . import specials
     if late := out_of_time():
         return None, f"{late} was reached"
     (name, index), (name2, index2) = sys.fields
@@ -325,12 +324,12 @@ def fold_grazing(sys, u, y_fixed, ds=0.02, ds_min=1e-4, ds_max=0.25, reach=2.0, 
         i = min(range(len(ways)), key=lambda j: ways[j]["s"])
         w, sig = ways[i], ways[i]["contact"]["signature"]
         pred = np.r_[w["u"] + w["ds"] * w["tau"], u[-1]]
-        b, loc = specials.point_at(br, w, w["ds"]), False
+        b, loc = point_at(br, w, w["ds"]), False
         if b is not None and b["contact"]["signature"] != sig:
-            loc = specials.graze(br, w, b, w["ds"], iters)
+            loc = graze(br, w, b, w["ds"], iters)
         elif b is None and not w.get("diagnosed") and br.signature(pred[:-1]) != sig:
             w["diagnosed"] = True       # once from a point, as continuation's diagnosis
-            loc = specials.graze(br, w, None, w["ds"], iters)
+            loc = graze(br, w, None, w["ds"], iters)
         if loc:
             return dict(loc[-1], bracket=abs(loc[1]["p"] - loc[0]["p"])), "found"
         if b is None:
@@ -356,7 +355,6 @@ def extended(case, field, start, stop, name2, index2, values2, n, progress, cont
     Returns (the FoldSystem, None when no value has a fold; curves: lists of point records;
     ends: (last point or None, what ended each direction); tried: the continuation of each
     value tried, in order (its error's text where it found no orbit), the seed's last)."""
-    from .arclength import _map_only, continuation, parse_field
     from .core import load
     tried, fold = [], np.zeros(0, bool)
     for v0 in map(float, values2):
@@ -473,11 +471,11 @@ def curve_dataset(sys, curves, ends, tried, label1, label2, values2, margin=1e-4
     stops = [p for p, w in ends if p is not None and w != "complete"]
     other = [np.abs(np.delete(x["mu"], np.argmin(np.abs(x["mu"] - 1)))).max() for _, x in pts]
     cu = [(i, sys.p_of(np.r_[0.0, q])) for i, c in enumerate(curves) for _, q in cusps(c)]
-    graze = [[] if isinstance(d, str) else d[f"special_{label1}"].values[
+    grazed = [[] if isinstance(d, str) else d[f"special_{label1}"].values[
         d.special_type.values.astype(str) == "grazing"] for d in tried]
     out = xr.Dataset({
         "fold": (("value2", "fold"), _padded(folds)),
-        "grazing": (("value2", "grazing"), _padded(graze + [[]] * (len(values2) - len(graze)))),
+        "grazing": (("value2", "grazing"), _padded(grazed + [[]] * (len(values2) - len(grazed)))),
         "fold_grazing": (("value2", "fold"), _padded([[np.nan if g is None else g["p"]
                                                        for g, _ in r] for r in near])),
         "fold_grazing_bracket": (("value2", "fold"), _padded(
