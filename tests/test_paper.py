@@ -132,6 +132,21 @@ def test_the_calibrated_values_are_the_cores():
     assert ratio_flash == pytest.approx(t_f[0] / t_f[1], abs=0.5)
     doc = " ".join((CASES.parent / "docs" / "verification.md").read_text().split())
     assert f"**Calibrated values.** {text}" in doc
+    # docs/model.md explains the same deviations in words with the same numbers
+    model = " ".join((CASES.parent / "docs" / "model.md").read_text().split())
+    about = re.search(r"k_m is about ([\d ]+) times softer", model).group(1)
+    assert float(about.replace(" ", "")) == pytest.approx(ratio_bare, rel=0.02)
+    fitted = re.search(r"it is (\S+) N/m; Eq. 18 gives (\S+) N/m", model).groups()
+    assert tuple(map(float, fitted)) == pytest.approx((k, bare), rel=5e-4)
+    falls = re.search(r"k_m falls from (\S+) to (\S+) N/m", model).groups()
+    assert tuple(map(float, falls)) == pytest.approx((bare, fillet), rel=5e-3)
+    flash = re.search(r"flash temperatures are about (\d+) times what Eqs. 3-7 give\.\*\* With a "
+                      r"physical f_m = (\S+) the largest T_f at l_x = \S+ m is (\S+) degC against "
+                      r"the paper's (\S+) degC", model).groups()
+    times, f_phys, t_phys, t_paper = map(float, flash)
+    assert times == pytest.approx(ratio_flash, rel=0.02) and f_phys == f0
+    assert t_paper == paper.CAL_FM.paper
+    assert t_phys == pytest.approx(t_paper / ratio_flash, abs=5e-4)
 
 
 def test_the_ideal_poincare_miss_quotes_its_spread():
