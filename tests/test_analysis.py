@@ -401,8 +401,9 @@ def test_plot_scene(tmp_path):
     assert fig._suptitle.get_text() == "synthetic run"
     ax_d, ax_t, ax_p, ax_f, ax_tf, ax_s = fig.axes[:6]
     assert [a.get_title() for a in (ax_t, ax_p, ax_f, ax_tf, ax_s)] == [
-        "meshing torque T_m", "phase plane", "tooth load F_j", "flash temperature T_f",
-        "spectrum of T_m"]
+        "meshing torque T_m", f"phase plane; red: section points ({len(k)})", "tooth load F_j",
+        "flash temperature T_f", "spectrum of T_m"]
+    assert ax_p.get_legend() is None          # the key is in the title, no box over the arcs
     assert ax_d.get_ylabel() == "D_2 [µm]" and ax_p.get_ylabel() == "dD_2/dt [mm/s]"
     for ax, x in ((ax_d, D2 * 1e6), (ax_t, Tm)):   # the whole range (no start transient), margins
         lo, hi = ax.get_ylim()

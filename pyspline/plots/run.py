@@ -176,15 +176,15 @@ def _phase_plane(ax, D2, vD2, section, d_axis, v_scale, t=None, rtol=1e-8):
     late_v = settled_range(t, vD2, rtol, "m/s") if t is not None and d_flat is None else None
     kv, uv = ps.prefix([v_scale] if v_flat is not None else (late_v[:2] if late_v else vD2),
                        "m/s")
-    ax.plot(D2 / kd, vD2 / kv, lw=0.4, color="0.55", label="trajectory")
+    ax.plot(D2 / kd, vD2 / kv, lw=0.4, color="0.55")
+    title = "phase plane"      # the key in the title: a legend inside would cover the arcs
     if section is not None:
         s = np.asarray(section, dtype=float).reshape(-1, 2)
-        ax.plot(s[:, 0] / kd, s[:, 1] / kv, "o", ms=4, color="tab:red", zorder=3,
-                label=f"section points ({len(s)})")
-    ax.legend(fontsize=8, loc="upper right")
+        ax.plot(s[:, 0] / kd, s[:, 1] / kv, "o", ms=4, color="tab:red", zorder=3)
+        title += f"; red: section points ({len(s)})"
     ax.set_xlabel(f"D_2 [{ud}]")
     ax.set_ylabel(f"dD_2/dt [{uv}]")
-    ax.set_title("phase plane", fontsize=10)
+    ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3, lw=0.5)
     ax.ticklabel_format(useOffset=False)
     ax.xaxis.set_major_locator(MaxNLocator(nbins=6))
