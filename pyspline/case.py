@@ -30,7 +30,6 @@ NAME_BYTES = 128   #: longest case name (UTF-8 bytes; fortran/input/case.f90 nam
 #: list fields with one number per tooth (as many as the most teeth): a shorter list gives the
 #: first teeth, as in a namelist file
 PER_TOOTH = frozenset({"spacing_error"})
-_MODEL_BYTES = bridge.MODEL_BYTES
 
 
 @functools.cache
@@ -297,7 +296,7 @@ def load_case(source, **overrides) -> Case:
         raise CaseError(f"case file {_shown(path)!r}: embedded null byte")
     rows, nv, nc = _layout()
     model, sizes, values, chars, warn, stage, ierr, msg = bridge.load_file(
-        os.fsencode(path), 0 if overrides else 1, _MODEL_BYTES, nv, nc)
+        os.fsencode(path), 0 if overrides else 1, bridge.MODEL_BYTES, nv, nc)
     if stage == 0:
         raise CaseError(decode(msg))
     fields, exact = _fields_of(values, chars)
@@ -333,9 +332,9 @@ class Model:
             packed = _values_of(case._fields)
             if packed is None:                   # a value only the reader can judge
                 data, sizes, warn, ierr, msg = bridge.load_text(case.text().encode("utf-8"),
-                                                                _MODEL_BYTES)
+                                                                bridge.MODEL_BYTES)
             else:
-                data, sizes, warn, ierr, msg = bridge.load_fields(*packed, _MODEL_BYTES)
+                data, sizes, warn, ierr, msg = bridge.load_fields(*packed, bridge.MODEL_BYTES)
             raise_for(ierr, msg)
             data.flags.writeable = False
         self.case, self.bytes = case, data

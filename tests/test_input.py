@@ -475,6 +475,6 @@ def test_reader_puts_every_element_in_its_field(tmp_path):
     path = tmp_path / "every.nml"
     path.write_text("\n".join(lines + ["/", ""]))
     _, _, values, chars, _, stage, ierr, msg = pyspline.bridge._api.api_load_file(
-        os.fsencode(path), 0, pc._MODEL_BYTES, nv, nc)
+        os.fsencode(path), 0, pyspline.bridge.MODEL_BYTES, nv, nc)
     assert stage == 1 and ierr == 0, msg
     assert pc._fields_of(values, chars)[0] == want
