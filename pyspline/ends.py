@@ -87,7 +87,7 @@ def _gap(br, pt):
     return float(np.linalg.norm(half(br, pt["y"], pt["u"]) - pt["u"]))
 
 
-def reached_merge(br, pts, back=4):
+def reached_merge(br, pts, back=12):
     """A period-n branch (n even) whose steps from its last point a fail next to its period
     doubling (there it crosses the period-n/2 branch, a branch point of P^n: its corrector's
     bordered Jacobian is near singular and does not converge to tol): the doubling, located by

@@ -285,11 +285,11 @@ def test_period_two_branch_ends_at_its_doubling(doubling_band, phase):
                   / s).max() < 1e-3
 
 
-def test_period_two_branch_doubles_to_period_four():
+def test_period_two_branch_doubles_to_period_four(monkeypatch):
     """The doubling scene's period-2 branch (stable at 1723.5 r/min, from a settled run)
     continued down doubles at 1722.90 r/min (a multiplier of P^2 at -1), and the period-4
     branch is followed from there: its points are fixed points of P^4 (to 1e-5 scaled) and not
-    of P^2 (1e3 tol or more away)."""
+    of P^2 (1e3 tol or more away). Continued up, the period-4 branch ends at that doubling."""
     from pyspline.orbits import _period_map, periodic_orbit
     from test_orbits import scale_of
     T = 60 / 1723.5
@@ -315,6 +315,27 @@ def test_period_two_branch_doubles_to_period_four():
         y4, _ = _period_map(m, 0.0, 4 * 60 / x, y[:, None])
         assert np.abs((y4[:, 0] - y)[free] / s[free]).max() < 1e-5, x
         assert np.abs((y2[:, 0] - y)[free] / s[free]).max() > 1e3 * 100 * case["rtol"], x
+    # continued up from its orbit at 1722.898 r/min (short steps), the period-4 branch ends at
+    # its merge into the period-2 branch: next to it its corrector stalls (steps fail), and
+    # the doubling it leads into is located on the period-2 orbit (ends.reached_merge), as on
+    # the period-2 branch to 1e-4 r/min. Before, its steps failed there until the bound.
+    found, reached = [], pyspline.ends.reached_merge
+    monkeypatch.setattr(pyspline.ends, "reached_merge",
+                        lambda br, pts: found.append(reached(br, pts)) or found[-1])
+    y = periodic_orbit(case.replace(speed_rpm=1722.898), n=4, guess=ds.y0.values[b == 1][0]).y0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        up = pyspline.continuation(case, "speed_rpm", 1722.898, 1722.95, n=4, guess=y,
+                                   band=(1722.89, 1723), progress=False, ds=0.005, ds_max=0.01,
+                                   max_angle=0.3)
+    assert re.fullmatch(r"the period-4 branch reached a period doubling .* merges into the "
+                        r"period-2 branch .*", up.attrs["status"]), up.attrs["status"]
+    assert found and found[-1] is not None and up.sizes["special"] == 1
+    q_d = float(ds.special_speed_rpm[pd[0]])
+    assert up.special_type[0] == "period_doubling" and up.special_n[0] == 2
+    assert float(up.special_speed_rpm[0]) == pytest.approx(q_d, abs=1e-4)
+    assert abs(complex(up.special_mu_real[0], up.special_mu_imag[0]) + 1) < 1e-3
+    assert (up.n == 4).all() and (up.speed_rpm < q_d).all()
 
 
 @pytest.mark.parametrize("stop", [1620.085, 1620.1, 1620.12])
