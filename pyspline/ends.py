@@ -1,7 +1,8 @@
 """How a continued branch ends before its band's end (docs/continuation.md): a period-n branch
 (n even) at its period doubling, where it merges into the period-n/2 branch (the doubling
-located there), a branch that comes back onto its own orbit at another of its section points,
-and a point whose steps keep failing (FAILED_EVALS). `br` is
+located there), past it or where its steps fail next to it (reached_merge), a branch that
+comes back onto its own orbit at another of its section points, and a point whose steps keep
+failing (FAILED_EVALS, each fallback's share of it, the fallbacks themselves). `br` is
 the branch being followed (arclength._Branch); the maps are the core's, nothing here computes
 physics."""
 from __future__ import annotations

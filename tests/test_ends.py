@@ -1,9 +1,9 @@
 """How a continued branch ends before its band's end (pyspline/ends.py, docs/continuation.md):
 the n-general tests of a period-n branch's merge into the period-n/2 branch and of a branch
 that comes back onto its own orbit, on section points and branch records made up here (the
-doubling scene's period-4 branch comes back onto itself after 77 s, and does not reach its
-merge: docs/continuation.md, Limits), and their wiring into continuation on the linear
-scene."""
+doubling scene's period-4 branch comes back onto itself after 77 s: docs/continuation.md,
+Limits; its merge is tested on the scene, tests/test_cont_more.py), and their wiring into
+continuation on the linear scene, with the failed-step bound and its fallbacks' shares."""
 import re
 import warnings
 from types import SimpleNamespace
