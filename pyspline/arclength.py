@@ -405,8 +405,8 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
         field's valid range, a converged point further from its predictor than the step or
         whose contact sequence changed with no grazing located between, i.e. on another
         branch, fail it), unless its predictor changes the contact sequence and the grazing
-        is located on the step: the branch goes on past it; below ds_min the other monodromy,
-        then the other
+        is located on the step: the branch goes on past it; below ds_min (or past the halvings'
+        share of the failed-step bound, ends.halvings_end) the other monodromy, then the other
         integrator (ERK, or BDF for ERK) are tried (attrs['fallbacks']); when they fail too,
         the branch so far is returned with attrs['status'] saying where and why, and a
         SplineWarning. max_angle [rad]: a step whose tangent turns more than twice it is
@@ -508,7 +508,8 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
     bounds (the last point put on its end: 'complete'), max_points, a step that fails below
     ds_min with every fallback (the other monodromy, then the other integrator) or after
     ends.FAILED_EVALS corrector iterations from its point, a period doubling where the branch
-    merges into the period-n/2 one (located: the last point's 'merge') or its own orbit
+    merges into the period-n/2 one (past it, or its steps failing next to it: located, the
+    last point's 'merge') or its own orbit
     reached again (ends): a sentence saying where and why. A converged point further from its
     predictor than the step itself, or whose contact sequence changed with no grazing located
     between (specials.graze), is on another branch: a rejected step. A failed step whose
