@@ -4,7 +4,7 @@ FAILED_EVALS; 1e9: unbounded). The linear scene (tests/test_orbits.py) continued
 2600-2650 r/min with a wrong dF/dp column for its first method (1e3 times a random vector)
 and the fallbacks' own tangents switched off (tests/test_ends.py): the branch is its start
 alone. Prints the CPU time of the call (the heavy imports made before), the corrector
-iterations and the calls of the core's map, and the status."""
+iterations and the calls of the core's map, the status and the fallbacks tried."""
 import sys
 import time
 import warnings
@@ -54,4 +54,4 @@ with warnings.catch_warnings():
                                max_points=6)
 print(f"bound {ends.FAILED_EVALS}: CPU {time.process_time() - t:.2f} s, {evals[0]} corrector "
       f"iterations, {calls[0]} calls of the core, {ds.sizes['point']} point(s)\n"
-      f"status: {ds.attrs['status']}")
+      f"status: {ds.attrs['status']}\nfallbacks: {ds.attrs['fallbacks']}")

@@ -405,8 +405,8 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
         field's valid range, a converged point further from its predictor than the step or
         whose contact sequence changed with no grazing located between, i.e. on another
         branch, fail it), unless its predictor changes the contact sequence and the grazing
-        is located on the step: the branch goes on past it; below ds_min the other monodromy,
-        then the other
+        is located on the step: the branch goes on past it; below ds_min (or past the halvings'
+        share of the failed-step bound, ends.halvings_end) the other monodromy, then the other
         integrator (ERK, or BDF for ERK) are tried (attrs['fallbacks']); when they fail too,
         the branch so far is returned with attrs['status'] saying where and why, and a
         SplineWarning. max_angle [rad]: a step whose tangent turns more than twice it is
@@ -466,7 +466,7 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
                 pts, why = _follow(br, u_start, tau0, q_end, sorted((0.0, q_end)) if tau0 is None
                                    else prob.band, ds, ds_min, ds_max, max_angle,
                                    max_points - sum(len(b) for b in branches), len(branches), bar)
-                _use(prob, monodromy, base["method"])
+                ends.use(prob, monodromy, base["method"])
                 if why != "complete" and status == "complete":
                     status = why
                 branches.append(pts)
@@ -508,7 +508,8 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
     bounds (the last point put on its end: 'complete'), max_points, a step that fails below
     ds_min with every fallback (the other monodromy, then the other integrator) or after
     ends.FAILED_EVALS corrector iterations from its point, a period doubling where the branch
-    merges into the period-n/2 one (located: the last point's 'merge') or its own orbit
+    merges into the period-n/2 one (past it, or its steps failing next to it: located, the
+    last point's 'merge') or its own orbit
     reached again (ends): a sentence saying where and why. A converged point further from its
     predictor than the step itself, or whose contact sequence changed with no grazing located
     between (specials.graze), is on another branch: a rejected step. A failed step whose
@@ -539,7 +540,7 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
 
     def inside(q):                    # q within the bounds, to round-off
         return lo - 1e-12 <= q <= hi + 1e-12
-    fallbacks = _fallbacks(prob)
+    fallbacks = ends.fallbacks(prob)
     primary, on_fallback = (prob.how, prob.case["method"]), 0
     mark = prob.evals               # corrector iterations at the last point (but diagnoses)
     while len(pts) < max_points:
@@ -597,10 +598,17 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
                 a["tau"], a["null"] = _null_tangent(a["J"], a["tau"]), True
                 continue
             ds /= 2
-            if ds < ds_min:
+            if ds < ds_min or ends.halvings_end(lost, len(fallbacks)):
+                if br.n % 2 == 0 and not a.get("merge_tried"):    # next to its doubling?
+                    e, a["merge_tried"] = prob.evals, True      # bounded on its own
+                    sp = ends.reached_merge(br, pts)
+                    mark += prob.evals - e
+                    if sp:
+                        a["merge"] = sp
+                        return pts, ends.merge_words(br, a, sp["p"])
                 if not fallbacks:
                     return pts, _where(br, pred, ds, f"after point {len(pts)} of branch {ibranch}")
-                _use(prob, *fallbacks.pop(0))
+                ends.use(prob, *fallbacks.pop(0))
                 prob.log.append(f"{prob.name} = {a['p']:.6g}: {prob.how} monodromy, method "
                                 f"{prob.case['method']} ({getattr(br, 'last_error', '')})")
                 _retangent(br, a, a["u"] - pts[-2]["u"] if len(pts) > 1 else head)
@@ -626,8 +634,8 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
         if on_fallback:                 # a few points on the fallback, then the primary again
             on_fallback -= 1
             if not on_fallback:
-                _use(prob, *primary)
-                fallbacks = _fallbacks(prob)
+                ends.use(prob, *primary)
+                fallbacks = ends.fallbacks(prob)
         grow = 1.5 if it <= 2 else (0.6 if it >= 4 else 1.0)
         ds = max(ds_min, min(ds_max, ds * grow, ds * max_angle / max(angle, 1e-12)))
     return pts, f"max_points = {max_points} reached at {prob.name} = {pts[-1]['p']:.6g}"
@@ -651,20 +659,6 @@ def _onto(br, u, pred, ds, end):
     further than the step from the predictor."""
     res = br.correct(u, np.eye(len(u))[-1], end)
     return None if res is None or specials.far(res[0], pred, ds) else res
-
-
-def _fallbacks(prob):
-    """What a failed step tries next: the other monodromy, then the other integrator (ERK for
-    a CVODE method, BDF for ERK) with each monodromy."""
-    other = "fd" if prob.how == "exact" else "exact"
-    method = "bdf" if prob.case["method"] == "erk" else "erk"
-    return [(other, prob.case["method"]), (prob.how, method), (other, method)]
-
-
-def _use(prob, monodromy, method):
-    prob.set_monodromy(monodromy)
-    if method != prob.case["method"]:
-        prob.set_method(method)
 
 
 def _fail(br, u, ds, where):

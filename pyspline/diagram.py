@@ -14,7 +14,7 @@ from .arclength import (check_handed_on, continuation, field_label, parse_field,
 from .errors import CaseError, SolverError, SplineError, SplineWarning
 from .orbits import (CALL_SECONDS, OrbitError, out_of_time, repeat_revolutions,
                      section_points, time_bound)
-from .specials import on_polyline
+from .specials import on_polyline, same_point
 
 
 def _stretches(period):
@@ -193,6 +193,26 @@ def _distinct(ds, label, scale, tol, phases=None):
     return ds, kept
 
 
+def one_doubling(ds, label, scale, tol):
+    """The special points of `ds` with each period doubling once: the one recorded where a
+    period-2n branch ends at its merge (special_n n on a branch of period 2n) goes when the
+    period-n branch located it too (the same field value and state within sqrt(tol) in the
+    scaled unknowns, specials.same_point): that one lists the merging branch in
+    special_merge (-1: none)."""
+    kind, sb, sn = ds.special_type.values, ds.special_branch.values, ds.special_n.values
+    n_of = {int(b): int(n) for b, n in zip(ds.branch.values, ds.n.values)}
+    pscale = 0.1 * np.abs(ds[label].values).max()
+    u = np.c_[ds[f"special_{label}"].values / pscale, ds.special_y0.values / scale]
+    other, drop = np.full(len(kind), -1), np.zeros(len(kind), bool)
+    for i in np.flatnonzero((kind == "period_doubling") & (sn != [n_of[int(b)] for b in sb])):
+        for j in np.flatnonzero((kind == "period_doubling") & (sn == sn[i])):
+            if n_of[int(sb[j])] == sn[j] and same_point(u[i], u[j], tol):
+                other[j], drop[i] = sb[i], True
+    ds["special_merge"] = ("special", other, {
+        "long_name": "the period-2n branch that ends at this period doubling (-1: none)"})
+    return ds.isel(special=~drop)
+
+
 def _join(down, up, label):
     """One branch from a seed's two halves: `down` (seed to start) reversed, then `up` (seed to
     stop) without its first point (the seed again). Doubled branches keep their own numbers."""
@@ -348,6 +368,7 @@ def _branches(case, field, start, stop, points, max_n, progress, command, sweep_
                           f"{_spans(no_period) or 'none'})")
     ds, kept = _distinct(_concat(pieces), field, scale, tol,
                          lambda piece: _phases(case, name, piece))
+    ds = one_doubling(ds, field, scale, tol)
     if no_period:       # plots.frequency_response shades them
         ds["no_period_range"] = (("stretch", "end"),
                                  np.sort([[a, b] for _, a, b, *_ in no_period]))

@@ -369,3 +369,28 @@ def test_cli_fold_input(tmp_path, every_branch):
     run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
               "--stop", "2500", "--repeated")
     assert run.returncode == 2 and "--repeated: the method of --fold" in run.stderr, run.stderr
+
+
+def test_a_doubling_on_two_branches_is_reported_once():
+    """branches: a period doubling located on the period-1 branch (0) and again where the
+    period-2 branch (1) ends at it (its merge: special_n 1 on a period-2 branch, at the same
+    field value and state to within sqrt(tol)) is one special point, on branch 0, listing
+    branch 1 in special_merge; a merge record that is another point (its state 0.01 scaled
+    away) and the fold stay. Made-up records."""
+    import xarray as xr
+    from pyspline.diagram import one_doubling
+    scale, y = np.full(14, 1e-3), np.full(14, 1e-3)
+    ds = xr.Dataset({
+        "speed_rpm": ("point", [1600.0, 1620.0, 1615.0, 1623.0]),
+        "branch": ("point", [0, 0, 1, 1]), "n": ("point", [1, 1, 2, 2]),
+        "special_type": ("special", ["period_doubling", "fold", "period_doubling",
+                                     "period_doubling"]),
+        "special_speed_rpm": ("special", [1623.614, 1618.4, 1623.614 + 1e-5, 1623.624]),
+        "special_branch": ("special", [0, 1, 1, 1]), "special_n": ("special", [1, 2, 1, 1]),
+        "special_y0": (("special", "state"), np.array([y, 2 * y, y * (1 + 1e-5), y * 1.01])),
+    }, attrs={"field": "speed_rpm"})
+    out = one_doubling(ds, "speed_rpm", scale, TOL)
+    assert list(out.special_type.values) == ["period_doubling", "fold", "period_doubling"]
+    assert list(out.special_branch.values) == [0, 1, 1]
+    assert list(out.special_merge.values) == [1, -1, -1]
+    assert out.special_speed_rpm.values[-1] == 1623.624

@@ -285,13 +285,11 @@ def test_period_two_branch_ends_at_its_doubling(doubling_band, phase):
                   / s).max() < 1e-3
 
 
-def test_period_two_branch_doubles_to_period_four():
-    """The doubling scene's period-2 branch (stable at 1723.5 r/min, from a settled run)
-    continued down doubles at 1722.90 r/min (a multiplier of P^2 at -1), and the period-4
-    branch is followed from there: its points are fixed points of P^4 (to 1e-5 scaled) and not
-    of P^2 (1e3 tol or more away)."""
-    from pyspline.orbits import _period_map, periodic_orbit
-    from test_orbits import scale_of
+@pytest.fixture(scope="module")
+def period_four():
+    """The doubling scene's stable period-2 orbit at 1723.5 r/min (from a settled run) and its
+    branch continued down to 1722.7 r/min, with the period-4 branch from its doubling."""
+    from pyspline.orbits import periodic_orbit
     T = 60 / 1723.5
     case = DOUBLING8.replace(speed_rpm=1723.5)
     with warnings.catch_warnings():
@@ -300,6 +298,17 @@ def test_period_two_branch_doubles_to_period_four():
         ds = pyspline.continuation(case, "speed_rpm", 1723.5, 1722.7, n=2, guess=orbit.y0,
                                    band=(1722.7, 1725), progress=False, ds_max=0.5,
                                    max_angle=0.3)
+    return case, orbit, ds
+
+
+def test_period_two_branch_doubles_to_period_four(period_four, monkeypatch):
+    """The doubling scene's period-2 branch (stable at 1723.5 r/min, from a settled run)
+    continued down doubles at 1722.90 r/min (a multiplier of P^2 at -1), and the period-4
+    branch is followed from there: its points are fixed points of P^4 (to 1e-5 scaled) and not
+    of P^2 (1e3 tol or more away). Continued up, the period-4 branch ends at that doubling."""
+    from pyspline.orbits import _period_map, periodic_orbit
+    from test_orbits import scale_of
+    case, orbit, ds = period_four
     assert orbit.stable and ds.attrs["status"] == "complete", ds.attrs["status"]
     kind, b = ds.special_type.values, ds.branch.values
     pd = np.flatnonzero(kind == "period_doubling")
@@ -315,6 +324,69 @@ def test_period_two_branch_doubles_to_period_four():
         y4, _ = _period_map(m, 0.0, 4 * 60 / x, y[:, None])
         assert np.abs((y4[:, 0] - y)[free] / s[free]).max() < 1e-5, x
         assert np.abs((y2[:, 0] - y)[free] / s[free]).max() > 1e3 * 100 * case["rtol"], x
+    # continued up from its orbit at 1722.898 r/min (short steps), the period-4 branch ends at
+    # its merge into the period-2 branch: next to it its corrector stalls (steps fail), and
+    # the doubling it leads into is located on the period-2 orbit (ends.reached_merge), as on
+    # the period-2 branch to 1e-4 r/min. Before, its steps failed there until the bound.
+    found, reached = [], pyspline.ends.reached_merge
+    monkeypatch.setattr(pyspline.ends, "reached_merge",
+                        lambda br, pts: found.append(reached(br, pts)) or found[-1])
+    y = periodic_orbit(case.replace(speed_rpm=1722.898), n=4, guess=ds.y0.values[b == 1][0]).y0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        up = pyspline.continuation(case, "speed_rpm", 1722.898, 1722.95, n=4, guess=y,
+                                   band=(1722.89, 1723), progress=False, ds=0.005, ds_max=0.01,
+                                   max_angle=0.3)
+    assert re.fullmatch(r"the period-4 branch reached a period doubling .* merges into the "
+                        r"period-2 branch .*", up.attrs["status"]), up.attrs["status"]
+    assert found and found[-1] is not None and up.sizes["special"] == 1
+    q_d = float(ds.special_speed_rpm[pd[0]])
+    assert up.special_type[0] == "period_doubling" and up.special_n[0] == 2
+    assert float(up.special_speed_rpm[0]) == pytest.approx(q_d, abs=1e-4)
+    assert abs(complex(up.special_mu_real[0], up.special_mu_imag[0]) + 1) < 1e-3
+    assert (up.n == 4).all() and (up.speed_rpm < q_d).all()
+
+
+def test_period_four_branch_turns_at_two_real_folds(period_four):
+    """Below its merge the period-4 branch (continued up from its orbit at 1722.891 r/min)
+    turns back at a fold near 1722.8935 r/min and up again at one near 1722.8929 r/min, with a
+    grazing between (224 to 256 contact switches a period): real folds, not the corrector's.
+    Each has its multiplier at +1 to 1e-3, the field turns back between them, where a real
+    multiplier is above 1 (a saddle), and at a field value between them Newton at that value
+    from the three parts' points nearest it finds three distinct period-4 orbits, the middle
+    one unstable (a real multiplier > 1), the outer two stable."""
+    from pyspline.orbits import periodic_orbit
+    from test_orbits import scale_of
+    case, _, ds = period_four
+    y0 = ds.y0.values[ds.branch.values == 1][0]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        y = periodic_orbit(case.replace(speed_rpm=1722.891), n=4, guess=y0).y0
+        up = pyspline.continuation(case, "speed_rpm", 1722.891, 1722.8937, n=4, guess=y,
+                                   band=(1722.88, 1722.9), progress=False, ds_max=0.5,
+                                   max_angle=0.3)
+    assert up.attrs["status"] == "complete", up.attrs["status"]
+    kind = up.special_type.values
+    assert list(kind) == ["fold", "grazing", "fold"], kind
+    f1, g, f2 = up.special_speed_rpm.values
+    assert 1722.8925 < f2 < g < f1 < 1722.894
+    mu = up.special_mu_real.values + 1j * up.special_mu_imag.values
+    assert abs(mu[0] - 1) < 1e-3 and abs(mu[2] - 1) < 1e-3 and (up.special_smooth[::2] == 1).all()
+    p, top = up.speed_rpm.values, up.mu_real.values[:, 0]
+    i1, i2 = np.flatnonzero(np.diff(np.sign(np.diff(p))) != 0) + 1     # the two turns
+    assert p[i1] > p[i2] and (top[i1 + 1:i2] > 1).all()
+    mid, parts = (f1 + f2) / 2, (slice(0, i1 + 1), slice(i1, i2 + 1), slice(i2, len(p)))
+    orbits = []
+    for part in parts:
+        k = np.argmin(np.abs(p[part] - mid))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", pyspline.SplineWarning)
+            orbits.append(periodic_orbit(case.replace(speed_rpm=float(mid)), n=4,
+                                         guess=up.y0.values[part][k]))
+    s = np.array([o.y0 for o in orbits]) / scale_of(case)
+    assert min(np.abs(s[i] - s[j]).max() for i, j in ((0, 1), (1, 2), (0, 2))) > 1e-3
+    assert orbits[0].stable and orbits[2].stable and not orbits[1].stable
+    assert orbits[1].multipliers[0].real > 1 and abs(orbits[1].multipliers[0].imag) < 1e-9
 
 
 @pytest.mark.parametrize("stop", [1620.085, 1620.1, 1620.12])

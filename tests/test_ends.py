@@ -1,9 +1,9 @@
 """How a continued branch ends before its band's end (pyspline/ends.py, docs/continuation.md):
 the n-general tests of a period-n branch's merge into the period-n/2 branch and of a branch
 that comes back onto its own orbit, on section points and branch records made up here (the
-doubling scene's period-4 branch comes back onto itself after 77 s, and does not reach its
-merge: docs/continuation.md, Limits), and their wiring into continuation on the linear
-scene."""
+doubling scene's period-4 branch comes back onto itself after 77 s: docs/continuation.md,
+Limits; its merge is tested on the scene, tests/test_cont_more.py), and their wiring into
+continuation on the linear scene, with the failed-step bound and its fallbacks' shares."""
 import re
 import warnings
 from types import SimpleNamespace
@@ -92,27 +92,33 @@ def test_continuation_ends_where_it_comes_back(monkeypatch):
 def test_failing_steps_end_within_their_bound(monkeypatch):
     """The linear scene whose first method has a wrong dF/dp (tests/test_cont_more.py) and
     whose fallbacks keep the tangent it had (their own switched off): every step from the
-    start fails. With the bound per point lowered to 10 corrector iterations the branch is its
-    start alone, its status naming the bound, after at most one failed step's iterations
-    (max_corrector + 1, and one for a fallback's tangent) past it: the evaluations counted
-    here, the start's included."""
+    start fails. With the bound per point lowered to 28 corrector iterations, 8 of them each
+    fallback's (one failed step: max_corrector + 1), the branch is its start alone, its status naming the bound, after at most one
+    failed step's iterations (max_corrector + 1, and one for a fallback's tangent) past it: the
+    evaluations counted here, the start's included. Each of the three fallbacks is tried (the
+    halvings of the method before it stop where only the shares of the fallbacks not yet tried
+    are left; before, the first fallback's halvings took the whole bound)."""
     from test_orbits import linear_scene
     case, *_ = linear_scene(2.0)
     evaluate, calls = arc._Problem.evaluate, []
 
     def wrong(self, y, u, n):
-        calls.append(u)
+        calls.append((self.how, self.case["method"]))
         F, J, M, yy = evaluate(self, y, u, n)
         if self.how == "exact":
             J = np.c_[J[:, :-1], 1e3 * np.random.default_rng(1).standard_normal(len(F))]
         return F, J, M, yy
     monkeypatch.setattr(arc._Problem, "evaluate", wrong)
     monkeypatch.setattr(arc, "_retangent", lambda *args: None)
-    monkeypatch.setattr(ends, "FAILED_EVALS", 10)
-    with pytest.warns(pyspline.SplineWarning, match="within the bound of 10 corrector"):
+    monkeypatch.setattr(ends, "FAILED_EVALS", 28)
+    monkeypatch.setattr(ends, "FALLBACK_EVALS", 8)
+    with pytest.warns(pyspline.SplineWarning, match="within the bound of 28 corrector"):
         ds = pyspline.continuation(case, "speed_rpm", 2600, 2650, progress=False, ds_min=0.01,
                                    max_points=6)
-    taken = int(re.search(r"within the bound of 10 corrector iterations for a point's failed "
+    taken = int(re.search(r"within the bound of 28 corrector iterations for a point's failed "
                           r"steps \((\d+) taken\)", ds.attrs["status"]).group(1))
-    assert ds.sizes["point"] == 1 and 10 < taken <= 10 + 6 + 2, ds.attrs["status"]
+    assert ds.sizes["point"] == 1 and 28 < taken <= 28 + 6 + 2, ds.attrs["status"]
+    assert ds.attrs["fallbacks"].count("speed_rpm = 2600") == 3, ds.attrs["fallbacks"]
+    stages = [calls[0]] + [c for i, c in enumerate(calls[1:]) if c != calls[i]]
+    assert len(stages) == 4 and len(set(stages)) == 4, stages
     assert len(calls) <= 2 + taken, len(calls)
