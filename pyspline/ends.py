@@ -74,10 +74,19 @@ def merged(br, a, new, secs):
     return merge_words(br, a, new["p"])
 
 
+def apart(x, y):
+    """x and y with as many significant digits (6 at least) as tell them apart."""
+    d = 6
+    while d < 17 and f"{x:.{d}g}" == f"{y:.{d}g}":
+        d += 1
+    return f"{x:.{d}g}", f"{y:.{d}g}"
+
+
 def merge_words(br, a, p):
     """The status of a period-n branch that ends at a, before its doubling at or before p."""
+    lo, hi = apart(a["p"], p)
     return (f"the period-{br.n} branch reached a period doubling between {br.prob.name} = "
-            f"{a['p']:.6g} and {p:.6g}, where it merges into the period-{br.n // 2} "
+            f"{lo} and {hi}, where it merges into the period-{br.n // 2} "
             f"branch (past it: the period-{br.n // 2} orbit, or this orbit at its other section "
             "points): it ends there")
 

@@ -42,6 +42,7 @@ def test_merged_at_the_middle_section_point(n):
     assert re.fullmatch(rf"the period-{n} branch reached a period doubling between speed_rpm = "
                         rf"0 and 0.01, where it merges into the period-{n // 2} branch .*", said)
     assert ends.merged(br, a, _pt(1e-7, 0.01), secs(1e-7))
+    assert ends.apart(1722.90168, 1722.902139) == ("1722.9017", "1722.9021")   # never "1722.9 and 1722.9"
     assert ends.merged(br, a, _pt(1e-7, 0.01), secs(1e-7)[:n - 1]) == ""
 
 
