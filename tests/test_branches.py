@@ -196,7 +196,18 @@ def cusp_curve():
 CUSP_AMPS = [0.085, 0.0875, 0.08, 0.0865]
 
 
-def test_fold_curve_through_its_cusp(cusp_curve):
+@pytest.fixture(scope="module")
+def cusp_repeated():
+    """method='repeated' at the three values of a with a fold pair (0.085, 0.0875, 0.0865): a
+    one-parameter continuation at each over 2575-2600 r/min, bisecting grazings 8 times."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        return pyspline.fold_curve(FAST, "speed_rpm", 2575, 2600, "ripple_amp(1)",
+                                   [CUSP_AMPS[i] for i in (0, 1, 3)], method="repeated",
+                                   progress=False, ds_max=0.5, max_angle=0.3)
+
+
+def test_fold_curve_through_its_cusp(cusp_curve, cusp_repeated):
     """From a = 0.085 the curve of the lower fold goes down in a, turns at the cusp between
     a = 0.08 and 0.085 (docs: the pair 1.5 r/min wide at 0.085, none at 0.08) and comes back
     up as the upper fold: one curve, traced through the cusp (points either side of it, their
@@ -204,7 +215,9 @@ def test_fold_curve_through_its_cusp(cusp_curve):
     continuation there (measured 1.1e-4 and 1.2e-4 r/min at rtol 1e-7: both correctors stop
     at the scaled residual tol = 1e-5, and the secant of the one-parameter location stops on
     the arclength to 1e-6 of the step);
-    none at 0.08. Follow sweeps at the middle of the 0.085 pair and 8 r/min either side say
+    none at 0.08 (the one-parameter continuation: cusp_repeated's at 0.0875, its band
+    narrowed around the folds predicted from 0.085). Follow sweeps at the middle of the 0.085
+    pair and 8 r/min either side say
     two orbits there and one outside; at 0.08, at the same speeds, the up and the down chains
     end on the same orbit (T_m peak-to-peak to 0.5 %): no hysteresis past the cusp."""
     fc = cusp_curve
@@ -219,11 +232,8 @@ def test_fold_curve_through_its_cusp(cusp_curve):
     assert 0 < k < len(y) - 1 and y[k] == pytest.approx(a_c, abs=2e-4)
     assert x[:k].min() > f[1, 0] - 1e-6 and x[k] == pytest.approx(p_c, abs=1)
     assert np.isclose(x, f[1, 0], atol=1e-3).any() and np.isclose(x, f[1, 1], atol=1e-3).any()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", pyspline.SplineWarning)
-        ds = pyspline.continuation(FAST.replace(ripple_amp=[0.0875, 0, 0, 0]), "speed_rpm",
-                                   2575, 2600, progress=False, ds_max=0.5, max_angle=0.3)
-    one = np.sort(ds.special_speed_rpm.values[ds.special_type.values.astype(str) == "fold"])
+    one = cusp_repeated.fold.values[1]
+    assert cusp_repeated.value2[1] == 0.0875 and np.isfinite(one).sum() == 2, one
     assert np.abs(f[1, :2] - one).max() < 5e-4, (f[1], one)
     lo, hi = f[0, :2]
     speeds = [lo - 8, (lo + hi) / 2, hi + 8]
@@ -241,7 +251,7 @@ def test_fold_curve_through_its_cusp(cusp_curve):
     assert (np.abs(pp[0.08][0] - pp[0.08][1]) < 5e-3 * pp[0.08].max(0)).all(), pp[0.08]
 
 
-def test_fold_grazings_are_the_repeated_methods(cusp_curve):
+def test_fold_grazings_are_the_repeated_methods(cusp_curve, cusp_repeated):
     """At the three values of a with a fold pair (0.085, 0.0875, 0.0865) the extended system's
     grazing nearest each fold (the branch at that value walked from the fold's orbit both
     ways, the grazing bisected 12 times) is the grazing of `method='repeated'` (a
@@ -249,12 +259,7 @@ def test_fold_grazings_are_the_repeated_methods(cusp_curve):
     folds reach the same one (the pair is 1.5-4.3 r/min wide, the grazing 1.2-1.6 r/min below
     its upper fold, on the full-contact branch) to their brackets' sum; none at 0.08 (no
     fold)."""
-    fc = cusp_curve
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", pyspline.SplineWarning)
-        rep = pyspline.fold_curve(FAST, "speed_rpm", 2575, 2600, "ripple_amp(1)",
-                                  [CUSP_AMPS[i] for i in (0, 1, 3)], method="repeated",
-                                  progress=False, ds_max=0.5, max_angle=0.3)
+    fc, rep = cusp_curve, cusp_repeated
     near, width = fc.fold_grazing.values[[0, 1, 3], :2], fc.fold_grazing_bracket.values
     g = rep.grazing.values
     assert np.isfinite(near).all() and np.isnan(fc.fold_grazing.values[2]).all(), near
@@ -345,17 +350,18 @@ def test_cli_all(tmp_path):
 
 
 def test_cli_fold_input(tmp_path, every_branch):
-    """`pyspline continue --fold` writes the folds at one amplitude (the Python --all call's)
-    with the follow sweeps' verdict (2330, 2395, 2460 r/min: two orbits exactly between the
-    folds, 2354.6 and 2439.3), exit 0; a --fold without numbers, or --repeated without
-    --fold, is a CaseError naming it, exit 2."""
+    """`pyspline continue --fold` writes the folds at one amplitude (the Python --all call's,
+    to 0.01 r/min: here at FAST's rtol 1e-7 and steps, --ds-max 0.5 --max-angle 0.3, as the
+    fold curves above) with the follow sweeps' verdict (2330, 2395, 2460 r/min: two orbits
+    exactly between the folds, 2354.6 and 2439.3), exit 0; a --fold without numbers, or
+    --repeated without --fold, is a CaseError naming it, exit 2."""
     import xarray as xr
     from test_continuation import cli
     path = tmp_path / "drive.nml"
-    path.write_text(SETTLED.text())
+    path.write_text(SETTLED.replace(rtol=FAST["rtol"], atol=FAST["atol"]).text())
     run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2330",
               "--stop", "2460", "--fold", "ripple_amp(1)=0.25", "--check", "0.25", "--sweep",
-              "3", "--out", "fold", "--quiet")
+              "3", "--ds-max", "0.5", "--max-angle", "0.3", "--out", "fold", "--quiet")
     assert run.returncode == 0, run.stderr
     fc = xr.open_dataset(tmp_path / "fold" / "fold_curve.nc", engine="h5netcdf")
     assert fc.fold.values[0] == pytest.approx(folds(every_branch[0]), abs=1e-2)
