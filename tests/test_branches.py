@@ -14,6 +14,9 @@ from test_cont_drives import (BAND, DRIVE, every_branch_of_the_band, folds,  # n
 
 SETTLED = DRIVE.replace(t_end=2.0, t_transient=1.0, n_out=8001)  # the seeding sweep's runs
 TOL = 100 * DRIVE["rtol"]       # continuation's corrector's tol, branches' to tell points apart
+#: the whole module runs on the worker that computes the band's branches (test_cli_fold_input
+#: holds the fold curves' command against them)
+pytestmark = pytest.mark.xdist_group("z16_band")
 
 
 @pytest.fixture
@@ -133,11 +136,29 @@ FAST = DRIVE.replace(rtol=1e-7, atol=1e-9)   # the folds within 1e-4 r/min of rt
 
 
 @pytest.fixture(scope="module")
-def fold_curves():
+def fold_command(tmp_path_factory):
     """The folds of a = 0.25 over 2300-2500 r/min followed in a down to 0.18 by the extended
-    system, at rtol 1e-7 with steps up to twice the default's."""
-    return pyspline.fold_curve(FAST, "speed_rpm", 2300, 2500, "ripple_amp(1)", AMPS,
-                               progress=False, ds_max=0.5, max_angle=0.3)
+    system, at rtol 1e-7 with steps up to twice the default's, from `pyspline continue --fold`
+    with the follow sweeps' verdict at a = 0.25 (3 speeds; runs of 80 revolutions, the last
+    40 at 200 samples a revolution: the revolution fields, which the orbits' own runs do not
+    use): (its fold_curve.nc, the command's outcome, its directory)."""
+    import xarray as xr
+    from test_continuation import cli
+    tmp = tmp_path_factory.mktemp("fold")
+    (tmp / "drive.nml").write_text(FAST.replace(revolutions=80, transient_revolutions=40,
+                                                outputs_per_revolution=200).text())
+    run = cli(tmp, "continue", "drive.nml", "--field", "speed_rpm", "--start", "2300",
+              "--stop", "2500", "--fold", "ripple_amp(1)=" + ",".join(map(str, AMPS)),
+              "--check", "0.25", "--sweep", "3", "--ds-max", "0.5", "--max-angle", "0.3",
+              "--out", "fold", "--quiet")
+    assert run.returncode == 0, run.stderr
+    with xr.open_dataset(tmp / "fold" / "fold_curve.nc", engine="h5netcdf") as fc:
+        return fc.load(), run, tmp
+
+
+@pytest.fixture
+def fold_curves(fold_command):
+    return fold_command[0]
 
 
 def test_fold_curve_against_follow_sweeps(fold_curves):
@@ -349,26 +370,21 @@ def test_cli_all(tmp_path):
     assert (tmp_path / "out" / "branches.png").stat().st_size > 10_000
 
 
-def test_cli_fold_input(tmp_path, every_branch):
-    """`pyspline continue --fold` writes the folds at one amplitude (the Python --all call's,
-    to 0.01 r/min: here at FAST's rtol 1e-7 and steps, --ds-max 0.5 --max-angle 0.3, as the
-    fold curves above) with the follow sweeps' verdict (2330, 2395, 2460 r/min: two orbits
-    exactly between the folds, 2354.6 and 2439.3), exit 0; a --fold without numbers, or
-    --repeated without --fold, is a CaseError naming it, exit 2."""
-    import xarray as xr
+def test_cli_fold_input(tmp_path, every_branch, fold_command):
+    """`pyspline continue --fold` (the fold curves' command above) writes the folds at a =
+    0.25 (the Python --all call's, to 0.01 r/min) with the follow sweeps' verdict (2300, 2400,
+    2500 r/min: two orbits exactly between the folds, 2354.6 and 2439.3), exit 0; a --fold
+    without numbers, or --repeated without --fold, is a CaseError naming it, exit 2."""
     from test_continuation import cli
-    path = tmp_path / "drive.nml"
-    path.write_text(SETTLED.replace(rtol=FAST["rtol"], atol=FAST["atol"]).text())
-    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2330",
-              "--stop", "2460", "--fold", "ripple_amp(1)=0.25", "--check", "0.25", "--sweep",
-              "3", "--ds-max", "0.5", "--max-angle", "0.3", "--out", "fold", "--quiet")
-    assert run.returncode == 0, run.stderr
-    fc = xr.open_dataset(tmp_path / "fold" / "fold_curve.nc", engine="h5netcdf")
+    fc, run, out = fold_command
+    assert "wrote fold/fold_curve.nc" in run.stdout
     assert fc.fold.values[0] == pytest.approx(folds(every_branch[0]), abs=1e-2)
     lo, hi = fc.fold.values[0]
     x, two = fc.check_field.values, fc.coexist.values[0].astype(bool)
     assert len(x) == 3 and (two == ((x > lo) & (x < hi))).all(), (x[two], lo, hi)
-    assert (tmp_path / "fold" / "fold_curve.png").stat().st_size > 10_000
+    assert (out / "fold" / "fold_curve.png").stat().st_size > 10_000
+    path = tmp_path / "drive.nml"
+    path.write_text(SETTLED.text())
     run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
               "--stop", "2500", "--fold", "ripple_amp(1)=0.2,x")
     assert run.returncode == 2 and "--fold ripple_amp(1)=" in run.stderr, run.stderr
