@@ -70,6 +70,7 @@ def cmd_continue(args, fixed, exit_code) -> int:
         if band is not None:
             command += f" --band {band[0]:g} {band[1]:g}"
         ds = continuation(case, args.field, args.start, args.stop, n=args.n, ds=args.ds,
+                          ds_max=args.ds_max, max_angle=args.max_angle,
                           max_points=args.max_points, tol=args.tol, progress=not args.quiet,
                           command=command, max_seconds=args.max_seconds, band=band)
         sw = None
@@ -148,8 +149,8 @@ def _other(args, case, name, index, command, out) -> int:
     if args.all:
         ds, sw = branches(case, args.field, args.start, args.stop, points=points,
                           progress=not args.quiet, command=command + " --all", ds=args.ds,
-                          max_points=args.max_points, tol=args.tol,
-                          max_seconds=args.max_seconds)
+                          ds_max=args.ds_max, max_angle=args.max_angle,
+                          max_points=args.max_points, tol=args.tol, max_seconds=args.max_seconds)
         write_netcdf(ds, out / "branches.nc")
         write_netcdf(sw, out / "sweep.nc")
         print(f"{ds.attrs['n_points']} points on {ds.attrs['n_branches']} branch(es) from the "
@@ -168,8 +169,8 @@ def _other(args, case, name, index, command, out) -> int:
                         check=_values(args.check, "--check") if args.check else (),
                         check_points=points, command=command + f" --fold {args.fold}"
                         + " --repeated" * args.repeated,
-                        ds=args.ds, max_points=args.max_points, tol=args.tol,
-                        max_seconds=args.max_seconds,
+                        ds=args.ds, ds_max=args.ds_max, max_angle=args.max_angle,
+                        max_points=args.max_points, tol=args.tol, max_seconds=args.max_seconds,
                         method="repeated" if args.repeated else "extended")
         write_netcdf(fc, out / "fold_curve.nc")
         near = fc.fold_grazing.values if "fold_grazing" in fc else fc.fold.values * np.nan
@@ -204,6 +205,10 @@ def add_continue(sub, fixed, exit_code) -> None:
     r.add_argument("--stop", type=float, required=True, help="the field's last value")
     r.add_argument("--n", type=int, default=1, help="shaft revolutions of the period (default 1)")
     r.add_argument("--ds", type=float, default=0.05, help="first arclength step (default 0.05)")
+    r.add_argument("--ds-max", type=float, default=0.25, help="largest arclength step "
+                   "(default 0.25)")
+    r.add_argument("--max-angle", type=float, default=0.15, metavar="RAD", help="the tangent's "
+                   "turn a step aims at (default 0.15 rad; twice it halves the step)")
     r.add_argument("--max-points", type=int, default=200, help="most branch points (200)")
     r.add_argument("--tol", type=float, help="corrector residual, scaled (default 100 rtol)")
     r.add_argument("--band", nargs=2, type=float, metavar=("LO", "HI"),

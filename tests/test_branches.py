@@ -14,6 +14,9 @@ from test_cont_drives import (BAND, DRIVE, every_branch_of_the_band, folds,  # n
 
 SETTLED = DRIVE.replace(t_end=2.0, t_transient=1.0, n_out=8001)  # the seeding sweep's runs
 TOL = 100 * DRIVE["rtol"]       # continuation's corrector's tol, branches' to tell points apart
+#: the whole module runs on the worker that computes the band's branches (test_cli_fold_input
+#: holds the fold curves' command against them)
+pytestmark = pytest.mark.xdist_group("z16_band")
 
 
 @pytest.fixture
@@ -133,11 +136,29 @@ FAST = DRIVE.replace(rtol=1e-7, atol=1e-9)   # the folds within 1e-4 r/min of rt
 
 
 @pytest.fixture(scope="module")
-def fold_curves():
+def fold_command(tmp_path_factory):
     """The folds of a = 0.25 over 2300-2500 r/min followed in a down to 0.18 by the extended
-    system, at rtol 1e-7 with steps up to twice the default's."""
-    return pyspline.fold_curve(FAST, "speed_rpm", 2300, 2500, "ripple_amp(1)", AMPS,
-                               progress=False, ds_max=0.5, max_angle=0.3)
+    system, at rtol 1e-7 with steps up to twice the default's, from `pyspline continue --fold`
+    with the follow sweeps' verdict at a = 0.25 (3 speeds; runs of 80 revolutions, the last
+    40 at 200 samples a revolution: the revolution fields, which the orbits' own runs do not
+    use): (its fold_curve.nc, the command's outcome, its directory)."""
+    import xarray as xr
+    from test_continuation import cli
+    tmp = tmp_path_factory.mktemp("fold")
+    (tmp / "drive.nml").write_text(FAST.replace(revolutions=80, transient_revolutions=40,
+                                                outputs_per_revolution=200).text())
+    run = cli(tmp, "continue", "drive.nml", "--field", "speed_rpm", "--start", "2300",
+              "--stop", "2500", "--fold", "ripple_amp(1)=" + ",".join(map(str, AMPS)),
+              "--check", "0.25", "--sweep", "3", "--ds-max", "0.5", "--max-angle", "0.3",
+              "--out", "fold", "--quiet")
+    assert run.returncode == 0, run.stderr
+    with xr.open_dataset(tmp / "fold" / "fold_curve.nc", engine="h5netcdf") as fc:
+        return fc.load(), run, tmp
+
+
+@pytest.fixture
+def fold_curves(fold_command):
+    return fold_command[0]
 
 
 def test_fold_curve_against_follow_sweeps(fold_curves):
@@ -196,7 +217,18 @@ def cusp_curve():
 CUSP_AMPS = [0.085, 0.0875, 0.08, 0.0865]
 
 
-def test_fold_curve_through_its_cusp(cusp_curve):
+@pytest.fixture(scope="module")
+def cusp_repeated():
+    """method='repeated' at the three values of a with a fold pair (0.085, 0.0875, 0.0865): a
+    one-parameter continuation at each over 2575-2600 r/min, bisecting grazings 8 times."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        return pyspline.fold_curve(FAST, "speed_rpm", 2575, 2600, "ripple_amp(1)",
+                                   [CUSP_AMPS[i] for i in (0, 1, 3)], method="repeated",
+                                   progress=False, ds_max=0.5, max_angle=0.3)
+
+
+def test_fold_curve_through_its_cusp(cusp_curve, cusp_repeated):
     """From a = 0.085 the curve of the lower fold goes down in a, turns at the cusp between
     a = 0.08 and 0.085 (docs: the pair 1.5 r/min wide at 0.085, none at 0.08) and comes back
     up as the upper fold: one curve, traced through the cusp (points either side of it, their
@@ -204,7 +236,9 @@ def test_fold_curve_through_its_cusp(cusp_curve):
     continuation there (measured 1.1e-4 and 1.2e-4 r/min at rtol 1e-7: both correctors stop
     at the scaled residual tol = 1e-5, and the secant of the one-parameter location stops on
     the arclength to 1e-6 of the step);
-    none at 0.08. Follow sweeps at the middle of the 0.085 pair and 8 r/min either side say
+    none at 0.08 (the one-parameter continuation: cusp_repeated's at 0.0875, its band
+    narrowed around the folds predicted from 0.085). Follow sweeps at the middle of the 0.085
+    pair and 8 r/min either side say
     two orbits there and one outside; at 0.08, at the same speeds, the up and the down chains
     end on the same orbit (T_m peak-to-peak to 0.5 %): no hysteresis past the cusp."""
     fc = cusp_curve
@@ -219,11 +253,8 @@ def test_fold_curve_through_its_cusp(cusp_curve):
     assert 0 < k < len(y) - 1 and y[k] == pytest.approx(a_c, abs=2e-4)
     assert x[:k].min() > f[1, 0] - 1e-6 and x[k] == pytest.approx(p_c, abs=1)
     assert np.isclose(x, f[1, 0], atol=1e-3).any() and np.isclose(x, f[1, 1], atol=1e-3).any()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", pyspline.SplineWarning)
-        ds = pyspline.continuation(FAST.replace(ripple_amp=[0.0875, 0, 0, 0]), "speed_rpm",
-                                   2575, 2600, progress=False, ds_max=0.5, max_angle=0.3)
-    one = np.sort(ds.special_speed_rpm.values[ds.special_type.values.astype(str) == "fold"])
+    one = cusp_repeated.fold.values[1]
+    assert cusp_repeated.value2[1] == 0.0875 and np.isfinite(one).sum() == 2, one
     assert np.abs(f[1, :2] - one).max() < 5e-4, (f[1], one)
     lo, hi = f[0, :2]
     speeds = [lo - 8, (lo + hi) / 2, hi + 8]
@@ -241,7 +272,7 @@ def test_fold_curve_through_its_cusp(cusp_curve):
     assert (np.abs(pp[0.08][0] - pp[0.08][1]) < 5e-3 * pp[0.08].max(0)).all(), pp[0.08]
 
 
-def test_fold_grazings_are_the_repeated_methods(cusp_curve):
+def test_fold_grazings_are_the_repeated_methods(cusp_curve, cusp_repeated):
     """At the three values of a with a fold pair (0.085, 0.0875, 0.0865) the extended system's
     grazing nearest each fold (the branch at that value walked from the fold's orbit both
     ways, the grazing bisected 12 times) is the grazing of `method='repeated'` (a
@@ -249,12 +280,7 @@ def test_fold_grazings_are_the_repeated_methods(cusp_curve):
     folds reach the same one (the pair is 1.5-4.3 r/min wide, the grazing 1.2-1.6 r/min below
     its upper fold, on the full-contact branch) to their brackets' sum; none at 0.08 (no
     fold)."""
-    fc = cusp_curve
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", pyspline.SplineWarning)
-        rep = pyspline.fold_curve(FAST, "speed_rpm", 2575, 2600, "ripple_amp(1)",
-                                  [CUSP_AMPS[i] for i in (0, 1, 3)], method="repeated",
-                                  progress=False, ds_max=0.5, max_angle=0.3)
+    fc, rep = cusp_curve, cusp_repeated
     near, width = fc.fold_grazing.values[[0, 1, 3], :2], fc.fold_grazing_bracket.values
     g = rep.grazing.values
     assert np.isfinite(near).all() and np.isnan(fc.fold_grazing.values[2]).all(), near
@@ -344,25 +370,21 @@ def test_cli_all(tmp_path):
     assert (tmp_path / "out" / "branches.png").stat().st_size > 10_000
 
 
-def test_cli_fold_input(tmp_path, every_branch):
-    """`pyspline continue --fold` writes the folds at one amplitude (the Python --all call's)
-    with the follow sweeps' verdict (2330, 2395, 2460 r/min: two orbits exactly between the
-    folds, 2354.6 and 2439.3), exit 0; a --fold without numbers, or --repeated without
-    --fold, is a CaseError naming it, exit 2."""
-    import xarray as xr
+def test_cli_fold_input(tmp_path, every_branch, fold_command):
+    """`pyspline continue --fold` (the fold curves' command above) writes the folds at a =
+    0.25 (the Python --all call's, to 0.01 r/min) with the follow sweeps' verdict (2300, 2400,
+    2500 r/min: two orbits exactly between the folds, 2354.6 and 2439.3), exit 0; a --fold
+    without numbers, or --repeated without --fold, is a CaseError naming it, exit 2."""
     from test_continuation import cli
-    path = tmp_path / "drive.nml"
-    path.write_text(SETTLED.text())
-    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2330",
-              "--stop", "2460", "--fold", "ripple_amp(1)=0.25", "--check", "0.25", "--sweep",
-              "3", "--out", "fold", "--quiet")
-    assert run.returncode == 0, run.stderr
-    fc = xr.open_dataset(tmp_path / "fold" / "fold_curve.nc", engine="h5netcdf")
+    fc, run, out = fold_command
+    assert "wrote fold/fold_curve.nc" in run.stdout
     assert fc.fold.values[0] == pytest.approx(folds(every_branch[0]), abs=1e-2)
     lo, hi = fc.fold.values[0]
     x, two = fc.check_field.values, fc.coexist.values[0].astype(bool)
     assert len(x) == 3 and (two == ((x > lo) & (x < hi))).all(), (x[two], lo, hi)
-    assert (tmp_path / "fold" / "fold_curve.png").stat().st_size > 10_000
+    assert (out / "fold" / "fold_curve.png").stat().st_size > 10_000
+    path = tmp_path / "drive.nml"
+    path.write_text(SETTLED.text())
     run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
               "--stop", "2500", "--fold", "ripple_amp(1)=0.2,x")
     assert run.returncode == 2 and "--fold ripple_amp(1)=" in run.stderr, run.stderr

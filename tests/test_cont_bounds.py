@@ -66,9 +66,10 @@ def test_continuation_keeps_its_points_at_the_bound():
 
 def test_branches_and_fold_curve_end_at_their_bounds():
     """branches: a bound that passes within the seeding sweep leaves no branch traced: an
-    OrbitError naming it. fold_curve over three values of the ripple amplitude within 1.5 s:
+    OrbitError naming it. fold_curve over three values of the ripple amplitude within 0.75 s:
     the extended system's seed stops at it, every value's status names it; the repeated
-    method's each value gets its share of what is left (0.5 s for the first), every one stops at it
+    method's each value gets its share of what is left (0.25 s for the first), every one stops
+    at it
     (its status names the share), the call within the bound and the slack, a SplineWarning;
     the check sweep after it is not run (-1)."""
     with pytest.raises(pyspline.OrbitError, match=r"branches, max_seconds = 0.001 s, was "
@@ -77,18 +78,18 @@ def test_branches_and_fold_curve_end_at_their_bounds():
                           max_seconds=1e-3)
     fc, took, said = timed(lambda: pyspline.fold_curve(
         DRIVE, "speed_rpm", *BAND, "ripple_amp(1)", [0.25, 0.2, 0.18], progress=False,
-        check=[0.25], max_seconds=1.5))
-    assert took < 1.5 + SLACK
-    assert all("fold_curve, max_seconds = 1.5 s, was reached" in s for s in fc.status.values)
+        check=[0.25], max_seconds=0.75))
+    assert took < 0.75 + SLACK
+    assert all("fold_curve, max_seconds = 0.75 s, was reached" in s for s in fc.status.values)
     assert (fc.coexist == -1).all() and "before the check sweeps at 0.25" in fc.attrs["status"]
     assert len(said) == 1 and fc.attrs["status"] in said[0]
     fc, took, said = timed(lambda: pyspline.fold_curve(
         DRIVE, "speed_rpm", *BAND, "ripple_amp(1)", [0.25, 0.2, 0.18], progress=False,
-        check=[0.25], max_seconds=1.5, method="repeated"))
-    assert took < 1.5 + SLACK
+        check=[0.25], max_seconds=0.75, method="repeated"))
+    assert took < 0.75 + SLACK
     st = fc.status.values
-    assert re.search(r"fold_curve at ripple_amp\(1\) = 0.25, max_seconds = 0.(5|49\d) s, was "
-                     "reached", st[0]), st[0]     # 0.498: a few ms passed before the first
+    assert re.search(r"fold_curve at ripple_amp\(1\) = 0.25, max_seconds = 0.2(5|4\d) s, "
+                     "was reached", st[0]), st[0]    # 0.248: a few ms passed before the first
     assert all("max_seconds" in s for s in st), st
     assert (fc.coexist == -1).all() and "before the check sweeps at 0.25" in fc.attrs["status"]
     assert len(said) == 1 and fc.attrs["status"] in said[0]
@@ -110,16 +111,17 @@ def test_follow_sweeps_end_at_the_call_bound():
     """The follow sweeps inside branches and fold_curve share the call's bound: runs of 1000 s
     without the closed-form tail (a minute each; the sweeps would take minutes) are cut where
     it passes, the rest not run.
-    branches with 1 s: an OrbitError naming it within the slack. fold_curve with 3 s over a
+    branches with 0.25 s: an OrbitError naming it within the slack. fold_curve with 3 s over a
     10 r/min band (its continuation: one step, complete): the check sweep is cut, each
     speed's verdict -1, the status naming the bound, the call within the bound and the
     slack."""
     long = DRIVE.replace(t_end=1000.0, n_out=201, linear_tail=False)
     t = time.perf_counter()
-    with pytest.raises(pyspline.OrbitError, match=r"branches, max_seconds = 1 s, was reached"):
+    with pytest.raises(pyspline.OrbitError, match=r"branches, max_seconds = 0.25 s, was "
+                       "reached"):
         pyspline.branches(DRIVE, "speed_rpm", 2200, 2210, points=3, progress=False,
-                          sweep_case=long, max_seconds=1)
-    assert time.perf_counter() - t < 1 + SLACK
+                          sweep_case=long, max_seconds=0.25)
+    assert time.perf_counter() - t < 0.25 + SLACK
     fc, took, said = timed(lambda: pyspline.fold_curve(
         DRIVE, "speed_rpm", 2200, 2210, "ripple_amp(1)", [0.25], progress=False, check=[0.25],
         check_points=3, check_case=long, max_seconds=3))
