@@ -13,8 +13,8 @@ v / (2 h), with [w^T, g'] the transposed bordered solve; F_q from the same runs 
 seven variational runs per Newton iteration whatever the state's size. The contact signature
 of the orbit (specials.contact_measures) must stay the seed's (the saltation in M holds within one contact sequence):
 where it changes, the direction stops ('grazing at ...'). At each value of field2 the grazing
-nearest each fold is found along that value's branch from the fold's orbit (fold_grazing:
-arclength's corrector, specials' bisection). Nothing here computes physics: the map, M and
+nearest each fold is found along that value's branch from the fold's orbit, and followed in
+field2 on request (pyspline.grazecurve: fold_grazing, curves). Nothing here computes physics: the map, M and
 the trajectories are the core's."""
 from __future__ import annotations
 
@@ -402,6 +402,7 @@ def curve_dataset(sys, curves, ends, tried, label1, label2, values2, margin=1e-4
     with sundials_said("the runs from the folds to their nearest grazings"):    # after the
         near = [[fold_grazing(sys, x["u"], x["y"]) if x["exact"] else   # folds: a time bound
                  (None, "no exact fold") for x in xs] for xs in at]     # cuts only these
+    with sundials_said("the runs along the grazing curves"):
         traced = graze_curves(sys, near, [[x["y"] for x in xs] for xs in at], values2, graze) \
             if graze is not None and sys is not None else None
     for j, r in enumerate(near):
