@@ -443,7 +443,7 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
         ds_max: steps in field2, scaled by a tenth of its magnitude; move: the largest miss of
         the prediction, in the first field so scaled; max_points per direction): from the
         grazing nearest each fold, the grazing curve followed in field2 over [min, max of
-        values2] (a walk and bisection per point, about a second of CPU each; default False).
+        values2] (a short walk and a bisection per point, 0.1-0.3 s of CPU each; default False).
     check : values of field2 at which a follow sweep up and down (`check_points` values over
     the band, runs of `check_case`, default `case`: give it a t_end that settles) gives the
     brute-force verdict per value: one orbit or two coexisting (`coexistence`).
@@ -466,9 +466,9 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
     first field either side of the grazing), `graze_curve_y0`; `graze_curve_status` (dim
     `graze_curve`: each direction's end; attrs['graze_curve_status']). With check, dims `check`
     and `check_point`: `check_value`, `check_field`, `coexist` (-1: a run of either direction
-    cut or not run, the time bound had passed). A value at which no orbit is found at its band's start
-    (OrbitError, SolverError) has no folds and says so in `status`. attrs['status']:
-    'complete' or what was not, with a SplineWarning."""
+    cut or not run, the time bound had passed). A value at which no orbit is found at its
+    band's start (OrbitError, SolverError) has no folds and says so in `status`.
+    attrs['status']: 'complete' or what was not, with a SplineWarning."""
     name2, index2 = parse_field(case, field2)
     values2 = _values(case, name2, index2, "values2", values2, 1)
     check = _values(case, name2, index2, "check", check, 0)
