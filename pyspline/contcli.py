@@ -228,7 +228,7 @@ def add_continue(sub, fixed, exit_code) -> None:
                    "grazings)")
     r.add_argument("--graze-curves", action="store_true", help="with --fold: the grazing "
                    "nearest each fold followed as a curve in FIELD2 over the values' range "
-                   "(graze_curve_*; 0.1-0.3 s of CPU a point)")
+                   "(graze_curve_*; 0.3-0.5 s of CPU a point)")
     r.add_argument("--check", metavar="V1,V2,...", help="with --fold: values of FIELD2 with a "
                    "follow sweep's verdict (one orbit or two) overlaid")
     r.add_argument("--max-seconds", type=float, default=CALL_SECONDS, metavar="S",

@@ -443,7 +443,7 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
         ds_max: steps in field2, scaled by a tenth of its magnitude; move: the largest miss of
         the prediction, in the first field so scaled; max_points per direction): from the
         grazing nearest each fold, the grazing curve followed in field2 over [min, max of
-        values2] (a short walk and a bisection per point, 0.1-0.3 s of CPU each; default False).
+        values2] (a short walk and a bisection per point, 0.3-0.5 s of CPU each; default False).
     check : values of field2 at which a follow sweep up and down (`check_points` values over
     the band, runs of `check_case`, default `case`: give it a t_end that settles) gives the
     brute-force verdict per value: one orbit or two coexisting (`coexistence`).

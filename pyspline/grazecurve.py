@@ -164,7 +164,8 @@ def trace(sys, g, q2, y_fixed, values, bounds, direction, ds, ds_min, ds_max, mo
     """One direction of the grazing curve from the located grazing g (a record of `nearest`)
     at the scaled value q2 of field2: steps in q2 (landing on each of the scaled `values`
     passed), the first field predicted by the secant of the last two points (the first step:
-    unchanged), each grazing located by `_located`; a step that fails is halved. (the points
+    unchanged), each grazing located by `_located`; a step that fails is halved, one that
+    succeeds grows 1.5x (not one cut short to land on a value) up to ds_max. (the points
     in order, what ended it: 'complete' at the side of `bounds` (q2 lo, hi); 'the grazing is
     lost ...' with the step below ds_min; max_points, the time bound)."""
     pts = [dict(g, q=np.array([g["u"][-1], q2]))]
@@ -179,15 +180,16 @@ def trace(sys, g, q2, y_fixed, values, bounds, direction, ds, ds_min, ds_max, mo
         passed = [v for v in values if 1e-12 < (v - q[1]) * direction < (to - q[1]) * direction]
         to = min(passed + [to], key=lambda v: abs(v - q[1]))
         to = end if (to - end) * direction > 0 else to
+        step = abs(to - q[1])
         slope = 0.0 if len(pts) < 2 else (q[0] - pts[-2]["q"][0]) / (q[1] - pts[-2]["q"][1])
         new, why = _located(sys, pts[-1], q[0] + slope * (to - q[1]), to, y_fixed, move)
         if new is None:
-            ds = abs(to - q[1]) / 2
+            ds = step / 2
             if ds < ds_min:
                 return pts, f"the grazing is lost past {at(sys, q)} (step below {ds_min:g}): {why}"
             continue
         pts.append(new)
-        ds = min(ds_max, 1.5 * abs(to - q[1]))
+        ds = min(ds_max, 1.5 * ds) if step >= ds else ds    # a step cut to a value: kept
     return pts, f"max_points = {max_points} reached at {at(sys, pts[-1]['q'])}"
 
 
