@@ -265,10 +265,10 @@ def test_fold_grazings_are_the_repeated_methods(cusp_curve):
     assert ((near < upper) & (near > upper - 2)).all(), (near, upper)
 
 
-#: how well a grazing is located in speed (r/min): the corrector's residual (100 rtol) moves
-#: an orbit's closest approach by about 1e-8 m, about 2e-3 r/min of the grazing's slope; its
-#: bisection's bracket (1e-4 to 1.5e-3 r/min) is finer than that (measured: the orbits either
-#: side differ within 3e-3 r/min of every point, 1e-4 of most)
+#: how well a grazing is located in speed (r/min): next to it the contact signature depends on
+#: the orbit to within the corrector's residual (100 rtol), coarser than the bisection's
+#: bracket (1e-4 to 1.5e-3 r/min): orbits either side converged to that residual differ in
+#: signature 3e-3 r/min beyond the bracket of every point (docs/branches.md, measured)
 GRAZE_PRECISION = 5e-3
 
 
