@@ -145,7 +145,7 @@ def _located(sys, g, q1, q2, y_fixed, move):
                      f"{getattr(br, 'last_error', 'no convergence')}"
     new, why = nearest(sys, br, a, q2, reach=max(4 * move, 0.1))
     if new is None:
-        return None, f"no grazing within {move:g} of the prediction {at(sys, [q1, q2])}: {why}"
+        return None, f"no grazing found from the prediction {at(sys, [q1, q2])}: {why}"
     if set(new["sides"]) != set(g["sides"]):
         return None, (f"the grazing next to {at(sys, [q1, q2])} is another: the contact "
                       f"changes per period either side {_changes(new)} against {_changes(g)}")
