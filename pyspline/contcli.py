@@ -35,7 +35,8 @@ branches), sweep.nc and branches.png. With --fold FIELD2=V1,V2,...: the folds of
 over --start..--stop at V1 followed in FIELD2 over the values' range by the extended system,
 through cusps (pyspline.fold_curve; --repeated: a continuation at each value instead), the
 folds at each value, the brute-force verdicts of follow sweeps of --sweep N points (default
-31) at the values of --check V,V,... overlaid; fold_curve.nc and fold_curve.png.
+31) at the values of --check V,V,... overlaid; fold_curve.nc and fold_curve.png. With
+--graze-curves the grazing nearest each fold is followed as a curve in FIELD2 too.
 
 example: pyspline continue cases/physical_ripple.nml --field speed_rpm --start 5000 --stop 7000
 """
@@ -60,8 +61,9 @@ def cmd_continue(args, fixed, exit_code) -> int:
             raise CaseError(f"--sweep: a follow sweep runs whole fields; {args.field} is "
                             "one element of an array field")
         band = _band(args)
-        if args.repeated and not args.fold:
-            raise CaseError("--repeated: the method of --fold; give --fold FIELD2=V1,V2,...")
+        for flag, on in (("--repeated", args.repeated), ("--graze-curves", args.graze_curves)):
+            if on and not args.fold:
+                raise CaseError(f"{flag}: an option of --fold; give --fold FIELD2=V1,V2,...")
         if args.all or args.fold:
             if band is not None:
                 raise CaseError("--band: the range of continue's doubled branches; --all and "
@@ -168,10 +170,11 @@ def _other(args, case, name, index, command, out) -> int:
                         _values(text, f"--fold {field2}="), n=args.n, progress=not args.quiet,
                         check=_values(args.check, "--check") if args.check else (),
                         check_points=points, command=command + f" --fold {args.fold}"
-                        + " --repeated" * args.repeated,
+                        + " --repeated" * args.repeated + " --graze-curves" * args.graze_curves,
                         ds=args.ds, ds_max=args.ds_max, max_angle=args.max_angle,
                         max_points=args.max_points, tol=args.tol, max_seconds=args.max_seconds,
-                        method="repeated" if args.repeated else "extended")
+                        method="repeated" if args.repeated else "extended",
+                        graze_curves=args.graze_curves)
         write_netcdf(fc, out / "fold_curve.nc")
         near = fc.fold_grazing.values if "fold_grazing" in fc else fc.fold.values * np.nan
         for v, f, g, h in zip(fc.value2.values, fc.fold.values, fc.grazing.values, near):
@@ -181,6 +184,9 @@ def _other(args, case, name, index, command, out) -> int:
                      if np.isfinite(h).any() else ""))
         if "cusp" in fc.attrs:
             print(f"cusps: {fc.attrs['cusp']}")
+        if "graze_curve_status" in fc.attrs:
+            print(f"grazing curves ({fc.sizes['graze_point']} points): "
+                  f"{fc.attrs['graze_curve_status']}")
         fold_plane(fc, path=out / "fold_curve.png")
         print(f"wrote {out / 'fold_curve.nc'}, {out / 'fold_curve.png'}")
         status = fc.attrs["status"]
@@ -225,6 +231,9 @@ def add_continue(sub, fixed, exit_code) -> None:
     r.add_argument("--repeated", action="store_true", help="with --fold: a continuation at "
                    "each value of FIELD2 instead of the extended system (gives every value's "
                    "grazings)")
+    r.add_argument("--graze-curves", action="store_true", help="with --fold: the grazing "
+                   "nearest each fold followed as a curve in FIELD2 over the values' range "
+                   "(graze_curve_*; 0.3-0.5 s of CPU a point)")
     r.add_argument("--check", metavar="V1,V2,...", help="with --fold: values of FIELD2 with a "
                    "follow sweep's verdict (one orbit or two) overlaid")
     r.add_argument("--max-seconds", type=float, default=CALL_SECONDS, metavar="S",

@@ -12,6 +12,7 @@ import numpy as np
 from .arclength import (check_handed_on, continuation, field_label, parse_field, set_field,
                         valid_value)
 from .errors import CaseError, SolverError, SplineError, SplineWarning
+from .grazecurve import options
 from .orbits import (CALL_SECONDS, OrbitError, out_of_time, repeat_revolutions,
                      section_points, time_bound)
 from .specials import on_polyline, same_point
@@ -432,7 +433,7 @@ def _guess_at(ds, p):
 def fold_curve(case, field: str, start: float, stop: float, field2: str, values2, n: int = 1,
                *, check=(), check_points: int = 31, check_case=None, progress: bool = True,
                command: str | None = None, method: str = "extended", narrow: bool = True,
-               max_seconds: float = CALL_SECONDS, **cont):
+               max_seconds: float = CALL_SECONDS, graze_curves=False, **cont):
     """The folds of the period-n branch over `field` in [start, stop], followed in a second
     field: two folds bound the band where two orbits coexist; where they meet (a cusp) the
     hysteresis ends.
@@ -459,6 +460,11 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
         take the others' time; its status says when its share ran out. The check sweeps run
         after the folds, in what is left (a run is cut where it passes, the runs after it not
         run: those values' verdicts -1).
+    graze_curves : (extended) True, or a dict of some of pyspline.grazecurve.STEPS (ds, ds_min,
+        ds_max: steps in field2, scaled by a tenth of its magnitude; move: the largest miss of
+        the prediction, in the first field so scaled; max_points per direction): from the
+        grazing nearest each fold, the grazing curve followed in field2 over [min, max of
+        values2] (a short walk and a bisection per point, 0.3-0.5 s of CPU each; default False).
     check : values of field2 at which a follow sweep up and down (`check_points` values over
     the band, runs of `check_case`, default `case`: give it a t_end that settles) gives the
     brute-force verdict per value: one orbit or two coexisting (`coexistence`).
@@ -476,11 +482,14 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
     `curve_mu_other` (the largest |mu| besides the one at +1), `curve_stable`; dims `cusp`
     (`cusp_field`, `cusp_field2`; attrs['cusp']) and `stop` (`stop_field`, `stop_field2`,
     `stop_status`: where a direction stopped short of the rectangle's side, and why);
-    attrs['curve_status'] each direction's. With check, dims `check` and `check_point`:
-    `check_value`, `check_field`, `coexist` (-1: a run of either direction cut or not run, the
-    time bound had passed). A value at which no orbit is found at its band's start
-    (OrbitError, SolverError) has no folds and says so in `status`. attrs['status']:
-    'complete' or what was not, with a SplineWarning."""
+    attrs['curve_status'] each direction's. With graze_curves, along dim `graze_point`:
+    `graze_curve` (which), `graze_curve_field`, `graze_curve_field2`, `graze_curve_ends` (the
+    first field either side of the grazing), `graze_curve_y0`; `graze_curve_status` (dim
+    `graze_curve`: each direction's end; attrs['graze_curve_status']). With check, dims `check`
+    and `check_point`: `check_value`, `check_field`, `coexist` (-1: a run of either direction
+    cut or not run, the time bound had passed). A value at which no orbit is found at its
+    band's start (OrbitError, SolverError) has no folds and says so in `status`.
+    attrs['status']: 'complete' or what was not, with a SplineWarning."""
     name2, index2 = parse_field(case, field2)
     values2 = _values(case, name2, index2, "values2", values2, 1)
     check = _values(case, name2, index2, "check", check, 0)
@@ -492,13 +501,17 @@ def fold_curve(case, field: str, start: float, stop: float, field2: str, values2
     if method not in ("extended", "repeated"):
         raise CaseError(f"method = {method!r}: 'extended' (the fold followed by the extended "
                         "system) or 'repeated' (a continuation per value of field2)")
+    graze = options(graze_curves)
+    if graze is not None and method != "extended":
+        raise CaseError(f"graze_curves with method = {method!r}: the grazing curves start from "
+                        "the extended system's grazings (method='extended')")
     with time_bound(max_seconds, "fold_curve"):
         if method == "extended":
             from .foldcurve import curve_dataset, extended
             label = field_label(*parse_field(case, field))
             out = curve_dataset(*extended(case, field, start, stop, name2, index2, values2, n,
                                           progress, cont), label, field_label(name2, index2),
-                                values2)
+                                values2, graze=graze)
             out["band"] = (("value2", "end"), np.tile([start, stop], (len(values2), 1)))
             out.attrs["field"] = label
         else:

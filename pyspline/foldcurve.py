@@ -13,8 +13,8 @@ v / (2 h), with [w^T, g'] the transposed bordered solve; F_q from the same runs 
 seven variational runs per Newton iteration whatever the state's size. The contact signature
 of the orbit (specials.contact_measures) must stay the seed's (the saltation in M holds within one contact sequence):
 where it changes, the direction stops ('grazing at ...'). At each value of field2 the grazing
-nearest each fold is found along that value's branch from the fold's orbit (fold_grazing:
-arclength's corrector, specials' bisection). Nothing here computes physics: the map, M and
+nearest each fold is found along that value's branch from the fold's orbit, and followed in
+field2 on request (pyspline.grazecurve: fold_grazing, curves). Nothing here computes physics: the map, M and
 the trajectories are the core's."""
 from __future__ import annotations
 
@@ -22,12 +22,13 @@ import warnings
 
 import numpy as np
 
-from .arclength import (_Branch, _Problem, _map_only, _null_tangent, continuation, field_label,
-                        parse_field, scaled_map, set_field)
+from .arclength import (_map_only, _null_tangent, continuation, field_label, parse_field,
+                        scaled_map, set_field)
 from .errors import CaseError, SolverError, SplineError, SplineWarning
+from .grazecurve import at as _at, curves as graze_curves, fold_grazing, variables
 from .orbits import _scale, _trajectory, forcing_periods, map_and_monodromy, out_of_time
 from .result import sundials_said
-from .specials import contact_measures, graze, multipliers, point_at
+from .specials import contact_measures, multipliers
 
 
 class FoldSystem:
@@ -252,11 +253,6 @@ def _failed(sys, a, pred, ds, sig0, y_fixed):
             f"{ds:.3g}: {sys.last_error}")
 
 
-def _at(sys, u):
-    p = sys.p_of(u)
-    return ", ".join(f"{field_label(*f)} = {v:.6g}" for f, v in zip(sys.fields, p))
-
-
 def cusps(pts):
     """The cusps of a traced curve (points in order): where the q2 component of the secant
     changes sign and the q1 component too (the curve's projection on the two fields turns
@@ -288,64 +284,6 @@ def at_value(sys, pts, q2, y_fixed):
             res = sys.correct(u, np.eye(len(u))[-1], q2, y_fixed)
             found.append(dict(u=u, exact=False) if res is None else dict(u=res[0], exact=True))
     return found
-
-
-def fold_grazing(sys, u, y_fixed, ds=0.02, ds_min=1e-4, ds_max=0.25, reach=2.0, iters=12):
-    """The grazing nearest the fold point u (converged, at field2 fixed) along its
-    one-parameter branch in the first field: the branch followed from the fold both ways by
-    arclength steps (continuation's corrector, the secant as predictor), always the way walked
-    less, until the contact signature changes at a point (or, in a failed step, at its
-    predictor), the grazing then bisected (`iters` times) as continuation locates it
-    (specials.graze). (the grazing's special record with 'bracket': the field's span between
-    the points either side of it, or None; 'found' or why not: none within the arclength
-    `reach` (scaled) either way, or the way's corrector failed)."""
-    if late := out_of_time():
-        return None, f"{late} was reached"
-    (name, index), (name2, index2) = sys.fields
-    with warnings.catch_warnings():     # the case's notes: said by the seed's run
-        warnings.simplefilter("ignore", SplineWarning)
-        prob = _Problem(set_field(sys.case, name2, index2, sys.p_of(u)[1]), name, index,
-                        sys.n, sys.p0[0], sys.p0[0], sys.t0)
-    prob.pscale, prob.d0, prob.free = sys.pscale[0], sys.d0, sys.free     # sys's unknowns
-    br = _Branch(prob, sys.n, y_fixed, sys.tol, 6)
-    try:
-        F, J, M, y = prob.evaluate(y_fixed, u[:-1], sys.n)
-        a = br.point((u[:-1], F, J, M, y, 0, [float(np.abs(F).max())]),
-                     np.linalg.svd(J)[2][-1])
-    except (SolverError, CaseError) as exc:
-        a, br.last_error = None, str(exc)
-    if a is None:
-        return None, f"the fold's orbit did not run: {br.last_error}"
-    ways = [dict(a, tau=s * a["tau"], s=0.0, ds=ds) for s in (1, -1)]
-    why = f"no grazing within {reach:g} of arclength (scaled) either way"
-    while ways:
-        if late := out_of_time():
-            return None, f"{late} was reached"
-        i = min(range(len(ways)), key=lambda j: ways[j]["s"])
-        w, sig = ways[i], ways[i]["contact"]["signature"]
-        pred = np.r_[w["u"] + w["ds"] * w["tau"], u[-1]]
-        b, loc = point_at(br, w, w["ds"]), False
-        if b is not None and b["contact"]["signature"] != sig:
-            loc = graze(br, w, b, w["ds"], iters)
-        elif b is None and not w.get("diagnosed") and br.signature(pred[:-1]) != sig:
-            w["diagnosed"] = True       # once from a point, as continuation's diagnosis
-            loc = graze(br, w, None, w["ds"], iters)
-        if loc:
-            return dict(loc[-1], bracket=abs(loc[1]["p"] - loc[0]["p"])), "found"
-        if b is None:
-            w["ds"] /= 2
-            if w["ds"] < ds_min:
-                why = (f"the branch's corrector failed at {_at(sys, pred)} with the step down "
-                       f"to {w['ds']:.3g}: {getattr(br, 'last_error', '')}")
-                ways.pop(i)
-        elif loc is None:
-            why = f"a contact change with no grazing located next to {_at(sys, pred)}"
-            ways.pop(i)
-        else:
-            ways[i] = dict(b, s=w["s"] + w["ds"], ds=min(ds_max, 1.5 * w["ds"]))
-            if ways[i]["s"] >= reach:
-                ways.pop(i)
-    return None, why
 
 
 def extended(case, field, start, stop, name2, index2, values2, n, progress, cont):
@@ -438,11 +376,12 @@ def _status(sys, ends, q2):
     return out
 
 
-def curve_dataset(sys, curves, ends, tried, label1, label2, values2, margin=1e-4):
+def curve_dataset(sys, curves, ends, tried, label1, label2, values2, margin=1e-4, graze=None):
     """The fold curves as fold_curve's variables: fold (value2, fold), status (value2), and
     along the curves (dim curve_point): curve, the two fields, y0, Tm_pp, the largest |mu|
     besides the one at +1 (mu_other) and stable; cusps (dim cusp); the grazings of the
-    values continued (those tried for a seed)."""
+    values continued (those tried for a seed); with graze (grazecurve.options), the grazing
+    curves through the grazings nearest the folds (grazecurve.variables)."""
     import xarray as xr
     said = [d if isinstance(d, str) else d.attrs["status"] for d in tried]
     if sys is None:     # no value with a fold: each value continued says what it found
@@ -460,9 +399,12 @@ def curve_dataset(sys, curves, ends, tried, label1, label2, values2, margin=1e-4
         if not all(x["exact"] for x in xs) and status[j] == "complete":
             status[j] = "a fold interpolated on the curve's chord (its corrector failed)"
     folds = [[sys.p_of(x["u"])[0] for x in xs] for xs in at]
-    with sundials_said("the runs from the folds to their nearest grazings"):   # after the
+    with sundials_said("the runs from the folds to their nearest grazings"):    # after the
         near = [[fold_grazing(sys, x["u"], x["y"]) if x["exact"] else   # folds: a time bound
                  (None, "no exact fold") for x in xs] for xs in at]     # cuts only these
+    with sundials_said("the runs along the grazing curves"):
+        traced = graze_curves(sys, near, [[x["y"] for x in xs] for xs in at], values2, graze) \
+            if graze is not None and sys is not None else None
     for j, r in enumerate(near):
         cut = [why for _, why in r if why.endswith(" was reached")]
         if cut and status[j] == "complete":
@@ -493,7 +435,8 @@ def curve_dataset(sys, curves, ends, tried, label1, label2, values2, margin=1e-4
         "stop_status": (("stop",), np.array([w for p, w in ends if p is not None
                                              and w != "complete"], dtype=object)),
         "cusp_field": (("cusp",), np.array([p[0] for _, p in cu])),
-        "cusp_field2": (("cusp",), np.array([p[1] for _, p in cu]))},
+        "cusp_field2": (("cusp",), np.array([p[1] for _, p in cu])),
+        **({} if traced is None else variables(sys, *traced))},
         coords={"value2": values2})
     out.attrs.update(method="extended", seed_status=said[-1] if said else "none",
                      curve_status="; ".join(w for _, w in ends) or "none traced",
@@ -503,6 +446,8 @@ def curve_dataset(sys, curves, ends, tried, label1, label2, values2, margin=1e-4
                          f"{label2} = {v:g}, the fold at {label1} = {f:.6g}: {why}"
                          for v, fs, r in zip(values2, folds, near) for f, (_, why) in zip(fs, r)
                          if why != "found") or "complete")
+    if traced is not None:
+        out.attrs["graze_curve_status"] = "; ".join(traced[1]) or "no grazing to follow"
     return out
 
 

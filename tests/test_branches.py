@@ -209,9 +209,10 @@ def test_fold_curve_grazing_below_the_upper_fold(fold_curves):
 @pytest.fixture(scope="module")
 def cusp_curve():
     """The fold pair of a = 0.085 over 2575-2600 r/min (docs: 1.5 r/min wide) followed in a
-    over 0.08-0.0875 (the folds also at 0.0865, inside)."""
+    over 0.08-0.0875 (the folds also at 0.0865, inside), and the grazing nearest its folds
+    followed in a over the same range."""
     return pyspline.fold_curve(FAST, "speed_rpm", 2575, 2600, "ripple_amp(1)", CUSP_AMPS,
-                               progress=False, ds_max=0.5, max_angle=0.3)
+                               progress=False, ds_max=0.5, max_angle=0.3, graze_curves=True)
 
 
 CUSP_AMPS = [0.085, 0.0875, 0.08, 0.0865]
@@ -290,6 +291,81 @@ def test_fold_grazings_are_the_repeated_methods(cusp_curve, cusp_repeated):
     assert ((near < upper) & (near > upper - 2)).all(), (near, upper)
 
 
+#: how well a grazing is located in speed (r/min): next to it the contact signature depends on
+#: the orbit to within the corrector's residual (100 rtol), coarser than the bisection's
+#: bracket (1e-4 to 1.5e-3 r/min): orbits either side converged to that residual differ in
+#: signature 3e-3 r/min beyond the bracket of every point (docs/branches.md, measured)
+GRAZE_PRECISION = 5e-3
+
+
+def test_grazing_curve_through_the_sampled_grazings(cusp_curve):
+    """The grazing nearest the folds (the same one for both folds at each value) followed in a
+    is one curve over the whole range, 0.08-0.0875, both ways complete, through the cusp's
+    value without meeting a fold (its field2 past the cusp, 0.08, where there is no fold); it
+    has a point at each value of a, there within the located precision of each fold's
+    `fold_grazing` (measured 1.4e-3 r/min), and falls in speed as a rises (the full-contact
+    orbit opens its teeth at lower speed with more ripple)."""
+    fc = cusp_curve
+    assert set(fc.graze_curve.values) == {0}, fc.graze_curve.values
+    assert list(fc.graze_curve_status.values) == ["down: complete; up: complete"]
+    x, a = fc.graze_curve_field.values, fc.graze_curve_field2.values
+    assert a.min() == 0.08 and a.max() == 0.0875 and (np.diff(a) > 0).all(), a
+    assert (np.diff(x) < 0).all(), x
+    for v, near in zip(fc.value2.values, fc.fold_grazing.values):
+        on = np.flatnonzero(a == v)
+        assert len(on) == 1, (v, a)
+        ok = np.isfinite(near)
+        assert ok.any() == (v != 0.08), (v, near)
+        assert (np.abs(near[ok] - x[on]) < GRAZE_PRECISION).all(), (v, near, x[on])
+
+
+def test_every_grazing_curve_point_is_a_grazing(cusp_curve):
+    """At every point of the grazing curve the periodic orbits (Newton from the point's orbit)
+    at the speeds either side of it, its bracket widened by the located precision, have
+    different contact signatures: a grazing lies between them; 0.1 r/min off the curve they
+    have the same."""
+    from pyspline.specials import contact_measures
+    fc = cusp_curve
+
+    def signature(p, a, y):
+        case = FAST.replace(speed_rpm=p, ripple_amp=[a, 0, 0, 0])
+        return contact_measures(pyspline.periodic_orbit(case, guess=y).trajectory)["signature"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        for (lo, hi), a, y in zip(np.sort(fc.graze_curve_ends.values, axis=1),
+                                  fc.graze_curve_field2.values, fc.graze_curve_y0.values):
+            assert hi - lo < GRAZE_PRECISION
+            assert signature(lo - GRAZE_PRECISION, a, y) != signature(hi + GRAZE_PRECISION, a, y)
+        assert signature(lo - 0.1, a, y) == signature(lo - 0.1 + 2 * GRAZE_PRECISION, a, y)
+
+
+def test_a_grazing_curve_stopped_keeps_its_points(cusp_curve):
+    """A direction cut by max_points keeps its points and says so; one whose prediction is
+    never close enough (move 1e-9) halves its step below ds_min (here at once) and keeps the
+    start, saying where the grazing was lost and why."""
+    from pyspline.arclength import parse_field
+    from pyspline.foldcurve import FoldSystem
+    from pyspline.grazecurve import STEPS, fold_grazing, trace
+    from pyspline.orbits import _scale
+    fc = cusp_curve
+    i = np.flatnonzero(fc.curve_field2.values == 0.085)[0]      # the seed, a fold at 0.085
+    p = np.array([float(fc.curve_field[i]), 0.085])
+    y = fc.curve_y0.values[i]
+    d0 = _scale(FAST.replace(speed_rpm=p[0], ripple_amp=[p[1], 0, 0, 0]).model)
+    fs = FoldSystem(FAST, parse_field(FAST, "speed_rpm"), parse_field(FAST, "ripple_amp(1)"),
+                    1, p, (260.0, 0.00875), np.ones(14, bool), d0, 1e-5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        g, why = fold_grazing(fs, np.r_[y / d0, 0.0, 0.0], y)
+        assert why == "found" and abs(g["p"] - fc.fold_grazing.values[0, 0]) < GRAZE_PRECISION
+        pts, why = trace(fs, g, 0.0, y, [], (-1.0, 1.0), 1, **(STEPS | dict(max_points=2)))
+        assert len(pts) == 2 and pts[1]["q"][1] > 0, pts
+        assert why.startswith("max_points = 2 reached at speed_rpm = "), why
+        pts, why = trace(fs, g, 0.0, y, [], (-1.0, 1.0), -1, **(STEPS | dict(move=1e-9, ds_min=0.1)))
+    assert len(pts) == 1 and why.startswith("the grazing is lost past speed_rpm = "), why
+    assert "from the prediction (move 1e-09)" in why, why
+
+
 def test_g_derivatives_against_differences(cusp_curve):
     """At a point of the fold curve the extended system's last Jacobian row, g's gradient
     (from two variational runs along v for the states, M(p +- h) v for the fields), equals
@@ -333,11 +409,19 @@ def test_bad_input_is_a_case_error(monkeypatch):
             pyspline.branches(DRIVE, "speed_rpm", BAND[0], progress=False, **args)
     for kw in (dict(values2=[np.nan]), dict(values2="x"), dict(values2=[0.2, 1e9]),
                dict(check=[np.nan]), dict(check="x"), dict(check_points=1),
-               dict(check_points=2.5), dict(ds_min=0.5), dict(bogus=1), dict(method="x")):
+               dict(check_points=2.5), dict(ds_min=0.5), dict(bogus=1), dict(method="x"),
+               dict(graze_curves="x"), dict(graze_curves=True, method="repeated")):
         args = dict(values2=[0.2]) | kw
         with pytest.raises(pyspline.CaseError, match=list(kw)[0]):
             pyspline.fold_curve(DRIVE, "speed_rpm", *BAND, "ripple_amp(1)", progress=False,
                                 **args)
+    for kw, key in ((dict(ds=-0.1), "ds"), (dict(move=np.nan), "move"),
+                    (dict(ds_max=np.inf), "ds_max"), (dict(max_points=1), "max_points"),
+                    (dict(max_points=2.0), "max_points"), (dict(bogus=1), "bogus"),
+                    (dict(ds_min=1.0), "ds_min <= ds")):
+        with pytest.raises(pyspline.CaseError, match=rf"graze_curves(\['{key}'\]|: {key})"):
+            pyspline.fold_curve(DRIVE, "speed_rpm", *BAND, "ripple_amp(1)", [0.2],
+                                progress=False, graze_curves=kw)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         with pytest.raises(pyspline.CaseError, match="scalar field"):
@@ -370,11 +454,12 @@ def test_cli_all(tmp_path):
     assert (tmp_path / "out" / "branches.png").stat().st_size > 10_000
 
 
-def test_cli_fold_input(tmp_path, every_branch, fold_command):
+def test_cli_fold_input(tmp_path, every_branch, fold_command, monkeypatch):
     """`pyspline continue --fold` (the fold curves' command above) writes the folds at a =
     0.25 (the Python --all call's, to 0.01 r/min) with the follow sweeps' verdict (2300, 2400,
     2500 r/min: two orbits exactly between the folds, 2354.6 and 2439.3), exit 0; a --fold
-    without numbers, or --repeated without --fold, is a CaseError naming it, exit 2."""
+    without numbers, or --repeated or --graze-curves without --fold, is a CaseError naming it,
+    exit 2; --graze-curves asks fold_curve for the grazing curves."""
     from test_continuation import cli
     fc, run, out = fold_command
     assert "wrote fold/fold_curve.nc" in run.stdout
@@ -390,7 +475,20 @@ def test_cli_fold_input(tmp_path, every_branch, fold_command):
     assert run.returncode == 2 and "--fold ripple_amp(1)=" in run.stderr, run.stderr
     run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
               "--stop", "2500", "--repeated")
-    assert run.returncode == 2 and "--repeated: the method of --fold" in run.stderr, run.stderr
+    assert run.returncode == 2 and "--repeated: an option of --fold" in run.stderr, run.stderr
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
+              "--stop", "2500", "--graze-curves")
+    assert run.returncode == 2 and "--graze-curves: an option of --fold" in run.stderr, \
+        run.stderr
+    import pyspline.diagram
+
+    def asked(*args, **kw):            # the flag's way into fold_curve, without the computing
+        raise pyspline.CaseError(f"graze_curves={kw['graze_curves']}")
+    monkeypatch.setattr(pyspline.diagram, "fold_curve", asked)
+    for flags, said in (((), "graze_curves=False"), (("--graze-curves",), "graze_curves=True")):
+        run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
+                  "--stop", "2500", "--fold", "ripple_amp(1)=0.2", *flags)
+        assert run.returncode == 2 and said in run.stderr, run.stderr
 
 
 def test_a_doubling_on_two_branches_is_reported_once():

@@ -328,6 +328,15 @@ def test_fold_plane_shades_the_band_between_the_folds():
                   "grazing nearest each fold"):
         assert words in legend
     assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
+    fc["graze_curve"] = ("graze_point", [0, 0, 0, 1])      # the grazing curves followed:
+    fc["graze_curve_field"] = ("graze_point", [2390.0, 2340.0, 2290.0, 2590.0])
+    fc["graze_curve_field2"] = ("graze_point", [0.0, 2.5e-5, 5e-5, 0.0])
+    fig = pc.fold_plane(fc)         # lines through the diamonds, which stand alone
+    green = [x for x in fig.axes[0].get_lines() if x.get_color() == "#009E73"]
+    assert [x.get_linestyle() for x in green[:2]] == ["None", "None"]
+    assert [x.get_xdata().tolist() for x in green[2:]] == [[2390.0, 2340.0, 2290.0], [2590.0]]
+    assert "grazing curve" in _words(fig, ["legend"])
+    assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
 # --------------------------------------------------------------------------- one run

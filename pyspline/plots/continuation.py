@@ -222,14 +222,22 @@ def fold_plane(fc, path=None, title: str | None = None) -> Figure:
 
 
 def _grazing_curves(ax, fc, v):
-    """fold_grazing per fold column, through the values of field2 in order; the line broken
-    between two values with another number of folds (the columns pair other folds there)."""
+    """fold_grazing per fold column, through the values of field2 in order (the line broken
+    between two values with another number of folds: the columns pair other folds there), or,
+    where the grazing curves were followed (graze_curve), those curves through them."""
     o = np.argsort(v)
     count = np.isfinite(fc.fold.values).sum(axis=1)[o]
     cut = np.flatnonzero(count[1:] != count[:-1]) + 1
+    followed = "graze_curve" in fc and fc.sizes["graze_point"] > 0
     for j, x in enumerate(fc.fold_grazing.values[o].T):
         ok = np.isfinite(x)
         if ok.any():
-            ax.plot(np.insert(x, cut, np.nan), np.insert(v[o], cut, np.nan), "d--",
-                    color="#009E73", ms=4, lw=1, label=None if j else
-                    "grazing nearest each fold (its contact sequence changes): fold_grazing")
+            ax.plot(np.insert(x, cut, np.nan), np.insert(v[o], cut, np.nan),
+                    "d" if followed else "d--", color="#009E73", ms=4, lw=1, label=None if j
+                    else "grazing nearest each fold (its contact sequence changes): "
+                         "fold_grazing")
+    for i in np.unique(fc.graze_curve.values) if followed else ():
+        on = fc.graze_curve.values == i
+        ax.plot(fc.graze_curve_field.values[on], fc.graze_curve_field2.values[on], "-",
+                color="#009E73", lw=1.2, label=None if i else "grazing curve (followed in "
+                f"{fc.attrs['field2']}: graze_curve)")
