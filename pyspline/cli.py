@@ -429,7 +429,7 @@ def cmd_sweep(args) -> int:
     if a["n_failed"] or a["n_missing"]:
         errors = [e for e in ds["error"].values.ravel() if e]
         print(f"first error: {errors[0]}", file=sys.stderr)
-    print(f"wrote {out / MERGED} (xarray.open_dataset(path, engine='h5netcdf') or "
+    print(f"wrote {out / MERGED} (xarray.open_dataset(path) or "
           "pyspline.open_sweep)")
     if "point" in ds.dims:    # a design table: no line or grid to draw
         return 1 if a["n_missing"] or a["n_executor_errors"] else 0
@@ -490,8 +490,8 @@ dim 'point' with the fields as coordinates (no figures).
 
 Writes into --out DIR:
   DIR/points/<index>.<hash>.npz   one file per finished point, written as it finishes
-  DIR/sweep.nc                    all points merged (NetCDF-4; xarray.open_dataset(path,
-                                  engine='h5netcdf') or pyspline.open_sweep(DIR))
+  DIR/sweep.nc                    all points merged (NetCDF-4; xarray.open_dataset(path)
+                                  or pyspline.open_sweep(DIR))
   DIR/bifurcation.png             section D2 against the first field, coloured by period
                                   (two fields: one panel per value of the second, and
                                   DIR/period_map.png, the period over the grid)

@@ -17,7 +17,7 @@ complex pair through the unit circle) and grazing (a tooth's contact sequence ch
 
 Writes into --out DIR:
   DIR/continuation.nc          the branch points and special points (xarray.open_dataset(
-                               path, engine='h5netcdf'); docs/continuation.md)
+                               path); docs/continuation.md)
   DIR/frequency_response.png   --measure (T_m peak-to-peak) against the field: stable solid,
                                unstable dashed, special points marked; with --sweep N the
                                runs of a follow-up and follow-down sweep of N points over it

@@ -1,7 +1,8 @@
 """The dataset of a sweep: the per-point summaries gathered into an xarray.Dataset (units and
 descriptions in each variable's attrs: from the core's tables for the swept fields, the
 statistics, the loads and the summaries of a result quantity), written to NetCDF-4 (engine
-h5netcdf) atomically, and read back (`open_sweep`); and a continuation's branches as one
+netcdf4: netCDF-C, 5-10x faster than h5netcdf at writing and reading these files of many small
+variables) atomically, and read back (`open_sweep`); and a continuation's branches as one
 (`continuation_dataset`)."""
 from __future__ import annotations
 
@@ -19,7 +20,7 @@ from .summary import _version
 
 __all__ = ["build_dataset", "continuation_dataset", "field_meta", "open_sweep", "write_netcdf"]
 
-ENGINE = "h5netcdf"
+ENGINE = "netcdf4"
 MERGED = "sweep.nc"     #: the merged sweep in a sweep's output directory
 
 
@@ -169,7 +170,7 @@ def build_dataset(grid: dict, keys: list, summaries: dict, hashes: dict, options
 
 
 def write_netcdf(ds, path) -> Path:
-    """Write a dataset to NetCDF-4 (engine h5netcdf, float arrays compressed) through a
+    """Write a dataset to NetCDF-4 (engine netcdf4, float arrays compressed) through a
     temporary file and os.replace, so a reader never sees half a file."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -203,7 +204,7 @@ def open_sweep(path):
     try:
         with xr.open_dataset(path, engine=ENGINE) as ds:
             ds = ds.load()
-    except Exception as exc:     # h5py, h5netcdf, xarray: whatever the damage, name the file
+    except Exception as exc:     # netCDF4, xarray: whatever the damage, name the file
         raise CaseError(f"open_sweep: {path} cannot be read as a sweep (NetCDF-4): "
                         f"{type(exc).__name__}: {exc}") from None
     missing = [k for k in _SWEEP_MARKS if k not in ds]

@@ -6,7 +6,7 @@ solver statistics, spectrum of T_m in shaft orders), gathered into an xarray.Dat
 runs the points in parallel (threads: the core releases the GIL; processes; Dask's
 ``distributed.Client(...).get_executor()``). With ``out=DIR`` every finished point is saved at
 once as ``DIR/points/<index>.<hash>.npz`` and all of them are merged into ``DIR/sweep.nc``
-(NetCDF-4, engine h5netcdf) at the end, also after a crash or Ctrl-C; a rerun into the same
+(NetCDF-4, engine netcdf4) at the end, also after a crash or Ctrl-C; a rerun into the same
 directory computes only the points whose file is missing (a point is known by its grid index
 and a hash of its case text, so a changed case is never served from a stale file).
 
@@ -318,7 +318,7 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
         ``sum(client.nthreads().values())``).
     progress : bool, tqdm progress bar on stderr.
     out : directory or None. Each finished point is written to ``out/points/`` at once; the
-        merge goes to ``out/sweep.nc`` (NetCDF-4, h5netcdf), also when the sweep is stopped by
+        merge goes to ``out/sweep.nc`` (NetCDF-4, netcdf4), also when the sweep is stopped by
         an exception or KeyboardInterrupt (pending points are cancelled, the exception is
         re-raised). A rerun into the same directory reuses every point file whose index and
         hash (case text + summary options) match and computes the rest.

@@ -80,7 +80,7 @@ pip_install() { python3 -m pip install -q --disable-pip-version-check "${pip_opt
 # The Python packages need nothing from apt: pip fetches and installs them while apt installs the
 # toolchain and SUNDIALS builds (network and disk against CPU). ninja is meson's.
 background "pip: build tools and pyspline's packages" pip pip_install "numpy>=2.0" meson \
-  meson-python ninja matplotlib scipy tqdm xarray "h5netcdf[h5py]" distributed
+  meson-python ninja matplotlib scipy tqdm xarray netCDF4 distributed
 
 need=(); update=0
 pkgs=(gfortran cmake liblapack-dev libblas-dev)

@@ -152,7 +152,7 @@ def fold_command(tmp_path_factory):
               "--check", "0.25", "--sweep", "3", "--ds-max", "0.5", "--max-angle", "0.3",
               "--out", "fold", "--quiet")
     assert run.returncode == 0, run.stderr
-    with xr.open_dataset(tmp / "fold" / "fold_curve.nc", engine="h5netcdf") as fc:
+    with xr.open_dataset(tmp / "fold" / "fold_curve.nc", engine="netcdf4") as fc:
         return fc.load(), run, tmp
 
 
@@ -440,8 +440,8 @@ def test_cli_all(tmp_path):
     run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2200",
               "--stop", "2300", "--all", "--sweep", "3", "--out", "out", "--quiet")
     assert run.returncode == 0, run.stderr
-    ds = xr.open_dataset(tmp_path / "out" / "branches.nc", engine="h5netcdf")
-    sw = xr.open_dataset(tmp_path / "out" / "sweep.nc", engine="h5netcdf")
+    ds = xr.open_dataset(tmp_path / "out" / "branches.nc", engine="netcdf4")
+    sw = xr.open_dataset(tmp_path / "out" / "sweep.nc", engine="netcdf4")
     want, want_sw = pyspline.branches(SETTLED, "speed_rpm", 2200, 2300, points=3,
                                       progress=False)
     assert ds.attrs["n_branches"] == 1 and ds.attrs["seeds"] == want.attrs["seeds"]

@@ -174,5 +174,5 @@ def test_cli_max_seconds(tmp_path):
               str(BAND[0]), "--stop", str(BAND[1]), "--quiet", "--out", "out",
               "--max-seconds", "1")
     assert run.returncode == 1 and "stopped: the wall-time bound" in run.stderr, run.stderr
-    ds = xr.open_dataset(tmp_path / "out" / "continuation.nc", engine="h5netcdf")
+    ds = xr.open_dataset(tmp_path / "out" / "continuation.nc", engine="netcdf4")
     assert "max_seconds = 1 s" in ds.attrs["status"] and ds.sizes["point"] >= 1

@@ -435,7 +435,7 @@ def test_cli_all_and_fold_keep_what_they_have(tmp_path):
     assert run.returncode == 1, run.stderr
     assert re.search(r"stopped: seed \w+ speed_rpm = 23\d+ to 23\d+: max_points = 3 reached",
                      run.stderr), run.stderr
-    ds = xr.open_dataset(tmp_path / "all" / "branches.nc", engine="h5netcdf")
+    ds = xr.open_dataset(tmp_path / "all" / "branches.nc", engine="netcdf4")
     assert ds.attrs["status"] in run.stderr and ds.sizes["point"] >= 3
     assert (tmp_path / "all" / "branches.png").stat().st_size > 10_000
     assert (tmp_path / "all" / "sweep.nc").exists()
@@ -445,7 +445,7 @@ def test_cli_all_and_fold_keep_what_they_have(tmp_path):
         run = cli(tmp_path, *args, *extra, "--fold", "ripple_amp(1)=0.15", "--out", out)
         assert run.returncode == 1 and "stopped: " in run.stderr and why in run.stderr, \
             run.stderr
-        fc = xr.open_dataset(out / "fold_curve.nc", engine="h5netcdf")
+        fc = xr.open_dataset(out / "fold_curve.nc", engine="netcdf4")
         assert why in fc.attrs["status"] and np.isnan(fc.fold.values).all()
         assert (out / "fold_curve.png").exists()
 
@@ -529,7 +529,7 @@ def test_cli_band(tmp_path):
     assert not (tmp_path / "bad").exists()
     run = cli(tmp_path, *args, "--band", "1621", "1626", "--out", "out")
     assert run.returncode == 0, run.stderr
-    ds = xr.open_dataset(tmp_path / "out" / "continuation.nc", engine="h5netcdf")
+    ds = xr.open_dataset(tmp_path / "out" / "continuation.nc", engine="netcdf4")
     p, b = ds.speed_rpm.values, ds.branch.values
     assert "--band 1621 1626" in ds.attrs["command"]
     assert (ds.n.values[b == 1] == 2).all() and p[b == 1].min() == pytest.approx(1621, abs=1e-9)

@@ -62,7 +62,7 @@ def linear_branch(tmp_path_factory):
     run = cli(tmp, "continue", "scene.nml", "--field", "speed_rpm", "--start", "2600",
               "--stop", "3800", "--ds", "0.1", "--out", "out", "--quiet")
     assert run.returncode == 0, run.stderr
-    with xr.open_dataset(tmp / "out" / "continuation.nc", engine="h5netcdf") as ds:
+    with xr.open_dataset(tmp / "out" / "continuation.nc", engine="netcdf4") as ds:
         return case, ds.load(), run, tmp
 
 

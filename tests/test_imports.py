@@ -134,7 +134,7 @@ def test_import_pyspline_is_light():
     """`import pyspline` (every public name bound) loads none of the heavy packages: figures,
     datasets, clusters and SciPy are imported by the functions that use them (0.13 s of CPU for
     the import against about 2 s with matplotlib, xarray, dask and scipy)."""
-    heavy = ("matplotlib", "xarray", "pandas", "dask", "distributed", "scipy", "h5netcdf")
+    heavy = ("matplotlib", "xarray", "pandas", "dask", "distributed", "scipy", "netCDF4")
     run = subprocess.run([sys.executable, "-P", "-c", "import sys, pyspline; "
                           "[getattr(pyspline, n) for n in pyspline.__all__]; "
                           "print(' '.join(sorted({m.split('.')[0] for m in sys.modules})))"],

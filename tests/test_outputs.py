@@ -53,8 +53,8 @@ def test_extremes_in_xarray_round_trip(tmp_path):
     res = pyspline.simulate(pyspline.load_case(CASES / "paper_flash_lx1e-4.nml", t_end=0.02,
                                                n_out=81))
     path = tmp_path / "run.nc"
-    res.to_xarray().to_netcdf(path, engine="h5netcdf")
-    with xr.open_dataset(path, engine="h5netcdf") as ds:
+    res.to_xarray().to_netcdf(path, engine="netcdf4")
+    with xr.open_dataset(path, engine="netcdf4") as ds:
         assert {n: float(ds["run_" + n]) for n in EXTREMES} == res.extremes
         for n, (long, unit) in EXTREMES.items():
             assert ds["run_" + n].dims == () and ds["run_" + n].attrs["long_name"] == long

@@ -433,8 +433,8 @@ def test_result_to_xarray_roundtrip(case, tmp_path):
     assert ds.attrs["lyapunov_exponent"] == res.lyapunov["exponent"]
     np.testing.assert_array_equal(ds["section_D2"], res.section_y[:, 5])
     path = tmp_path / "run.nc"
-    ds.to_netcdf(path, engine="h5netcdf")
-    with xr.open_dataset(path, engine="h5netcdf") as back:
+    ds.to_netcdf(path, engine="netcdf4")
+    with xr.open_dataset(path, engine="netcdf4") as back:
         xr.testing.assert_identical(back.load(), ds)
 
 
@@ -455,10 +455,10 @@ def test_design_table_with_a_byte_order_mark_and_bad_cells_named(tmp_path):
 
 def test_open_sweep_refuses_what_is_no_sweep_naming_the_path(tmp_path):
     """A continuation.nc (or any other netCDF), a damaged file and a missing one: CaseError
-    with the path, never a raw h5py error."""
+    with the path, never a raw netCDF4 error."""
     other = tmp_path / "continuation.nc"
     xr.Dataset({"Tm_pp": ("point", np.arange(3.0))}, attrs={"field": "speed_rpm"}).to_netcdf(
-        other, engine="h5netcdf")
+        other, engine="netcdf4")
     with pytest.raises(pyspline.CaseError, match=f"{other} is no sweep of pyspline"):
         pyspline.open_sweep(other)
     damaged = tmp_path / "d" / "sweep.nc"
