@@ -83,11 +83,19 @@ contains
     type(model_t), intent(in) :: m
     integer, intent(in) :: idx(nstate), n
     real(wp), intent(in) :: tau, ys(nstate)
-    real(wp) :: y(nstate), g(2*m%z), z(n)
+    real(wp) :: y(nstate), g(2*m%z), z(n), e2, d
     integer :: s
     ok = .false.
     if (tl%off) return
     call from_scaled(m, ys, y)
+    ! the tooth nearest the direction of the centre offset e (within pi/Z) has s dn_j <= s D2 -
+    ! |e| cos(pi/Z) on either flank s (Eq. 11, no spacing errors): where |D2| - |e| cos(pi/Z)
+    ! falls short of the backlash (by more than any round-off), some tooth is off both flanks and
+    ! the test below fails: skipped, the same decision (a chaotic drive tries at every output).
+    ! cos^2(pi/Z) = (1 + cos(2 pi/Z))/2, the model's cos_pitch
+    e2 = (y(1) + m%l_x - y(3))**2 + (y(2) + m%l_y - y(4))**2
+    d = abs(y(6)) - m%c_bulk*(1.0_wp - 1.0e-9_wp)
+    if (d < 0.0_wp .or. d**2 < (1.0_wp - 1.0e-9_wp)*e2*0.5_wp*(1.0_wp + m%cos_pitch)) return
     call mesh_switch_functions(m, tau/m%w_ref, y(1:ndof), g)   ! g(2j-1) = dn_j - c, g(2j) = dn_j + c
     if (all(g(1::2) > 0.0_wp)) then
       s = 1
