@@ -25,7 +25,7 @@ module spline_linear
   use spline_mesh, only: mesh_switch_functions
   implicit none
   private
-  public :: tail_t, tail_possible, tail_try, tail_state, tail_states
+  public :: tail_t, tail_possible, tail_try, tail_state, tail_states, tail_out_of_reach
 
   !> The closed-form tail of one run (held by the solver's context).
   type :: tail_t
@@ -88,6 +88,7 @@ contains
     ok = .false.
     if (tl%off) return
     call from_scaled(m, ys, y)
+    if (tail_out_of_reach(m, y)) return     ! the test below would fail (a chaotic drive: mostly)
     call mesh_switch_functions(m, tau/m%w_ref, y(1:ndof), g)   ! g(2j-1) = dn_j - c, g(2j) = dn_j + c
     if (all(g(1::2) > 0.0_wp)) then
       s = 1
@@ -109,6 +110,20 @@ contains
       tl%held = ys
     end if
   end function tail_try
+
+  !> Whether some tooth is off both flanks at the SI state y (tail_try's test then fails), known
+  !> without the switch functions: the tooth nearest the direction of the centre offset e (within
+  !> pi/Z) has s dn_j <= s D2 - |e| cos(pi/Z) on either flank s (Eq. 11, no spacing errors), so
+  !> where |D2| - |e| cos(pi/Z) falls short of the backlash by more than any round-off (1e-9 of
+  !> c and |e|) the test fails. cos^2(pi/Z) = (1 + cos(2 pi/Z))/2, the model's cos_pitch.
+  pure logical function tail_out_of_reach(m, y) result(out)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: y(nstate)
+    real(wp) :: e2, d
+    e2 = (y(1) + m%l_x - y(3))**2 + (y(2) + m%l_y - y(4))**2
+    d = abs(y(6)) - m%c_bulk*(1.0_wp - 1.0e-9_wp)
+    out = d < 0.0_wp .or. d**2 < (1.0_wp - 1.0e-9_wp)*e2*0.5_wp*(1.0_wp + m%cos_pitch)
+  end function tail_out_of_reach
 
   !> The system of flank s: A = rhs_jacobian with every contact frozen on s, checked against
   !> rhs_scaled (affine and time-invariant); y*; the eigenpairs of A and V^-1.

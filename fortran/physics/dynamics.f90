@@ -165,12 +165,22 @@ contains
     ys(ndof+1:) = y(ndof+1:)/(m%l_ref*m%w_ref)
   end subroutine to_scaled
 
+  !> The SI state y of the scaled ys (y = ys state_units). For other modules; this one calls
+  !> unscale, which the compiler inlines (spline_mesh::tooth_approach says why).
   pure subroutine from_scaled(m, ys, y)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: ys(nstate)
     real(wp), intent(out) :: y(nstate)
-    y = ys*state_units(m)
+    call unscale(m, ys, y)
   end subroutine from_scaled
+
+  pure subroutine unscale(m, ys, y)
+    type(model_t), intent(in) :: m
+    real(wp), intent(in) :: ys(nstate)
+    real(wp), intent(out) :: y(nstate)
+    y(1:ndof) = ys(1:ndof)*m%l_ref
+    y(ndof+1:) = ys(ndof+1:)*(m%l_ref*m%w_ref)
+  end subroutine unscale
 
   !> The SI unit of each scaled state (from_scaled: y = ys state_units): l for the
   !> displacements, l w for the velocities.
@@ -191,7 +201,7 @@ contains
     integer, intent(in), optional :: mode(m%z*m%n_slices)
     type(coupling_stats_t), intent(inout), optional :: cstats
     real(wp) :: y(nstate), a(ndof)
-    call from_scaled(m, ys, y)
+    call unscale(m, ys, y)
     call accelerations(m, tau*m%inv_w_ref, y(1:ndof), y(ndof+1:), a, ierr, errmsg, mode, cstats)
     dys(1:ndof) = ys(ndof+1:)
     dys(ndof+1:) = a*m%inv_acc_ref

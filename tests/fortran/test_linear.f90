@@ -4,12 +4,16 @@
 !> motion about the equilibrium) within 1e-12 of the motion's largest excursion per state kind,
 !> displacements and velocities (the bound of tail_states: about nanchor n eps |P| ~ 1e-13); in
 !> SI units (units = state_units, as the run asks for them) from_scaled's bits of every column.
+!> tail_out_of_reach, which lets tail_try skip the switch functions: over random states about the
+!> backlash, never where every tooth is on one flank (by the switch functions), and it decides
+!> most of the states where not.
 program test_linear
   use spline_kinds, only: wp
   use spline_case, only: case_t
   use spline_model, only: model_t, nstate, ndof
   use spline_dynamics, only: start_state, to_scaled, from_scaled, state_units, integrated_states
-  use spline_linear, only: tail_t, tail_try, tail_state, tail_states
+  use spline_linear, only: tail_t, tail_try, tail_state, tail_states, tail_out_of_reach
+  use spline_mesh, only: mesh_switch_functions
   use check, only: check_true, check_done, default_case_model
   implicit none
   integer, parameter :: nt = 1000
@@ -18,7 +22,10 @@ program test_linear
   type(tail_t) :: tl
   real(wp) :: y(nstate), ys(nstate), taus(nt), tau0, ref(nstate, nt), got(nstate, nt), ex(nstate), &
        err(nstate), scale(2), tol(nstate), si(nstate, nt), col(nstate)
-  integer :: idx(nstate), n, i, ierr
+  integer :: idx(nstate), n, i, ierr, nout, nflank, nmiss
+  integer, allocatable :: seed(:)
+  real(wp), allocatable :: g(:)
+  real(wp) :: r(6), c
   character(len=512) :: msg
   logical :: ok
 
@@ -65,6 +72,36 @@ program test_linear
   end do
   call tail_states(tl, taus, got)
   call check_true('tail_states: non-uniform times to the bit', all(got == ref))
+
+  ! tail_out_of_reach against the switch functions at 20 000 random states: centre offsets and
+  ! D2 within 3 backlashes (all teeth on a flank, some free, all free), random shaft angles
+  call random_seed(size=i)
+  allocate(seed(i), g(2*md%z))
+  seed = 20261127
+  call random_seed(put=seed)
+  c = md%c_bulk
+  nout = 0; nflank = 0; nmiss = 0
+  ok = .true.
+  do i = 1, 20000
+    call random_number(r)
+    y = 0.0_wp
+    y(1:2) = 3.0_wp*c*(2.0_wp*r(1:2) - 1.0_wp) - [md%l_x, md%l_y]
+    y(6) = 3.0_wp*c*(2.0_wp*r(3) - 1.0_wp)
+    call mesh_switch_functions(md, r(4), y(1:ndof), g)
+    if (all(g(1::2) > 0.0_wp) .or. all(g(2::2) < 0.0_wp)) then
+      nflank = nflank + 1
+      ok = ok .and. .not. tail_out_of_reach(md, y)
+    else if (tail_out_of_reach(md, y)) then
+      nout = nout + 1
+    else
+      nmiss = nmiss + 1
+    end if
+  end do
+  call check_true('tail_out_of_reach: never where every tooth is on one flank', ok)
+  call check_true('tail_out_of_reach: both kinds of states sampled', nflank > 100 .and. nout > 100)
+  call check_true('tail_out_of_reach: decides most states with a tooth off its flank', &
+       nout > 10*nmiss, 'out of reach '//trim(fmt(real(nout, wp)))//', not decided '// &
+       trim(fmt(real(nmiss, wp))))
   call check_done('test_linear')
 contains
   function fmt(x) result(s)
