@@ -162,13 +162,20 @@ def test_map_runs_bounded_in_wall_time(z24):
 
 def test_wall_bound_leaves_the_numbers_unchanged(z24):
     """Under a wall-time bound the integrator is called in chunks of steps (the clock read
-    between them): the map and its monodromy are the same to the bit."""
+    between them): the map and its monodromy are the same to the bit. Over 3 periods each
+    takes more steps in one call than a chunk (spline_integrator's wall_chunk = 20000: a bound
+    of one chunk stops it)."""
     case, y0, period = z24
-    long = case.replace(t_end=12 * period, max_steps=10 ** 6)   # more steps than a chunk
-    runs = [orbits.map_and_monodromy(long, 0.0, 10 * period, y0, max_seconds=s)
+    long = case.replace(t_end=5 * period, max_steps=10 ** 6)
+    chunk = long.replace(max_steps=20000)
+    with pytest.raises(pyspline.SolverError, match="took max_steps = 20000"):
+        orbits.map_and_monodromy(chunk, 0.0, 3 * period, y0)
+    with pytest.raises(pyspline.SolverError, match="took max_steps = 20000"):
+        orbits._period_map(pyspline.load(chunk), 0.0, 3 * period, y0[:, None])
+    runs = [orbits.map_and_monodromy(long, 0.0, 3 * period, y0, max_seconds=s)
             for s in (math.inf, 1e6)]
     np.testing.assert_array_equal(runs[0][0], runs[1][0])
     np.testing.assert_array_equal(runs[0][1], runs[1][1])
-    maps = [orbits._period_map(pyspline.load(long), 0.0, 10 * period, y0[:, None], max_seconds=s)[0]
+    maps = [orbits._period_map(pyspline.load(long), 0.0, 3 * period, y0[:, None], max_seconds=s)[0]
             for s in (math.inf, 1e6)]
     np.testing.assert_array_equal(maps[0], maps[1])

@@ -194,7 +194,9 @@ def test_interrupt_keeps_finished_points(case, tmp_path, monkeypatch, kind):
 
 def test_ctrl_c_in_a_real_sweep(case, tmp_path):
     """SIGINT to `pyspline sweep` (serial) during a run: exit 130, finished points kept and
-    merged, a rerun completes the sweep."""
+    merged, a rerun reuses them (here over the points that finished: the rest would take 0.2 s
+    each; that a rerun then computes only the missing points:
+    test_resume_computes_only_missing_points)."""
     path = tmp_path / "long.nml"
     case.replace(t_end=12.0, n_out=1001, name="long", linear_tail=False).to_namelist(path)  # 0.2 s
     # a point (the linear tail would finish a point in a few ms, and the sweep before SIGINT)
@@ -218,6 +220,9 @@ def test_ctrl_c_in_a_real_sweep(case, tmp_path):
     assert 2 <= n < 40
     merged = pyspline.open_sweep(out)
     assert merged.attrs["n_ok"] == n and merged.attrs["n_missing"] == 40 - n
+    rerun = pyspline.sweep(pyspline.load_case(path), progress=False, out=out,
+                           l_x=sw.parse_values("l_x", "0:3e-4:40")[:n])
+    assert rerun.attrs["n_reused"] == n and rerun.attrs["n_computed"] == 0
 
 
 # --------------------------------------------------------------------------- Dask
