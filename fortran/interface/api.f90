@@ -285,6 +285,10 @@ contains
            tm(r*nt+1:(r+1)*nt))
       nqw = nw
       sec_y = transpose(scol)
+      if (ie == err_ok .and. m%realisations == 1) then     ! nk = 1: the arrays, contiguous
+        call run_results(m, t, y, tooth(:, :, 1:nw), tm, stats, consts, loads, tload, ext, text)
+        warnings = text
+      end if
     else
       t = 0; y = 0; tooth = 0; tm = 0       ! run_case defines them whenever it runs
     end if
@@ -307,10 +311,6 @@ contains
       else
         call run_case(m, t, y, tooth, tm, stats, ie, errmsg, interruptible=.true., &
              sec_t=sec_t, sec_y=scol, lyap_t=lyap_t, lyap_g=lyap_g, nq=nw, consts=consts)
-      end if
-      if (ie == err_ok .and. m%realisations == 1) then
-        call run_results(m, t, y, tooth(:, :, 1:nw), tm, stats, consts, loads, tload, ext, text)
-        warnings = text
       end if
     end subroutine run_rows
   end subroutine api_simulate

@@ -542,14 +542,22 @@ contains
     real(wp), intent(out) :: tm(:)
     logical, intent(in) :: fill
     logical, intent(out) :: finite
+    real(wp), allocatable :: part(:, :, :)
     integer :: q
     if (fill) then
       do q = 5, ntooth_q
         tooth(:, :, q) = cq(q - 4)
       end do
     end if
-    call mesh_outputs(m, size(t), t, y, modes, tooth(:, :, 1), tooth(:, :, 2), tooth(:, :, 3), &
-         tooth(:, :, 4), tm, finite)
+    if (is_contiguous(tooth)) then
+      call mesh_outputs(m, size(t), t, y, modes, tooth(:, :, 1), tooth(:, :, 2), tooth(:, :, 3), &
+           tooth(:, :, 4), tm, finite)
+    else                 ! a copy's rows of the copies' array (realisations): formed, then stored
+      allocate(part(size(t), m%z, 4))
+      call mesh_outputs(m, size(t), t, y, modes, part(:, :, 1), part(:, :, 2), part(:, :, 3), &
+           part(:, :, 4), tm, finite)
+      tooth(:, :, 1:4) = part
+    end if
   end subroutine bulk_tooth_outputs
 
   !> Every per-tooth quantity (order of spline_quantities tooth_q) and the meshing torque at one state y (SI):

@@ -305,7 +305,7 @@ contains
     integer, intent(in) :: nt
     real(wp), intent(in) :: t(nt), y(:, :)
     integer, intent(in) :: modes(:, :)
-    real(wp), intent(out), dimension(:, :) :: f, fx, fy, dn   ! (nt, z); a copy's rows of more
+    real(wp), intent(out), dimension(nt, m%z) :: f, fx, fy, dn
     real(wp), intent(out) :: tm(nt)
     logical, intent(out) :: finite
     integer, parameter :: nblk = 64
