@@ -319,30 +319,36 @@ class SerialExecutor(cf.Executor):
         return f
 
 
-def _simulate(model, copy: int = 0, ya=None, max_seconds: float = 0.0) -> tuple:
+def _outputs(model, nk: int = 1) -> tuple:
+    """The arrays api_simulate writes in place, of nk runs (1, or the K copies of realisations =
+    K, copy k into block k of rows): t, y columns, tooth, tm. Not zeroed (the core writes each
+    element of a run's rows; f2py would zero its own)."""
+    nt = model.n_out * nk
+    return (np.empty(nt), np.empty((14, nt), order="F"),
+            np.empty((nt, model.z, len(_names("tooth"))), order="F"), np.empty(nt))
+
+
+def _simulate(model, copy: int = 0, ya=None, max_seconds: float = 0.0, out=None) -> tuple:
     """api_simulate on a loaded Model (copy k of realisations = K > 1 from ya, the state at the
-    end of the transient; max_seconds > 0: the call's wall-time bound): (t, y columns, tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face,
-    tilt, nqw, consts, loads, tload, ext, warnings, ierr, msg); a copy's loads, tload, ext and
-    warnings are 0 and blank (the copies' together: _copies). Module level, so a process
-    executor can take it."""
-    nq, ns = len(_names("tooth")), len(_names("stats"))
-    nft = model.n_out if model.n_slices else 0
-    # the arrays of every output (the core writes each element) are allocated here, not zeroed
-    # (f2py zeroes its own)
-    nt = model.n_out
-    t, y, tm = np.empty(nt), np.empty((14, nt), order="F"), np.empty(nt)
-    tooth = np.empty((nt, model.z, nq), order="F")
-    return bridge.simulate(model.bytes, model.z, nt, nq, ns, model.n_section,
-                           model.n_lyapunov, nft, model.n_slices, len(LOAD_QUANTITIES),
-                           len(TOOTH_LOAD_QUANTITIES), len(EXTREMES), t, y, tooth, tm, copy,
+    end of the transient; max_seconds > 0: the call's wall-time bound; out: _outputs' arrays to
+    write into, of this run or of the K copies): (t, y columns, tooth, tm, stats, sec_t, sec_y,
+    lyap_t, lyap_g, face, tilt, nqw, consts, loads, tload, ext, warnings, ierr, msg); a copy's
+    loads, tload, ext and warnings are 0 and blank (the copies' together: _copies). Module
+    level, so a process executor can take it."""
+    t, y, tooth, tm = _outputs(model) if out is None else out
+    return bridge.simulate(model.bytes, model.z, model.n_out, len(t) // model.n_out,
+                           tooth.shape[2], len(_names("stats")), model.n_section,
+                           model.n_lyapunov, model.n_out if model.n_slices else 0,
+                           model.n_slices, len(LOAD_QUANTITIES), len(TOOTH_LOAD_QUANTITIES),
+                           len(EXTREMES), t, y, tooth, tm, copy,
                            np.zeros(14) if ya is None else ya, max_seconds)
 
 
-def _copy(model, copy: int, ya, end: float) -> tuple:
+def _copy(model, copy: int, ya, end: float, out=None) -> tuple:
     """_simulate of copy `copy` within the time left until `end` (time.time(); 0: no bound; a
     microsecond once it has passed: the run stops at once). Module level, for a process
     executor."""
-    return _simulate(model, copy, ya, max(end - time.time(), 1e-6) if end else 0.0)
+    return _simulate(model, copy, ya, max(end - time.time(), 1e-6) if end else 0.0, out)
 
 
 def _copies(model, executor, max_seconds: float = 0.0) -> tuple:
@@ -351,33 +357,40 @@ def _copies(model, executor, max_seconds: float = 0.0) -> tuple:
     after another, and what follows from them in one call of the core (api_results: the
     statistics combined, the loads with standard errors from the copies' spread, the extremes
     and RMS, the warnings; spline_run::run_results, as spline-dyn): _simulate's tuple.
+    On threads (None, a ThreadPoolExecutor or a SerialExecutor) each copy writes its rows of one
+    set of output arrays (_outputs) in place; another executor's copies return theirs, copied
+    in; sections, face and tilt are each copy's own, concatenated.
     max_seconds > 0: the wall-time bound of the transient and the copies together (each copy
     gets what is left when it starts: _copy)."""
-    k, n = model.case["realisations"], model.n_out
+    k = model.case["realisations"]
     end = time.time() + max_seconds if max_seconds > 0 else 0.0
     ya, ierr, msg = bridge.start_state(model.bytes, 1, max_seconds)
     raise_for(ierr, msg)
     own = executor is None
     if own:
         executor = cf.ThreadPoolExecutor(min(k, os.cpu_count() or 1))
+    shared = own or isinstance(executor, (cf.ThreadPoolExecutor, SerialExecutor))
+    out = _outputs(model, k)
     try:
-        outs = list(executor.map(_copy, [model] * k, range(1, k + 1), [ya] * k, [end] * k))
+        outs = list(executor.map(_copy, [model] * k, range(1, k + 1), [ya] * k, [end] * k,
+                                 [out if shared else None] * k))
     finally:
         if own:
             executor.shutdown()
     for o in outs:
         raise_for(o[-2], o[-1])              # the first failed copy raises
+    if not shared:                           # each copy's rows, one after another
+        for i, a in enumerate(out):
+            np.concatenate([o[i] for o in outs], axis=1 if i == 1 else 0, out=a)
+    t, y, tooth, tm = out
     nqw, consts = outs[0][11], outs[0][12]
-    cat = [np.concatenate([o[i] for o in outs], axis=1 if i == 1 else 0) for i in range(11)]
-    cat[2] = np.empty((k * n, model.z, nqw), order="F")   # the quantities written (nqw)
-    for j, o in enumerate(outs):
-        cat[2][j * n:(j + 1) * n] = o[2][:, :, :nqw]
-    cat[4], loads, tload, ext, warned, ierr, msg = bridge.results(
-        model.bytes, len(LOAD_QUANTITIES), len(TOOTH_LOAD_QUANTITIES), len(EXTREMES), cat[0],
-        cat[1], cat[2], cat[3], np.stack([o[4] for o in outs], axis=1), consts)
+    st, loads, tload, ext, warned, ierr, msg = bridge.results(
+        model.bytes, len(LOAD_QUANTITIES), len(TOOTH_LOAD_QUANTITIES), len(EXTREMES), t, y,
+        tooth[:, :, :nqw], tm, np.stack([o[4] for o in outs], axis=1), consts)
     raise_for(ierr, msg)
     said = "\n".join(decode(o[-1]) for o in outs)     # each copy's SUNDIALS warnings
-    return (*cat, nqw, consts, loads, tload, ext, warned, 0, said)
+    cat = [np.concatenate([o[i] for o in outs]) for i in (5, 6, 7, 8, 9, 10)]  # sections, face
+    return (t, y, tooth, tm, st, *cat, nqw, consts, loads, tload, ext, warned, 0, said)
 
 
 def run(model, executor=None, max_seconds: float = 0.0) -> Result:

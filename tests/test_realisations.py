@@ -1,5 +1,6 @@
 """realisations = K (docs/accuracy.md): K perturbed copies after the transient read the statistics
 one long run reads, with standard errors from their spread; spline-dyn gives Python's numbers."""
+import concurrent.futures as cf
 import re
 import subprocess
 import warnings
@@ -19,10 +20,10 @@ def chaos(**fields):
                                   **{"goal": "statistics", "lyapunov": False, **fields})
 
 
-def simulate(case):
+def simulate(case, executor=None):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pyspline.SplineWarning)
-        return pyspline.simulate(case)
+        return pyspline.simulate(case, executor)
 
 
 def rms(res):
@@ -68,6 +69,36 @@ def test_executable_gives_the_realisations_of_python(exe, tmp_path):
     got = float(re.search(r"stats\.rhs_evals \[.*\] = +(\S+)", text).group(1))
     assert got == res.stats["rhs_evals"]
     assert len(res.section_t) == 2 * pyspline.load(case).n_section > 0
+
+
+class Apart(cf.Executor):
+    """Each call at once in the caller, as an executor whose workers do not share the caller's
+    memory (a process pool): the copies write arrays of their own, concatenated after."""
+
+    def submit(self, fn, /, *args, **kwargs):
+        f = cf.Future()
+        f.set_result(fn(*args, **kwargs))
+        return f
+
+
+def test_copies_in_place_give_the_numbers_of_copies_run_apart():
+    """realisations = 2 on threads, each copy writing its rows of one set of output arrays in
+    place (pyspline.result._copies), gives to the bit what the copies give run one after another
+    in one thread, each into arrays of its own, concatenated: every output, section point, load,
+    extreme and statistic."""
+    case = chaos(t_transient=0.05, t_end=0.1, n_out=501, realisations=2, section="shaft")
+    threads, apart = simulate(case), simulate(case, Apart())
+    assert np.count_nonzero(threads.t == threads.t[0]) == 2 and len(threads.section_t) == 4
+    for name in ("t", "y", "Tm", "section_t", "section_y"):
+        np.testing.assert_array_equal(getattr(threads, name), getattr(apart, name), name)
+    assert threads.tooth.keys() == apart.tooth.keys()
+    for name in threads.tooth:
+        np.testing.assert_array_equal(threads.tooth[name], apart.tooth[name], name)
+    for name in threads.loads:
+        np.testing.assert_array_equal(threads.loads[name], apart.loads[name], name)
+    assert threads.extremes == apart.extremes
+    assert ({k: v for k, v in threads.stats.items() if "wall" not in k}
+            == {k: v for k, v in apart.stats.items() if "wall" not in k})
 
 
 @pytest.mark.parametrize("fields, message", [

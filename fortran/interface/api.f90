@@ -241,16 +241,21 @@ contains
   !> A case with realisations = K > 1 runs copy `copy` (1..K) from ya, the state at the end of
   !> the transient (api_start_state), over its window (spline_realisations); loads, tload, ext
   !> and warnings stay 0 and blank: they are the K copies' together (api_results).
+  !> nk: the runs t, y, tooth and tm hold (1, or K: the copies' arrays, copy k writing block k
+  !> of nt rows in place and no other element, so the K copies may run at once on one set of
+  !> arrays; its sections, face and tilt are its own).
   !> A SIGINT during the run stops it (ierr 4). max_seconds > 0: the call's wall-time bound
   !> over all its runs (a run past it fails naming it, as a solver failure; 0: none).
   !> Called without the GIL.
-  subroutine api_simulate(model, nb, z, nt, nq, ns, nsec, nlyap, nft, nslice, nl, ntl, nx, t, y, &
-       tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, nqw, consts, loads, tload, ext, &
-       warnings, copy, ya, ierr, errmsg, max_seconds)
-    integer(c_int), intent(in) :: nb, z, nt, nq, ns, nsec, nlyap, nft, nslice, nl, ntl, nx, copy
+  subroutine api_simulate(model, nb, z, nt, nk, nq, ns, nsec, nlyap, nft, nslice, nl, ntl, nx, t, &
+       y, tooth, tm, stats, sec_t, sec_y, lyap_t, lyap_g, face, tilt, nqw, consts, loads, tload, &
+       ext, warnings, copy, ya, ierr, errmsg, max_seconds)
+    integer(c_int), intent(in) :: nb, z, nt, nk, nq, ns, nsec, nlyap, nft, nslice, nl, ntl, nx
+    integer(c_int), intent(in) :: copy
     real(c_double), intent(in) :: ya(14), max_seconds
     integer(c_int), intent(in) :: model(nb)
-    real(c_double), intent(out) :: t(nt), y(14, nt), tooth(nt, z, nq), tm(nt), stats(ns)
+    real(c_double), intent(inout) :: t(nt*nk), y(14, nt*nk), tooth(nt*nk, z, nq), tm(nt*nk)
+    real(c_double), intent(out) :: stats(ns)
     real(c_double), intent(out) :: sec_t(nsec), sec_y(nsec, 14), lyap_t(nlyap), lyap_g(nlyap)
     real(c_double), intent(out) :: face(nft, z, nslice), tilt(nft, 2), consts(4)
     real(c_double), intent(out) :: loads(nl), tload(z, ntl), ext(nx)
@@ -260,7 +265,7 @@ contains
     type(model_t) :: m
     real(wp), allocatable :: scol(:, :)
     character(len=:), allocatable :: text
-    integer :: ie, nw
+    integer :: ie, nw, r
     stats = 0; sec_t = 0; sec_y = 0; lyap_t = 0; lyap_g = 0   ! t, y, tooth, tm: below
     face = 0; tilt = 0; nqw = nq; consts = 0; loads = 0; tload = 0; ext = 0; warnings = ''
     call unpack(model, m, ie, errmsg, max_seconds)
@@ -268,12 +273,30 @@ contains
          .or. nsec /= run_sections(m) .or. (m%realisations > 1 .and. &
          (copy < 1 .or. copy > m%realisations)) .or. nlyap /= lyapunov_count(m) .or. &
          nslice /= merge(m%n_slices, 0, m%n_slices > 1) .or. nft /= merge(nt, 0, nslice > 0) &
-         .or. nl /= nload .or. ntl /= nload_tooth .or. nx /= nextreme)) then
+         .or. nl /= nload .or. ntl /= nload_tooth .or. nx /= nextreme .or. &
+         (nk /= 1 .and. nk /= max(m%realisations, 1)))) then
       ie = err_case
       errmsg = 'api_simulate: array sizes do not match the loaded case'
     end if
     if (ie == err_ok) then
       allocate(scol(nstate, nsec))
+      r = merge(copy - 1, 0, nk > 1)            ! this run's block of rows
+      call run_rows(t(r*nt+1:(r+1)*nt), y(:, r*nt+1:(r+1)*nt), tooth(r*nt+1:(r+1)*nt, :, :), &
+           tm(r*nt+1:(r+1)*nt))
+      nqw = nw
+      sec_y = transpose(scol)
+      if (ie == err_ok .and. m%realisations == 1) then     ! nk = 1: the arrays, contiguous
+        call run_results(m, t, y, tooth(:, :, 1:nw), tm, stats, consts, loads, tload, ext, text)
+        warnings = text
+      end if
+    else
+      t = 0; y = 0; tooth = 0; tm = 0       ! run_case defines them whenever it runs
+    end if
+    ierr = ie
+  contains
+    !> The run into its rows (t, y, tm contiguous; tooth a section of the caller's array).
+    subroutine run_rows(t, y, tooth, tm)
+      real(wp), intent(out) :: t(nt), y(nstate, nt), tooth(:, :, :), tm(nt)
       if (m%realisations > 1 .and. nslice > 0) then
         call run_case(copy_model(m), t, y, tooth, tm, stats, ie, errmsg, interruptible=.true., &
              sec_t=sec_t, sec_y=scol, face=face, tilt=tilt, nq=nw, consts=consts, &
@@ -289,16 +312,7 @@ contains
         call run_case(m, t, y, tooth, tm, stats, ie, errmsg, interruptible=.true., &
              sec_t=sec_t, sec_y=scol, lyap_t=lyap_t, lyap_g=lyap_g, nq=nw, consts=consts)
       end if
-      nqw = nw
-      sec_y = transpose(scol)
-      if (ie == err_ok .and. m%realisations == 1) then
-        call run_results(m, t, y, tooth(:, :, 1:nw), tm, stats, consts, loads, tload, ext, text)
-        warnings = text
-      end if
-    else
-      t = 0; y = 0; tooth = 0; tm = 0       ! run_case defines them whenever it runs
-    end if
-    ierr = ie
+    end subroutine run_rows
   end subroutine api_simulate
 
   !> What follows from the outputs of a case with realisations = K (spline_run::run_results):

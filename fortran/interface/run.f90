@@ -47,7 +47,9 @@ contains
   end subroutine output_times
 
   !> Run a validated case: y(:, k) is the SI state at t(k), tooth(k, j, :) the quantities of
-  !> spline_quantities tooth_q for tooth j, tm(k) the meshing torque (Eq. 22).
+  !> spline_quantities tooth_q for tooth j (n_out x z x ntooth_q: an array or, for a copy of
+  !> realisations, its rows of the copies' array, written in place), tm(k) the meshing torque
+  !> (Eq. 22).
   !> fidelity = 'auto' runs the cheapest level of the ladder within fidelity_tol (auto_level);
   !> a coupled case runs one-way first and is run again coupled if the one-way flash
   !> temperature's estimate (backlash_estimate of its largest T_f) exceeds auto_tol.
@@ -64,7 +66,7 @@ contains
   subroutine run_case(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
        lyap_t, lyap_g, face, tilt, nq, consts, y_start)
     type(model_t), intent(in) :: m
-    real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
+    real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(:, :, :)
     real(wp), intent(out) :: tm(m%n_out), stats(nstats)
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
@@ -226,9 +228,11 @@ contains
     known = .false.
     if (present(tooth_finite)) known = tooth_finite
     ! one contiguous pass over each array (tooth not again where the pass that wrote it found
-    ! every value finite: tooth_finite); the output-by-output search only to name a failure
+    ! every value finite: tooth_finite; a copy's rows of a larger array are packed for it only
+    ! then); the output-by-output search only to name a failure
+    if (.not. known) known = all_finite(size(tooth), tooth)
     if (all_finite(size(t), t) .and. all_finite(size(y), y) .and. all_finite(size(tm), tm) .and. &
-         (known .or. all_finite(size(tooth), tooth))) then
+         known) then
       k1 = size(t) + 1
     else
       k1 = 1
@@ -378,7 +382,7 @@ contains
   subroutine run_level(m, t, y, tooth, tm, stats, ierr, errmsg, interruptible, sec_t, sec_y, &
        face, tilt, lazy, nw, consts, fin, lib, y_start)
     type(model_t), intent(in) :: m
-    real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(m%n_out, m%z, ntooth_q)
+    real(wp), intent(out) :: t(m%n_out), y(nstate, m%n_out), tooth(:, :, :)
     real(wp), intent(out) :: tm(m%n_out), stats(nstats)
     integer, intent(out) :: ierr
     character(len=*), intent(out) :: errmsg
@@ -538,14 +542,22 @@ contains
     real(wp), intent(out) :: tm(:)
     logical, intent(in) :: fill
     logical, intent(out) :: finite
+    real(wp), allocatable :: part(:, :, :)
     integer :: q
     if (fill) then
       do q = 5, ntooth_q
         tooth(:, :, q) = cq(q - 4)
       end do
     end if
-    call mesh_outputs(m, size(t), t, y, modes, tooth(:, :, 1), tooth(:, :, 2), tooth(:, :, 3), &
-         tooth(:, :, 4), tm, finite)
+    if (is_contiguous(tooth)) then
+      call mesh_outputs(m, size(t), t, y, modes, tooth(:, :, 1), tooth(:, :, 2), tooth(:, :, 3), &
+           tooth(:, :, 4), tm, finite)
+    else                 ! a copy's rows of the copies' array (realisations): formed, then stored
+      allocate(part(size(t), m%z, 4))
+      call mesh_outputs(m, size(t), t, y, modes, part(:, :, 1), part(:, :, 2), part(:, :, 3), &
+           part(:, :, 4), tm, finite)
+      tooth(:, :, 1:4) = part
+    end if
   end subroutine bulk_tooth_outputs
 
   !> Every per-tooth quantity (order of spline_quantities tooth_q) and the meshing torque at one state y (SI):
