@@ -105,7 +105,9 @@ def graze(br, a, b, sigma_b, iters=8):
             hi, past, beyond = s, pt, beyond or pt
     if past is None:
         return None
-    chain = [(lo, last), (hi, past)] + ([] if beyond is past else [(beyond.get("sigma", sigma_b), beyond)])
+    chain = [(lo, last), (hi, past)]
+    if beyond is not past:
+        chain.append((beyond.get("sigma", sigma_b), beyond))
     if any(np.linalg.norm(v["u"] - u["u"]) > CONTINUITY * max(t - s, 1e-12)
            for (s, u), (t, v) in zip(chain, chain[1:])):
         return None

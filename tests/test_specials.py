@@ -64,6 +64,35 @@ def test_a_point_located_twice_is_reported_once():
         (first, 0), (other, 1), ([2.0, 2.0, 5.0], 0)]
 
 
+@pytest.mark.parametrize("fails, offset, found", [
+    ((0.45, 1.1), 0.0, True),       # failing past the grazing only: bracketed between converged
+    ((0.3, 0.45), 0.05, False),     # failing between converged points (a jump past them)
+    ((2.0, 2.0), 5.0, False)])      # all converge, the first past it a branch away
+def test_a_failed_steps_grazing_needs_converged_points_either_side(monkeypatch, fails,
+                                                                   offset, found):
+    """specials.graze in a failed step (no end point) on a made-up line branch u = (sigma, 0)
+    whose contact signature changes at sigma 0.3, the points from sigma 0.45 on moved by
+    `offset` (another part of the branch), the corrector failing on the hyperplanes inside
+    `fails`: a midpoint that fails before any past the grazing converged counts as past it,
+    and the grazing is bracketed between converged points to the bisection's width; one that
+    fails between converged points, or a first point past it further from the next than 8
+    times their sigma difference, leaves it not located (the step is a failed step)."""
+    def at(br, a, s, start=None):
+        if fails[0] < s < fails[1]:
+            return None
+        u = np.array([s, offset * (s >= 0.45)])
+        return dict(u=u, tau=np.array([1.0, 0.0]), p=s, mu=MU, tests=specials.tests(MU), sigma=s,
+                    contact={"signature": (int(s > 0.3),), "closest_approach": abs(s - 0.3)})
+    monkeypatch.setattr(specials, "point_at", at)
+    a = dict(at(None, None, 0.0), sigma=None)
+    loc = specials.graze(type("Br", (), {"restart": lambda self, a, s: None})(), a, None, 1.0)
+    assert (loc is not None) == found
+    if found:
+        last, past, beyond, sp = loc
+        assert last["p"] <= 0.3 < past["p"] == sp["p"] and past["p"] - last["p"] == 2.0 ** -8
+        assert beyond["p"] == 0.375
+
+
 @pytest.mark.filterwarnings("ignore:SUNDIALS warned:pyspline.SplineWarning")
 def test_the_z16_drive_turns_at_a_smooth_fold_past_its_grazing():
     """The 7-DOF Z16 drive near its cusp (ripple amplitude a = 0.085, docs/continuation.md):
