@@ -4,7 +4,8 @@ is a non-smooth fold, one the branch passes through is a grazing, and a grazing 
 smooth fold (a multiplier at +1) stays a grazing beside that fold. No drive turns at a
 grazing (the contact force is continuous there, so are the multipliers: docs/continuation.md),
 so the records stand in for one; the Z16 drive near its cusp, whose turn lies 1.57 r/min past
-its grazing, is held as a smooth fold and a grazing, with no jump of the multipliers."""
+its grazing, is held as a smooth fold and a grazing, with no jump of the multipliers. A
+failed step's grazing is bisected on a made-up line branch."""
 import numpy as np
 import pytest
 
