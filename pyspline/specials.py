@@ -20,7 +20,7 @@ SPECIAL_TYPES = {"fold": "a real multiplier through +1 (det(M - I) changes sign)
                  "nonsmooth_fold": "the branch turns back in the field at a grazing (no "
                                    "multiplier at +1: it jumps there)"}
 
-#: the points either side of a located grazing lie within this many bracket widths
+#: consecutive points about a located grazing lie within this many of their arclength differences
 CONTINUITY = 8.0
 
 
@@ -75,20 +75,23 @@ def point_at(br, a, sigma, start=None):
 def graze(br, a, b, sigma_b, iters=8):
     """The grazing between branch point a (sigma 0) and b (sigma_b along a's tangent), whose
     contact signatures differ, by bisection on sigma: (last, past, beyond, special): the
-    corrected points nearest it with a's signature (last) and with another (past), the one
-    furthest past it (beyond: b, or in a failed step the first midpoint past it), the grazing
-    recorded at past (at last when the correctors between it and the bracket failed) with
-    last's closest approach. A midpoint whose corrector fails is corrected again from a short
-    simulation there (br.restart); in a failed step (b None) it is past the grazing when that
-    fails too. None when it is not located: a midpoint that fails (b given), no corrected
-    point past it, a midpoint with a third signature, or last and past further apart than
-    CONTINUITY bracket widths (a jump to another branch, not a grazing)."""
+    corrected points either side of it, with a's signature (last) and with another (past), the
+    one furthest past it (beyond: b, or in a failed step the first midpoint past it), the
+    grazing recorded at past with last's closest approach. A midpoint whose corrector fails is
+    corrected again from a short simulation there (br.restart); in a failed step (b None) one
+    that fails too before any midpoint past the grazing converged is past it (the bracket
+    shrinks to the converged ones). None when it is not located: a midpoint that fails
+    between two converged ones (b's or beyond's side: the bracket's ends then are not known
+    to be one branch, and a jump across a fold passes the test below), no converged point
+    past it, a midpoint with a third signature, or consecutive points of last, past, beyond
+    further apart than CONTINUITY times their arclength difference (a jump to another branch,
+    not a grazing: each lies on the hyperplane at its sigma along a's tangent)."""
     sig_a = a["contact"]["signature"]
     lo, hi, last, past, beyond = 0.0, sigma_b, a, b, b
     for _ in range(iters):
         s = (lo + hi) / 2
         pt = point_at(br, a, s) or br.restart(a, s)
-        if pt is None and b is None:
+        if pt is None and beyond is None:
             hi = s
             continue
         if pt is None:
@@ -102,12 +105,13 @@ def graze(br, a, b, sigma_b, iters=8):
             hi, past, beyond = s, pt, beyond or pt
     if past is None:
         return None
-    s_past = past.get("sigma", sigma_b)
-    if np.linalg.norm(past["u"] - last["u"]) > CONTINUITY * max(s_past - lo, 1e-12):
+    chain = [(lo, last), (hi, past)]
+    if beyond is not past:
+        chain.append((beyond.get("sigma", sigma_b), beyond))
+    if any(np.linalg.norm(v["u"] - u["u"]) > CONTINUITY * max(t - s, 1e-12)
+           for (s, u), (t, v) in zip(chain, chain[1:])):
         return None
-    # at past, or at last where the correctors between past and the bracket failed
-    at = past if s_past - hi <= hi - lo else last
-    sp = special(dict(at, sigma=at.get("sigma", 0.0)), "grazing")
+    sp = special(dict(past, sigma=hi), "grazing")
     sp["closest_approach"] = last["contact"]["closest_approach"]
     return last, past, beyond, sp
 

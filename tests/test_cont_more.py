@@ -389,6 +389,39 @@ def test_period_four_branch_turns_at_two_real_folds(period_four):
     assert orbits[1].multipliers[0].real > 1 and abs(orbits[1].multipliers[0].imag) < 1e-9
 
 
+def test_period_four_branch_jumping_its_folds_is_a_failed_step(period_four, monkeypatch):
+    """The period-4 branch continued up from its orbit at 1722.8766 r/min with the default
+    first step: that step fails, and its predictor's contact sequence differs (224 to 256
+    switches a period), so the failed step is diagnosed; on the bisection's hyperplanes the
+    corrector lands past both folds (near 1722.898 r/min, the sequence past the grazing) or
+    fails, so no grazing is located (before, the failed midpoints counted as past it and a
+    grazing at 1722.8915 was handed on with that point beyond it, the folds skipped). The
+    step is halved instead, the step that lands past the folds is rejected (no grazing located
+    between), and the branch goes over both folds and the grazing between them."""
+    from pyspline import specials
+    from pyspline.orbits import periodic_orbit
+    case, _, ds = period_four
+    said, diagnose = [], specials.diagnose
+    monkeypatch.setattr(specials, "diagnose", lambda *a: said.append(diagnose(*a)) or said[-1])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        y = periodic_orbit(case.replace(speed_rpm=1722.8766), n=4,
+                           guess=ds.y0.values[ds.branch.values == 1][0]).y0
+        up = pyspline.continuation(case, "speed_rpm", 1722.8766, 1723.2, n=4, guess=y,
+                                   band=(1722.5, 1723.5), progress=False, ds_max=0.5,
+                                   max_angle=0.3, max_points=16)
+    assert said[:1] == [None] and up.attrs["diagnosed_grazings"] == 0
+    assert up.attrs["rejected_unlocated"] >= 1 and up.attrs["status"].startswith("max_points")
+    assert list(up.special_type.values) == ["fold", "grazing", "fold"], up.special_type.values
+    f1, g, f2 = up.special_speed_rpm.values
+    assert 1722.8925 < f2 < g < f1 < 1722.894
+    mu = up.special_mu_real.values + 1j * up.special_mu_imag.values
+    assert abs(mu[0] - 1) < 1e-3 and abs(mu[2] - 1) < 1e-3
+    p = up.speed_rpm.values                  # up to the first fold, back, up again (a jump:
+    turns = np.flatnonzero(np.diff(np.sign(np.diff(p))) != 0) + 1    # straight up)
+    assert len(turns) == 2 and p[turns[0]] > p[turns[1]], p
+
+
 @pytest.mark.parametrize("stop", [1620.085, 1620.1, 1620.12])
 def test_switch_crossing_the_section_time(doubling_band, stop):
     """The stable period-2 orbit near 1619.3 r/min continued up past 1620.092 r/min, where its

@@ -4,7 +4,8 @@ is a non-smooth fold, one the branch passes through is a grazing, and a grazing 
 smooth fold (a multiplier at +1) stays a grazing beside that fold. No drive turns at a
 grazing (the contact force is continuous there, so are the multipliers: docs/continuation.md),
 so the records stand in for one; the Z16 drive near its cusp, whose turn lies 1.57 r/min past
-its grazing, is held as a smooth fold and a grazing, with no jump of the multipliers."""
+its grazing, is held as a smooth fold and a grazing, with no jump of the multipliers. A
+failed step's grazing is bisected on a made-up line branch."""
 import numpy as np
 import pytest
 
@@ -62,6 +63,35 @@ def test_a_point_located_twice_is_reported_once():
                          1e-6)
     assert [(list(k["u"]), k["branch"]) for k in kept] == [
         (first, 0), (other, 1), ([2.0, 2.0, 5.0], 0)]
+
+
+@pytest.mark.parametrize("fails, offset, found", [
+    ((0.45, 1.1), 0.0, True),       # failing past the grazing only: bracketed between converged
+    ((0.3, 0.45), 0.05, False),     # failing between converged points (a jump past them)
+    ((2.0, 2.0), 5.0, False)])      # all converge, the first past it a branch away
+def test_a_failed_steps_grazing_needs_converged_points_either_side(monkeypatch, fails,
+                                                                   offset, found):
+    """specials.graze in a failed step (no end point) on a made-up line branch u = (sigma, 0)
+    whose contact signature changes at sigma 0.3, the points from sigma 0.45 on moved by
+    `offset` (another part of the branch), the corrector failing on the hyperplanes inside
+    `fails`: a midpoint that fails before any past the grazing converged counts as past it,
+    and the grazing is bracketed between converged points to the bisection's width; one that
+    fails between converged points, or a first point past it further from the next than 8
+    times their sigma difference, leaves it not located (the step is a failed step)."""
+    def at(br, a, s, start=None):
+        if fails[0] < s < fails[1]:
+            return None
+        u = np.array([s, offset * (s >= 0.45)])
+        return dict(u=u, tau=np.array([1.0, 0.0]), p=s, mu=MU, tests=specials.tests(MU), sigma=s,
+                    contact={"signature": (int(s > 0.3),), "closest_approach": abs(s - 0.3)})
+    monkeypatch.setattr(specials, "point_at", at)
+    a = dict(at(None, None, 0.0), sigma=None)
+    loc = specials.graze(type("Br", (), {"restart": lambda self, a, s: None})(), a, None, 1.0)
+    assert (loc is not None) == found
+    if found:
+        last, past, beyond, sp = loc
+        assert last["p"] <= 0.3 < past["p"] == sp["p"] and past["p"] - last["p"] == 2.0 ** -8
+        assert beyond["p"] == 0.375
 
 
 @pytest.mark.filterwarnings("ignore:SUNDIALS warned:pyspline.SplineWarning")
