@@ -164,8 +164,9 @@ else
 fi
 finish pip
 if [ $tests = 1 ]; then
-  # ROSS 2.3 needs plotly < 6
-  step "pip: test packages" pip_install pytest pytest-xdist hypothesis f90nml \
+  # ROSS 2.3 needs plotly < 6; under pytest 9.2 pytest-xdist 3.8's --dist loadgroup stops
+  # grouping (pytest-xdist issue 1386): every shared fixture would run on both workers
+  step "pip: test packages" pip_install "pytest<9.2" pytest-xdist hypothesis f90nml \
     ross-rotordynamics "plotly<6" numba numbalsoda dask-jobqueue
 fi
 step "pip install . (pyspline)" pip_install --no-build-isolation "${setup_args[@]}" .
