@@ -7,11 +7,12 @@ import numpy as np
 
 out = sys.argv[1]
 for c in sys.argv[2:]:
-    rows, rhs = [], None
+    rows, rhs, blocks = [], None, []
     for p in sorted(glob.glob(f"{out}/real.{c}.*.json")):
         d = json.load(open(p))
         rows += d["rows"]
         rhs = d["rhs_evals"]
+        blocks.append(d["rows"])
     col = {k: np.array([r[k] for r in rows]) for k in rows[0]}
     # the parts: the transient and the copies' RHS calls, at the single run's CPU per call
     parts = (rhs["transient"] + rhs["real2"]) / rhs["single"]
@@ -23,3 +24,7 @@ for c in sys.argv[2:]:
     for k, v in col.items():
         q = np.percentile(v, [0, 25, 50, 75, 100])
         print(f"  {k:24s} median {q[2]:9.3f}  quartiles {q[1]:.3f}-{q[3]:.3f}  [{q[0]:.3f}-{q[4]:.3f}]")
+    block_medians = [np.median([r["real2_cpu_ms"] - parts * r["single_cpu_ms"] for r in b]) for b in blocks]
+    print("  real2_beyond_parts per block (medians): " + ", ".join(f"{m:.2f}" for m in block_medians))
+    block_faults = [f"{min(r['real2_minflt'] for r in b)}-{max(r['real2_minflt'] for r in b)}" for b in blocks]
+    print("  real2_minflt per block (ranges): " + ", ".join(block_faults))
