@@ -15,7 +15,8 @@ for c in sys.argv[2:]:
         blocks.append(d["rows"])
     col = {k: np.array([r[k] for r in rows]) for k in rows[0]}
     # the parts: the transient and the copies' RHS calls, at the single run's CPU per call
-    parts = (rhs["transient"] + rhs["real2"]) / rhs["single"]
+    # (a first version of realisations.py did not count the transient: parts then unknown)
+    parts = (rhs["transient"] + rhs["real2"]) / rhs["single"] if "transient" in rhs else float("nan")
     for kind in ("real2", "real2_serial")[:1 + ("real2_serial_cpu_ms" in col)]:
         col[f"{kind}_minus_single"] = col[f"{kind}_cpu_ms"] - col["single_cpu_ms"]
         col[f"{kind}_beyond_parts"] = col[f"{kind}_cpu_ms"] - parts * col["single_cpu_ms"]
