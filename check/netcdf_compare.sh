@@ -1,7 +1,8 @@
 #!/bin/bash
 # Claim 3: a 70-variable sweep (physical_z24 over 4 misalignments) written by the CLI at both
 # commits (wall and CPU of the whole call, alternating), then the engines warm and cold.
-# usage: check/netcdf_compare.sh OUTDIR CALLS WARM_REPEATS COLD_REPEATS BEFORE AFTER
+# usage: [CLI_ONLY=1] check/netcdf_compare.sh OUTDIR CALLS WARM_REPEATS COLD_REPEATS BEFORE AFTER
+# (the CLI calls append to OUTDIR/cli_times.txt; the medians are over every call there)
 out=$1; calls=$2; warm=$3; colds=$4; shift 4; mkdir -p "$out"
 here=$(dirname "$0"); case=$here/../cases/physical_z24.nml
 uptime
@@ -16,11 +17,17 @@ grep call "$out/cli_times.txt"
 python3 - "$out/cli_times.txt" "$@" <<'PY'
 import re, sys, statistics as st
 lines = open(sys.argv[1]).read().splitlines()
+cpu = {}
 for c in sys.argv[2:]:
     rows = [list(map(float, re.findall(r"([\d.]+) s", l))) for l in lines if l.startswith(c + " call")]
+    cpu[c] = [r[1] + r[2] for r in rows]
     print(f"{c}: {len(rows)} CLI calls, median wall {st.median(r[0] for r in rows):.2f} s, "
-          f"median CPU (user+sys) {st.median(r[1] + r[2] for r in rows):.2f} s")
+          f"median CPU (user+sys) {st.median(cpu[c]):.2f} s")
+a, b = sys.argv[2:4]
+d = [x - y for x, y in zip(cpu[a], cpu[b])]
+print(f"{a} - {b}, calls paired in order: CPU median {st.median(d):.2f} s [{min(d):.2f} to {max(d):.2f}]")
 PY
+[ -n "$CLI_ONLY" ] && { uptime; exit 0; }
 py=/work/venv/ic34/bin/python
 for c in "$@"; do echo "sweep.nc written at $c:"; $py -P "$here/netcdf_io.py" "$out/sweep.$c/sweep.nc" "$out/io.$c" 1 | grep -E "variables|written by|bytes"; done
 $py -P "$here/netcdf_io.py" "$out/sweep.$1/sweep.nc" "$out/io" "$warm"
