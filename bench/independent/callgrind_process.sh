@@ -1,7 +1,7 @@
 #!/bin/bash
-# Instructions of a whole process (every thread) running check/goal_run.py MODE, per build,
+# Instructions of a whole process (every thread) running bench/independent/goal_run.py MODE, per build,
 # less the same process with MODE empty (imports, the model loaded, no run). PYTHONHASHSEED=0.
-# usage: check/callgrind_process.sh OUTDIR MODE COMMIT...
+# usage: bench/independent/callgrind_process.sh OUTDIR MODE COMMIT...
 out=$1; mode=$2; shift 2; mkdir -p "$out"; here=$(dirname "$0")
 for c in "$@"; do
   for m in empty "$mode"; do

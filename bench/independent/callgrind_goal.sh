@@ -1,6 +1,6 @@
 #!/bin/bash
 # Instructions of one goal run inside the core's simulate (f2py entry), per build.
-# usage: check/callgrind_goal.sh OUTDIR lyap|nolyap COMMIT...   (venv /work/venv/ic34_COMMIT)
+# usage: bench/independent/callgrind_goal.sh OUTDIR lyap|nolyap COMMIT...   (venv /work/venv/ic34_COMMIT)
 out=$1; mode=$2; shift 2; mkdir -p "$out"
 case=$(dirname "$0")/../cases/chaos_z24.nml
 for c in "$@"; do

@@ -1,6 +1,6 @@
 """CPU, wall and minor page faults of realisations = 2 against a single run, many calls in one process.
 
-usage: python -P check/realisations.py CASE.nml ROUNDS OUT.json [serial]
+usage: python -P bench/independent/realisations.py CASE.nml ROUNDS OUT.json [serial]
 
 Each round runs, on loaded models, one single run (goal = 'statistics', lyapunov off), one
 realisations = 2 call (the same, two copies on simulate's default executor, a thread each) and

@@ -1,6 +1,6 @@
 """One simulate of chaos_z24 with goal = 'statistics' (the callgrind target of claim 1).
 
-usage: python -P check/goal_run.py CASE.nml lyap|nolyap|real2|empty
+usage: python -P bench/independent/goal_run.py CASE.nml lyap|nolyap|real2|empty
 lyap: the case as shipped (lyapunov = .true.), nolyap: lyapunov off, real2: lyapunov off and
 realisations = 2, empty: nolyap's model loaded but not run (a whole process's baseline).
 Prints the RHS calls.

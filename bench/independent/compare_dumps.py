@@ -1,6 +1,6 @@
-"""Compare two check/dump_cases.py directories array by array, bit for bit.
+"""Compare two bench/independent/dump_cases.py directories array by array, bit for bit.
 
-usage: python -P check/compare_dumps.py DIR_A DIR_B
+usage: python -P bench/independent/compare_dumps.py DIR_A DIR_B
 
 Prints one line per run (case.setting): 'same' (every array has the same dtype, shape and
 bytes), or the arrays that differ (with the largest absolute difference), or are missing on a

@@ -1,4 +1,4 @@
-"""Medians [min-max] of check/realisations.py's blocks per build: python3 summarize_realisations.py DIR C1 C2."""
+"""Medians [min-max] of bench/independent/realisations.py's blocks per build: python3 summarize_realisations.py DIR C1 C2."""
 import glob
 import json
 import sys

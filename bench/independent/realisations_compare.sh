@@ -1,6 +1,6 @@
 #!/bin/bash
-# Claim 2: check/realisations.py at two builds in alternating blocks (one process at a time).
-# usage: [SERIAL=serial] check/realisations_compare.sh OUTDIR BLOCKS ROUNDS BEFORE AFTER
+# Claim 2: bench/independent/realisations.py at two builds in alternating blocks (one process at a time).
+# usage: [SERIAL=serial] bench/independent/realisations_compare.sh OUTDIR BLOCKS ROUNDS BEFORE AFTER
 out=$1; blocks=$2; rounds=$3; shift 3; mkdir -p "$out"
 here=$(dirname "$0"); case=$here/../cases/chaos_z24.nml
 for b in $(seq 1 "$blocks"); do

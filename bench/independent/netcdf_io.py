@@ -1,7 +1,7 @@
 """Claim 3: write and read a sweep dataset through xarray's h5netcdf and netcdf4 engines.
 
-usage: python -P check/netcdf_io.py SWEEP.nc OUTDIR REPEATS        (warm: one process)
-       python -P check/netcdf_io.py SWEEP.nc OUTDIR cold ENGINE     (one cold write + read)
+usage: python -P bench/independent/netcdf_io.py SWEEP.nc OUTDIR REPEATS        (warm: one process)
+       python -P bench/independent/netcdf_io.py SWEEP.nc OUTDIR cold ENGINE     (one cold write + read)
 
 Warm: the dataset is loaded into memory once; then REPEATS rounds, the engines' order
 alternating, each writing OUTDIR/ENGINE.nc (to_netcdf(engine=...)) and reading it back fully

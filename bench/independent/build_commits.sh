@@ -1,6 +1,6 @@
 #!/bin/bash
 # Build pyspline at each commit the claims compare, one worktree + venv per commit.
-# usage: check/build_commits.sh COMMIT...   (worktree /work/wt/ic34_C, venv /work/venv/ic34_C)
+# usage: bench/independent/build_commits.sh COMMIT...   (worktree /work/wt/ic34_C, venv /work/venv/ic34_C)
 set -e
 SUN=/root/.cache/pyspline/sundials-6.4.1+dfsg1-3-O3-arkode
 for c in "$@"; do

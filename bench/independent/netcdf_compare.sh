@@ -1,7 +1,7 @@
 #!/bin/bash
 # Claim 3: a 70-variable sweep (physical_z24 over 4 misalignments) written by the CLI at both
 # commits (wall and CPU of the whole call, alternating), then the engines warm and cold.
-# usage: [CLI_ONLY=1] check/netcdf_compare.sh OUTDIR CALLS WARM_REPEATS COLD_REPEATS BEFORE AFTER
+# usage: [CLI_ONLY=1] bench/independent/netcdf_compare.sh OUTDIR CALLS WARM_REPEATS COLD_REPEATS BEFORE AFTER
 # (the CLI calls append to OUTDIR/cli_times.txt; the medians are over every call there)
 out=$1; calls=$2; warm=$3; colds=$4; shift 4; mkdir -p "$out"
 here=$(dirname "$0"); case=$here/../cases/physical_z24.nml

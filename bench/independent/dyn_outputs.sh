@@ -2,7 +2,7 @@
 # spline-dyn's CSV and summary of every shipped case (as shipped; goal = 'statistics'; the
 # same with lyapunov off and realisations = 2 on 2 OpenMP threads),
 # per build, then compared between two builds, every byte but the clocks (core_wall_s, wall_s)
-# and the output's own path. usage: [COMPARE_ONLY=1] check/dyn_outputs.sh OUTDIR BEFORE AFTER
+# and the output's own path. usage: [COMPARE_ONLY=1] bench/independent/dyn_outputs.sh OUTDIR BEFORE AFTER
 out=$1; shift; here=$(dirname "$0")
 norm() { sed -E 's/(core_wall_s|wall_s)( \[s\])?[= ]+[^ ]+//g; s#'"$out"'/[^/]+/##g' "$1"; }
 [ -n "$COMPARE_ONLY" ] || for c in "$@"; do

@@ -1,9 +1,9 @@
 """Run every shipped case under a few settings and store every output of each run, exactly.
 
-usage: python -P check/dump_cases.py OUTDIR [CASES_DIR]
+usage: python -P bench/independent/dump_cases.py OUTDIR [CASES_DIR]
 
 Run it with the python of the build to check (its venv); compare two OUTDIRs with
-check/compare_dumps.py. Per case and setting one OUTDIR/<case>.<setting>.npz holds every array
+bench/independent/compare_dumps.py. Per case and setting one OUTDIR/<case>.<setting>.npz holds every array
 of the Result (outputs, per-tooth arrays, sections, Lyapunov record, face loads), every entry
 of loads, extremes and stats (except the two wall-clock stats), the model level and the
 warnings' text; or the error's class and text if the run refused or failed.
