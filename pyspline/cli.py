@@ -322,7 +322,11 @@ def cmd_cases(args) -> int:
     if dest.exists() and not args.force:
         print(f"pyspline: error: {dest} exists (--force replaces it)", file=sys.stderr)
         return 2
-    dest.write_text((src / f"{args.name}.nml").read_text())
+    try:
+        dest.write_text((src / f"{args.name}.nml").read_text())
+    except OSError as exc:
+        print(f"pyspline: error: cannot write {dest}: {exc.strerror or exc}", file=sys.stderr)
+        return 2
     print(f"wrote {dest}")
     return 0
 
@@ -361,7 +365,11 @@ def _make_executor(args):
     --scheduler; a Dask cluster's workers are its threads when the sweep starts."""
     if args.scheduler:
         from distributed import Client
-        client = Client(args.scheduler)
+        try:
+            client = Client(args.scheduler)
+        except (ValueError, OSError) as exc:      # a bad address, or no scheduler there
+            raise CaseError(f"--scheduler {args.scheduler}: no Dask scheduler reached: "
+                            f"{_one_line(exc)}") from None
         return client.get_executor(), max(1, sum(client.nthreads().values())), client.close
     if args.workers > 1:
         ex = (cf.ThreadPoolExecutor(args.workers) if args.threads

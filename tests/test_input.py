@@ -351,6 +351,21 @@ def test_cli_reproduce_refuses_files_it_did_not_write(tmp_path, capsys):
     assert (out / "summary.json").read_text() == "{}"
 
 
+def test_cli_cases_copy_and_scheduler_errors_name_the_argument(tmp_path, capsys):
+    """A copy into a folder that does not exist and a --scheduler that is no address: one
+    error line naming it and why, exit 2 (they were a FileNotFoundError and a ValueError
+    traceback, exit 1)."""
+    from pyspline.cli import main
+    dest = tmp_path / "no" / "such.nml"
+    assert main(["cases", "copy", "template", str(dest)]) == 2
+    err = capsys.readouterr().err
+    assert f"cannot write {dest}: No such file or directory" in err and "Traceback" not in err
+    assert main(["sweep", str(CORPUS / "ok_minimal.nml"), "--set", "l_x=0,1e-5",
+                 "--scheduler", "nohost", "--out", str(tmp_path / "s"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "--scheduler nohost: no Dask scheduler reached" in err and "port" in err, err
+
+
 def test_byte_order_mark_is_accepted(tmp_path, exe):
     """A case file that starts with a UTF-8 byte-order mark (EF BB BF, which some editors
     write) is read as without it, by pyspline and by spline-dyn, to the same numbers."""
