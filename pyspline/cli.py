@@ -50,7 +50,9 @@ def _summary(res, warned: int | None = None) -> str:
         f"  teeth:  load sharing {ld['load_sharing']:.3f} (tooth "
         f"{ld['load_sharing_tooth']:.0f}: {ld['F_static'] * ld['load_sharing']:.1f} N against "
         f"{ld['F_static']:.1f} N static); per revolution "
-        f"{_pm(ld['load_sharing_rev'], ld['load_sharing_rev_se'], '.3f')}",
+        f"{_pm(ld['load_sharing_rev'], ld['load_sharing_rev_se'], '.3f')}" if ld["F_static"] > 0
+        else f"  teeth:  load sharing undefined (T_d = 0: no static tooth load); largest tooth "
+             f"load {np.max(ld['F_peak']):.1f} N",
         f"  rattle: free teeth {_pm(ld['teeth_free_mean'], ld['teeth_free_mean_se'], '.2f')} "
         f"of {z} (never loaded {ld['teeth_unloaded']:.0f}); on the back flank "
         f"{ld['teeth_back']:.0f} teeth; impacts/rev "
