@@ -458,7 +458,7 @@ contains
       h = ': a dynamic peak (no drive torque)'
       if (.not. loads(il_f_static) > 0.0_wp) return
       if (x/loads(il_load_sharing) > limit) then
-        h = ': the static load alone is beyond it, a torque in N mm?'
+        h = ': the static load alone is beyond it (a torque in N mm?)'
       else
         h = ': a dynamic peak, load-sharing factor '//ftoa(loads(il_load_sharing), '(f0.2)')
       end if
