@@ -61,7 +61,8 @@ def cmd_continue(args, fixed, exit_code) -> int:
             raise CaseError(f"--sweep: a follow sweep runs whole fields; {args.field} is "
                             "one element of an array field")
         band = _band(args)
-        for flag, on in (("--repeated", args.repeated), ("--graze-curves", args.graze_curves)):
+        for flag, on in (("--repeated", args.repeated), ("--graze-curves", args.graze_curves),
+                         ("--check", args.check)):
             if on and not args.fold:
                 raise CaseError(f"{flag}: an option of --fold; give --fold FIELD2=V1,V2,...")
         if args.all or args.fold:

@@ -175,7 +175,7 @@ def test_cli_end_to_end(tmp_path, linear_branch):
     """`pyspline continue` on the linear scene (the fixture's run): continuation.nc holds the
     branch (the same numbers as the Python call: its first 4 points, where the Python call
     stops at max_points = 4), frequency_response.png is drawn, exit 0; a field that cannot be
-    continued is a CaseError naming it, exit 2."""
+    continued, or --check without --fold, is a CaseError naming it, exit 2."""
     case, ds, run, out = linear_branch
     assert "wrote out/continuation.nc" in run.stdout and "points on 1 branch(es)" in run.stdout
     with warnings.catch_warnings():
@@ -190,6 +190,10 @@ def test_cli_end_to_end(tmp_path, linear_branch):
     path = out / "scene.nml"
     run = cli(tmp_path, "continue", str(path), "--field", "z", "--start", "16", "--stop", "20")
     assert run.returncode == 2 and "field z cannot be continued" in run.stderr, run.stderr
+    # --check without --fold was ignored, whatever its value
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2600",
+              "--stop", "3000", "--check", "x")
+    assert run.returncode == 2 and "--check: an option of --fold" in run.stderr, run.stderr
     # a follow sweep from the command line: both directions in sweep.nc, one overlaid figure
     run = cli(tmp_path, "sweep", str(path), "--set", "speed_rpm=2600:3000:3", "--follow", "both",
               "--fix", "t_end=0.04", "--out", "sw", "--quiet")
