@@ -217,9 +217,11 @@ def merge(summaries, out=None, fields=None, command=None, mixed=False):
                   len({_scalar(c[f]) for c in have}) > 1]
     else:
         fields = [f.strip().lower() for f in fields]
-        for f in fields:
+        for i, f in enumerate(fields):
             if f not in defaults():
                 raise CaseError(f"unknown field '{f}' (see cases/template.nml)")
+            if f in fields[:i]:
+                raise CaseError(f"fields: {f} given twice")
     for f in fields:
         if have and isinstance(have[0][f], list):
             raise CaseError(f"field {f} differs between the summaries but has several values: "
