@@ -477,7 +477,7 @@ def cmd_plot(args) -> int:
         if res.section_y is not None and len(res.section_y):
             sec = np.c_[res.section_y[:, i_D2], res.section_y[:, 7 + i_D2]]
         thermal = case["thermal"] != "none"
-        target = out / f"{case.name}.png"
+        target = out / f"{_safe_stem(case.name)}.png"     # the case name as a file name
         plots.scene(res.t, res.D2, res.vD2, res.Tm, res.tooth["F"],
                     Tf=res.tooth["Tf"] if thermal else None, section=sec, spectrum=spectrum,
                     speed_rpm=case["speed_rpm"], z=case["z"], path=target, rtol=case["rtol"],

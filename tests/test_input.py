@@ -366,6 +366,18 @@ def test_cli_cases_copy_and_scheduler_errors_name_the_argument(tmp_path, capsys)
     assert "--scheduler nohost: no Dask scheduler reached" in err and "port" in err, err
 
 
+def test_cli_plot_writes_inside_out_whatever_the_case_name(tmp_path, capsys):
+    """`pyspline plot` names its PNG as `run --out` names its .npz: a case name with '/' wrote
+    to out/../../NAME.png, outside --out."""
+    from pyspline.cli import main
+    (tmp_path / "a" / "b").mkdir(parents=True)
+    path = tmp_path / "a" / "odd.nml"
+    path.write_text((CORPUS / "ok_minimal.nml").read_text().replace("'ok_minimal'", "'../../x y'"))
+    assert main(["plot", str(path), "--out", str(tmp_path / "a" / "b")]) == 0
+    assert [p.name for p in tmp_path.rglob("*.png")] == ["_.._x_y.png"]
+    assert (tmp_path / "a" / "b" / "_.._x_y.png").is_file()
+
+
 def test_byte_order_mark_is_accepted(tmp_path, exe):
     """A case file that starts with a UTF-8 byte-order mark (EF BB BF, which some editors
     write) is read as without it, by pyspline and by spline-dyn, to the same numbers."""
