@@ -204,6 +204,27 @@ def test_cli_end_to_end(tmp_path, linear_branch):
     assert (tmp_path / "sw" / "bifurcation.png").exists()
 
 
+def test_cli_special_lines_say_a_grazing_without_a_closest_approach():
+    """The printed line of each special point; a grazing where every tooth switches has no
+    closest approach (NaN, docs/continuation.md): said in words (the resonance's grazing at
+    2414.95 r/min printed 'closest approach nan m')."""
+    from pyspline.contcli import special_line
+    xr = pytest.importorskip("xarray")
+    ds = xr.Dataset({"special_type": ("special", ["grazing", "grazing", "fold"]),
+                     "special_speed_rpm": ("special", [2509.7, 2414.95, 2410.64]),
+                     "special_n": ("special", [1, 1, 1]),
+                     "special_mu_real": ("special", [np.nan, np.nan, 1.0]),
+                     "special_mu_imag": ("special", [np.nan, np.nan, 0.0]),
+                     "special_closest_approach": ("special", [1.17e-7, np.nan, 2e-6]),
+                     "special_Tm_pp": ("special", [61.4, 75.69, 80.89]),
+                     "special_smooth": ("special", [1, 1, 1])}, attrs={"field": "speed_rpm"})
+    lines = [special_line(ds, i) for i in range(3)]
+    assert "closest approach 1.17e-07 m" in lines[0]
+    assert "closest approach none (every tooth switches over the period)" in lines[1]
+    assert "critical multiplier 1.0000+0.0000j" in lines[2]
+    assert not any("nan" in line for line in lines), lines
+
+
 @pytest.mark.parametrize("field, match", [
     ("method", "field method cannot be continued"),
     ("rtol", "field rtol cannot be continued"),
