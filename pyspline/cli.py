@@ -458,7 +458,7 @@ def cmd_plot(args) -> int:
     from .core import STATE_NAMES, simulate
     i_D2 = STATE_NAMES.index("D2")          # its column in section_y; dD2/dt is 7 later
     out = Path(args.out)
-    status = 0
+    status, drawn = 0, set()
     try:
         fixed = _fixed(args.fix)
     except SplineError as exc:
@@ -477,7 +477,10 @@ def cmd_plot(args) -> int:
         if res.section_y is not None and len(res.section_y):
             sec = np.c_[res.section_y[:, i_D2], res.section_y[:, 7 + i_D2]]
         thermal = case["thermal"] != "none"
-        target = out / f"{_safe_stem(case.name)}.png"     # the case name as a file name
+        stem, k = _safe_stem(case.name), 1      # the case name as a file name; one per case
+        while (target := out / (f"{stem}.png" if k == 1 else f"{stem}-{k}.png")) in drawn:
+            k += 1
+        drawn.add(target)
         plots.scene(res.t, res.D2, res.vD2, res.Tm, res.tooth["F"],
                     Tf=res.tooth["Tf"] if thermal else None, section=sec, spectrum=spectrum,
                     speed_rpm=case["speed_rpm"], z=case["z"], path=target, rtol=case["rtol"],
@@ -523,6 +526,8 @@ Run each CASE (with the Poincare section once per shaft revolution) and draw one
 case into DIR/CASENAME.png: D2(t), T_m(t), the phase plane (D2, dD2/dt) with the exact
 section points, the tooth x time map of the tooth loads F_j, the flash temperatures T_f (thermal
 cases), and the spectrum of T_m with shaft orders (1x, 2x) and tooth-pass orders (Zx, 2Zx).
+CASENAME: the case name as a file name (as run --out's NAME.npz; a second case of the same
+name gets CASENAME-2.png).
 """
 
 

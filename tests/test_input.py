@@ -368,14 +368,14 @@ def test_cli_cases_copy_and_scheduler_errors_name_the_argument(tmp_path, capsys)
 
 def test_cli_plot_writes_inside_out_whatever_the_case_name(tmp_path, capsys):
     """`pyspline plot` names its PNG as `run --out` names its .npz: a case name with '/' wrote
-    to out/../../NAME.png, outside --out."""
+    to out/../../NAME.png, outside --out; a second case of the same name overwrote the first."""
     from pyspline.cli import main
     (tmp_path / "a" / "b").mkdir(parents=True)
     path = tmp_path / "a" / "odd.nml"
     path.write_text((CORPUS / "ok_minimal.nml").read_text().replace("'ok_minimal'", "'../../x y'"))
-    assert main(["plot", str(path), "--out", str(tmp_path / "a" / "b")]) == 0
-    assert [p.name for p in tmp_path.rglob("*.png")] == ["_.._x_y.png"]
-    assert (tmp_path / "a" / "b" / "_.._x_y.png").is_file()
+    assert main(["plot", str(path), str(path), "--out", str(tmp_path / "a" / "b")]) == 0
+    assert sorted(p.name for p in tmp_path.rglob("*.png")) == ["_.._x_y-2.png", "_.._x_y.png"]
+    assert (tmp_path / "a" / "b" / "_.._x_y-2.png").is_file()
 
 
 def test_byte_order_mark_is_accepted(tmp_path, exe):
