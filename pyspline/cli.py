@@ -407,6 +407,9 @@ def cmd_sweep(args) -> int:
             grid = dict(table=args.table)
         elif not 1 <= len(grid) <= 2:
             raise CaseError("give one or two --set FIELD=VALUES to sweep")
+        if args.threads and (args.workers < 2 or args.scheduler):
+            raise CaseError("--threads: an option of --workers N >= 2 (N threads instead of N "
+                            "processes); without it the sweep would run serially")
         case = load_case(args.case, **_fixed(args.fix))
     except SplineError as exc:
         print(f"error: {exc}", file=sys.stderr)

@@ -354,7 +354,7 @@ def test_cli_reproduce_refuses_files_it_did_not_write(tmp_path, capsys):
 def test_cli_cases_copy_and_scheduler_errors_name_the_argument(tmp_path, capsys):
     """A copy into a folder that does not exist and a --scheduler that is no address: one
     error line naming it and why, exit 2 (they were a FileNotFoundError and a ValueError
-    traceback, exit 1)."""
+    traceback, exit 1); --threads without --workers likewise (it was ignored)."""
     from pyspline.cli import main
     dest = tmp_path / "no" / "such.nml"
     assert main(["cases", "copy", "template", str(dest)]) == 2
@@ -364,6 +364,9 @@ def test_cli_cases_copy_and_scheduler_errors_name_the_argument(tmp_path, capsys)
                  "--scheduler", "nohost", "--out", str(tmp_path / "s"), "--quiet"]) == 2
     err = capsys.readouterr().err
     assert "--scheduler nohost: no Dask scheduler reached" in err and "port" in err, err
+    assert main(["sweep", str(CORPUS / "ok_minimal.nml"), "--set", "l_x=0,1e-5", "--threads",
+                 "--out", str(tmp_path / "s"), "--quiet"]) == 2       # ran serially, exit 0
+    assert "--threads: an option of --workers N >= 2" in capsys.readouterr().err
 
 
 def test_cli_plot_writes_inside_out_whatever_the_case_name(tmp_path, capsys):
