@@ -46,8 +46,8 @@ def _unquote(text: str) -> str:
 def _check_values(path, values: dict, z: int) -> None:
     """Every array of a finished run's summary that merge reads has its shape (one value per
     statistic, load and run value, Z per tooth, a section's and a Benettin record's arrays alike
-    long) and is finite (the loads may be NaN where the core gives none: a standard error of
-    fewer than 2 revolutions)."""
+    long) and is finite (the loads and k_v's extremes may be NaN where the core gives none: a
+    standard error of fewer than 2 revolutions, a load sharing or k_v at T_d = 0)."""
     sizes = {"stats": 1, "run": 1, "loads": 1, "tooth_loads": z,
              "section": len(values.get("section.t", ())),
              "lyapunov": len(values.get("lyapunov.t", ()))}
@@ -58,7 +58,8 @@ def _check_values(path, values: dict, z: int) -> None:
             continue
         if x.size != want:
             raise CaseError(f"summary {path}: {name} has {x.size} values, {want} expected")
-        bad = np.isinf(x) if group in ("loads", "tooth_loads") else ~np.isfinite(x)
+        nan_ok = group in ("loads", "tooth_loads") or name.startswith("run.kv_")
+        bad = np.isinf(x) if nan_ok else ~np.isfinite(x)
         if bad.any():
             raise CaseError(f"summary {path}: {name} = {float(x[bad][0])} is not finite")
 
@@ -216,9 +217,11 @@ def merge(summaries, out=None, fields=None, command=None, mixed=False):
                   len({_scalar(c[f]) for c in have}) > 1]
     else:
         fields = [f.strip().lower() for f in fields]
-        for f in fields:
+        for i, f in enumerate(fields):
             if f not in defaults():
                 raise CaseError(f"unknown field '{f}' (see cases/template.nml)")
+            if f in fields[:i]:
+                raise CaseError(f"fields: {f} given twice")
     for f in fields:
         if have and isinstance(have[0][f], list):
             raise CaseError(f"field {f} differs between the summaries but has several values: "

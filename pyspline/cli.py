@@ -50,7 +50,9 @@ def _summary(res, warned: int | None = None) -> str:
         f"  teeth:  load sharing {ld['load_sharing']:.3f} (tooth "
         f"{ld['load_sharing_tooth']:.0f}: {ld['F_static'] * ld['load_sharing']:.1f} N against "
         f"{ld['F_static']:.1f} N static); per revolution "
-        f"{_pm(ld['load_sharing_rev'], ld['load_sharing_rev_se'], '.3f')}",
+        f"{_pm(ld['load_sharing_rev'], ld['load_sharing_rev_se'], '.3f')}" if ld["F_static"] > 0
+        else f"  teeth:  load sharing undefined (T_d = 0: no static tooth load); largest tooth "
+             f"load {np.max(ld['F_peak']):.1f} N",
         f"  rattle: free teeth {_pm(ld['teeth_free_mean'], ld['teeth_free_mean_se'], '.2f')} "
         f"of {z} (never loaded {ld['teeth_unloaded']:.0f}); on the back flank "
         f"{ld['teeth_back']:.0f} teeth; impacts/rev "
@@ -322,7 +324,11 @@ def cmd_cases(args) -> int:
     if dest.exists() and not args.force:
         print(f"pyspline: error: {dest} exists (--force replaces it)", file=sys.stderr)
         return 2
-    dest.write_text((src / f"{args.name}.nml").read_text())
+    try:
+        dest.write_text((src / f"{args.name}.nml").read_text())
+    except OSError as exc:
+        print(f"pyspline: error: cannot write {dest}: {exc.strerror or exc}", file=sys.stderr)
+        return 2
     print(f"wrote {dest}")
     return 0
 
@@ -361,7 +367,11 @@ def _make_executor(args):
     --scheduler; a Dask cluster's workers are its threads when the sweep starts."""
     if args.scheduler:
         from distributed import Client
-        client = Client(args.scheduler)
+        try:
+            client = Client(args.scheduler)
+        except (ValueError, OSError) as exc:      # a bad address, or no scheduler there
+            raise CaseError(f"--scheduler {args.scheduler}: no Dask scheduler reached: "
+                            f"{_one_line(exc)}") from None
         return client.get_executor(), max(1, sum(client.nthreads().values())), client.close
     if args.workers > 1:
         ex = (cf.ThreadPoolExecutor(args.workers) if args.threads
@@ -397,6 +407,9 @@ def cmd_sweep(args) -> int:
             grid = dict(table=args.table)
         elif not 1 <= len(grid) <= 2:
             raise CaseError("give one or two --set FIELD=VALUES to sweep")
+        if args.threads and (args.workers < 2 or args.scheduler):
+            raise CaseError("--threads: an option of --workers N >= 2 (N threads instead of N "
+                            "processes); without it the sweep would run serially")
         case = load_case(args.case, **_fixed(args.fix))
     except SplineError as exc:
         print(f"error: {exc}", file=sys.stderr)
@@ -448,7 +461,7 @@ def cmd_plot(args) -> int:
     from .core import STATE_NAMES, simulate
     i_D2 = STATE_NAMES.index("D2")          # its column in section_y; dD2/dt is 7 later
     out = Path(args.out)
-    status = 0
+    status, drawn = 0, set()
     try:
         fixed = _fixed(args.fix)
     except SplineError as exc:
@@ -467,7 +480,10 @@ def cmd_plot(args) -> int:
         if res.section_y is not None and len(res.section_y):
             sec = np.c_[res.section_y[:, i_D2], res.section_y[:, 7 + i_D2]]
         thermal = case["thermal"] != "none"
-        target = out / f"{case.name}.png"
+        stem, k = _safe_stem(case.name), 1      # the case name as a file name; one per case
+        while (target := out / (f"{stem}.png" if k == 1 else f"{stem}-{k}.png")) in drawn:
+            k += 1
+        drawn.add(target)
         plots.scene(res.t, res.D2, res.vD2, res.Tm, res.tooth["F"],
                     Tf=res.tooth["Tf"] if thermal else None, section=sec, spectrum=spectrum,
                     speed_rpm=case["speed_rpm"], z=case["z"], path=target, rtol=case["rtol"],
@@ -513,6 +529,8 @@ Run each CASE (with the Poincare section once per shaft revolution) and draw one
 case into DIR/CASENAME.png: D2(t), T_m(t), the phase plane (D2, dD2/dt) with the exact
 section points, the tooth x time map of the tooth loads F_j, the flash temperatures T_f (thermal
 cases), and the spectrum of T_m with shaft orders (1x, 2x) and tooth-pass orders (Zx, 2Zx).
+CASENAME: the case name as a file name (as run --out's NAME.npz; a second case of the same
+name gets CASENAME-2.png).
 """
 
 

@@ -61,7 +61,8 @@ def cmd_continue(args, fixed, exit_code) -> int:
             raise CaseError(f"--sweep: a follow sweep runs whole fields; {args.field} is "
                             "one element of an array field")
         band = _band(args)
-        for flag, on in (("--repeated", args.repeated), ("--graze-curves", args.graze_curves)):
+        for flag, on in (("--repeated", args.repeated), ("--graze-curves", args.graze_curves),
+                         ("--check", args.check)):
             if on and not args.fold:
                 raise CaseError(f"{flag}: an option of --fold; give --fold FIELD2=V1,V2,...")
         if args.all or args.fold:
@@ -88,14 +89,7 @@ def cmd_continue(args, fixed, exit_code) -> int:
     print(f"{ds.attrs['n_points']} points on {ds.attrs['n_branches']} branch(es), "
           f"{int(ds.stable.sum())} stable, in {ds.attrs['wall_s']:.1f} s")
     for i in range(ds.sizes["special"]):
-        kind = str(ds.special_type.values[i])
-        mu = complex(ds.special_mu_real[i], ds.special_mu_imag[i])
-        what = (f"closest approach {float(ds.special_closest_approach[i]):.3g} m" if kind ==
-                "grazing" else f"critical multiplier {mu:.4f}")
-        print(f"{kind:16s} {label} = {float(ds[f'special_{label}'][i]):.6g}  period "
-              f"{int(ds.special_n[i])}  {what}  {MEASURES['Tm_pp'][0]} "
-              f"{float(ds.special_Tm_pp[i]):.4g} N m"
-              + ("" if ds.special_smooth[i] else "  (non-smooth: the multiplier jumped across)"))
+        print(special_line(ds, i))
     print(f"wrote {out / 'continuation.nc'}")
     if sw is not None:
         write_netcdf(sw, out / "sweep.nc")
@@ -111,6 +105,22 @@ def cmd_continue(args, fixed, exit_code) -> int:
         print(f"stopped: {ds.attrs['status']}", file=sys.stderr)
         return 1
     return 0
+
+
+def special_line(ds, i: int) -> str:
+    """The line `pyspline continue` prints for special point i of a continuation Dataset; a
+    grazing's closest approach is NaN when every tooth switches over the period: said so."""
+    from .plots.continuation import MEASURES
+    label, kind = ds.attrs["field"], str(ds.special_type.values[i])
+    mu = complex(ds.special_mu_real[i], ds.special_mu_imag[i])
+    near = float(ds.special_closest_approach[i])
+    what = (f"critical multiplier {mu:.4f}" if kind != "grazing" else
+            f"closest approach {near:.3g} m" if np.isfinite(near) else
+            "closest approach none (every tooth switches over the period)")
+    return (f"{kind:16s} {label} = {float(ds[f'special_{label}'][i]):.6g}  period "
+            f"{int(ds.special_n[i])}  {what}  {MEASURES['Tm_pp'][0]} "
+            f"{float(ds.special_Tm_pp[i]):.4g} N m"
+            + ("" if ds.special_smooth[i] else "  (non-smooth: the multiplier jumped across)"))
 
 
 def _band(args):

@@ -370,13 +370,18 @@ def _run(case: Case, **times) -> Case:
 
 def _settled_state(model, t0: float, period: float) -> np.ndarray:
     """The state at the first t0 + k period (k >= 1) at or after the case's t_end, from a run of
-    the case from its start (the default guess)."""
+    the case from its start (the default guess), a map run per period (the first up to the first
+    t0 + j period after the case's t0): the case's max_steps bounds a period's steps, not the
+    whole settling run's, as it bounds an output interval's in the case's own run."""
     case = model.case
     t_end = float(model.output_times()[-1])      # the case's t_end, however it was given
-    k = max(int(np.ceil((t_end - t0) / period - 1e-9)),
-            int(np.floor((case["t0"] - t0) / period)) + 1)
-    y1, _ = _period_map(model, case["t0"], t0 + k * period, model.start_state()[:, None])
-    return y1[:, 0]
+    j = int(np.floor((case["t0"] - t0) / period)) + 1
+    k = max(int(np.ceil((t_end - t0) / period - 1e-9)), j)
+    y, ta = model.start_state()[:, None], case["t0"]
+    for tb in t0 + period * np.arange(j, k + 1):
+        y, _ = _period_map(model, ta, tb, y)
+        ta = tb
+    return y[:, 0]
 
 
 def _trajectory(case: Case, t0: float, t1: float, y0: np.ndarray) -> Result:

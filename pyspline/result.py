@@ -225,8 +225,9 @@ class Result:
 
     @property
     def kv(self) -> np.ndarray:
-        """Dynamic load coefficient k_v = |T_m| / T_d, shape (nt,)."""
-        return np.abs(self.Tm) / self.case["t_d"]
+        """Dynamic load coefficient k_v = |T_m| / |T_d|, shape (nt,); NaN at T_d = 0."""
+        with np.errstate(invalid="ignore"):
+            return np.abs(self.Tm) / abs(self.case["t_d"])
 
     def __getattr__(self, name):
         # per-tooth quantities that the core has and this class does not name yet

@@ -349,7 +349,8 @@ def edited(good, tmp_path, name, change):
 
 
 def test_merge_refuses_duplicates_mixed_cases_and_damage_naming_the_file(tmp_path, good):
-    """The same point twice, summaries of two cases (unless mixed=True), a missing key, a NaN,
+    """The same point twice, summaries of two cases (unless mixed=True), a field given twice in
+    fields, a missing key, a NaN,
     a section shorter than its times and an invalid case: CaseError naming the file."""
     a, b = good / "0.summary", good / "1.summary"
     with pytest.raises(pyspline.CaseError, match=r"0\.summary and .*dup\.summary are the same "
@@ -361,6 +362,8 @@ def test_merge_refuses_duplicates_mixed_cases_and_damage_naming_the_file(tmp_pat
     with pytest.raises(pyspline.CaseError, match="2 cases .*--mixed"):
         merge([a, b, other])
     assert merge([a, b, other], mixed=True).attrs["n_ok"] == 3
+    with pytest.raises(pyspline.CaseError, match="fields: l_x given twice"):   # an IndexError
+        merge([a, b], fields=["l_x", "L_X"])
     damage = {
         "missing": (lambda ls: [x for x in ls if not x.startswith("loads.Tm_rms_se ")],
                     "no loads.Tm_rms_se"),

@@ -175,7 +175,7 @@ def test_cli_end_to_end(tmp_path, linear_branch):
     """`pyspline continue` on the linear scene (the fixture's run): continuation.nc holds the
     branch (the same numbers as the Python call: its first 4 points, where the Python call
     stops at max_points = 4), frequency_response.png is drawn, exit 0; a field that cannot be
-    continued is a CaseError naming it, exit 2."""
+    continued, or --check without --fold, is a CaseError naming it, exit 2."""
     case, ds, run, out = linear_branch
     assert "wrote out/continuation.nc" in run.stdout and "points on 1 branch(es)" in run.stdout
     with warnings.catch_warnings():
@@ -190,6 +190,10 @@ def test_cli_end_to_end(tmp_path, linear_branch):
     path = out / "scene.nml"
     run = cli(tmp_path, "continue", str(path), "--field", "z", "--start", "16", "--stop", "20")
     assert run.returncode == 2 and "field z cannot be continued" in run.stderr, run.stderr
+    # --check without --fold was ignored, whatever its value
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2600",
+              "--stop", "3000", "--check", "x")
+    assert run.returncode == 2 and "--check: an option of --fold" in run.stderr, run.stderr
     # a follow sweep from the command line: both directions in sweep.nc, one overlaid figure
     run = cli(tmp_path, "sweep", str(path), "--set", "speed_rpm=2600:3000:3", "--follow", "both",
               "--fix", "t_end=0.04", "--out", "sw", "--quiet")
@@ -198,6 +202,27 @@ def test_cli_end_to_end(tmp_path, linear_branch):
     assert list(sw.direction.values) == ["up", "down"] and sw.attrs["follow"] == "both"
     assert "--follow=both" in sw.attrs["command"] and (sw.error == "").all()
     assert (tmp_path / "sw" / "bifurcation.png").exists()
+
+
+def test_cli_special_lines_say_a_grazing_without_a_closest_approach():
+    """The printed line of each special point; a grazing where every tooth switches has no
+    closest approach (NaN, docs/continuation.md): said in words (the resonance's grazing at
+    2414.95 r/min printed 'closest approach nan m')."""
+    from pyspline.contcli import special_line
+    xr = pytest.importorskip("xarray")
+    ds = xr.Dataset({"special_type": ("special", ["grazing", "grazing", "fold"]),
+                     "special_speed_rpm": ("special", [2509.7, 2414.95, 2410.64]),
+                     "special_n": ("special", [1, 1, 1]),
+                     "special_mu_real": ("special", [np.nan, np.nan, 1.0]),
+                     "special_mu_imag": ("special", [np.nan, np.nan, 0.0]),
+                     "special_closest_approach": ("special", [1.17e-7, np.nan, 2e-6]),
+                     "special_Tm_pp": ("special", [61.4, 75.69, 80.89]),
+                     "special_smooth": ("special", [1, 1, 1])}, attrs={"field": "speed_rpm"})
+    lines = [special_line(ds, i) for i in range(3)]
+    assert "closest approach 1.17e-07 m" in lines[0]
+    assert "closest approach none (every tooth switches over the period)" in lines[1]
+    assert "critical multiplier 1.0000+0.0000j" in lines[2]
+    assert not any("nan" in line for line in lines), lines
 
 
 @pytest.mark.parametrize("field, match", [

@@ -91,6 +91,24 @@ def test_readme_quick_start_runs(tmp_path):
         assert (tmp_path / path).stat().st_size > 0, path
 
 
+def test_readme_run_answers_as_written(tmp_path, capsys):
+    """The commands of README's 'What one run answers' print its block, line for line, from a
+    directory outside the checkout (the block said 'no plausibility warning' where the run
+    gives the support warning, and the run needs the case copied first)."""
+    from pyspline.cli import main
+    text = (ROOT / "README.md").read_text()
+    head, block = re.search(r"## What one run answers \((.*?)\)\n```text\n(.*?)```", text,
+                            re.S).groups()
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        for cmd in re.findall(r"`pyspline ([^`]+)`", head):
+            assert main(shlex.split(cmd)) == 0, cmd
+    finally:
+        os.chdir(cwd)
+    assert capsys.readouterr().out.splitlines()[2:] == block.splitlines()
+
+
 def test_readme_opens_with_the_two_commands():
     lines = (ROOT / "README.md").read_text().splitlines()
     block = lines[lines.index("```bash") + 1:lines.index("```bash") + 3]

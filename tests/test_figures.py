@@ -292,6 +292,31 @@ def test_frequency_response_draws_stability_specials_and_gaps(branch):
     assert _cut_off(fig) == [] and _crowded(fig) == [] and _legend_over_words(fig) == []
 
 
+def test_frequency_response_prefix_fits_the_follow_sweeps_too():
+    """The measure's SI prefix is chosen over all it draws: a branch at round-off (1e-14 to
+    1e-11 N m) under follow sweeps whose first points hold a start from rest (43 N m), the
+    README's `pyspline continue` on paper_lx1e-4, read 'pN m' with a 1e13 offset."""
+    p = SPEED[:4]
+    br = xr.Dataset({"Tm_pp": ("point", [3e-14, 1e-12, 5e-12, 1.7e-11]),
+                     "branch": ("point", [0] * 4), "n": ("point", [1] * 4),
+                     "stable": ("point", [1] * 4)},
+                    coords={"speed_rpm": _coord("speed_rpm", p)}, attrs={"field": "speed_rpm"})
+    tm_max = np.full((4, 2), -30.7)
+    tm_max[0, 0] = tm_max[-1, 1] = 12.5                          # 43.2 N m peak-to-peak
+    sweep = xr.Dataset({"Tm_max": _var(("speed_rpm", "direction"), tm_max, "Tm_max"),
+                        "Tm_min": _var(("speed_rpm", "direction"), np.full((4, 2), -30.7),
+                                       "Tm_min")},
+                       coords={"speed_rpm": _coord("speed_rpm", p),
+                               "direction": ("direction", ["up", "down"])},
+                       attrs={"swept": "speed_rpm", "follow": "both"})
+    fig = pc.frequency_response(br, sweep=sweep)
+    ax = fig.axes[0]
+    fig.draw_without_rendering()
+    assert ax.get_ylabel() == "T_m peak-to-peak [N m]"
+    assert ax.yaxis.get_offset_text().get_text() == ""
+    assert _inside(ax, p, br["Tm_pp"].values) and _inside(ax, p[[0, -1]], [43.2, 43.2])
+
+
 def test_fold_plane_shades_the_band_between_the_folds():
     lx = np.array([0.0, 5e-5, 1e-4, 1.5e-4])
     folds = np.array([[2400.0, 2600.0], [2300.0, 2800.0], [2250.0, 2950.0], [np.nan, np.nan]])

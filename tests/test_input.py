@@ -351,6 +351,36 @@ def test_cli_reproduce_refuses_files_it_did_not_write(tmp_path, capsys):
     assert (out / "summary.json").read_text() == "{}"
 
 
+def test_cli_cases_copy_and_scheduler_errors_name_the_argument(tmp_path, capsys):
+    """A copy into a folder that does not exist and a --scheduler that is no address: one
+    error line naming it and why, exit 2 (they were a FileNotFoundError and a ValueError
+    traceback, exit 1); --threads without --workers likewise (it was ignored)."""
+    from pyspline.cli import main
+    dest = tmp_path / "no" / "such.nml"
+    assert main(["cases", "copy", "template", str(dest)]) == 2
+    err = capsys.readouterr().err
+    assert f"cannot write {dest}: No such file or directory" in err and "Traceback" not in err
+    assert main(["sweep", str(CORPUS / "ok_minimal.nml"), "--set", "l_x=0,1e-5",
+                 "--scheduler", "nohost", "--out", str(tmp_path / "s"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "--scheduler nohost: no Dask scheduler reached" in err and "port" in err, err
+    assert main(["sweep", str(CORPUS / "ok_minimal.nml"), "--set", "l_x=0,1e-5", "--threads",
+                 "--out", str(tmp_path / "s"), "--quiet"]) == 2       # ran serially, exit 0
+    assert "--threads: an option of --workers N >= 2" in capsys.readouterr().err
+
+
+def test_cli_plot_writes_inside_out_whatever_the_case_name(tmp_path, capsys):
+    """`pyspline plot` names its PNG as `run --out` names its .npz: a case name with '/' wrote
+    to out/../../NAME.png, outside --out; a second case of the same name overwrote the first."""
+    from pyspline.cli import main
+    (tmp_path / "a" / "b").mkdir(parents=True)
+    path = tmp_path / "a" / "odd.nml"
+    path.write_text((CORPUS / "ok_minimal.nml").read_text().replace("'ok_minimal'", "'../../x y'"))
+    assert main(["plot", str(path), str(path), "--out", str(tmp_path / "a" / "b")]) == 0
+    assert sorted(p.name for p in tmp_path.rglob("*.png")) == ["_.._x_y-2.png", "_.._x_y.png"]
+    assert (tmp_path / "a" / "b" / "_.._x_y-2.png").is_file()
+
+
 def test_byte_order_mark_is_accepted(tmp_path, exe):
     """A case file that starts with a UTF-8 byte-order mark (EF BB BF, which some editors
     write) is read as without it, by pyspline and by spline-dyn, to the same numbers."""

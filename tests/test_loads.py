@@ -144,6 +144,33 @@ def test_loads_in_xarray_and_npz(offset_scene, tmp_path):
         np.testing.assert_array_equal(f["kv"], np.abs(f["Tm"]) / case["t_d"])
 
 
+def test_k_v_takes_the_magnitude_of_a_reversed_or_zero_drive_torque(tmp_path, exe):
+    """k_v = |T_m| / |T_d|: a reversed drive in static full contact has k_v = 1, not -1, in
+    Python, the core's extremes and spline-dyn's CSV. At T_d = 0 k_v and the load sharing are
+    NaN (README) without a numpy warning, `pyspline run` says the load sharing is undefined, and
+    merge takes spline-dyn's summary of it as sweep takes the point (it refused kv_max = nan)."""
+    import warnings
+    from pyspline.batch import merge
+    from pyspline.cli import _summary
+    from conftest import assert_executable_matches_python
+    case = full_contact(t_d=-30.7, t_l=-30.7, n_out=11)
+    _, col, data, res = assert_executable_matches_python(case, exe, tmp_path)
+    np.testing.assert_allclose(res.kv, 1.0, rtol=1e-8)
+    np.testing.assert_array_equal(data[:, col["kv"]], res.kv)
+    assert res.extremes["kv_max"] == res.kv.max() and res.extremes["kv_min"] == res.kv.min()
+    zero = full_contact(t_d=0.0, t_l=0.0, n_out=11, start="rest")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        res = pyspline.simulate(zero)
+        assert np.isnan(res.kv).all() and np.isnan(res.loads["load_sharing"])
+        assert "load sharing undefined (T_d = 0" in _summary(res)
+    zero.to_namelist(tmp_path / "zero.nml")
+    subprocess.run([exe, str(tmp_path / "zero.nml"), "--summary", str(tmp_path / "zero.summary")],
+                   check=True, capture_output=True)
+    ds = merge([tmp_path / "zero.summary"])
+    assert ds.attrs["n_ok"] == 1 and np.isnan(ds["kv_max"].values).all()
+
+
 def read_csv_loads(path) -> dict:
     """The loads spline-dyn writes in its CSV's comment lines."""
     out = {}

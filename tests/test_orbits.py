@@ -167,6 +167,18 @@ def test_newton_converges_quadratically_on_a_switching_orbit():
     assert orbit.stable
 
 
+def test_default_guess_settles_within_the_cases_step_bound():
+    """The default guess settles the case as its own run does, max_steps bounding each period's
+    steps (a map run per period), not the whole settling run's: a run with one output per
+    revolution within max_steps = 5000 but 37815 steps in all finds its orbit (it was a
+    SolverError 'max_steps = 5000 ... raise max_steps or n_out')."""
+    case = pyspline.load_case(CASES / "chaos_z24.nml", zeta_m=0.1, t_transient=0.0, t_end=0.1,
+                              n_out=11, section="none", lyapunov=False, max_steps=5000)
+    assert pyspline.simulate(case).stats["steps"] > 5 * case["max_steps"]
+    orbit = pyspline.periodic_orbit(case, tol=1e-6)
+    assert orbit.residual <= 1e-6 and orbit.stable
+
+
 def test_exact_monodromy_is_the_matrix_exponential():
     """Full contact: the variational equations give M = exp(A T) in the scaled states (A the
     Jacobian of Model.rhs, central differences: conftest), to the integration's error, and

@@ -95,6 +95,8 @@ def test_shipped_physical_cases_warn_no_stress_but_the_torque_in_n_mm_does(path)
     assert len(msgs) == 3, msgs
     for n, msg in zip(LIMITS, msgs):
         assert WORDS[n] in msg and f"exceeds {LIMITS[n]:.0f} MPa" in msg, msg
+        assert msg.endswith("the static load alone is beyond it (a torque in N mm?). Run as "
+                            "given"), msg
         assert res.loads[n] > LIMITS[n] * 1e6
         got = float(re.search(r"= ([0-9.]+) MPa", msg).group(1))
         assert got == pytest.approx(res.loads[n] * 1e-6, abs=0.051), msg

@@ -51,7 +51,7 @@ module spline_quantities
   type(quantity_t), parameter :: output_q(nout_q) = [ &
        quantity_t('t', 's', 'output time'), state_q, &
        quantity_t('Tm', 'N m', 'meshing torque T_m (Eq. 22)'), &
-       quantity_t('kv', '-', 'dynamic load coefficient k_v = |T_m|/T_d'), tooth_q]
+       quantity_t('kv', '-', 'dynamic load coefficient k_v = |T_m|/|T_d|'), tooth_q]
 
   !> The statistics of a run: the solver's (spline_solver::integrate fills stats(1:
   !> nsolver_stats)), then the run's (spline_run::run_case).

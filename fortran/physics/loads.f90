@@ -325,7 +325,7 @@ contains
 
 
   !> The extremes and RMS of a run's outputs x(nextreme), spline_quantities' extreme_q: max, min
-  !> and RMS (sqrt(sum(x**2)/n), a sequential sum) of T_m (tm), k_v = |T_m|/T_d, the tooth loads
+  !> and RMS (sqrt(sum(x**2)/n), a sequential sum) of T_m (tm), k_v = |T_m|/|T_d|, the tooth loads
   !> f(nt, Z) and flash temperatures tf(nt, Z) over all teeth, D_2 and dD_2/dt (y: SI states,
   !> a column per output). tf absent: T_f is the level's constant tf_const at every output (0
   !> without flash temperature: its RMS |tf_const|). The one computation of them: spline-dyn's
@@ -340,7 +340,7 @@ contains
     real(wp), intent(in), contiguous, optional :: tf(:, :)
     real(wp), intent(in), optional :: tf_const
     x(1:3) = three(size(tm), tm)
-    x(4:6) = three(size(tm), abs(tm)/m%t_d)
+    x(4:6) = three(size(tm), abs(tm)/abs(m%t_d))
     x(7:9) = three(size(f), f)
     if (present(tf)) then
       x(10:12) = three(size(tf), tf)
@@ -458,7 +458,7 @@ contains
       h = ': a dynamic peak (no drive torque)'
       if (.not. loads(il_f_static) > 0.0_wp) return
       if (x/loads(il_load_sharing) > limit) then
-        h = ': the static load alone is beyond it, a torque in N mm?'
+        h = ': the static load alone is beyond it (a torque in N mm?)'
       else
         h = ': a dynamic peak, load-sharing factor '//ftoa(loads(il_load_sharing), '(f0.2)')
       end if
@@ -470,7 +470,7 @@ contains
   !> .. k0(r + 1) - 1 of run r (run_loads) to revolution rev(r) (0 outside the nb =
   !> floor(revolutions) whole ones, which are the batches). Per batch b its value of each
   !> statistic that is a mean over the outputs (docs/model.md section 15): the RMS of T_m, k_v =
-  !> |T_m| / T_d, F_j (all teeth) and D_2; the load-sharing factor max |F_j| / F_s and the
+  !> |T_m| / |T_d|, F_j (all teeth) and D_2; the load-sharing factor max |F_j| / F_s and the
   !> largest T_f of the revolution (their means load_sharing_rev, Tf_max_rev: what an extreme is
   !> given instead); per tooth the fractions free and on the back flank (free_b, back_b: counts),
   !> the mean number of free teeth and the contact onsets (ons_b) of the revolution. From

@@ -374,6 +374,7 @@ contains
     type(model_t), intent(in) :: m
     character(len=:), allocatable, intent(inout) :: text
     real(wp) :: l, k_mesh, k_s, e, delta
+    character(len=:), allocatable :: alone
     l = hypot(m%l_x, m%l_y)
     if (m%dof /= 7 .or. min(m%k_p1, m%k_p2) <= 0.0_wp .or. m%t_d == 0.0_wp) return
     k_mesh = m%z*m%k_m/2.0_wp
@@ -381,6 +382,8 @@ contains
     e = l*k_s/(k_mesh + k_s)
     delta = static_tooth_load(m)/m%k_m
     if (l <= delta .or. e > support_limit*delta) return
+    alone = ''
+    if (m%spacing) alone = ' from the misalignment alone (the spacing errors add their own)'
     text = text//'case '//trim(m%name)//': fields k_p1 = '//num(m%k_p1, readable=.true.)// &
          ', k_p2 = '//num(m%k_p2, readable=.true.)//' N/m: the supports (in series '// &
          num(k_s, readable=.true.)//' N/m, the mesh Z k_m / 2 = '// &
@@ -390,7 +393,7 @@ contains
          ' % of the static tooth deflection |T_d| / (Z r_b k_m) = '// &
          num(delta, readable=.true.)//' m (limit '//itoa(nint(100.0_wp*support_limit))// &
          ' %): the teeth barely see the misalignment: it raises the static load-sharing '// &
-         'factor to 1 + e / delta = '//num(1.0_wp + e/delta, readable=.true.)// &
+         'factor to 1 + e / delta = '//num(1.0_wp + e/delta, readable=.true.)//alone// &
          '. Run as given'//new_line('a')
   end subroutine support_warning
 

@@ -33,6 +33,17 @@ def _runs(mask):
     return list(zip(bounds[:-1], bounds[1:]))
 
 
+def _sweep_runs(sweep, field, from_sweep) -> list:
+    """(direction, field values, measure) of each direction of a follow sweep's points."""
+    sx = sweep.attrs.get("swept", "").split()
+    key = sx[-1] if sx else field
+    dirs = list(sweep["direction"].values) if "direction" in sweep.dims else \
+        [sweep.attrs.get("follow") or "runs"]
+    subs = [(d, sweep.sel(direction=d) if "direction" in sweep.dims else sweep) for d in dirs]
+    return [(d, np.asarray(sub[key], float), np.asarray(from_sweep(sub), float))
+            for d, sub in subs]
+
+
 def frequency_response(branch, measure: str = "Tm_pp", sweep=None, path=None,
                        title: str | None = None) -> Figure:
     """A response measure ('Tm_pp', 'F_max', 'D2_pp') of a continuation Dataset against its
@@ -44,7 +55,8 @@ def frequency_response(branch, measure: str = "Tm_pp", sweep=None, path=None,
     name, unit, from_sweep = MEASURES[measure]
     p = np.asarray(branch[field], float)
     y = np.asarray(branch[measure], float)
-    fy, uy = ps.prefix(y, unit)
+    runs = [] if sweep is None else _sweep_runs(sweep, field, from_sweep)
+    fy, uy = ps.prefix(np.concatenate([y, *(v for _, _, v in runs)]), unit)  # all drawn
     fx, ux = ps.prefix(p, ps.unit_of(branch, field))
     fig = Figure(figsize=(9, 5.5), layout="constrained")
     ax = fig.add_subplot()
@@ -74,20 +86,14 @@ def frequency_response(branch, measure: str = "Tm_pp", sweep=None, path=None,
                     mec="k", mew=0.6, zorder=5)
             handles.append(Line2D([], [], ls="", marker=mk, ms=7, mfc=colour, mec="k",
                                   label=f"{label} ({int(sel.sum())})"))
-    if sweep is not None:
-        sx = sweep.attrs.get("swept", "").split()
-        key = sx[-1] if sx else field
-        dirs = list(sweep["direction"].values) if "direction" in sweep.dims else \
-            [sweep.attrs.get("follow") or "runs"]
-        for d in dirs:
-            sub = sweep.sel(direction=d) if "direction" in sweep.dims else sweep
-            mk, colour, label = DIRECTION_MARKS.get(str(d), ("o", "0.4", "runs"))
-            label += (" (runs, each from the one before)" if str(d) in DIRECTION_MARKS else
-                      " (each from the case's start)")
-            ax.plot(np.asarray(sub[key], float) / fx, np.asarray(from_sweep(sub), float) / fy,
-                    ls="", marker=mk, ms=6, mfc="none", mec=colour, mew=1.2, zorder=4)
-            handles.append(Line2D([], [], ls="", marker=mk, ms=6, mfc="none", mec=colour,
-                                  mew=1.2, label=label))
+    for d, sx, sy in runs:
+        mk, colour, label = DIRECTION_MARKS.get(str(d), ("o", "0.4", "runs"))
+        label += (" (runs, each from the one before)" if str(d) in DIRECTION_MARKS else
+                  " (each from the case's start)")
+        ax.plot(sx / fx, sy / fy, ls="", marker=mk, ms=6, mfc="none", mec=colour, mew=1.2,
+                zorder=4)
+        handles.append(Line2D([], [], ls="", marker=mk, ms=6, mfc="none", mec=colour,
+                              mew=1.2, label=label))
     ranges = branch["no_period_range"].values if "no_period_range" in branch else []
     chaotic = branch["no_period_chaotic"].values if "no_period_chaotic" in branch else \
         [-1] * len(ranges)                # pyspline.branches: no seed there; -1: not told
