@@ -553,15 +553,20 @@ contains
   end function roots_cb
 
   !> The scaled full state of copy c: the held (frozen) entries from ys_full, the integrated ones
-  !> from v, CVODE's vector (the copies one after the other, n states each). Element by element:
-  !> the array assignment with a vector subscript made a heap temporary on every call (at every
-  !> output and tail try).
+  !> from v, CVODE's vector (the copies one after the other, n states each). Every state
+  !> integrated: one copy (its stores are read back as pairs at once: stored element by element
+  !> they could not be forwarded); else element by element (an array assignment with a vector
+  !> subscript made a heap temporary on every call, at every output and tail try).
   pure function copy_state(ctx, v, c) result(yf)
     type(solver_ctx_t), intent(in) :: ctx
     real(c_double), intent(in) :: v(:)
     integer, intent(in) :: c
     real(c_double) :: yf(nstate)
     integer :: i
+    if (ctx%n == nstate) then
+      yf = v((c - 1)*nstate + 1:c*nstate)
+      return
+    end if
     yf = ctx%ys_full(:, c)
     do i = 1, ctx%n
       yf(ctx%idx(i)) = v((c - 1)*ctx%n + i)
