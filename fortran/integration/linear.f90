@@ -18,7 +18,7 @@
 !> rhs_jacobian, every contact frozen on flank s); the right-hand side (rhs_scaled) is checked to
 !> be that affine, time-invariant map at a second state and time before use.
 module spline_linear
-  use spline_kinds, only: wp
+  use spline_kinds, only: wp, max_teeth
   use spline_errors, only: err_ok
   use spline_model, only: model_t, nstate, ndof, thermal_coupled
   use spline_dynamics, only: rhs_scaled, rhs_jacobian, from_scaled
@@ -83,16 +83,17 @@ contains
     type(model_t), intent(in) :: m
     integer, intent(in) :: idx(nstate), n
     real(wp), intent(in) :: tau, ys(nstate)
-    real(wp) :: y(nstate), g(2*m%z), z(n)
-    integer :: s
+    real(wp) :: y(nstate), g(2*max_teeth), z(nstate)   ! fixed sizes: no allocation per try
+    integer :: s, nz
     ok = .false.
     if (tl%off) return
     call from_scaled(m, ys, y)
     if (tail_out_of_reach(m, y)) return     ! the test below would fail (a chaotic drive: mostly)
-    call mesh_switch_functions(m, tau/m%w_ref, y(1:ndof), g)   ! g(2j-1) = dn_j - c, g(2j) = dn_j + c
-    if (all(g(1::2) > 0.0_wp)) then
+    nz = 2*m%z                              ! g(2j-1) = dn_j - c, g(2j) = dn_j + c
+    call mesh_switch_functions(m, tau/m%w_ref, y(1:ndof), g(1:nz))
+    if (all(g(1:nz:2) > 0.0_wp)) then
       s = 1
-    else if (all(g(2::2) < 0.0_wp)) then
+    else if (all(g(2:nz:2) < 0.0_wp)) then
       s = -1
     else
       return
@@ -102,8 +103,8 @@ contains
       if (tl%off) return
     end if
     ! the motion about the equilibrium, bounded mode by mode, against the equilibrium's margin
-    z = ys(idx(1:n)) - tl%ystar
-    tl%c = matmul(tl%w, cmplx(z, 0.0_wp, wp))
+    z(1:n) = ys(idx(1:n)) - tl%ystar
+    tl%c = matmul(tl%w, cmplx(z(1:n), 0.0_wp, wp))
     ok = tl%margin - 1.01_wp*sum(tl%weight*abs(tl%c)) > 0.0_wp
     if (ok) then
       tl%tau0 = tau

@@ -517,13 +517,14 @@ contains
   end function rhs_cb
 
   !> The n numbers of the serial vector v. SUNDIALS' Fortran FN_VGetArrayPointer asks the
-  !> vector's length through three more calls on each use (2 % of an ERK run on chaos_z24).
+  !> vector's length through three more calls on each use (2 % of an ERK run on chaos_z24), its
+  !> C N_VGetArrayPointer through the vector's operations (lincomb.c's spline_serial_data not).
   function vector_data(v, n) result(x)
     type(N_Vector), target, intent(in) :: v
     integer, intent(in) :: n
     real(c_double), pointer, contiguous :: x(:)
     interface
-      type(c_ptr) function array_pointer(v) bind(C, name='N_VGetArrayPointer')
+      type(c_ptr) function array_pointer(v) bind(C, name='spline_serial_data')
         import :: c_ptr
         type(c_ptr), value :: v
       end function array_pointer
@@ -552,14 +553,24 @@ contains
   end function roots_cb
 
   !> The scaled full state of copy c: the held (frozen) entries from ys_full, the integrated ones
-  !> from v, CVODE's vector (the copies one after the other, n states each).
+  !> from v, CVODE's vector (the copies one after the other, n states each). Every state
+  !> integrated: one copy (its stores are read back as pairs at once: stored element by element
+  !> they could not be forwarded); else element by element (an array assignment with a vector
+  !> subscript made a heap temporary on every call, at every output and tail try).
   pure function copy_state(ctx, v, c) result(yf)
     type(solver_ctx_t), intent(in) :: ctx
     real(c_double), intent(in) :: v(:)
     integer, intent(in) :: c
     real(c_double) :: yf(nstate)
+    integer :: i
+    if (ctx%n == nstate) then
+      yf = v((c - 1)*nstate + 1:c*nstate)
+      return
+    end if
     yf = ctx%ys_full(:, c)
-    yf(ctx%idx(1:ctx%n)) = v((c - 1)*ctx%n + 1:c*ctx%n)
+    do i = 1, ctx%n
+      yf(ctx%idx(i)) = v((c - 1)*ctx%n + i)
+    end do
   end function copy_state
 
 end module spline_solver

@@ -353,10 +353,11 @@ contains
   end subroutine mesh_outputs
 
   !> Eq. 16: contact state of a tooth pair, +1 drive flank (dn > c), -1 back flank (dn < -c),
-  !> 0 free: eq16_mode of its switch functions (dn - c > 0 exactly when dn > c).
+  !> 0 free: eq16_mode of its switch functions (dn - c > 0 exactly when dn > c), by eq16, which
+  !> the compiler inlines (tooth_approach says why: eq16_mode was a call at every output and tooth).
   pure integer function contact_state(dn, c)
     real(wp), intent(in) :: dn, c
-    contact_state = eq16_mode(dn - c, dn + c)
+    contact_state = eq16(dn - c, dn + c)
   end function contact_state
 
   !> Eqs. 15-17: tooth force in contact state mode (+-1): k_m (dn -+ c) + c_m d(dn)/dt.
@@ -533,12 +534,18 @@ contains
 
   !> The contact state of Eq. 16 from a contact's switch functions (mesh_switch_functions):
   !> +1 drive flank (g_drive = dn - c > 0), -1 back flank (g_back = dn + c < 0), else 0 free.
+  !> For callers in other modules; this module calls eq16, inlined (tooth_approach says why).
   elemental integer function eq16_mode(g_drive, g_back) result(mode)
+    real(wp), intent(in) :: g_drive, g_back
+    mode = eq16(g_drive, g_back)
+  end function eq16_mode
+
+  elemental integer function eq16(g_drive, g_back) result(mode)
     real(wp), intent(in) :: g_drive, g_back
     mode = 0
     if (g_drive > 0.0_wp) mode = 1
     if (g_back < 0.0_wp) mode = -1
-  end function eq16_mode
+  end function eq16
 
   !> The contact state of Eq. 16 after a located root of a contact's switch functions (root
   !> directions as SUNDIALS reports them, 0: no root): g_drive rising, the drive flank engages

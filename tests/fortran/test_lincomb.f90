@@ -2,7 +2,8 @@
 !> SUNDIALS' N_VLinearCombination_Serial, to the bit: random coefficients and vectors of mixed
 !> magnitudes (so that another order of the sums would change the last bits), 3 to 16 terms,
 !> lengths 1 to 31 (blocks of 8, 4, 2 and 1), z as the first term (with c_0 = 1 and not), and the
-!> cases it leaves to SUNDIALS (2 terms; z among the later terms).
+!> cases it leaves to SUNDIALS (2 terms; z among the later terms). spline_serial_data: the
+!> numbers SUNDIALS' N_VGetArrayPointer gives, of a vector made on an array and of its clone.
 program test_lincomb
   use, intrinsic :: iso_c_binding
   use check, only: check_true, check_done
@@ -37,6 +38,18 @@ program test_lincomb
       import :: c_int, c_ptr
       type(c_ptr), value :: v
     end function by_element
+    type(c_ptr) function serial_data(v) bind(C, name='spline_serial_data')
+      import :: c_ptr
+      type(c_ptr), value :: v
+    end function serial_data
+    type(c_ptr) function array_pointer(v) bind(C, name='N_VGetArrayPointer')
+      import :: c_ptr
+      type(c_ptr), value :: v
+    end function array_pointer
+    type(c_ptr) function clone(v) bind(C, name='N_VClone')
+      import :: c_ptr
+      type(c_ptr), value :: v
+    end function clone
   end interface
   integer, parameter :: maxn = 31, maxv = 16
   integer, parameter :: lengths(10) = [1, 2, 3, 5, 8, 13, 14, 15, 28, 31]
@@ -86,5 +99,10 @@ program test_lincomb
     end do
   end do
   call check_true('every combination SUNDIALS'' to the bit', nbad == 0 .and. ncase == 600)
+  wv = clone(zv)
+  call check_true('spline_serial_data: the array a vector was made on', &
+       c_associated(serial_data(zv), c_loc(zd)) .and. c_associated(serial_data(zv), array_pointer(zv)))
+  call check_true('spline_serial_data: a clone''s own array', c_associated(serial_data(wv), &
+       array_pointer(wv)) .and. .not. c_associated(serial_data(wv), c_loc(zd)))
   call check_done('test_lincomb')
 end program test_lincomb
