@@ -134,6 +134,8 @@ def summarise(res, options: dict) -> dict:
     return s
 
 
-def _version() -> str:
+def _provenance() -> dict:
+    """What made a dataset: pyspline's version and what its core is compiled for (attrs)."""
     from . import __version__
-    return __version__
+    from ._build_info import BUILD
+    return {"pyspline_version": __version__, "pyspline_build": BUILD}
