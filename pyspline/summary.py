@@ -133,9 +133,3 @@ def summarise(res, options: dict) -> dict:
     s["warnings"] = "\n".join(res.warnings)
     return s
 
-
-def _provenance() -> dict:
-    """What made a dataset: pyspline's version and what its core is compiled for (attrs)."""
-    from . import __version__
-    from ._build_info import BUILD
-    return {"pyspline_version": __version__, "pyspline_build": BUILD}
