@@ -47,7 +47,8 @@ def _floor_module():
 def _time_rhs_exe() -> Path:
     """bench/time_rhs.f90 linked with the core (meson target time-rhs): the one pip installed
     beside pyspline's extension, else (an editable install) built with the SUNDIALS the
-    installed pyspline links, into bench/build/meson (rebuilt when the sources change)."""
+    installed pyspline links and for the CPU its core is (host_tuned), into bench/build/meson
+    (rebuilt when the sources change)."""
     import subprocess
     import sys
     import pyspline
@@ -59,12 +60,15 @@ def _time_rhs_exe() -> Path:
     meson = [sys.executable, "-m", "mesonbuild.mesonmain"]
     prefix = (str(Path(_build_info.SUNDIALS_LIBDIR).parent) if _build_info.SUNDIALS_LIBDIR
               else "")
-    marker = build / "sundials_prefix.txt"      # a build for another SUNDIALS is set up anew
-    if not (build / "build.ninja").exists() or not marker.exists() or marker.read_text() != prefix:
+    options = [f"-Dsundials_prefix={prefix}",
+               f"-Dhost_tuned={str(_build_info.BUILD != 'portable').lower()}"]
+    marker = build / "options.txt"      # a build for another SUNDIALS or CPU is set up anew
+    if not (build / "build.ninja").exists() or not marker.exists() or \
+            marker.read_text() != " ".join(options):
         wipe = ["--wipe"] if (build / "build.ninja").exists() else []
-        subprocess.run(meson + ["setup", *wipe, str(build), str(HERE.parent),
-                                f"-Dsundials_prefix={prefix}"], check=True, capture_output=True)
-        marker.write_text(prefix)
+        subprocess.run(meson + ["setup", *wipe, str(build), str(HERE.parent), *options],
+                       check=True, capture_output=True)
+        marker.write_text(" ".join(options))
     subprocess.run(meson + ["compile", "-C", str(build), "time-rhs"], check=True,
                    capture_output=True)
     return build / "time-rhs"

@@ -269,11 +269,13 @@ def speed_ratios(rows, accuracy=1e-6):
 
 
 def build() -> str:
-    """The pyspline build being measured: the commit it was built from and where it is installed
-    (the working tree's commit can differ from the build on PYTHONPATH)."""
+    """The pyspline build being measured: the commit it was built from, what its core is
+    compiled for and where it is installed (the working tree's commit can differ from the build
+    on PYTHONPATH)."""
     import pyspline
-    from pyspline._build_info import COMMIT
-    return f"pyspline {COMMIT or '(commit unknown)'} at {Path(pyspline.__file__).parent}"
+    from pyspline._build_info import BUILD, COMMIT
+    return (f"pyspline {COMMIT or '(commit unknown)'}, {BUILD} build, at "
+            f"{Path(pyspline.__file__).parent}")
 
 
 def _write_csv(path, rows):

@@ -23,11 +23,12 @@ from pathlib import Path
 
 import numpy as np
 
+from ._build_info import provenance
 from .case import case_from_text, defaults
 from .dataset import MERGED, build_dataset, write_netcdf
 from .errors import BY_NAME, CaseError, SplineError
 from .result import collected
-from .summary import (SWEEP_EXTREMES, SWEEP_LOADS, _stat_names, _template, _version, lyapunov_summary,
+from .summary import (SWEEP_EXTREMES, SWEEP_LOADS, _stat_names, _template, lyapunov_summary,
                       section_summary)
 from .sweeps import point_hash
 from .warned import warn_grouped
@@ -253,7 +254,7 @@ def merge(summaries, out=None, fields=None, command=None, mixed=False):
         for i, r in zip(index_of, read):
             points[i] = summary_point(r, options)
     hashes = dict(zip(index_of, hashes_of))
-    attrs = dict(case=(have[0].text() if have else ""), pyspline_version=_version(),
+    attrs = dict(case=(have[0].text() if have else ""), **provenance(),
                  command=command or f"pyspline.merge([{len(paths)} spline-dyn summaries])",
                  swept=" ".join(fields), section=options["section"],
                  lyapunov=int(options["lyapunov"]),

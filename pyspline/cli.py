@@ -591,9 +591,10 @@ def _add_sweep_and_plot(sub) -> None:
 
 def main(argv=None) -> int:
     from . import __version__
+    from ._build_info import BUILD
     p = argparse.ArgumentParser(prog="pyspline", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--version", action="version", version=f"pyspline {__version__}")
+    p.add_argument("--version", action="version", version=f"pyspline {__version__}, {BUILD} build")
     sub = p.add_subparsers(dest="cmd", required=True)
     r = sub.add_parser("cases", help="list the shipped cases, or copy one to start your own "
                        "(template: every field with its default and unit)")

@@ -13,10 +13,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ._build_info import provenance
 from .core import LOAD_QUANTITIES, QUANTITIES, STATE_QUANTITIES, TOOTH_QUANTITIES, _names, cf_units
 from .errors import CaseError
 from .specials import SPECIAL_TYPES, smooth
-from .summary import _version
 
 __all__ = ["build_dataset", "continuation_dataset", "field_meta", "open_sweep", "write_netcdf"]
 
@@ -280,6 +280,6 @@ def continuation_dataset(case, prob, label, branches, found, margin, k, attrs):
                                   {"long_name": long, "units": unit})
     ds = xr.Dataset(data, coords={"state": state})
     ds.attrs.update(case=case.text(), field=label, field_name=prob.name,
-                    pyspline_version=_version(), n_points=npt, n_special=nsp,
+                    **provenance(), n_points=npt, n_special=nsp,
                     n_branches=len(branches), **attrs)
     return ds

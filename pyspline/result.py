@@ -251,10 +251,10 @@ class Result:
         (renormalisation, with coordinate lyapunov_t [s]); a sliced face (n_slices > 1): face
         (time, tooth, slice) [N] and tilt (time, moment: M_x, M_y) [N m]; the extremes and RMS
         (``extremes``) as run_<name> without a dim (run_Tm_max, run_F_rms, ...: spline-dyn's
-        summary lines run.<name>). attrs: case (namelist text), name, level, pyspline_version,
+        summary lines run.<name>). attrs: case (namelist text), name, level, pyspline_version, pyspline_build,
         the exponent as lyapunov_exponent [1/s], and the run statistics as stat_<name>."""
         import xarray as xr
-        from . import __version__
+        from ._build_info import provenance
         z = next(iter(self.tooth.values())).shape[1] if self.tooth else 0
         tooth_no = np.arange(1, z + 1)
         coords = {"time": ("time", np.asarray(self.t), _attrs("t")),
@@ -292,8 +292,7 @@ class Result:
             coords["slice"] = ("slice", np.arange(1, self.face.shape[2] + 1),
                                {"long_name": "face slice number"})
             coords["moment"] = ("moment", np.array(["M_x", "M_y"]))
-        attrs = {"case": self.case.text(), "name": self.case.name,
-                 "pyspline_version": __version__}
+        attrs = {"case": self.case.text(), "name": self.case.name, **provenance()}
         if self.stats:
             attrs["level"] = self.level
         if self.lyapunov is not None:

@@ -133,7 +133,3 @@ def summarise(res, options: dict) -> dict:
     s["warnings"] = "\n".join(res.warnings)
     return s
 
-
-def _version() -> str:
-    from . import __version__
-    return __version__

@@ -27,11 +27,12 @@ from pathlib import Path
 
 import numpy as np
 
+from ._build_info import provenance
 from .case import Case, defaults, load_case
 from .cluster import local_dask_client
 from .dataset import MERGED, build_dataset, open_sweep, write_netcdf
 from .errors import CaseError
-from .summary import _stat_names, _template, _version, failed_summary, summarise
+from .summary import _stat_names, _template, failed_summary, summarise
 from .warned import warn_grouped
 
 __all__ = ["local_dask_client", "open_sweep", "parse_values", "point_cases", "read_table",
@@ -349,7 +350,7 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
     Tf_max_rev; docs/model.md section 15);
     solver statistics (steps, rhs_evals, ..., core_wall_s, wall_s); Tm_spectrum (dim 'order');
     error, error_class ('' if ok), point_hash. A failed point has NaN values and its error.
-    attrs: case (namelist text of the base case), pyspline_version, command, swept, section,
+    attrs: case (namelist text of the base case), pyspline_version, pyspline_build, command, swept, section,
     lyapunov, created, out, and the counts n_points, n_ok, n_failed (incl. executor errors),
     n_missing (not run: the sweep stopped), n_computed (by this call), n_reused (from point
     files), n_executor_errors (the executor, not the case, failed: not saved, so a rerun tries
@@ -424,7 +425,7 @@ def sweep(case, executor=None, progress=True, out=None, section="shaft", lyapuno
             spec = f"table=[{len(grid['point'])} rows of {', '.join(point_fields)}]"
         command = f"pyspline.sweep({base.name!r}, {spec}, section={section!r}, " \
                   f"lyapunov={bool(lyapunov)})"
-    attrs = dict(case=base.text(), pyspline_version=_version(), command=command,
+    attrs = dict(case=base.text(), **provenance(), command=command,
                  swept=" ".join(point_fields or grid), section=section, lyapunov=int(bool(lyapunov)),
                  created=datetime.datetime.now(datetime.timezone.utc).isoformat(
                      timespec="seconds"),
@@ -539,7 +540,7 @@ def _follow(base, grid, cases, keys, options, follow, point_fields, executor, pr
     if command is None:
         command = f"pyspline.sweep({base.name!r}, {name}=[{len(values)} values], " \
                   f"section={section!r}, lyapunov={bool(lyapunov)}, follow={follow!r})"
-    attrs = dict(case=base.text(), pyspline_version=_version(), command=command, swept=name,
+    attrs = dict(case=base.text(), **provenance(), command=command, swept=name,
                  section=section, lyapunov=int(bool(lyapunov)), follow=follow,
                  created=datetime.datetime.now(datetime.timezone.utc).isoformat(
                      timespec="seconds"), n_reused=0, out="" if out is None else str(out),

@@ -1,6 +1,7 @@
 """The build links the SUNDIALS it was configured with, and the optimised CVODE that
 scripts/setup.sh builds gives the same numbers as Debian's unoptimised one."""
 import os
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -51,6 +52,31 @@ def test_every_module_of_the_source_tree_is_installed():
     for path in src.rglob("*.py"):
         rel = path.relative_to(src)
         assert (installed / rel).exists(), f"{rel} is not in meson.build's py.install_sources"
+
+
+@pytest.mark.skipif(shutil.which("nm") is None, reason="needs nm (binutils)")
+def test_the_build_names_what_its_core_is_compiled_for(exe, tmp_path, capsys):
+    """pyspline --version, spline-dyn's summary and a run's dataset name one build: portable
+    (any x86-64: SSE2, so glibc's SSE2 vector sin and cos only) or host-tuned (meson option
+    host_tuned: -march=native, named with the CPU gcc took the host for; docs/building.md)."""
+    from pyspline._build_info import BUILD
+    from pyspline.cli import main
+    assert BUILD == "portable" or re.fullmatch(r"host-tuned \(-march=native = [\w.-]+\)", BUILD)
+    with pytest.raises(SystemExit):
+        main(["--version"])
+    assert capsys.readouterr().out == f"pyspline {pyspline.__version__}, {BUILD} build\n"
+    case = pyspline.load_case(CASES / "paper_lx1e-4.nml", t_end=1e-3, n_out=2)
+    case.to_namelist(tmp_path / "c.nml")
+    subprocess.run([exe, str(tmp_path / "c.nml"), "--summary", str(tmp_path / "s")], check=True,
+                   capture_output=True)
+    assert (tmp_path / "s").read_text().startswith(
+        f"# spline-dyn summary (pyspline {pyspline.__version__}, {BUILD} build): ")
+    assert pyspline.simulate(case).to_xarray().attrs["pyspline_build"] == BUILD
+    core = next(Path(pyspline.__file__).parent.glob("_core*.so"))
+    symbols = subprocess.run(["nm", "-D", str(core)], capture_output=True, text=True,
+                             check=True).stdout.split()
+    wide = [s for s in symbols if s.startswith(("_ZGVc", "_ZGVd", "_ZGVe"))]   # AVX, AVX2, AVX-512
+    assert BUILD != "portable" or not wide, wide
 
 
 @pytest.mark.skipif(shutil.which("nm") is None, reason="needs nm (binutils)")

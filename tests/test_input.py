@@ -312,8 +312,11 @@ def test_executable_sigint_exits_130_and_leaves_no_file(exe, tmp_path):
 
 
 def test_executable_version_matches_the_package(exe):
+    # the version and the build (portable or host-tuned): the executable's and the package's
+    from pyspline._build_info import BUILD
     run = subprocess.run([exe, "--version"], capture_output=True, text=True)
-    assert run.returncode == 0 and run.stdout.split()[-1] == pyspline.__version__
+    assert run.returncode == 0
+    assert run.stdout == f"spline-dyn (pyspline) {pyspline.__version__}, {BUILD} build\n"
 
 
 # ------------------------------------------------------------------------------------ the CLI

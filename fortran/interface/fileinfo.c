@@ -15,6 +15,9 @@
 #ifndef SPLINE_VERSION
 #define SPLINE_VERSION "unknown"
 #endif
+#ifndef SPLINE_BUILD
+#define SPLINE_BUILD "unknown"
+#endif
 
 static void put_error(int err, char *errbuf, int errlen)
 {
@@ -100,9 +103,10 @@ int spline_getpid(void)
     return (int)getpid();
 }
 
-/* The version of this build (meson's project version), NUL-terminated in buf. */
+/* The version of this build (meson's project version) and what its core is compiled for
+   (meson.build's build_kind): "0.1.0, portable build", NUL-terminated in buf. */
 void spline_version(char *buf, int len)
 {
     if (len <= 0) return;
-    snprintf(buf, (size_t)len, "%s", SPLINE_VERSION);
+    snprintf(buf, (size_t)len, "%s, %s build", SPLINE_VERSION, SPLINE_BUILD);
 }

@@ -397,7 +397,7 @@ contains
 
   subroutine version(s)
     character(len=:), allocatable, intent(out) :: s
-    character(kind=c_char) :: buf(64)
+    character(kind=c_char) :: buf(256)
     integer :: i
     buf = c_null_char
     call c_version(buf, int(size(buf), c_int))

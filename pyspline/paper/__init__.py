@@ -341,8 +341,9 @@ def write_table(rows, out: Path, quick: bool, results):
         w.writerows(rows)
     import datetime
     from .. import __version__
+    from .._build_info import BUILD
     lines = ["# Verification against Xue, Shen & Xue (2025)", "",
-             f"Written by `pyspline reproduce` (pyspline {__version__}, "
+             f"Written by `pyspline reproduce` (pyspline {__version__}, {BUILD} build, "
              f"{datetime.date.today().isoformat()}); the figures, verification.csv and "
              "summary.json of the same run hold every number.", ""]
     if quick:
