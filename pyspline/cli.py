@@ -24,6 +24,7 @@ import numpy as np
 from .case import load_case
 from .errors import CaseError, SolverError, SplineError, SplineWarning, ThermalInterferenceError
 from .mergecli import add_merge
+from .summary import NOT_SETTLED
 from .sweeps import MERGED, POINTS_DIR, parse_values, sweep
 
 
@@ -439,6 +440,9 @@ def cmd_sweep(args) -> int:
         print(f"{n_chaos} of {a['n_ok']} points chaotic (Lyapunov exponent and the slope of its "
               "log growth positive beyond its spread): read their statistics, sections and "
               "spectra, not their trajectories")
+    if "lyapunov" in ds and (n_unsettled := int((ds["period"] == NOT_SETTLED).sum())):
+        print(f"{n_unsettled} of {a['n_ok']} points not settled (not periodic, Lyapunov exponent "
+              "< 0: the transient has not decayed): lengthen t_transient")
     if a["n_failed"] or a["n_missing"]:
         errors = [e for e in ds["error"].values.ravel() if e]
         print(f"first error: {errors[0]}", file=sys.stderr)
