@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from .case import load_case
-from .arclength import continuation, parse_field
+from .arclength import INTERRUPTED, continuation, parse_field
 from .errors import CaseError
 from .orbits import CALL_SECONDS
 
@@ -103,7 +103,7 @@ def cmd_continue(args, fixed, exit_code) -> int:
     print(f"wrote {path}")
     if ds.attrs["status"] != "complete":
         print(f"stopped: {ds.attrs['status']}", file=sys.stderr)
-        return 1
+        return 130 if ds.attrs["status"].startswith(INTERRUPTED) else 1
     return 0
 
 
