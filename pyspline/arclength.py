@@ -148,7 +148,7 @@ def valid_value(load_at, value: float, label: str, prefix: str):
 
 #: continuation's arguments that branches and fold_curve set themselves (not in their **cont)
 _OWN = ("case", "field", "start", "stop", "n", "guess", "progress", "command", "max_seconds",
-        "band")
+        "band", "keep_interrupted")
 
 
 def check_handed_on(case, field, start, stop, n, cont: dict) -> None:
@@ -390,7 +390,7 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
                  max_points: int = 200, tol: float | None = None, max_corrector: int = 6,
                  margin: float = 1e-4, switch: bool = True, detect: bool = True,
                  monodromy: str = "exact", progress: bool = True, command: str | None = None,
-                 max_seconds: float = CALL_SECONDS, band=None):
+                 max_seconds: float = CALL_SECONDS, band=None, keep_interrupted: bool = False):
     """Pseudo-arclength continuation of the period-n orbit of `case` in `field` from `start`
     to `stop`, through stable and unstable parts; returns an xarray.Dataset.
 
@@ -424,6 +424,8 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     max_seconds : the wall time of the call (orbits.CALL_SECONDS; math.inf: none): past it the
         branch so far is returned with its status saying so (special points not yet located
         stay so).
+    keep_interrupted : Ctrl-C (KeyboardInterrupt) while a branch is followed returns the points
+        so far, status 'interrupted (Ctrl-C) at ...' (`pyspline continue`); default: raised.
 
     Dataset: dim 'point' (the branch points in order; variable 'branch' numbers the branches,
     'n' their periods): the field's value, y0 (point, state), Tm_pp, F_max, D2_pp, the
@@ -470,7 +472,7 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
                                        len(branches), bar)
                 except KeyboardInterrupt:       # Ctrl-C: the points so far are the result
                     pts, todo = getattr(br, "pts", []), []
-                    if not pts and not branches:
+                    if not keep_interrupted or not pts and not branches:
                         raise
                     why = INTERRUPTED + (f" at {prob.name} = {pts[-1]['p']:.6g}" if pts else "")
                 ends.use(prob, monodromy, base["method"])

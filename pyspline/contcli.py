@@ -75,7 +75,8 @@ def cmd_continue(args, fixed, exit_code) -> int:
         ds = continuation(case, args.field, args.start, args.stop, n=args.n, ds=args.ds,
                           ds_max=args.ds_max, max_angle=args.max_angle,
                           max_points=args.max_points, tol=args.tol, progress=not args.quiet,
-                          command=command, max_seconds=args.max_seconds, band=band)
+                          command=command, max_seconds=args.max_seconds, band=band,
+                          keep_interrupted=True)
         sw = None
         if args.sweep:
             from .sweeps import sweep
