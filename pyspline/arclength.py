@@ -148,7 +148,7 @@ def valid_value(load_at, value: float, label: str, prefix: str):
 
 #: continuation's arguments that branches and fold_curve set themselves (not in their **cont)
 _OWN = ("case", "field", "start", "stop", "n", "guess", "progress", "command", "max_seconds",
-        "band")
+        "band", "keep_interrupted")
 
 
 def check_handed_on(case, field, start, stop, n, cont: dict) -> None:
@@ -390,7 +390,7 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
                  max_points: int = 200, tol: float | None = None, max_corrector: int = 6,
                  margin: float = 1e-4, switch: bool = True, detect: bool = True,
                  monodromy: str = "exact", progress: bool = True, command: str | None = None,
-                 max_seconds: float = CALL_SECONDS, band=None):
+                 max_seconds: float = CALL_SECONDS, band=None, keep_interrupted: bool = False):
     """Pseudo-arclength continuation of the period-n orbit of `case` in `field` from `start`
     to `stop`, through stable and unstable parts; returns an xarray.Dataset.
 
@@ -424,6 +424,8 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
     max_seconds : the wall time of the call (orbits.CALL_SECONDS; math.inf: none): past it the
         branch so far is returned with its status saying so (special points not yet located
         stay so).
+    keep_interrupted : Ctrl-C (KeyboardInterrupt) while a branch is followed returns the points
+        so far, status 'interrupted (Ctrl-C) at ...' (`pyspline continue`); default: raised.
 
     Dataset: dim 'point' (the branch points in order; variable 'branch' numbers the branches,
     'n' their periods): the field's value, y0 (point, state), Tm_pp, F_max, D2_pp, the
@@ -463,14 +465,21 @@ def continuation(case, field: str, start: float, stop: float, n: int = 1, guess=
                 nb, u_start, tau0, y_fixed = todo.pop(0)
                 br = _Branch(prob, nb, y_fixed, tol, max_corrector)
                 q_end = (stop - start) / prob.pscale
-                pts, why = _follow(br, u_start, tau0, q_end, sorted((0.0, q_end)) if tau0 is None
-                                   else prob.band, ds, ds_min, ds_max, max_angle,
-                                   max_points - sum(len(b) for b in branches), len(branches), bar)
+                try:
+                    pts, why = _follow(br, u_start, tau0, q_end, sorted((0.0, q_end)) if tau0
+                                       is None else prob.band, ds, ds_min, ds_max, max_angle,
+                                       max_points - sum(len(b) for b in branches),
+                                       len(branches), bar)
+                except KeyboardInterrupt:       # Ctrl-C: the points so far are the result
+                    pts, todo = getattr(br, "pts", []), []
+                    if not keep_interrupted or not pts and not branches:
+                        raise
+                    why = INTERRUPTED + (f" at {prob.name} = {pts[-1]['p']:.6g}" if pts else "")
                 ends.use(prob, monodromy, base["method"])
-                if why != "complete" and status == "complete":
+                if why != "complete" and (status == "complete" or why.startswith(INTERRUPTED)):
                     status = why
                 branches.append(pts)
-                if detect and not out_of_time():   # past it every map run fails
+                if detect and not out_of_time() and not why.startswith(INTERRUPTED):
                     for sp in locate(br, pts):
                         sp["branch"] = len(branches) - 1
                         found.append(sp)
@@ -502,6 +511,10 @@ def _doubled_start(sp, nb, y_fixed):
     return (2 * nb, sp["u"], tau, y_fixed)
 
 
+#: the status of a continuation stopped by Ctrl-C (KeyboardInterrupt), its points kept
+INTERRUPTED = "interrupted (Ctrl-C)"
+
+
 def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_points, ibranch,
             bar):
     """The points of one branch from u0 and what ended it: predictor-corrector until q leaves
@@ -524,7 +537,7 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
         first = None if first is None else br.point(first, head)
         if first is None:
             _fail(br, u0, ds, "at the start")
-        pts = [first]
+        pts = br.pts = [first]      # br.pts: the points so far, kept on Ctrl-C
     else:                             # a doubled branch: off the point along tau0
         tau = tau0
         res = br.correct(u0 + ds * tau, tau, tau @ (u0 + ds * tau))
@@ -534,7 +547,7 @@ def _follow(br, u0, tau0, q_end, bounds, ds, ds_min, ds_max, max_angle, max_poin
                           f"period doubling at {prob.name} = {prob.p_of(u0[-1]):.6g}",
                           SplineWarning, stacklevel=3)
             return [], "complete"
-        pts = [new]
+        pts = br.pts = [new]
     bar.update(1)
     lo, hi = bounds
 

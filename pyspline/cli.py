@@ -24,6 +24,7 @@ import numpy as np
 from .case import load_case
 from .errors import CaseError, SolverError, SplineError, SplineWarning, ThermalInterferenceError
 from .mergecli import add_merge
+from .summary import NOT_SETTLED
 from .sweeps import MERGED, POINTS_DIR, parse_values, sweep
 
 
@@ -84,7 +85,7 @@ def _accuracy_note(res) -> str:
         k = res.case["realisations"]
         return (f"; goal statistics: ERK (Cash-Karp) without root finding at rtol {s['rtol_used']:.0e} "
                 "(the transient looser), statistics unbiased (chaos_z24), the trajectory not resolved"
-                + (f"; {k} realisations, standard errors from their spread" if k > 1 else ""))
+                + (f"; {k} realisations, standard errors from their spread, at least their batch means'" if k > 1 else ""))
     if s["F_error_est"] < 0 and s["F_parted_t_s"] < 0:
         return ""
     note = (f"; F error est {s['F_error_est']:.2g} up to t = {s['F_error_t_s']:.4g} s"
@@ -244,8 +245,23 @@ def _foreign_files(out: Path) -> list[str]:
     return [n for n in _reproduce_files() if (out / n).exists() and n not in ours]
 
 
+def _cases_arg(args, names) -> Path | None:
+    """--cases DIR of reproduce, calibrate and check-exe: a directory holding the cases `names`
+    the command reads (a CaseError naming --cases and what is missing); None if not given."""
+    if args.cases is None:
+        return None
+    d = Path(args.cases)
+    if not d.is_dir():
+        raise CaseError(f"--cases {d}: no such directory")
+    missing = [f"{n}.nml" for n in names if not (d / f"{n}.nml").is_file()]
+    if missing:
+        raise CaseError(f"--cases {d}: the directory lacks {', '.join(missing)}")
+    return d
+
+
 def cmd_reproduce(args) -> int:
-    from .paper import reproduce
+    from .paper import ALL_CASES, reproduce
+    directory = _cases_arg(args, ALL_CASES)
     out = Path(args.out)          # a directory or a new path: main's check_out_dir
     foreign = _foreign_files(out)
     if foreign:
@@ -253,7 +269,7 @@ def cmd_reproduce(args) -> int:
               "by pyspline reproduce: not overwritten (choose another --out or remove them)",
               file=sys.stderr)
         return 2
-    s = reproduce(args.out, quick=args.quick, directory=args.cases)
+    s = reproduce(args.out, quick=args.quick, directory=directory)
     (out / _REPRODUCE_MARK).write_text("\n".join(sorted(set(_reproduce_files()) | set(s["figures"])))
                                        + "\n", encoding="utf-8")
     print((out / "verification.md").read_text())
@@ -268,7 +284,7 @@ def cmd_reproduce(args) -> int:
 
 def cmd_calibrate(args) -> int:
     from .paper import ROWS, calibrate, cases_dir, sensitivities, write_calibration
-    directory = cases_dir(args.cases)
+    directory = cases_dir(_cases_arg(args, sorted({r.case for r in ROWS})))
     fit = calibrate(directory, quick=args.quick)
     print(f"fitted k_m = {fit['k_m']:.6g} N/m to max|D2| = {ROWS[0].paper:g} m of {ROWS[0].case}")
     print(f"fitted f_m = {fit['f_m']:.6g} to max T_f = {ROWS[1].paper:g} degC of {ROWS[1].case}")
@@ -292,7 +308,7 @@ def cmd_calibrate(args) -> int:
 
 def cmd_check_exe(args) -> int:
     from .paper import ALL_CASES, cases_dir, check_executable
-    rep = check_executable(cases_dir(args.cases), ALL_CASES, quick=not args.full)
+    rep = check_executable(cases_dir(_cases_arg(args, ALL_CASES)), ALL_CASES, quick=not args.full)
     for k, v in rep.items():
         print(f"{k:24s} {v}")
     return 0 if all(v == "identical" for v in rep.values()) else 1
@@ -439,6 +455,9 @@ def cmd_sweep(args) -> int:
         print(f"{n_chaos} of {a['n_ok']} points chaotic (Lyapunov exponent and the slope of its "
               "log growth positive beyond its spread): read their statistics, sections and "
               "spectra, not their trajectories")
+    if "lyapunov" in ds and (n_unsettled := int((ds["period"] == NOT_SETTLED).sum())):
+        print(f"{n_unsettled} of {a['n_ok']} points not settled (not periodic, Lyapunov exponent "
+              "< 0: the transient has not decayed): lengthen t_transient")
     if a["n_failed"] or a["n_missing"]:
         errors = [e for e in ds["error"].values.ravel() if e]
         print(f"first error: {errors[0]}", file=sys.stderr)

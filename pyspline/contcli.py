@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from .case import load_case
-from .arclength import continuation, parse_field
+from .arclength import INTERRUPTED, continuation, parse_field
 from .errors import CaseError
 from .orbits import CALL_SECONDS
 
@@ -75,7 +75,8 @@ def cmd_continue(args, fixed, exit_code) -> int:
         ds = continuation(case, args.field, args.start, args.stop, n=args.n, ds=args.ds,
                           ds_max=args.ds_max, max_angle=args.max_angle,
                           max_points=args.max_points, tol=args.tol, progress=not args.quiet,
-                          command=command, max_seconds=args.max_seconds, band=band)
+                          command=command, max_seconds=args.max_seconds, band=band,
+                          keep_interrupted=True)
         sw = None
         if args.sweep:
             from .sweeps import sweep
@@ -103,7 +104,7 @@ def cmd_continue(args, fixed, exit_code) -> int:
     print(f"wrote {path}")
     if ds.attrs["status"] != "complete":
         print(f"stopped: {ds.attrs['status']}", file=sys.stderr)
-        return 1
+        return 130 if ds.attrs["status"].startswith(INTERRUPTED) else 1
     return 0
 
 

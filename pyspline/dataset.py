@@ -43,7 +43,8 @@ def _field_attrs(name: str) -> dict:
 
 _VAR_ATTRS = {
     "section_t": ("time of the Poincare section point", "s"),
-    "period": ("period of the section sequence (0: not periodic; NaN: no result)", ""),
+    "period": ("period of the section sequence (0: not periodic; -1: not settled, the Lyapunov "
+               "exponent < 0: lengthen t_transient; NaN: no result)", ""),
     "period_residual": ("largest relative mismatch of the section at the period found (at the "
                         "best period tested if none)", ""),
     "lyapunov": ("largest Lyapunov exponent", "1/s"),

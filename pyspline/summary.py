@@ -93,6 +93,11 @@ def section_summary(s: dict, case, section_t, D2s, vD2s, rms: tuple) -> None:
         s["period_residual"] = r[period] if period else (min(r.values()) if r else np.nan)
 
 
+#: the period of a section sequence that is not periodic while the largest Lyapunov exponent is
+#: negative: the drive contracts, its transient has not decayed (not chaos)
+NOT_SETTLED = -1.0
+
+
 def lyapunov_summary(s: dict, lyap_t, log_growth, exponent: float, t0: float) -> None:
     """Put the Lyapunov exponent and the fit of its Benettin record (times lyap_t, cumulative
     log growth; t0 the first output time) into summary `s`."""
@@ -123,6 +128,8 @@ def summarise(res, options: dict) -> dict:
     if options["lyapunov"] and res.lyapunov is not None:
         ly = res.lyapunov
         lyapunov_summary(s, ly["t"], ly["log_growth"], float(ly["exponent"]), float(res.t[0]))
+        if s["period"] == 0 and s["lyapunov"] < 0:   # contracting onto an orbit not yet reached
+            s["period"] = NOT_SETTLED
     s.update({k: res.extremes[k] for k in SWEEP_EXTREMES})
     s.update({k: float(res.loads[k]) for k in SWEEP_LOADS})
     for k in _stat_names():

@@ -42,7 +42,8 @@ __all__ = ["local_dask_client", "open_sweep", "parse_values", "point_cases", "re
 #: 2: the default Benettin separation (lyapunov_d0 = 0: 1e4 rtol, was 1e-8) changed exponents.
 #: 4: a point keeps its warnings.
 #: 5: chaotic asks the slope of the Benettin record too (analysis.is_chaotic).
-SUMMARY_VERSION = 5
+#: 6: period -1, not settled: not periodic with a negative Lyapunov exponent.
+SUMMARY_VERSION = 6
 #: Step of the common shaft-order axis of the T_m spectra [shaft orders].
 ORDER_STEP = 0.05
 SECTIONS = ("shaft", "tooth", "none")

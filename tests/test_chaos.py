@@ -180,6 +180,27 @@ def test_sweep_flags_chaos():
     assert ds["period"].values[0] == 1 and ds["lyapunov"].values[1] > 300
 
 
+def test_sweep_says_a_contracting_drive_is_not_settled(tmp_path, capsys, monkeypatch):
+    """physical_ripple without its transient: over the first 0.1 s its section is not yet
+    periodic while the largest Lyapunov exponent is negative (-1.3 1/s, the settling drive
+    contracts): that is no chaos. The point's period is -1 (summary.NOT_SETTLED), the command
+    says so and what to do, and the diagram names it; over 0.25 s the section is periodic."""
+    import pyspline.plots
+    from pyspline.cli import main
+    from pyspline.plots.sweeps import NOT_SETTLED_NAME, _period_class, _period_name
+    monkeypatch.setattr(pyspline.plots, "sweep_figures", lambda ds, out: [])   # words only
+    out = tmp_path / "s"
+    assert main(["sweep", str(CASES / "physical_ripple.nml"), "--set", "t_end=0.1,0.25",
+                 "--fix", "t_transient=0", "--lyapunov", "--out", str(out)]) == 0
+    said = capsys.readouterr().out
+    ds = pyspline.open_sweep(out / "sweep.nc")
+    assert ds["period"].values[0] == -1 and ds["period"].values[1] > 0
+    assert ds["lyapunov"].values[0] < 0 and ds["chaotic"].values[0] == 0
+    assert ("1 of 2 points not settled (not periodic, Lyapunov exponent < 0: the transient has "
+            "not decayed): lengthen t_transient") in said
+    assert _period_name(_period_class(ds["period"].values)[0]) == NOT_SETTLED_NAME
+
+
 def test_sweep_tells_chaos_from_a_transient_over_speed():
     """Over speed at l_x = 0.2 mm the drive from rest is chaotic at 1500 r/min and ordered at
     2500 after a chaotic transient (docs/sweeps.md). At 1500 the separation grows all through

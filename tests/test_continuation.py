@@ -330,6 +330,33 @@ def test_corrector_failure_keeps_the_branch_and_says_where(tmp_path):
         run.stderr and not (tmp_path / "out2").exists(), run.stderr
 
 
+def test_ctrl_c_keeps_the_points_found(tmp_path, monkeypatch):
+    """Ctrl-C during `pyspline continue` (a KeyboardInterrupt at the 4th point) writes the
+    points found so far as a stopped branch does (continuation.nc, the figure), its status
+    'interrupted (Ctrl-C) at speed_rpm = ...', and exits 130 (it wrote nothing)."""
+    import xarray as xr
+    from pyspline.arclength import _Branch
+    case, *_ = linear_scene(2.0)
+    path = tmp_path / "scene.nml"
+    path.write_text(case.replace(ripple_amp=[0.3, 0, 0, 0]).text())
+    point, calls = _Branch.point, []
+
+    def interrupted(self, res, prev):
+        calls.append(1)
+        if len(calls) == 4:
+            raise KeyboardInterrupt
+        return point(self, res, prev)
+    monkeypatch.setattr(_Branch, "point", interrupted)
+    run = cli(tmp_path, "continue", str(path), "--field", "speed_rpm", "--start", "2600",
+              "--stop", "3800", "--out", "out", "--quiet")
+    assert run.returncode == 130, run.stderr
+    assert re.search(r"stopped: interrupted \(Ctrl-C\) at speed_rpm = 26\d\d", run.stderr)
+    assert "3 points on 1 branch(es)" in run.stdout
+    with xr.open_dataset(tmp_path / "out" / "continuation.nc", engine="netcdf4") as ds:
+        assert ds.attrs["n_points"] == 3 and ds.attrs["status"].startswith("interrupted")
+    assert (tmp_path / "out" / "frequency_response.png").stat().st_size > 10_000
+
+
 def test_neimark_sacker_pair_on_the_unit_circle():
     """With a = 0.5 the upper branch, past its fold, loses stability to a torus and regains
     it: two Neimark-Sacker points, each with a complex pair located on the unit circle

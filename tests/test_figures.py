@@ -189,7 +189,7 @@ def test_param_map_of_periods_and_of_an_exponent(grid):
     assert cells.size == per.size and cells.mask.sum() == np.isnan(per).sum()   # hatched: none
     assert sorted(cells.compressed().tolist()) == sorted(per[np.isfinite(per)].tolist())
     assert [t.get_text() for t in cb.get_yticklabels()] == ["not periodic", "1", "2", "3", "4",
-                                                             "> 4"]
+                                                             "> 4", "not settled"]
     assert "hatched: no result" in cb.get_ylabel()
     assert ax.get_xlabel() == "shaft speed [r/min]" and ax.get_ylabel().endswith("[N m]")
     assert _inside(ax, SPEED, [20.0, 60.0])

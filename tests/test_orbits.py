@@ -179,6 +179,18 @@ def test_default_guess_settles_within_the_cases_step_bound():
     assert orbit.residual <= 1e-6 and orbit.stable
 
 
+def test_period_map_beyond_max_steps_says_what_helps():
+    """A period map is one run over a period (n_out does not split it): beyond max_steps it
+    says so and to raise max_steps (it said 'between two output times ... raise max_steps or
+    n_out', the state run's advice)."""
+    case = pyspline.load_case(CASES / "chaos_z24.nml", zeta_m=0.1, t_transient=0.0, t_end=0.1,
+                              n_out=11, section="none", lyapunov=False, max_steps=2000)
+    with pytest.raises(pyspline.SolverError, match=r"chaos_z24: the period map took max_steps "
+                       r"= 2000 CVODE steps without reaching its end, at t = .*: raise max_steps "
+                       r"\(it bounds this run as a whole: n_out does not split it\)$"):
+        pyspline.periodic_orbit(case, tol=1e-6)
+
+
 def test_exact_monodromy_is_the_matrix_exponential():
     """Full contact: the variational equations give M = exp(A T) in the scaled states (A the
     Jacobian of Model.rhs, central differences: conftest), to the integration's error, and

@@ -191,3 +191,23 @@ def test_write_calibration_keeps_comments(tmp_path):
     hot = pyspline.load_case(tmp_path / "paper_T100.nml")
     assert ideal["k_m"] == 1.5e5 and hot["k_m"] == 1.5e5 and hot["f_m"] == 0.2
     assert "fitted by 'pyspline calibrate'" in (tmp_path / "paper_T100.nml").read_text()
+
+
+@pytest.mark.parametrize("command", [["reproduce", "--quick"], ["calibrate", "--quick"],
+                                     ["check-exe"]])
+def test_cases_option_names_the_missing_directory_or_file(command, tmp_path, capsys):
+    """--cases of a directory that does not exist, or lacks a case the command reads: one
+    error line naming --cases and what is missing, exit 2 (it said 'case file
+    nodir/paper_ideal.nml does not exist'), before any run."""
+    from pyspline.cli import main
+    nodir = tmp_path / "nodir"
+    out = ["--out", str(tmp_path / "out")] if command[0] == "reproduce" else []
+    assert main(command + ["--cases", str(nodir)] + out) == 2
+    assert capsys.readouterr().err == f"error: CaseError: --cases {nodir}: no such directory\n"
+    partial = tmp_path / "partial"
+    partial.mkdir()
+    (partial / "paper_ideal.nml").write_text((CASES / "paper_ideal.nml").read_text())
+    assert main(command + ["--cases", str(partial)] + out) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: CaseError: --cases {partial}: the directory lacks ")
+    assert "paper_lx1e-4.nml" in err and "paper_ideal.nml" not in err

@@ -24,7 +24,7 @@ ROWS = dict(l_x=[0.0, 2.5e-4, 3e-4, 3.5e-4, 0.0, 0.0], k_t1=[1e4, 1e4, 1e4, 1e4,
 @pytest.fixture(scope="module")
 def base():
     return pyspline.load_case(CASES / "paper_lx1e-4.nml", t_end=0.02, t_transient=0.005,
-                              n_out=21, start="rest", k_t1=1e4, k_t2=1e4)
+                              n_out=61, start="rest", k_t1=1e4, k_t2=1e4)
 
 
 def direct(case) -> list[str]:

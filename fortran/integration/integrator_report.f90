@@ -85,7 +85,8 @@ contains
            trim(fname)//'): raise max_steps or n_out'
     else if (flag == CV_TOO_MUCH_WORK) then
       errmsg = head//' took max_steps = '//itoa(int(cv%max_steps))//' '//name//' steps '// &
-           'without reaching its end, at t = '//at//' s (flag '//trim(fname)//'): raise max_steps'
+           'without reaching its end, at t = '//at//' s (flag '//trim(fname)//'): raise max_steps '// &
+           '(it bounds this run as a whole: n_out does not split it)'
     else
       if (cv%run /= 'the run') name = name//' failed in '//trim(cv%run)
       if (cv%run == 'the run') name = name//' failed'

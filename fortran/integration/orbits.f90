@@ -57,7 +57,7 @@ contains
     errmsg = ''
     do k = 1, size(y0, 2)
       call integrate(run, y0(:, k), 1, tout, y1(:, k:k), modes, st, ierr, errmsg, interruptible, &
-           msgs=msgs, max_seconds=max_seconds, wall_start=c0)
+           msgs=msgs, max_seconds=max_seconds, wall_start=c0, name='the period map')
       if (ierr /= err_ok) return
     end do
   end subroutine period_map

@@ -74,7 +74,7 @@ contains
   !> max_seconds (optional, > 0): the run's wall-time bound (a map run's), counted from the
   !> system_clock count wall_start (optional; default: the run's start).
   subroutine integrate(m, y0, nt, tout, yout, modes_out, stats, ierr, errmsg, interruptible, &
-       tsec, ysec, y0b, youtb, msgs, max_seconds, wall_start)
+       tsec, ysec, y0b, youtb, msgs, max_seconds, wall_start, name)
     type(model_t), intent(in) :: m
     real(wp), intent(in) :: y0(nstate)
     integer, intent(in) :: nt
@@ -92,6 +92,7 @@ contains
     type(lib_log_t), intent(inout), optional :: msgs
     real(wp), intent(in), optional :: max_seconds
     integer(8), intent(in), optional :: wall_start
+    character(len=*), intent(in), optional :: name   !< the run's name in messages ('the run')
     type(solver_ctx_t), target :: ctx
     type(integrator_t), target :: cv
     real(c_double), allocatable, target :: yr(:)   !< CVODE's state vector (the copies' integrated states)
@@ -109,7 +110,11 @@ contains
 
     call start_run()
     if (present(msgs)) cv%log = msgs
-    call integrator_open(m, 'the run', yr, cv, flag, stage, max_seconds, wall_start)
+    if (present(name)) then
+      call integrator_open(m, name, yr, cv, flag, stage, max_seconds, wall_start)
+    else
+      call integrator_open(m, 'the run', yr, cv, flag, stage, max_seconds, wall_start)
+    end if
     if (flag == 0 .and. m%erk) then
       call erk_create(m, tau, nroot, c_funloc(rhs_cb), c_funloc(roots_cb), c_loc(ctx), cv, &
            flag, stage)

@@ -278,8 +278,8 @@ contains
       tload(j, ilt_free) = sum(tk(j, ilt_free, :))/m%realisations
       tload(j, ilt_back) = sum(tk(j, ilt_back, :))/m%realisations
       tload(j, ilt_onsets) = sum(tk(j, ilt_onsets, :))
-      tload(j, ilt_free_se) = spread_se(tk(j, ilt_free, :))
-      tload(j, ilt_back_se) = spread_se(tk(j, ilt_back, :))
+      tload(j, ilt_free_se) = se(tk(j, ilt_free, :), tk(j, ilt_free_se, :))
+      tload(j, ilt_back_se) = se(tk(j, ilt_back, :), tk(j, ilt_back_se, :))
     end do
     do j = 1, nload                             ! the run's
       if (any(j == [il_load_sharing, il_closing_speed, il_tf_max, il_sigma_root, il_sigma_flank, &
@@ -296,15 +296,15 @@ contains
     loads(il_back_max) = maxval(tload(:, ilt_back))
     loads(il_unloaded) = count(tload(:, ilt_free) == 1.0_wp)
     loads(il_back_teeth) = count(tload(:, ilt_back) > 0.0_wp)
-    loads(il_tm_rms_se) = spread_se(rms(:, 1))
+    loads(il_tm_rms_se) = se(rms(:, 1), lk(il_tm_rms_se, :))
     loads(il_kv_rms_se) = nan
-    if (m%t_d /= 0.0_wp) loads(il_kv_rms_se) = spread_se(rms(:, 1)/abs(m%t_d))
-    loads(il_f_rms_se) = spread_se(rms(:, 2))
-    loads(il_d2_rms_se) = spread_se(rms(:, 3))
-    loads(il_sharing_rev_se) = spread_se(lk(il_sharing_rev, :))
-    loads(il_free_mean_se) = spread_se(lk(il_free_mean, :))
-    loads(il_impacts_rev_se) = spread_se(lk(il_impacts_rev, :))
-    loads(il_tf_rev_se) = spread_se(lk(il_tf_rev, :))
+    if (m%t_d /= 0.0_wp) loads(il_kv_rms_se) = se(rms(:, 1)/abs(m%t_d), lk(il_kv_rms_se, :))
+    loads(il_f_rms_se) = se(rms(:, 2), lk(il_f_rms_se, :))
+    loads(il_d2_rms_se) = se(rms(:, 3), lk(il_d2_rms_se, :))
+    loads(il_sharing_rev_se) = se(lk(il_sharing_rev, :), lk(il_sharing_rev_se, :))
+    loads(il_free_mean_se) = se(lk(il_free_mean, :), lk(il_free_mean_se, :))
+    loads(il_impacts_rev_se) = se(lk(il_impacts_rev, :), lk(il_impacts_rev_se, :))
+    loads(il_tf_rev_se) = se(lk(il_tf_rev, :), lk(il_tf_rev_se, :))
     loads(il_free_max_se) = tload(maxloc(tload(:, ilt_free), 1), ilt_free_se)
     loads(il_back_max_se) = tload(maxloc(tload(:, ilt_back), 1), ilt_back_se)
   contains
@@ -314,13 +314,17 @@ contains
       biggest = maxval(x)
       if (any(x /= x)) biggest = nan
     end function biggest
-    !> the standard error of the mean of the copies' values x: sd(x) / sqrt(K)
-    pure real(wp) function spread_se(x)
-      real(wp), intent(in) :: x(:)
+    !> the standard error of the mean of the copies' values x: their spread sd(x) / sqrt(K),
+    !> never below the copies' own batch-means errors b combined, sqrt(sum(b^2)) / K, where
+    !> they have them (2 revolutions each): copies that did not part, a settled drive's, have
+    !> no spread, and it says nothing of the error
+    pure real(wp) function se(x, b)
+      real(wp), intent(in) :: x(:), b(:)
       real(wp) :: mean
       mean = sum(x)/size(x)
-      spread_se = sqrt(sum((x - mean)**2)/(size(x) - 1)/size(x))
-    end function spread_se
+      se = sqrt(sum((x - mean)**2)/(size(x) - 1)/size(x))
+      if (all(b == b)) se = max(se, sqrt(sum(b**2))/size(x))
+    end function se
   end subroutine combined_loads
 
 

@@ -21,7 +21,8 @@ from matplotlib.ticker import FuncFormatter
 from ..errors import SplineWarning
 
 # Colours of periods 1, 2, 3, 4 (Okabe-Ito, colour-blind safe) and > 4; not periodic is grey.
-PERIOD_COLOURS = {1: "#0072B2", 2: "#D55E00", 3: "#009E73", 4: "#CC79A7", 5: "#000000"}
+PERIOD_COLOURS = {1: "#0072B2", 2: "#D55E00", 3: "#009E73", 4: "#CC79A7", 5: "#000000",
+                  6: "#E69F00"}   # 6: not settled (summary.NOT_SETTLED), not a period
 NOT_PERIODIC = "0.6"
 SHAFT_STYLE = dict(color="0.25", ls=(0, (4, 3)), lw=0.9)
 TOOTH_STYLE = dict(color="tab:red", ls=(0, (6, 3)), lw=1.1)

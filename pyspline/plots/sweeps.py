@@ -78,14 +78,20 @@ def bifurcation(ds, param: str, coord: str = "section_D2", period: str = "period
     return ps.finish(fig, path)
 
 
+#: a section sequence not periodic while the Lyapunov exponent is negative (summary.NOT_SETTLED)
+NOT_SETTLED_NAME = "not settled (exponent < 0: lengthen t_transient)"
+
+
 def _period_class(per) -> np.ndarray:
-    """0: not periodic (0, negative, NaN); 1..4: the period; 5: period > 4."""
+    """0: not periodic (0, NaN); 1..4: the period; 5: period > 4; 6: not settled (negative:
+    summary.NOT_SETTLED)."""
     per = np.asarray(per, dtype=float)
-    return np.where(np.isfinite(per) & (per > 0), np.minimum(np.nan_to_num(per), 5), 0).astype(int)
+    cls = np.where(np.isfinite(per) & (per > 0), np.minimum(np.nan_to_num(per), 5), 0)
+    return np.where(per < 0, 6, cls).astype(int)
 
 
 def _period_name(c: int) -> str:
-    return "not periodic" if c == 0 else ("period > 4" if c == 5 else f"period {c}")
+    return {0: "not periodic", 5: "period > 4", 6: NOT_SETTLED_NAME}.get(c, f"period {c}")
 
 
 def _bifurcation_points(ax, x, y, per, counts=True, ms=9) -> list:
@@ -93,14 +99,14 @@ def _bifurcation_points(ax, x, y, per, counts=True, ms=9) -> list:
     cls = _period_class(per)
     handles = []
     drawn = np.isfinite(y).any(axis=1)      # a point that did not run has nothing to show
-    for c in (0, 1, 2, 3, 4, 5):
+    for c in (0, 6, 1, 2, 3, 4, 5):
         rows = (cls == c) & drawn
         if not rows.any():
             continue
         xs = np.repeat(x[rows], y.shape[1])
         ys = y[rows].ravel()
         ok = np.isfinite(ys)
-        colour = ps.NOT_PERIODIC if c == 0 else ps.PERIOD_COLOURS[c]
+        colour = ps.NOT_PERIODIC if c == 0 else ps.PERIOD_COLOURS[c]    # 6: not settled
         ax.scatter(xs[ok], ys[ok], s=ms / 3 if c == 0 else ms, c=colour, lw=0,
                    alpha=0.6 if c == 0 else 1.0, zorder=1 if c == 0 else 2, rasterized=True)
         label = f"{_period_name(c)} ({rows.sum()})" if counts else _period_name(c)
@@ -195,13 +201,13 @@ def param_map(ds, var: str, x: str, y: str, path=None, title: str | None = None,
     if var.startswith("period"):
         cls = np.where(np.isfinite(v), _period_class(v), -1).astype(float)
         cls[cls < 0] = np.nan
-        colours = [ps.NOT_PERIODIC] + [ps.PERIOD_COLOURS[c] for c in (1, 2, 3, 4, 5)]
+        colours = [ps.NOT_PERIODIC] + [ps.PERIOD_COLOURS[c] for c in (1, 2, 3, 4, 5, 6)]
         mesh = ax.pcolormesh(X, Y, np.ma.masked_invalid(cls), shading="nearest",
                              cmap=ListedColormap(colours),
-                             norm=BoundaryNorm(np.arange(-0.5, 6.5), 6), edgecolors="w",
+                             norm=BoundaryNorm(np.arange(-0.5, 7.5), 7), edgecolors="w",
                              linewidth=0.3 if max(v.shape) <= 30 else 0, rasterized=True)
-        cb = fig.colorbar(mesh, ax=ax, pad=0.01, ticks=np.arange(6))
-        cb.ax.set_yticklabels(["not periodic", "1", "2", "3", "4", "> 4"])
+        cb = fig.colorbar(mesh, ax=ax, pad=0.01, ticks=np.arange(7))
+        cb.ax.set_yticklabels(["not periodic", "1", "2", "3", "4", "> 4", "not settled"])
         cb.set_label("period of the section sequence (hatched: no result)")
     else:
         finite = v[np.isfinite(v)]
