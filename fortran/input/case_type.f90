@@ -208,7 +208,7 @@ module spline_case_type
        field_t('accuracy', 'r', 1, '-', 'largest relative error of F_j accepted; 0: rtol, atol as '// &
                'given', 'n', 1.0e-9_wp, 0.1_wp, 'a relative error of the tooth forces (0: rtol '// &
                'and atol as given)'), &
-       field_t('goal', 'c', optlen, '', 'trajectory | statistics (cheapest unbiased settings)'), &
+       field_t('goal', 'c', optlen, '', 'trajectory | statistics (cheapest settings, bias under the standard error)'), &
        field_t('check', 'l', 1, '', 'estimate the error of F_j against a tighter run (F_error_est)'), &
        field_t('realisations', 'i', 1, '', 'goal statistics: K perturbed copies after the '// &
                'transient, 1/K window each'), &

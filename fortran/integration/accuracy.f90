@@ -36,7 +36,7 @@ module spline_accuracy
        rule_t('computed k_m, from equilibrium, one slice', 1, .true., 0.1_wp, 1.0e-2_wp, 10.0_wp), &
        rule_t('computed k_m, from equilibrium, sliced face', 2, .true., 0.1_wp, 1.0e-2_wp, 10.0_wp)]
   !> goal = 'statistics': ERK without roots at rtol 1e-2 (atol 1e-4) reads chaos_z24's
-  !> statistics unbiased (docs/performance.md); CVODE with roots at such rtol reads them low.
+  !> statistics within about 1 % (under a run's standard error; docs/accuracy.md); CVODE with roots at such rtol reads them low.
   real(wp), parameter :: stats_rtol = 1.0e-2_wp
   !> ... and its transient (no outputs) at rtol 3e-2 (atol 3e-4): 21 % fewer right-hand sides
   !> there, and it still ends on the attractor the window samples (over 20 chaos_z24
