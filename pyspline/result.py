@@ -225,9 +225,10 @@ class Result:
 
     @property
     def kv(self) -> np.ndarray:
-        """Dynamic load coefficient k_v = |T_m| / |T_d|, shape (nt,); NaN at T_d = 0."""
-        with np.errstate(invalid="ignore"):
-            return np.abs(self.Tm) / abs(self.case["t_d"])
+        """Dynamic load coefficient k_v = |T_m| / |T_d|, shape (nt,); NaN at T_d = 0 (the core's
+        spline_loads::load_coefficient, which spline-dyn's kv column and the extremes use)."""
+        t_d = abs(self.case["t_d"])
+        return np.abs(self.Tm) / t_d if t_d > 0 else np.full(np.shape(self.Tm), np.nan)
 
     def __getattr__(self, name):
         # per-tooth quantities that the core has and this class does not name yet

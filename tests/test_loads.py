@@ -170,6 +170,21 @@ def test_k_v_takes_the_magnitude_of_a_reversed_or_zero_drive_torque(tmp_path, ex
                    check=True, capture_output=True)
     ds = merge([tmp_path / "zero.summary"])
     assert ds.attrs["n_ok"] == 1 and np.isnan(ds["kv_max"].values).all()
+    # a driveless drive that still moves (chaos_z24's excitation): T_m != 0, k_v still NaN
+    moving = pyspline.load_case(CASES / "chaos_z24.nml", t_d=0.0, t_l=0.0, start="rest",
+                                t_transient=0.0, t_end=0.02, n_out=41, lyapunov=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        res = pyspline.simulate(moving)
+    assert np.abs(res.Tm).max() > 1.0
+    assert np.isnan(res.kv).all() and np.isnan([res.extremes[k] for k in ("kv_max", "kv_rms")]).all()
+    moving.to_namelist(tmp_path / "moving.nml")
+    subprocess.run([exe, str(tmp_path / "moving.nml"), "-o", str(tmp_path / "moving.csv"),
+                    "--summary", str(tmp_path / "moving.summary")], check=True, capture_output=True)
+    with warnings.catch_warnings():          # the case's start and stress warnings, again
+        warnings.simplefilter("ignore", pyspline.SplineWarning)
+        assert merge([tmp_path / "moving.summary"]).attrs["n_ok"] == 1
 
 
 def read_csv_loads(path) -> dict:

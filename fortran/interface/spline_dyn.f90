@@ -34,6 +34,7 @@ program spline_dyn
   use spline_realisations, only: copy_model, copy_start, run_sections, transient_state, &
        combined_stats
   use spline_sections, only: section_count
+  use spline_loads, only: load_coefficient
   use spline_lyapunov, only: lyapunov_count
   implicit none
 
@@ -283,7 +284,7 @@ program spline_dyn
   allocate(character(len=26*size(row)) :: record)
   do k = 1, size(t)
     if (ios /= 0) exit
-    row = [t(k), y(:, k), tm(k), abs(tm(k))/abs(m%t_d), &   ! the columns of output_q
+    row = [t(k), y(:, k), tm(k), load_coefficient(tm(k), m%t_d), &   ! the columns of output_q
          ((tooth(k, j, q), j = 1, m%z), q = 1, ntooth_q)]
     n = c_csv_record(row, size(row), record, len(record))
     if (n < 0) then                        ! cannot happen: a number takes at most 26 bytes

@@ -23,7 +23,7 @@ module spline_loads
   implicit none
   private
   public :: run_loads, combined_loads, run_extremes, drive_flank, approach_speed, tooth_stresses, &
-       stress_warnings
+       stress_warnings, load_coefficient
 
   !> Limits of stress_warnings [Pa] (docs/model.md section 15, "Tooth stresses"): typical
   !> allowables of case-hardened steel splines (58-63 HRC) at full load, 10^4 torque cycles,
@@ -328,6 +328,17 @@ contains
   end subroutine combined_loads
 
 
+  !> The dynamic load coefficient k_v = |T_m|/|T_d| (output_q's kv, Eq. 22's torque over the
+  !> drive's); undefined (NaN) at T_d = 0, whatever T_m (a driveless run that still rattles).
+  elemental real(wp) function load_coefficient(tm, t_d) result(kv)
+    real(wp), intent(in) :: tm, t_d
+    if (t_d == 0.0_wp) then
+      kv = ieee_value(kv, ieee_quiet_nan)
+    else
+      kv = abs(tm)/abs(t_d)
+    end if
+  end function load_coefficient
+
   !> The extremes and RMS of a run's outputs x(nextreme), spline_quantities' extreme_q: max, min
   !> and RMS (sqrt(sum(x**2)/n), a sequential sum) of T_m (tm), k_v = |T_m|/|T_d|, the tooth loads
   !> f(nt, Z) and flash temperatures tf(nt, Z) over all teeth, D_2 and dD_2/dt (y: SI states,
@@ -344,7 +355,7 @@ contains
     real(wp), intent(in), contiguous, optional :: tf(:, :)
     real(wp), intent(in), optional :: tf_const
     x(1:3) = three(size(tm), tm)
-    x(4:6) = three(size(tm), abs(tm)/abs(m%t_d))
+    x(4:6) = three(size(tm), load_coefficient(tm, m%t_d))
     x(7:9) = three(size(f), f)
     if (present(tf)) then
       x(10:12) = three(size(tf), tf)
